@@ -1,0 +1,470 @@
+//! The skeleton graph shared by every method and step.
+//!
+//! Nodes carry a position, the radius r = Euclidean distance to ∂P (the same
+//! definition for every method; for MA it is the disc radius) and, for the
+//! straight skeleton, the event time. Edges are polylines between two nodes.
+//!
+//! Handles are typed indices ([`NodeId`], [`EdgeId`]), never pointers.
+//! Invariant kept by every operation: each edge's end nodes exist, and an
+//! edge's polyline runs from `nodes[a].pos` through `interior` to
+//! `nodes[b].pos`. Graphs are values: pruning and extension build new graphs.
+
+pub mod extend;
+pub mod prune;
+
+use crate::geometry::Boundary;
+use geo::{Coord, LineString, MultiLineString};
+use std::collections::HashMap;
+
+/// Typed index of a node.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct NodeId(pub u32);
+
+/// Typed index of an edge.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct EdgeId(pub u32);
+
+/// A skeleton node.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Node {
+    /// Position (CRS units).
+    pub pos: Coord<f64>,
+    /// Distance to ∂P.
+    pub radius: f64,
+    /// Straight-skeleton event time (offset distance), when the method has one.
+    pub time: Option<f64>,
+}
+
+/// A skeleton edge: a polyline between two nodes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Edge {
+    /// First end node.
+    pub a: NodeId,
+    /// Second end node.
+    pub b: NodeId,
+    /// Interior vertices of the polyline from `a` to `b` (may be empty).
+    pub interior: Vec<Coord<f64>>,
+}
+
+/// A maximal chain of edges between two nodes of degree ≠ 2 (SPEC §2), or a
+/// closed cycle of degree-2 nodes (then `start == end`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Branch {
+    /// Node where the chain starts.
+    pub start: NodeId,
+    /// Node where the chain ends.
+    pub end: NodeId,
+    /// Edges in chain order.
+    pub edges: Vec<EdgeId>,
+    /// The chain's polyline from `start` to `end`.
+    pub coords: Vec<Coord<f64>>,
+}
+
+impl Branch {
+    /// Length of the chain's polyline.
+    pub fn length(&self) -> f64 {
+        polyline_length(&self.coords)
+    }
+}
+
+/// Length of a polyline.
+pub fn polyline_length(c: &[Coord<f64>]) -> f64 {
+    c.windows(2)
+        .map(|w| (w[1] - w[0]).x.hypot((w[1] - w[0]).y))
+        .sum()
+}
+
+/// The skeleton of one polygon: nodes and polyline edges.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SkeletonGraph {
+    nodes: Vec<Node>,
+    edges: Vec<Edge>,
+}
+
+impl SkeletonGraph {
+    /// An empty graph.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Adds a node.
+    pub fn add_node(&mut self, pos: Coord<f64>, radius: f64, time: Option<f64>) -> NodeId {
+        self.nodes.push(Node { pos, radius, time });
+        NodeId(self.nodes.len() as u32 - 1)
+    }
+
+    /// Adds an edge between existing nodes.
+    pub fn add_edge(&mut self, a: NodeId, b: NodeId, interior: Vec<Coord<f64>>) -> EdgeId {
+        debug_assert!((a.0 as usize) < self.nodes.len() && (b.0 as usize) < self.nodes.len());
+        self.edges.push(Edge { a, b, interior });
+        EdgeId(self.edges.len() as u32 - 1)
+    }
+
+    /// All nodes.
+    pub fn nodes(&self) -> &[Node] {
+        &self.nodes
+    }
+
+    /// Mutable nodes (positions must keep the edge invariant).
+    pub fn nodes_mut(&mut self) -> &mut [Node] {
+        &mut self.nodes
+    }
+
+    /// All edges.
+    pub fn edges(&self) -> &[Edge] {
+        &self.edges
+    }
+
+    /// One node.
+    pub fn node(&self, n: NodeId) -> &Node {
+        &self.nodes[n.0 as usize]
+    }
+
+    /// One edge.
+    pub fn edge(&self, e: EdgeId) -> &Edge {
+        &self.edges[e.0 as usize]
+    }
+
+    /// True when the graph has no edge.
+    pub fn is_empty(&self) -> bool {
+        self.edges.is_empty()
+    }
+
+    /// The polyline of an edge from `a` to `b`.
+    pub fn edge_coords(&self, e: EdgeId) -> Vec<Coord<f64>> {
+        let ed = self.edge(e);
+        let mut v = Vec::with_capacity(ed.interior.len() + 2);
+        v.push(self.node(ed.a).pos);
+        v.extend_from_slice(&ed.interior);
+        v.push(self.node(ed.b).pos);
+        v
+    }
+
+    /// Length of an edge's polyline.
+    pub fn edge_length(&self, e: EdgeId) -> f64 {
+        polyline_length(&self.edge_coords(e))
+    }
+
+    /// Total length of all edges.
+    pub fn total_length(&self) -> f64 {
+        (0..self.edges.len())
+            .map(|i| self.edge_length(EdgeId(i as u32)))
+            .sum()
+    }
+
+    /// Incident edges of every node (a loop edge appears twice).
+    pub fn adjacency(&self) -> Vec<Vec<EdgeId>> {
+        let mut adj = vec![Vec::new(); self.nodes.len()];
+        for (i, e) in self.edges.iter().enumerate() {
+            adj[e.a.0 as usize].push(EdgeId(i as u32));
+            adj[e.b.0 as usize].push(EdgeId(i as u32));
+        }
+        adj
+    }
+
+    /// Degree of every node.
+    pub fn degrees(&self) -> Vec<usize> {
+        let mut d = vec![0; self.nodes.len()];
+        for e in &self.edges {
+            d[e.a.0 as usize] += 1;
+            d[e.b.0 as usize] += 1;
+        }
+        d
+    }
+
+    /// The other end of edge `e` seen from node `n`.
+    pub fn opposite(&self, e: EdgeId, n: NodeId) -> NodeId {
+        let ed = self.edge(e);
+        if ed.a == n {
+            ed.b
+        } else {
+            ed.a
+        }
+    }
+
+    /// Number of connected components that have at least one edge.
+    pub fn components(&self) -> usize {
+        let mut uf = UnionFind::new(self.nodes.len());
+        for e in &self.edges {
+            uf.union(e.a.0 as usize, e.b.0 as usize);
+        }
+        let mut roots: Vec<usize> = self.edges.iter().map(|e| uf.find(e.a.0 as usize)).collect();
+        roots.sort_unstable();
+        roots.dedup();
+        roots.len()
+    }
+
+    /// Component label of every node (nodes without edges get their own).
+    pub fn component_labels(&self) -> Vec<usize> {
+        let mut uf = UnionFind::new(self.nodes.len());
+        for e in &self.edges {
+            uf.union(e.a.0 as usize, e.b.0 as usize);
+        }
+        (0..self.nodes.len()).map(|i| uf.find(i)).collect()
+    }
+
+    /// Branches: maximal chains between nodes of degree ≠ 2, plus closed
+    /// cycles made only of degree-2 nodes. Deterministic order (by first edge).
+    pub fn branches(&self) -> Vec<Branch> {
+        let adj = self.adjacency();
+        let deg: Vec<usize> = adj.iter().map(Vec::len).collect();
+        let mut used = vec![false; self.edges.len()];
+        let mut out = Vec::new();
+        let walk = |start: NodeId, first: EdgeId, used: &mut Vec<bool>| -> Branch {
+            let mut edges = vec![first];
+            used[first.0 as usize] = true;
+            let mut coords = self.oriented_coords(first, start);
+            let mut cur = self.opposite(first, start);
+            while deg[cur.0 as usize] == 2 && cur != start {
+                let next = adj[cur.0 as usize]
+                    .iter()
+                    .copied()
+                    .find(|e| !used[e.0 as usize]);
+                let Some(next) = next else { break };
+                used[next.0 as usize] = true;
+                edges.push(next);
+                let c = self.oriented_coords(next, cur);
+                coords.extend_from_slice(&c[1..]);
+                cur = self.opposite(next, cur);
+            }
+            Branch {
+                start,
+                end: cur,
+                edges,
+                coords,
+            }
+        };
+        for n in 0..self.nodes.len() {
+            if deg[n] == 2 {
+                continue;
+            }
+            for &e in &adj[n] {
+                if !used[e.0 as usize] {
+                    out.push(walk(NodeId(n as u32), e, &mut used));
+                }
+            }
+        }
+        // Remaining edges lie on cycles of degree-2 nodes.
+        for i in 0..self.edges.len() {
+            if !used[i] {
+                let start = self.edges[i].a;
+                out.push(walk(start, EdgeId(i as u32), &mut used));
+            }
+        }
+        out
+    }
+
+    /// The polyline of edge `e` oriented to start at node `from`.
+    pub fn oriented_coords(&self, e: EdgeId, from: NodeId) -> Vec<Coord<f64>> {
+        let mut c = self.edge_coords(e);
+        if self.edge(e).a != from {
+            c.reverse();
+        }
+        c
+    }
+
+    /// A new graph in which every chain through degree-2 nodes is one edge.
+    /// Unused nodes are dropped.
+    pub fn merged(&self) -> SkeletonGraph {
+        let mut g = SkeletonGraph::new();
+        let mut map: HashMap<NodeId, NodeId> = HashMap::new();
+        let mut id = |g: &mut SkeletonGraph, n: NodeId| -> NodeId {
+            *map.entry(n).or_insert_with(|| {
+                let nd = self.node(n);
+                g.add_node(nd.pos, nd.radius, nd.time)
+            })
+        };
+        for b in self.branches() {
+            let s = id(&mut g, b.start);
+            let t = id(&mut g, b.end);
+            let interior = b.coords[1..b.coords.len() - 1].to_vec();
+            g.add_edge(s, t, interior);
+        }
+        g
+    }
+
+    /// A copy keeping only the edges for which `keep` is true; unused nodes dropped.
+    pub fn filter_edges(&self, mut keep: impl FnMut(EdgeId, &Edge) -> bool) -> SkeletonGraph {
+        let mut g = SkeletonGraph::new();
+        let mut map: HashMap<NodeId, NodeId> = HashMap::new();
+        for (i, e) in self.edges.iter().enumerate() {
+            if !keep(EdgeId(i as u32), e) {
+                continue;
+            }
+            let mut id = |n: NodeId| -> NodeId {
+                *map.entry(n).or_insert_with(|| {
+                    let nd = self.node(n);
+                    g.add_node(nd.pos, nd.radius, nd.time)
+                })
+            };
+            let a = id(e.a);
+            let b = id(e.b);
+            g.add_edge(a, b, e.interior.clone());
+        }
+        g
+    }
+
+    /// The skeleton as a multilinestring, one linestring per branch.
+    pub fn to_multilinestring(&self) -> MultiLineString<f64> {
+        MultiLineString(
+            self.branches()
+                .into_iter()
+                .map(|b| LineString(b.coords))
+                .collect(),
+        )
+    }
+
+    /// Recomputes every node's radius as its distance to ∂P.
+    pub fn set_radii(&mut self, boundary: &Boundary) {
+        for n in &mut self.nodes {
+            n.radius = boundary.distance(n.pos);
+        }
+    }
+
+    /// Number of legs (branches with a leaf at one end).
+    pub fn leg_count(&self) -> usize {
+        let deg = self.degrees();
+        self.branches()
+            .iter()
+            .filter(|b| {
+                b.start != b.end && (deg[b.start.0 as usize] == 1 || deg[b.end.0 as usize] == 1)
+            })
+            .count()
+    }
+}
+
+/// Builds a graph from segments or polylines, merging end points that are
+/// bit-for-bit equal (methods compute shared points from the same inputs, so
+/// exact equality is the right test and no tolerance is needed).
+#[derive(Debug, Default)]
+pub struct GraphBuilder {
+    graph: SkeletonGraph,
+    index: HashMap<(u64, u64), NodeId>,
+}
+
+impl GraphBuilder {
+    /// An empty builder.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// The node at `p`, created when absent (radius set by [`GraphBuilder::finish`]).
+    pub fn node(&mut self, p: Coord<f64>) -> NodeId {
+        // +0.0 normalises −0.0 so both zeros share a node.
+        let key = ((p.x + 0.0).to_bits(), (p.y + 0.0).to_bits());
+        let g = &mut self.graph;
+        *self
+            .index
+            .entry(key)
+            .or_insert_with(|| g.add_node(p, 0.0, None))
+    }
+
+    /// Sets the event time of the node at `p` (straight skeleton).
+    pub fn set_time(&mut self, n: NodeId, time: f64) {
+        self.graph.nodes[n.0 as usize].time = Some(time);
+    }
+
+    /// Adds the segment `pq` (ignored when degenerate).
+    pub fn segment(&mut self, p: Coord<f64>, q: Coord<f64>) -> Option<EdgeId> {
+        if p == q {
+            return None;
+        }
+        let a = self.node(p);
+        let b = self.node(q);
+        Some(self.graph.add_edge(a, b, Vec::new()))
+    }
+
+    /// Adds a polyline as one edge (ignored when shorter than two distinct points).
+    pub fn polyline(&mut self, pts: &[Coord<f64>]) -> Option<EdgeId> {
+        let mut v: Vec<Coord<f64>> = Vec::with_capacity(pts.len());
+        for &p in pts {
+            if v.last() != Some(&p) {
+                v.push(p);
+            }
+        }
+        if v.len() < 2 {
+            return None;
+        }
+        let a = self.node(v[0]);
+        let b = self.node(*v.last().unwrap());
+        let interior = v[1..v.len() - 1].to_vec();
+        Some(self.graph.add_edge(a, b, interior))
+    }
+
+    /// Finishes the graph: node radii set to their distance to ∂P.
+    pub fn finish(mut self, boundary: &Boundary) -> SkeletonGraph {
+        self.graph.set_radii(boundary);
+        self.graph
+    }
+
+    /// Finishes the graph without touching radii (they stay as set).
+    pub fn finish_raw(self) -> SkeletonGraph {
+        self.graph
+    }
+}
+
+struct UnionFind {
+    parent: Vec<usize>,
+}
+
+impl UnionFind {
+    fn new(n: usize) -> Self {
+        Self {
+            parent: (0..n).collect(),
+        }
+    }
+    fn find(&mut self, mut x: usize) -> usize {
+        while self.parent[x] != x {
+            self.parent[x] = self.parent[self.parent[x]];
+            x = self.parent[x];
+        }
+        x
+    }
+    fn union(&mut self, a: usize, b: usize) {
+        let (ra, rb) = (self.find(a), self.find(b));
+        if ra != rb {
+            let (lo, hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
+            self.parent[hi] = lo;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn c(x: f64, y: f64) -> Coord<f64> {
+        Coord { x, y }
+    }
+
+    #[test]
+    fn builder_merges_shared_points_and_branches() {
+        let mut b = GraphBuilder::new();
+        b.segment(c(0., 0.), c(1., 0.));
+        b.segment(c(1., 0.), c(2., 0.));
+        b.segment(c(2., 0.), c(3., 1.));
+        b.segment(c(2., 0.), c(3., -1.));
+        let g = b.finish_raw();
+        assert_eq!(g.nodes().len(), 5);
+        assert_eq!(g.components(), 1);
+        let br = g.branches();
+        assert_eq!(br.len(), 3);
+        assert_eq!(g.leg_count(), 3);
+        let m = g.merged();
+        assert_eq!(m.edges().len(), 3);
+        assert!((m.total_length() - g.total_length()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn cycle_is_one_branch() {
+        let mut b = GraphBuilder::new();
+        b.segment(c(0., 0.), c(1., 0.));
+        b.segment(c(1., 0.), c(1., 1.));
+        b.segment(c(1., 1.), c(0., 0.));
+        let g = b.finish_raw();
+        let br = g.branches();
+        assert_eq!(br.len(), 1);
+        assert_eq!(br[0].start, br[0].end);
+        assert_eq!(g.leg_count(), 0);
+    }
+}
