@@ -1,1 +1,92 @@
-//! GDAL I/O.
+//! Everything that touches GDAL: the [`reader`] turns any OGR source into
+//! owned features with `geo` geometries; the [`writer`] writes the
+//! GeoPackage layers. No GDAL type leaves this module.
+
+pub mod reader;
+pub mod writer;
+
+pub use reader::{
+    read_layer_polygons, AttributeValue, FieldInfo, InputFeature, InputSpec, LayerRef, Reader,
+    SourceInfo,
+};
+
+use thiserror::Error;
+
+/// Errors opening, reading or writing data sources. Each says what went wrong,
+/// where, and what to do about it.
+#[derive(Debug, Error)]
+pub enum IoError {
+    /// The input could not be opened.
+    #[error("cannot open input `{source_name}`: {reason}; check the path, the connection string or the file permissions")]
+    Open {
+        /// The data source string.
+        source_name: String,
+        /// GDAL's message.
+        reason: String,
+    },
+    /// The requested layer does not exist.
+    #[error("layer {layer} not found in `{source_name}`; available layers: {available}")]
+    NoLayer {
+        /// The data source string.
+        source_name: String,
+        /// The requested layer (name or index).
+        layer: String,
+        /// Comma-separated names of the layers that exist.
+        available: String,
+    },
+    /// The attribute filter was rejected by OGR.
+    #[error("invalid `input.where` filter `{filter}`: {reason}; use OGR SQL syntax, e.g. \"area_m2 > 1e6\"")]
+    BadWhere {
+        /// The filter text.
+        filter: String,
+        /// GDAL's message.
+        reason: String,
+    },
+    /// A geographic CRS and no reprojection.
+    #[error("layer `{layer}` has the geographic CRS {crs}; skeleton radii and scores need a projected CRS: add `input.reproject: EPSG:<code>` (e.g. the layer's UTM zone) to the pipeline")]
+    Geographic {
+        /// Layer name.
+        layer: String,
+        /// The CRS's name.
+        crs: String,
+    },
+    /// The reprojection target is unusable.
+    #[error("invalid `input.reproject` value `{target}`: {reason}")]
+    BadReproject {
+        /// The requested CRS.
+        target: String,
+        /// Why it is unusable.
+        reason: String,
+    },
+    /// The output exists and `overwrite` is off.
+    #[error("output `{path}` already exists; set `output.overwrite: true` or choose another path with `-o`")]
+    OutputExists {
+        /// The output path.
+        path: String,
+    },
+    /// The output cannot be written.
+    #[error("cannot write output `{path}`: {reason}")]
+    Output {
+        /// The output path.
+        path: String,
+        /// What failed.
+        reason: String,
+    },
+    /// Any other GDAL failure.
+    #[error("{context}: {reason}")]
+    Gdal {
+        /// What was being done.
+        context: String,
+        /// GDAL's message.
+        reason: String,
+    },
+}
+
+impl IoError {
+    pub(crate) fn gdal(context: impl Into<String>, e: impl std::fmt::Display) -> Self {
+        IoError::Gdal {
+            context: context.into(),
+            reason: e.to_string(),
+        }
+    }
+}

@@ -1,0 +1,444 @@
+//! Reader: any OGR data source (file, folder, `PG:` connection, `/vsizip/…`)
+//! → owned [`InputFeature`]s with `geo` geometries.
+//!
+//! Z and M are dropped, curves linearised, geometries reprojected when asked
+//! and, with `make_valid`, repaired by GDAL's MakeValid (keeping only the
+//! areal parts of the result). Features come in batches to a callback so the
+//! GDAL dataset and layer stay on the reader's thread.
+
+use super::IoError;
+use gdal::cpl::CslStringList;
+use gdal::spatial_ref::{AxisMappingStrategy, CoordTransform, SpatialRef};
+use gdal::vector::{FieldValue, Geometry, LayerAccess};
+use gdal::{Dataset, DatasetOptions, GdalOpenFlags};
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+/// A layer chosen by name or by index.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(untagged)]
+pub enum LayerRef {
+    /// Zero-based layer index.
+    Index(usize),
+    /// Layer name.
+    Name(String),
+}
+
+impl std::fmt::Display for LayerRef {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            LayerRef::Index(i) => write!(f, "#{i}"),
+            LayerRef::Name(n) => write!(f, "`{n}`"),
+        }
+    }
+}
+
+/// The `input` section of a pipeline file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct InputSpec {
+    /// Any OGR data source string: file, folder, `PG:…`, `/vsizip/…`.
+    pub source: String,
+    /// Layer name or zero-based index; default the first layer.
+    #[serde(default)]
+    pub layer: Option<LayerRef>,
+    /// OGR SQL attribute filter.
+    #[serde(default, rename = "where")]
+    pub where_: Option<String>,
+    /// Spatial filter `[xmin, ymin, xmax, ymax]` in the source CRS.
+    #[serde(default)]
+    pub bbox: Option<[f64; 4]>,
+    /// Target CRS (e.g. `EPSG:3035`); required when the source CRS is geographic.
+    #[serde(default)]
+    pub reproject: Option<String>,
+}
+
+/// An attribute value of a source feature, carried unchanged to the output.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AttributeValue(pub(crate) Option<FieldValue>);
+
+impl AttributeValue {
+    /// The value as text (for logs and tests); `None` for NULL.
+    pub fn as_text(&self) -> Option<String> {
+        self.0.as_ref().map(|v| match v {
+            FieldValue::IntegerValue(i) => i.to_string(),
+            FieldValue::Integer64Value(i) => i.to_string(),
+            FieldValue::RealValue(r) => r.to_string(),
+            FieldValue::StringValue(s) => s.clone(),
+            other => format!("{other:?}"),
+        })
+    }
+}
+
+/// A source field definition.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FieldInfo {
+    /// Field name.
+    pub name: String,
+    /// OGR field type code.
+    pub(crate) kind: u32,
+    /// Declared width (0 = unknown).
+    pub width: i32,
+    /// Declared precision.
+    pub precision: i32,
+}
+
+/// What the reader found out about the source before reading.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SourceInfo {
+    /// The data source string.
+    pub source: String,
+    /// Name of the layer read.
+    pub layer: String,
+    /// Source fields, in order.
+    pub fields: Vec<FieldInfo>,
+    /// WKT of the CRS of the geometries handed out (after reprojection).
+    pub srs_wkt: Option<String>,
+    /// Human-readable name of that CRS.
+    pub crs_name: String,
+    /// Features in the layer without filters.
+    pub total: u64,
+    /// Features that pass `where` and `bbox`.
+    pub selected: u64,
+}
+
+/// One source feature, owned.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InputFeature {
+    /// The source FID.
+    pub fid: Option<u64>,
+    /// Attribute values in [`SourceInfo::fields`] order.
+    pub attributes: Vec<AttributeValue>,
+    /// The geometry (2D, linear, reprojected); `None` when NULL or unreadable.
+    pub geometry: Option<geo::Geometry<f64>>,
+    /// Why the geometry could not be read, when it could not.
+    pub geometry_error: Option<String>,
+    /// The source geometry as WKB (2D), kept for the `rejected` layer.
+    pub source_wkb: Option<Vec<u8>>,
+    /// Set when MakeValid changed the geometry.
+    pub repaired: bool,
+}
+
+/// An open input layer.
+pub struct Reader {
+    dataset: Dataset,
+    layer_index: usize,
+    spec: InputSpec,
+    info: SourceInfo,
+    target: Option<SpatialRef>,
+}
+
+fn traditional(mut s: SpatialRef) -> SpatialRef {
+    s.set_axis_mapping_strategy(AxisMappingStrategy::TraditionalGisOrder);
+    s
+}
+
+impl Reader {
+    /// Opens the source and layer and checks filters and CRS; reads nothing.
+    pub fn open(spec: &InputSpec) -> Result<Self, IoError> {
+        let dataset = Dataset::open_ex(
+            &spec.source,
+            DatasetOptions {
+                open_flags: GdalOpenFlags::GDAL_OF_VECTOR | GdalOpenFlags::GDAL_OF_READONLY,
+                ..Default::default()
+            },
+        )
+        .map_err(|e| IoError::Open {
+            source_name: spec.source.clone(),
+            reason: e.to_string(),
+        })?;
+        let names: Vec<String> = dataset.layers().map(|l| l.name()).collect();
+        let no_layer = |layer: String| IoError::NoLayer {
+            source_name: spec.source.clone(),
+            layer,
+            available: if names.is_empty() {
+                "(none)".into()
+            } else {
+                names.join(", ")
+            },
+        };
+        let layer_index = match &spec.layer {
+            None if names.is_empty() => return Err(no_layer("#0".into())),
+            None => 0,
+            Some(LayerRef::Index(i)) if *i < names.len() => *i,
+            Some(LayerRef::Name(n)) => names
+                .iter()
+                .position(|x| x == n)
+                .ok_or_else(|| no_layer(format!("`{n}`")))?,
+            Some(other) => return Err(no_layer(other.to_string())),
+        };
+        let mut layer = dataset
+            .layer(layer_index)
+            .map_err(|e| IoError::gdal("opening the layer", e))?;
+        let layer_name = layer.name();
+        let total = layer.feature_count();
+        let defn = layer.defn();
+        let fields = defn
+            .fields()
+            .map(|f| FieldInfo {
+                name: f.name(),
+                kind: f.field_type(),
+                width: f.width(),
+                precision: f.precision(),
+            })
+            .collect();
+        let source_srs = layer.spatial_ref();
+        let target = match &spec.reproject {
+            Some(t) => {
+                let srs = SpatialRef::from_definition(t).map_err(|e| IoError::BadReproject {
+                    target: t.clone(),
+                    reason: e.to_string(),
+                })?;
+                if srs.is_geographic() {
+                    return Err(IoError::BadReproject {
+                        target: t.clone(),
+                        reason: "it is a geographic CRS; choose a projected one (metres), e.g. a UTM zone or EPSG:3035".into(),
+                    });
+                }
+                if source_srs.is_none() {
+                    return Err(IoError::BadReproject {
+                        target: t.clone(),
+                        reason: format!("layer `{layer_name}` has no CRS to reproject from; assign one to the source first"),
+                    });
+                }
+                Some(traditional(srs))
+            }
+            None => {
+                if let Some(s) = &source_srs {
+                    if s.is_geographic() {
+                        return Err(IoError::Geographic {
+                            layer: layer_name,
+                            crs: s.name().unwrap_or_else(|| "(unnamed)".into()),
+                        });
+                    }
+                }
+                None
+            }
+        };
+        let out_srs = target.as_ref().or(source_srs.as_ref());
+        let srs_wkt = out_srs.and_then(|s| s.to_wkt().ok());
+        let crs_name = out_srs
+            .map(|s| {
+                let code = s.auth_code().ok();
+                match (s.auth_name(), code) {
+                    (Some(a), Some(c)) => format!("{a}:{c}"),
+                    _ => s.name().unwrap_or_else(|| "(unnamed)".into()),
+                }
+            })
+            .unwrap_or_else(|| "(no CRS)".into());
+        Self::apply_filters(&mut layer, spec)?;
+        let selected = layer.feature_count();
+        let info = SourceInfo {
+            source: spec.source.clone(),
+            layer: layer_name,
+            fields,
+            srs_wkt,
+            crs_name,
+            total,
+            selected,
+        };
+        drop(layer);
+        Ok(Self {
+            dataset,
+            layer_index,
+            spec: spec.clone(),
+            info,
+            target,
+        })
+    }
+
+    fn apply_filters(layer: &mut gdal::vector::Layer<'_>, spec: &InputSpec) -> Result<(), IoError> {
+        if let Some(w) = &spec.where_ {
+            layer
+                .set_attribute_filter(w)
+                .map_err(|e| IoError::BadWhere {
+                    filter: w.clone(),
+                    reason: e.to_string(),
+                })?;
+        }
+        if let Some([x0, y0, x1, y1]) = spec.bbox {
+            layer.set_spatial_filter_rect(x0, y0, x1, y1);
+        }
+        Ok(())
+    }
+
+    /// What the source holds.
+    pub fn info(&self) -> &SourceInfo {
+        &self.info
+    }
+
+    /// Reads every selected feature, handing them to `on_batch` in batches of
+    /// at most `batch` features, in source order.
+    pub fn read<E: From<IoError>>(
+        &mut self,
+        batch: usize,
+        make_valid: bool,
+        mut on_batch: impl FnMut(Vec<InputFeature>) -> Result<(), E>,
+    ) -> Result<(), E> {
+        let mut layer = self
+            .dataset
+            .layer(self.layer_index)
+            .map_err(|e| IoError::gdal("opening the layer", e))?;
+        Self::apply_filters(&mut layer, &self.spec)?;
+        let transform = match (&self.target, layer.spatial_ref()) {
+            (Some(t), Some(s)) => Some(
+                CoordTransform::new(&traditional(s), t)
+                    .map_err(|e| IoError::gdal("creating the coordinate transformation", e))?,
+            ),
+            _ => None,
+        };
+        let n_fields = self.info.fields.len();
+        let mut buf = Vec::with_capacity(batch);
+        for f in layer.features() {
+            let attributes = (0..n_fields)
+                .map(|i| AttributeValue(f.field(i).ok().flatten()))
+                .collect();
+            let mut feat = InputFeature {
+                fid: f.fid(),
+                attributes,
+                geometry: None,
+                geometry_error: None,
+                source_wkb: None,
+                repaired: false,
+            };
+            if let Some(g) = f.geometry() {
+                match convert(g, transform.as_ref(), make_valid) {
+                    Ok((geom, wkb, repaired)) => {
+                        feat.geometry = geom;
+                        feat.source_wkb = wkb;
+                        feat.repaired = repaired;
+                    }
+                    Err(e) => feat.geometry_error = Some(e),
+                }
+            }
+            buf.push(feat);
+            if buf.len() >= batch {
+                on_batch(std::mem::take(&mut buf))?;
+            }
+        }
+        if !buf.is_empty() {
+            on_batch(buf)?;
+        }
+        Ok(())
+    }
+}
+
+type Converted = (Option<geo::Geometry<f64>>, Option<Vec<u8>>, bool);
+
+/// 2D, linear, reprojected, optionally repaired `geo` geometry (plus the 2D
+/// source WKB for the `rejected` layer).
+fn convert(
+    g: &Geometry,
+    transform: Option<&CoordTransform>,
+    make_valid: bool,
+) -> Result<Converted, String> {
+    let mut g = g.clone();
+    if g.is_empty() {
+        let wkb = g.wkb().ok();
+        return Ok((
+            Some(geo::Geometry::GeometryCollection(Default::default())),
+            wkb,
+            false,
+        ));
+    }
+    g.flatten_to_2d();
+    // SAFETY: the handle is valid for the lifetime of `g`.
+    let nonlinear = unsafe {
+        gdal_sys::OGR_GT_IsNonLinear(gdal_sys::OGR_G_GetGeometryType(g.c_geometry())) != 0
+    };
+    if nonlinear {
+        g = linearise(&g)?;
+    }
+    if let Some(ct) = transform {
+        g.transform_inplace(ct)
+            .map_err(|e| format!("reprojection failed: {e}"))?;
+    }
+    let wkb = g.wkb().ok();
+    let mut repaired = false;
+    if make_valid && !g.is_valid() {
+        let fixed = g
+            .make_valid(&CslStringList::new())
+            .map_err(|e| format!("make_valid could not repair the geometry: {e}"))?;
+        g = areal_parts(fixed)?;
+        repaired = true;
+    }
+    let geo = g
+        .to_geo()
+        .map_err(|e| format!("unsupported geometry: {e}"))?;
+    Ok((Some(geo), wkb, repaired))
+}
+
+fn linearise(g: &Geometry) -> Result<Geometry, String> {
+    // SAFETY: OGR_G_GetLinearGeometry returns a new geometry we own; it is
+    // exported to WKB and destroyed here.
+    unsafe {
+        let h = gdal_sys::OGR_G_GetLinearGeometry(g.c_geometry(), 0.0, std::ptr::null_mut());
+        if h.is_null() {
+            return Err("the curved geometry could not be linearised".into());
+        }
+        let size = gdal_sys::OGR_G_WkbSize(h) as usize;
+        let mut buf = vec![0u8; size];
+        let rv =
+            gdal_sys::OGR_G_ExportToWkb(h, gdal_sys::OGRwkbByteOrder::wkbNDR, buf.as_mut_ptr());
+        gdal_sys::OGR_G_DestroyGeometry(h);
+        if rv != gdal_sys::OGRErr::OGRERR_NONE {
+            return Err("the linearised geometry could not be exported".into());
+        }
+        Geometry::from_wkb(&buf).map_err(|e| e.to_string())
+    }
+}
+
+/// Keeps the polygons of a MakeValid result (which may mix in the lines and
+/// points that collapsed spikes become).
+fn areal_parts(g: Geometry) -> Result<Geometry, String> {
+    use gdal_sys::OGRwkbGeometryType as T;
+    let ty = gdal::vector::geometry_type_flatten(g.geometry_type());
+    if ty == T::wkbPolygon || ty == T::wkbMultiPolygon {
+        return Ok(g);
+    }
+    let mut mp = Geometry::empty(T::wkbMultiPolygon).map_err(|e| e.to_string())?;
+    collect_polygons(&g, &mut mp)?;
+    if mp.geometry_count() == 0 {
+        return Err("make_valid left no area (the polygon collapses to lines or points)".into());
+    }
+    Ok(mp)
+}
+
+fn collect_polygons(g: &Geometry, out: &mut Geometry) -> Result<(), String> {
+    use gdal_sys::OGRwkbGeometryType as T;
+    let ty = gdal::vector::geometry_type_flatten(g.geometry_type());
+    if ty == T::wkbPolygon {
+        out.add_geometry(g.clone()).map_err(|e| e.to_string())?;
+    } else if ty == T::wkbMultiPolygon || ty == T::wkbGeometryCollection {
+        for i in 0..g.geometry_count() {
+            let sub = g.get_geometry(i);
+            collect_polygons(&sub, out)?;
+        }
+    }
+    Ok(())
+}
+
+/// Reads every feature of one layer of a file as `(fid, geometry)`, skipping
+/// NULL geometries: for benchmarks, examples and tests.
+pub fn read_layer_polygons(
+    source: &str,
+    layer: &str,
+) -> Result<Vec<(Option<u64>, geo::Geometry<f64>)>, IoError> {
+    let mut r = Reader::open(&InputSpec {
+        source: source.into(),
+        layer: Some(LayerRef::Name(layer.into())),
+        where_: None,
+        bbox: None,
+        reproject: None,
+    })?;
+    let mut out = Vec::new();
+    r.read::<IoError>(1024, false, |batch| {
+        out.extend(
+            batch
+                .into_iter()
+                .filter_map(|f| f.geometry.map(|g| (f.fid, g))),
+        );
+        Ok(())
+    })?;
+    Ok(out)
+}
