@@ -114,9 +114,18 @@ fn t_shape_keeps_its_three_arms() {
     assert_eq!(extended.components(), 1);
     let l = leaves(&extended);
     // One leaf on each arm's end side: x = 0, y = 0 (stem), x = 30.
-    assert!(l[0].x.abs() < 1e-9 && (20.0..=30.0).contains(&l[0].y), "{l:?}");
-    assert!(l[1].y.abs() < 1e-9 && (10.0..=20.0).contains(&l[1].x), "{l:?}");
-    assert!((l[2].x - 30.).abs() < 1e-9 && (20.0..=30.0).contains(&l[2].y), "{l:?}");
+    assert!(
+        l[0].x.abs() < 1e-9 && (20.0..=30.0).contains(&l[0].y),
+        "{l:?}"
+    );
+    assert!(
+        l[1].y.abs() < 1e-9 && (10.0..=20.0).contains(&l[1].x),
+        "{l:?}"
+    );
+    assert!(
+        (l[2].x - 30.).abs() < 1e-9 && (20.0..=30.0).contains(&l[2].y),
+        "{l:?}"
+    );
     assert_leaves_on_boundary(&extended, &p, "T");
 }
 
@@ -161,7 +170,10 @@ fn river_with_bank_noise_keeps_no_spur() {
     assert!(is_simple_path(&pruned), "legs left: {}", pruned.leg_count());
     assert!(is_simple_path(&extended));
     let l = leaves(&extended);
-    assert!(l[0].x.abs() < 1e-9 && (l[1].x - 1000.0).abs() < 1e-9, "{l:?}");
+    assert!(
+        l[0].x.abs() < 1e-9 && (l[1].x - 1000.0).abs() < 1e-9,
+        "{l:?}"
+    );
 }
 
 #[test]
@@ -177,7 +189,10 @@ fn trunk_on_a_polygon_with_holes_is_one_path_from_end_to_end() {
     let e = extend(&t, &p, &ExtendParams::default());
     assert!(is_simple_path(&e));
     let l = leaves(&e);
-    assert!(l[0].x.abs() < 1e-9 && (l[1].x - 600.0).abs() < 1e-9, "{l:?}");
+    assert!(
+        l[0].x.abs() < 1e-9 && (l[1].x - 600.0).abs() < 1e-9,
+        "{l:?}"
+    );
     // `significance` keeps the loops around both islands instead.
     let (pruned, _) = default_steps(&raw, &p);
     assert_eq!(pruned.leg_count(), 2);
@@ -243,9 +258,7 @@ fn every_training_layer_and_method_ends_clean() {
         for m in MethodId::ALL {
             if let Some((b, a, parts, failed)) = check_layer(layer, m) {
                 any = true;
-                println!(
-                    "{layer:18} {m:4}: legs {b:6} -> {a:5}  ({parts} parts, {failed} failed)"
-                );
+                println!("{layer:18} {m:4}: legs {b:6} -> {a:5}  ({parts} parts, {failed} failed)");
             }
         }
     }

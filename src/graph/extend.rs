@@ -139,7 +139,7 @@ fn ray_target(boundary: &Boundary, leg: &[Coord<f64>], r: f64, tol: f64) -> Opti
     let q = point_at(leg, (2.0 * r).min(polyline_length(leg)));
     let d = p - q;
     let norm = d.x.hypot(d.y);
-    if !(norm > 0.0) || !boundary.contains_with_tolerance(p, tol) {
+    if norm.is_nan() || norm <= 0.0 || !boundary.contains_with_tolerance(p, tol) {
         return None;
     }
     let dir = d / norm;
