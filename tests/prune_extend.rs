@@ -201,6 +201,18 @@ fn trunk_on_a_polygon_with_holes_is_one_path_from_end_to_end() {
 }
 
 #[test]
+fn long_noisy_river_prunes_to_one_path_quickly() {
+    // About 4 000 whiskers: the priority queue keeps this near-linear.
+    let p = wavy_river(40_000.0, 10.0, 3.0, &[]);
+    let raw = Cdt.skeletonise(&p).unwrap();
+    let t0 = std::time::Instant::now();
+    let (pruned, _) = default_steps(&raw, &p);
+    println!("{} raw legs pruned in {:?}", raw.leg_count(), t0.elapsed());
+    assert!(raw.leg_count() > 3_000);
+    assert!(is_simple_path(&pruned));
+}
+
+#[test]
 fn pruning_and_extension_are_deterministic() {
     let p = wavy_river(300.0, 10.0, 3.0, &[120.0]);
     let raw = Cdt.skeletonise(&p).unwrap();
@@ -238,6 +250,16 @@ fn check_layer(layer: &str, m: MethodId) -> Option<(usize, usize, usize, usize)>
                 assert!(bad.is_empty(), "{what}: insignificant legs {bad:?}");
             }
             assert_eq!(pruned.components(), raw.components(), "{what}");
+            // `trunk`: one leaf-to-leaf line per component.
+            let trunk = PruneParams {
+                mode: PruneMode::Trunk,
+                ..Default::default()
+            };
+            let t = extend(&prune(&raw, &trunk), &p, &ExtendParams::default());
+            assert_eq!(t.components(), raw.components(), "{what} trunk");
+            assert!(t.degrees().iter().all(|&d| d <= 2), "{what} trunk");
+            assert_eq!(t.leg_count(), t.components(), "{what} trunk");
+            assert_leaves_on_boundary(&t, &p, &what);
             before += raw.leg_count();
             after += extended.leg_count();
         }
