@@ -325,25 +325,21 @@ fn validate(f: &PipelineFile, _locs: &Locations) -> Result<(), (String, String)>
                 if !(p.ratio >= 0.0 && p.ratio.is_finite()) {
                     return Err((at("ratio"), "ratio must be a finite number ≥ 0".into()));
                 }
-                if !(p.min_length >= 0.0) {
+                if p.min_length.is_nan() || p.min_length < 0.0 {
                     return Err((
                         at("min_length"),
                         "min_length must be ≥ 0 (CRS units)".into(),
                     ));
                 }
             }
-            Step::Select(p) => {
-                if !(0.0..=1.0).contains(&p.min_coverage) {
-                    return Err((
-                        at("min_coverage"),
-                        "min_coverage is a fraction between 0 and 1".into(),
-                    ));
-                }
+            Step::Select(p) if !(0.0..=1.0).contains(&p.min_coverage) => {
+                return Err((
+                    at("min_coverage"),
+                    "min_coverage is a fraction between 0 and 1".into(),
+                ));
             }
-            Step::Prepare(p) => {
-                if !(p.min_area >= 0.0) {
-                    return Err((at("min_area"), "min_area must be ≥ 0 (CRS units²)".into()));
-                }
+            Step::Prepare(p) if p.min_area.is_nan() || p.min_area < 0.0 => {
+                return Err((at("min_area"), "min_area must be ≥ 0 (CRS units²)".into()));
             }
             _ => {}
         }
