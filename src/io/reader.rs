@@ -300,7 +300,10 @@ impl Reader {
                 source_wkb: None,
                 repaired: false,
             };
-            if let Some(g) = f.geometry() {
+            // gdal hands out a wrapper around a null handle for NULL geometries.
+            // SAFETY: the handle is only compared with null.
+            let geometry = f.geometry().filter(|g| unsafe { !g.c_geometry().is_null() });
+            if let Some(g) = geometry {
                 match convert(g, transform.as_ref(), make_valid) {
                     Ok((geom, wkb, repaired)) => {
                         feat.geometry = geom;
