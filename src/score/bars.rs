@@ -138,12 +138,44 @@ pub fn bars(polygon: &PreparedPolygon, skeleton: &SkeletonGraph) -> Vec<Bar> {
             ];
             for (origin, ok) in origins {
                 if ok {
-                    out.push(cast(boundary, &sk, origin, u, eps, diagonal));
+                    let reach = Reach {
+                        start: norm(b - a),
+                        max: diagonal,
+                    };
+                    out.push(cast(boundary, &sk, origin, u, eps, reach));
                 }
             }
         }
     }
     out
+}
+
+/// How far to look for the ray's exit from P: first up to `start`, then
+/// four times as far, up to `max` (no ray stays in P longer than the
+/// bounding box's diagonal).
+#[derive(Clone, Copy)]
+struct Reach {
+    start: f64,
+    max: f64,
+}
+
+/// Where the ray `origin + t·u`, t > eps, leaves P. A search growing from the
+/// local scale: an unbounded ray would test every boundary segment along it
+/// across the whole polygon (a wide river, a long coast), while the exit is
+/// usually near.
+fn exit(boundary: &Boundary, origin: Coord<f64>, u: Coord<f64>, eps: f64, reach: Reach) -> f64 {
+    let mut t = reach.start.max(eps);
+    loop {
+        let last = t >= reach.max;
+        let limit = if last { f64::INFINITY } else { t };
+        if let Some(h) = boundary.first_hit(origin, u, eps, limit) {
+            return h.t;
+        }
+        if last {
+            return reach.max;
+        }
+        t *= 4.0;
+    }
 }
 
 /// One bar: its exit from P, its hit on the skeleton and the sides there.
@@ -153,11 +185,9 @@ fn cast(
     origin: Coord<f64>,
     u: Coord<f64>,
     eps: f64,
-    diagonal: f64,
+    reach: Reach,
 ) -> Bar {
-    let t_exit = boundary
-        .first_hit(origin, u, eps, f64::INFINITY)
-        .map_or(diagonal, |h| h.t);
+    let t_exit = exit(boundary, origin, u, eps, reach);
     let hit = sk.hit(origin, u, eps, t_exit).and_then(|(q, sigma)| {
         let nu = left_normal(sigma.b - sigma.a);
         let (_, d_left) = boundary.nearest_in_half_plane(q, nu)?;
