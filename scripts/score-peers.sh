@@ -2,7 +2,7 @@
 # Peer scores (issue 7): skeletons of lakes_scotland and islands_hebrides made
 # by two other tools — pygeoops.centerline (PyPI) and GRASS `v.voronoi -s`
 # (Debian grass-core) — written to one GeoPackage per tool with the source
-# FID, then scored with skeletonise's metrics next to our own methods.
+# FID (GRASS: one file per layer), then scored with skeletonise's metrics next to our own methods.
 #
 # usage: scripts/score-peers.sh            (installs what it needs; root for apt)
 # env:   DATA=…gshhg-train.gpkg  OUT=target/score-peers  LAYERS="…"  METHODS="CDT MA"
@@ -28,7 +28,7 @@ fi
 SCORE="$ROOT/target/release/examples/score_file"
 
 # --- peer skeletons ----------------------------------------------------------
-rm -f "$OUT/pygeoops.gpkg" "$OUT/grass.gpkg"
+rm -f "$OUT/pygeoops.gpkg" "$OUT"/grass-*.gpkg
 for L in $LAYERS; do
   "$OUT/venv/bin/python" "$ROOT/scripts/score_peers_pygeoops.py" "$DATA" "$L" "$OUT/pygeoops.gpkg"
   EPSG=$(ogrinfo -so "$DATA" "$L" | sed -n 's/.*ID\["EPSG",\([0-9]*\)\]\]$/\1/p' | tail -1)
@@ -40,7 +40,7 @@ for L in $LAYERS; do
     v.in.ogr -o --q input='$DATA' layer='$L' output=poly
     g.region --q vector=poly
     v.voronoi -s --q input=poly output=skel
-    v.out.ogr --q input=skel type=line output='$OUT/grass.gpkg' output_layer='$L' format=GPKG $( [ -f "$OUT/grass.gpkg" ] && echo -u )
+    v.out.ogr --q input=skel type=line output='$OUT/grass-$L.gpkg' output_layer='$L' format=GPKG
   " >"$OUT/grass-$L.log" 2>&1 || { echo "GRASS failed on $L: see $OUT/grass-$L.log" >&2; exit 1; }
   echo -e "$L\tGRASS v.voronoi -s\t$(echo "$(date +%s.%N) - $start" | bc)s"
 done
@@ -52,5 +52,5 @@ for L in $LAYERS; do
     "$SCORE" "$DATA" "$L" --method "$M" --csv "$OUT/$L-$M.csv"
   done
   "$SCORE" "$DATA" "$L" --skeletons "$OUT/pygeoops.gpkg" "$L" --fid-field src_fid --csv "$OUT/$L-pygeoops.csv"
-  "$SCORE" "$DATA" "$L" --skeletons "$OUT/grass.gpkg" "$L" --fid-field cat --csv "$OUT/$L-grass.csv"
+  "$SCORE" "$DATA" "$L" --skeletons "$OUT/grass-$L.gpkg" "$L" --fid-field cat --csv "$OUT/$L-grass.csv"
 done | tee "$OUT/scores.tsv"
