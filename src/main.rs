@@ -1,1 +1,238 @@
-fn main() {}
+//! `skeletonise` command line: parses arguments, sets up logging, maps errors
+//! to exit codes (0 ok, 1 runtime failure, 2 usage, 65 rejected features under
+//! `on_error: fail`, 78 invalid pipeline file).
+
+use clap::{Parser, Subcommand, ValueEnum};
+use skeletonise::config;
+use skeletonise::methods::MethodId;
+use skeletonise::pipeline::{self, RunError, RunOptions};
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+const EXIT_RUNTIME: u8 = 1;
+const EXIT_REJECTED: u8 = 65;
+const EXIT_CONFIG: u8 = 78;
+
+#[derive(Parser)]
+#[command(
+    name = "skeletonise",
+    version,
+    about = "Collapse polygons to skeletons (VD, DVD, CDT, StSk, MA) and score them with the paper's deviation and distortion metrics"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+    /// Log format: `text` for people, `json` for scheduled jobs.
+    #[arg(long, value_enum, default_value_t = LogFormat::Text, global = true)]
+    log_format: LogFormat,
+    /// Only warnings and errors.
+    #[arg(short, long, global = true, conflicts_with = "verbose")]
+    quiet: bool,
+    /// More detail (-v debug, -vv trace).
+    #[arg(short, long, action = clap::ArgAction::Count, global = true)]
+    verbose: u8,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum LogFormat {
+    Text,
+    Json,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run a pipeline file.
+    Run {
+        /// The pipeline file (YAML).
+        pipeline: PathBuf,
+        /// Override a key, e.g. `--set steps.prune.ratio=2` (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        /// Override `input.source`.
+        #[arg(short = 'i', long = "input", value_name = "SOURCE")]
+        input: Option<String>,
+        /// Override `output.path`.
+        #[arg(short = 'o', long = "output", value_name = "OUT.gpkg")]
+        output: Option<PathBuf>,
+        /// Worker threads (default: one per core).
+        #[arg(long)]
+        threads: Option<usize>,
+    },
+    /// Check a pipeline file and its input without processing anything.
+    Validate {
+        /// The pipeline file (YAML).
+        pipeline: PathBuf,
+        /// Override a key (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        /// Override `input.source`.
+        #[arg(short = 'i', long = "input", value_name = "SOURCE")]
+        input: Option<String>,
+        /// Override `output.path`.
+        #[arg(short = 'o', long = "output", value_name = "OUT.gpkg")]
+        output: Option<PathBuf>,
+    },
+    /// List the methods and steps with their options.
+    Methods,
+    /// Print the JSON Schema of the pipeline file.
+    Schema,
+}
+
+fn init_logging(cli: &Cli) {
+    let level = if cli.quiet {
+        "warn"
+    } else {
+        match cli.verbose {
+            0 => "info",
+            1 => "debug",
+            _ => "trace",
+        }
+    };
+    let filter = tracing_subscriber::EnvFilter::try_from_env("SKELETONISE_LOG")
+        .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new(level));
+    let b = tracing_subscriber::fmt()
+        .with_env_filter(filter)
+        .with_writer(std::io::stderr);
+    match cli.log_format {
+        LogFormat::Json => b.json().flatten_event(true).init(),
+        LogFormat::Text => b
+            .with_target(false)
+            .with_ansi(std::io::stderr().is_terminal())
+            .init(),
+    }
+}
+
+fn overrides(set: &[String], input: &Option<String>, output: &Option<PathBuf>) -> Vec<String> {
+    let mut v = set.to_vec();
+    // Quoted so that any path survives YAML parsing as a string.
+    if let Some(i) = input {
+        v.push(format!(
+            "input.source={}",
+            serde_json::to_string(i).unwrap_or_default()
+        ));
+    }
+    if let Some(o) = output {
+        v.push(format!(
+            "output.path={}",
+            serde_json::to_string(&o.display().to_string()).unwrap_or_default()
+        ));
+    }
+    v
+}
+
+fn load(path: &std::path::Path, ov: &[String]) -> Result<config::Pipeline, ExitCode> {
+    config::load(path, ov).map_err(|e| {
+        tracing::error!("{e}");
+        ExitCode::from(EXIT_CONFIG)
+    })
+}
+
+fn run_error(e: RunError) -> ExitCode {
+    tracing::error!("{e}");
+    match e {
+        RunError::Rejected { .. } => ExitCode::from(EXIT_REJECTED),
+        _ => ExitCode::from(EXIT_RUNTIME),
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    init_logging(&cli);
+    match &cli.command {
+        Command::Run {
+            pipeline: path,
+            set,
+            input,
+            output,
+            threads,
+        } => {
+            let p = match load(path, &overrides(set, input, output)) {
+                Ok(p) => p,
+                Err(c) => return c,
+            };
+            let opts = RunOptions {
+                threads: *threads,
+                progress: !cli.quiet
+                    && std::io::stderr().is_terminal()
+                    && matches!(cli.log_format, LogFormat::Text),
+                batch_size: None,
+            };
+            match pipeline::run(&p, &opts) {
+                Ok(s) => {
+                    let methods = s
+                        .methods
+                        .iter()
+                        .map(|(m, n)| format!("{m}={n}"))
+                        .collect::<Vec<_>>()
+                        .join(",");
+                    tracing::info!(
+                        read = s.read,
+                        written = s.written,
+                        rejected = s.rejected,
+                        filtered = s.filtered,
+                        rows = s.rows,
+                        seconds = format!("{:.2}", s.elapsed_s),
+                        methods = %methods,
+                        output = %s.output,
+                        "done: {} read, {} written, {} rejected, {} filtered in {:.2} s → {}",
+                        s.read, s.written, s.rejected, s.filtered, s.elapsed_s, s.output
+                    );
+                    ExitCode::SUCCESS
+                }
+                Err(e) => run_error(e),
+            }
+        }
+        Command::Validate {
+            pipeline: path,
+            set,
+            input,
+            output,
+        } => {
+            let p = match load(path, &overrides(set, input, output)) {
+                Ok(p) => p,
+                Err(c) => return c,
+            };
+            match pipeline::validate(&p) {
+                Ok(info) => {
+                    let fields = info
+                        .fields
+                        .iter()
+                        .map(|f| f.name.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ");
+                    println!(
+                        "{}: valid. input `{}` layer `{}`: {} features ({} after filters), CRS {}, fields: {}; output {}",
+                        p.origin, info.source, info.layer, info.total, info.selected, info.crs_name, fields, p.file.output.path
+                    );
+                    ExitCode::SUCCESS
+                }
+                Err(e) => run_error(e),
+            }
+        }
+        Command::Methods => {
+            println!("Methods (skeleton step, `methods: [...]`):");
+            for m in MethodId::ALL {
+                println!("  {:<5} {}", m.as_str(), m.description());
+            }
+            println!(
+                "\nSteps (in this order; only `skeleton` is required):\n  \
+                 prepare   make_valid (bool, default true), min_area (CRS units², default 0)\n  \
+                 skeleton  methods (list, default [CDT]), densify ({{factor: k}} default 4 | {{spacing: d}}), max_points (default 2000000), arc_tolerance ({{relative: f}} default 0.01 | {{absolute: d}})\n  \
+                 prune     mode (significance | length | trunk | none), ratio (default 1.0), min_length (default 0)\n  \
+                 extend    mode (ray | nearest | none)\n  \
+                 score     (no options)\n  \
+                 select    by (distortion | deviation | deviation_parts | distortion_sum), min_coverage (default 0.9)\n\n\
+                 `skeletonise schema` prints the full JSON Schema."
+            );
+            ExitCode::SUCCESS
+        }
+        Command::Schema => {
+            println!(
+                "{}",
+                serde_json::to_string_pretty(&config::json_schema()).unwrap_or_default()
+            );
+            ExitCode::SUCCESS
+        }
+    }
+}

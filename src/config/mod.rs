@@ -1,1 +1,576 @@
-//! Pipeline file.
+//! The pipeline file (SPEC §8): model, loading (with `--set` overrides and
+//! `${ENV}` substitution), validation and JSON Schema.
+//!
+//! Every error names the file, `line:column` and key path, and says what to
+//! do. `skeletonise validate` and `skeletonise run` share [`load`].
+//!
+//! ```
+//! let p = skeletonise::config::load_str(
+//!     "input: {source: in.gpkg}\nsteps:\n  - skeleton: {methods: [CDT]}\noutput: {path: out.gpkg}\n",
+//!     "demo.yaml",
+//!     &[],
+//! ).unwrap();
+//! assert_eq!(p.file.output.layer, "skeletons");
+//! ```
+
+pub mod locate;
+
+use crate::graph::extend::ExtendParams;
+use crate::graph::prune::PruneParams;
+use crate::io::writer::OutputSpec;
+use crate::io::InputSpec;
+use crate::methods::SkeletonParams;
+use crate::process::{PrepareParams, ProcessParams};
+use crate::score::select::SelectParams;
+use crate::score::ScoreParams;
+use locate::Locations;
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+use serde_yaml_ng::Value;
+use thiserror::Error;
+
+/// What to do with features that cannot be processed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "lowercase")]
+pub enum OnError {
+    /// Write them to the `rejected` layer with the reason and carry on.
+    #[default]
+    Reject,
+    /// Stop at the first one and exit with status 65; no output is written.
+    Fail,
+}
+
+/// One step of the pipeline, keyed by its name.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "lowercase", deny_unknown_fields)]
+pub enum Step {
+    /// Validity repair and area filter.
+    Prepare(PrepareParams),
+    /// The skeleton methods to run.
+    Skeleton(SkeletonParams),
+    /// Removal of insignificant legs.
+    Prune(PruneParams),
+    /// Extension of legs to the boundary.
+    Extend(ExtendParams),
+    /// The paper's metrics.
+    Score(ScoreParams),
+    /// Choice of the best method per feature.
+    Select(SelectParams),
+}
+
+impl Step {
+    /// The step's key in the pipeline file.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Step::Prepare(_) => "prepare",
+            Step::Skeleton(_) => "skeleton",
+            Step::Prune(_) => "prune",
+            Step::Extend(_) => "extend",
+            Step::Score(_) => "score",
+            Step::Select(_) => "select",
+        }
+    }
+
+    /// Steps in the only order they may appear in.
+    pub const ORDER: [&'static str; 6] =
+        ["prepare", "skeleton", "prune", "extend", "score", "select"];
+}
+
+/// The pipeline file as written.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct PipelineFile {
+    /// A name for logs and the `skeletonise_runs` table.
+    #[serde(default)]
+    pub name: Option<String>,
+    /// Where the polygons come from.
+    pub input: InputSpec,
+    /// Steps, in the order prepare → skeleton → prune → extend → score → select; only `skeleton` is required.
+    pub steps: Vec<Step>,
+    /// Where the GeoPackage goes.
+    pub output: OutputSpec,
+    /// `reject` (default) or `fail`.
+    #[serde(default)]
+    pub on_error: OnError,
+}
+
+/// A loaded, validated pipeline.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Pipeline {
+    /// The file's content after overrides and substitution.
+    pub file: PipelineFile,
+    /// The original text (recorded in the output's `skeletonise_runs` table).
+    pub text: String,
+    /// Where it came from.
+    pub origin: String,
+    /// The `--set` overrides applied.
+    pub overrides: Vec<String>,
+}
+
+impl Pipeline {
+    /// The per-feature parameters of the steps.
+    pub fn process_params(&self) -> ProcessParams {
+        let mut p = ProcessParams::default();
+        for s in &self.file.steps {
+            match s {
+                Step::Prepare(x) => p.prepare = *x,
+                Step::Skeleton(x) => p.skeleton = x.clone(),
+                Step::Prune(x) => p.prune = Some(*x),
+                Step::Extend(x) => p.extend = Some(*x),
+                Step::Score(x) => p.score = Some(*x),
+                Step::Select(x) => p.select = Some(*x),
+            }
+        }
+        p.keep_bars = self.file.output.bars;
+        p
+    }
+
+    /// The pipeline text with the overrides appended as comments, for provenance.
+    pub fn provenance_text(&self) -> String {
+        let mut t = self.text.clone();
+        for o in &self.overrides {
+            t.push_str(&format!("\n# --set {o}"));
+        }
+        t
+    }
+}
+
+/// An invalid pipeline file (exit status 78).
+#[derive(Debug, Error, Clone, PartialEq)]
+#[error("{origin}{}: {}{message}", .position.map(|(l, c)| format!(":{l}:{c}")).unwrap_or_default(), if .key.is_empty() { String::new() } else { format!("`{}`: ", .key) })]
+pub struct ConfigError {
+    /// The file (or `--set`).
+    pub origin: String,
+    /// `line:column`, when known.
+    pub position: Option<(usize, usize)>,
+    /// The key path, e.g. `steps[2].prune.ratio`.
+    pub key: String,
+    /// What is wrong and how to fix it.
+    pub message: String,
+}
+
+/// Loads, overrides, substitutes and validates a pipeline file.
+pub fn load(path: &std::path::Path, overrides: &[String]) -> Result<Pipeline, ConfigError> {
+    let origin = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| ConfigError {
+        origin: origin.clone(),
+        position: None,
+        key: String::new(),
+        message: format!("cannot read the pipeline file: {e}"),
+    })?;
+    load_str(&text, &origin, overrides)
+}
+
+/// [`load`] from text; `origin` names it in errors.
+pub fn load_str(text: &str, origin: &str, overrides: &[String]) -> Result<Pipeline, ConfigError> {
+    let err = |position, key: &str, message: String| ConfigError {
+        origin: origin.to_string(),
+        position,
+        key: key.to_string(),
+        message,
+    };
+    let mut value: Value = serde_yaml_ng::from_str(text).map_err(|e| {
+        let pos = e.location().map(|l| (l.line(), l.column()));
+        err(pos, "", format!("invalid YAML: {e}"))
+    })?;
+    if value.is_null() {
+        return Err(err(
+            None,
+            "",
+            "the pipeline file is empty; see `skeletonise schema` or pipelines/demo.yaml".into(),
+        ));
+    }
+    let locs = Locations::index(text);
+    for o in overrides {
+        apply_override(&mut value, o).map_err(|m| ConfigError {
+            origin: "--set".into(),
+            position: None,
+            key: o.clone(),
+            message: m,
+        })?;
+    }
+    substitute_env(&mut value, "").map_err(|(k, m)| err(locs.value(&k), &k, m))?;
+    // Enums are written as single-key maps (`prune: {...}`, `densify: {factor: 4}`).
+    let mut track = serde_path_to_error::Track::new();
+    let de = serde_path_to_error::Deserializer::new(value, &mut track);
+    let parsed: Result<PipelineFile, _> =
+        serde_yaml_ng::with::singleton_map_recursive::deserialize(de);
+    let file: PipelineFile = parsed.map_err(|e| {
+        let key = path_string(&track.path());
+        let inner = e.to_string();
+        // Point unknown keys at the key itself.
+        let pos = match unknown_field(&inner) {
+            Some(f) if key.ends_with(&f) => locs.key(&key),
+            Some(f) => locs.key(&locate::join(&key, &f)),
+            None => locs.value(&key),
+        };
+        err(pos, &key, hint(&inner))
+    })?;
+    validate(&file, &locs).map_err(|(k, m)| err(locs.key(&k), &k, m))?;
+    Ok(Pipeline {
+        file,
+        text: text.to_string(),
+        origin: origin.to_string(),
+        overrides: overrides.to_vec(),
+    })
+}
+
+fn path_string(p: &serde_path_to_error::Path) -> String {
+    use serde_path_to_error::Segment;
+    let mut s = String::new();
+    for seg in p.iter() {
+        match seg {
+            Segment::Seq { index } => s.push_str(&format!("[{index}]")),
+            Segment::Map { key } | Segment::Enum { variant: key } => {
+                if !s.is_empty() {
+                    s.push('.');
+                }
+                s.push_str(key);
+            }
+            Segment::Unknown => {}
+        }
+    }
+    s
+}
+
+fn unknown_field(msg: &str) -> Option<String> {
+    let rest = msg
+        .strip_prefix("unknown field `")
+        .or_else(|| msg.strip_prefix("unknown variant `"))?;
+    Some(rest[..rest.find('`')?].to_string())
+}
+
+fn hint(msg: &str) -> String {
+    if msg.starts_with("unknown variant") && msg.contains("prepare") {
+        format!("{msg}; steps are prepare, skeleton, prune, extend, score, select")
+    } else if msg.starts_with("unknown field") {
+        format!("{msg}; `skeletonise schema` lists every key")
+    } else {
+        msg.to_string()
+    }
+}
+
+fn validate(f: &PipelineFile, _locs: &Locations) -> Result<(), (String, String)> {
+    let mut last: Option<(usize, &str)> = None;
+    for (i, s) in f.steps.iter().enumerate() {
+        let rank = Step::ORDER.iter().position(|n| *n == s.name()).unwrap_or(0);
+        if let Some((r, name)) = last {
+            if rank == r {
+                return Err((
+                    format!("steps[{i}].{}", s.name()),
+                    format!(
+                        "step `{}` appears twice; merge its options into one entry",
+                        s.name()
+                    ),
+                ));
+            }
+            if rank < r {
+                return Err((
+                    format!("steps[{i}].{}", s.name()),
+                    format!(
+                        "step `{}` must come before `{name}`; steps run in the order {}",
+                        s.name(),
+                        Step::ORDER.join(" → ")
+                    ),
+                ));
+            }
+        }
+        last = Some((rank, s.name()));
+    }
+    let pos = |name: &str| f.steps.iter().position(|s| s.name() == name);
+    let Some(sk) = pos("skeleton") else {
+        return Err((
+            "steps".into(),
+            "the `skeleton` step is required, e.g. `- skeleton: { methods: [MA, CDT] }`".into(),
+        ));
+    };
+    if let (Some(sel), None) = (pos("select"), pos("score")) {
+        return Err((
+            format!("steps[{sel}].select"),
+            "`select` needs the `score` step before it: add `- score: {}`".into(),
+        ));
+    }
+    for s in &f.steps {
+        let at = |k: &str| format!("steps[{}].{}.{k}", pos(s.name()).unwrap_or(0), s.name());
+        match s {
+            Step::Skeleton(p) => {
+                if p.methods.is_empty() {
+                    return Err((
+                        at("methods"),
+                        "list at least one method: VD, DVD, CDT, StSk, MA".into(),
+                    ));
+                }
+                let mut seen = std::collections::HashSet::new();
+                if let Some(d) = p.methods.iter().find(|m| !seen.insert(**m)) {
+                    return Err((at("methods"), format!("method {d} is listed twice")));
+                }
+                match p.densify {
+                    crate::methods::DensifyParams::Factor(0) => {
+                        return Err((
+                            at("densify.factor"),
+                            "factor must be at least 1 (the paper uses 2 and 4)".into(),
+                        ))
+                    }
+                    crate::methods::DensifyParams::Spacing(d) if !(d > 0.0 && d.is_finite()) => {
+                        return Err((
+                            at("densify.spacing"),
+                            "spacing must be a positive number of CRS units".into(),
+                        ))
+                    }
+                    _ => {}
+                }
+                let _ = sk;
+            }
+            Step::Prune(p) => {
+                if !(p.ratio >= 0.0 && p.ratio.is_finite()) {
+                    return Err((at("ratio"), "ratio must be a finite number ≥ 0".into()));
+                }
+                if p.min_length.is_nan() || p.min_length < 0.0 {
+                    return Err((
+                        at("min_length"),
+                        "min_length must be ≥ 0 (CRS units)".into(),
+                    ));
+                }
+            }
+            Step::Select(p) if !(0.0..=1.0).contains(&p.min_coverage) => {
+                return Err((
+                    at("min_coverage"),
+                    "min_coverage is a fraction between 0 and 1".into(),
+                ));
+            }
+            Step::Prepare(p) if p.min_area.is_nan() || p.min_area < 0.0 => {
+                return Err((at("min_area"), "min_area must be ≥ 0 (CRS units²)".into()));
+            }
+            _ => {}
+        }
+    }
+    if f.output.path.trim().is_empty() {
+        return Err((
+            "output.path".into(),
+            "give the output GeoPackage path".into(),
+        ));
+    }
+    Ok(())
+}
+
+/// Applies `KEY=VALUE` (dotted path; `steps.NAME.key` addresses a step by name
+/// and adds the step when absent; the value is parsed as YAML).
+fn apply_override(root: &mut Value, o: &str) -> Result<(), String> {
+    let (key, val) = o
+        .split_once('=')
+        .ok_or_else(|| "expected KEY=VALUE, e.g. --set steps.prune.ratio=2".to_string())?;
+    let new: Value =
+        serde_yaml_ng::from_str(val).map_err(|e| format!("value is not valid YAML: {e}"))?;
+    let parts: Vec<&str> = key.split('.').collect();
+    if parts.iter().any(|p| p.is_empty()) {
+        return Err("empty key segment".into());
+    }
+    let mut cur = root;
+    let mut i = 0;
+    while i < parts.len() {
+        let seg = parts[i];
+        let last = i + 1 == parts.len();
+        cur = match cur {
+            Value::Mapping(m) => {
+                let k = Value::String(seg.to_string());
+                if last {
+                    m.insert(k, new);
+                    return Ok(());
+                }
+                if !m.contains_key(&k) {
+                    m.insert(k.clone(), Value::Mapping(Default::default()));
+                }
+                m.get_mut(&k).expect("inserted")
+            }
+            Value::Sequence(seq) => {
+                if let Ok(idx) = seg.parse::<usize>() {
+                    let len = seq.len();
+                    let slot = seq.get_mut(idx).ok_or_else(|| {
+                        format!("index {idx} is out of range (the list has {len} entries)")
+                    })?;
+                    if last {
+                        *slot = new;
+                        return Ok(());
+                    }
+                    slot
+                } else {
+                    // A step addressed by name.
+                    let k = Value::String(seg.to_string());
+                    let found = seq
+                        .iter()
+                        .position(|v| v.as_mapping().is_some_and(|m| m.contains_key(&k)));
+                    let idx = match found {
+                        Some(idx) => idx,
+                        None => {
+                            let rank =
+                                Step::ORDER.iter().position(|n| *n == seg).ok_or_else(|| {
+                                    format!("no step `{seg}`; steps are {}", Step::ORDER.join(", "))
+                                })?;
+                            let at = seq
+                                .iter()
+                                .position(|v| {
+                                    v.as_mapping()
+                                        .and_then(|m| m.keys().next())
+                                        .and_then(Value::as_str)
+                                        .and_then(|n| Step::ORDER.iter().position(|o| *o == n))
+                                        .is_some_and(|r| r > rank)
+                                })
+                                .unwrap_or(seq.len());
+                            let mut m = serde_yaml_ng::Mapping::new();
+                            m.insert(k.clone(), Value::Mapping(Default::default()));
+                            seq.insert(at, Value::Mapping(m));
+                            at
+                        }
+                    };
+                    let m = seq[idx].as_mapping_mut().expect("a step is a mapping");
+                    if last {
+                        m.insert(k, new);
+                        return Ok(());
+                    }
+                    let v = m.get_mut(&k).expect("present");
+                    if v.is_null() {
+                        *v = Value::Mapping(Default::default());
+                    }
+                    v
+                }
+            }
+            _ => {
+                return Err(format!(
+                    "`{}` is not a mapping or list",
+                    parts[..i].join(".")
+                ))
+            }
+        };
+        i += 1;
+    }
+    Ok(())
+}
+
+/// Replaces `${NAME}` and `${NAME:-default}` in every string.
+fn substitute_env(v: &mut Value, path: &str) -> Result<(), (String, String)> {
+    match v {
+        Value::String(s) if s.contains("${") => {
+            *s = expand(s).map_err(|m| (path.to_string(), m))?;
+        }
+        Value::Mapping(m) => {
+            for (k, val) in m.iter_mut() {
+                let key = k.as_str().map(str::to_string).unwrap_or_default();
+                substitute_env(val, &locate::join(path, &key))?;
+            }
+        }
+        Value::Sequence(s) => {
+            for (i, val) in s.iter_mut().enumerate() {
+                substitute_env(val, &format!("{path}[{i}]"))?;
+            }
+        }
+        _ => {}
+    }
+    Ok(())
+}
+
+fn expand(s: &str) -> Result<String, String> {
+    let mut out = String::new();
+    let mut rest = s;
+    while let Some(start) = rest.find("${") {
+        out.push_str(&rest[..start]);
+        let after = &rest[start + 2..];
+        let end = after
+            .find('}')
+            .ok_or_else(|| format!("unclosed `${{` in \"{s}\""))?;
+        let expr = &after[..end];
+        let (name, default) = match expr.split_once(":-") {
+            Some((n, d)) => (n, Some(d)),
+            None => (expr, None),
+        };
+        match (std::env::var(name), default) {
+            (Ok(v), _) => out.push_str(&v),
+            (Err(_), Some(d)) => out.push_str(d),
+            (Err(_), None) => {
+                return Err(format!(
+                    "environment variable `{name}` is not set; export it or write `${{{name}:-default}}`"
+                ))
+            }
+        }
+        rest = &after[end + 1..];
+    }
+    out.push_str(rest);
+    Ok(out)
+}
+
+/// The JSON Schema of the pipeline file.
+pub fn json_schema() -> serde_json::Value {
+    serde_json::to_value(schemars::schema_for!(PipelineFile)).unwrap_or_default()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const OK: &str = "input:\n  source: in.gpkg\nsteps:\n  - prepare: { make_valid: true }\n  - skeleton: { methods: [CDT] }\n  - prune: { ratio: 1.5 }\noutput:\n  path: out.gpkg\n";
+
+    #[test]
+    fn loads_and_applies_overrides() {
+        let p = load_str(
+            OK,
+            "p.yaml",
+            &[
+                "steps.prune.ratio=2".into(),
+                "steps.extend.mode=nearest".into(),
+                "output.overwrite=true".into(),
+            ],
+        )
+        .unwrap();
+        let pp = p.process_params();
+        assert_eq!(pp.prune.unwrap().ratio, 2.0);
+        assert_eq!(
+            pp.extend.unwrap().mode,
+            crate::graph::extend::ExtendMode::Nearest
+        );
+        assert!(p.file.output.overwrite);
+    }
+
+    #[test]
+    fn unknown_key_names_line_column_and_path() {
+        let t = OK.replace("ratio: 1.5", "ratoi: 1.5");
+        let e = load_str(&t, "p.yaml", &[]).unwrap_err();
+        assert_eq!(e.position, Some((6, 14)), "{e}");
+        assert_eq!(e.key, "steps[2].prune.ratoi");
+        assert!(
+            e.to_string()
+                .starts_with("p.yaml:6:14: `steps[2].prune.ratoi`: unknown field `ratoi`"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn wrong_type_and_wrong_order() {
+        let e = load_str(&OK.replace("ratio: 1.5", "ratio: lots"), "p.yaml", &[]).unwrap_err();
+        assert_eq!(e.key, "steps[2].prune.ratio");
+        assert_eq!(e.position, Some((6, 21)));
+        let t = "input: {source: a}\nsteps:\n  - skeleton: {}\n  - prepare: {}\noutput: {path: o.gpkg}\n";
+        let e = load_str(t, "p.yaml", &[]).unwrap_err();
+        assert_eq!(e.key, "steps[1].prepare");
+        assert_eq!(e.position, Some((4, 5)));
+        assert!(e.message.contains("must come before"), "{e}");
+    }
+
+    #[test]
+    fn env_substitution() {
+        std::env::set_var("SKELETONISE_TEST_SRC", "from-env.gpkg");
+        let t = OK
+            .replace("in.gpkg", "${SKELETONISE_TEST_SRC}")
+            .replace("out.gpkg", "${SKELETONISE_NOPE:-fallback.gpkg}");
+        let p = load_str(&t, "p.yaml", &[]).unwrap();
+        assert_eq!(p.file.input.source, "from-env.gpkg");
+        assert_eq!(p.file.output.path, "fallback.gpkg");
+        let e = load_str(&OK.replace("in.gpkg", "${SKELETONISE_NOPE}"), "p.yaml", &[]).unwrap_err();
+        assert_eq!(e.key, "input.source");
+        assert_eq!(e.position, Some((2, 11)));
+    }
+
+    #[test]
+    fn schema_lists_steps() {
+        let s = json_schema().to_string();
+        assert!(s.contains("skeleton") && s.contains("min_coverage"));
+    }
+}

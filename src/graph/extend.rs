@@ -1,7 +1,41 @@
 //! Extension of legs to the boundary (SPEC §5).
+//!
+//! After pruning, a leaf ℓ with r_ℓ > tolerance stops short of ∂P (most
+//! methods end legs inside P, and pruning a leg turns its junction into a
+//! leaf). `extend` joins every such leaf to ∂P with one new straight segment
+//! ending in a new node of radius 0, so that afterwards every leaf lies on ∂P.
+//!
+//! * `ray` (default): with L the leg's polyline from ℓ and
+//!   `q = L(min(2 r_ℓ, length(L)))` (the point at that arc length from ℓ),
+//!   cast the ray `ℓ + t · (ℓ − q) / |ℓ − q|`, t > 0, and add the segment from
+//!   ℓ to its first hit on ∂P: the leg continues in the direction it had over
+//!   the last two local radii, which averages out the zig-zag of discrete
+//!   skeletons. When there is no hit, the direction is undefined, or the
+//!   segment would leave P (ℓ itself outside P by more than the tolerance,
+//!   or crossing ∂P), the leaf falls back to `nearest`.
+//! * `nearest`: add the segment from ℓ to the nearest point of ∂P (it cannot
+//!   cross ∂P: no boundary point is closer than that point).
+//! * `none`: the graph unchanged.
+//!
+//! r_ℓ is measured afresh as the distance of ℓ to ∂P, and the tolerance is
+//! `1e-9 × extent` of the polygon ([`PreparedPolygon::extent`]). Leaves are
+//! visited in branch order, so the result is deterministic.
+//!
+//! ```
+//! use skeletonise::geometry::PreparedPolygon;
+//! use skeletonise::graph::{GraphBuilder, extend::{extend, ExtendParams}};
+//! use geo::{polygon, Coord};
+//! let p = PreparedPolygon::new(&polygon![(x: 0., y: 0.), (x: 10., y: 0.),
+//!                                        (x: 10., y: 4.), (x: 0., y: 4.)]).unwrap();
+//! let mut b = GraphBuilder::new();
+//! b.segment(Coord { x: 2., y: 2. }, Coord { x: 8., y: 2. });
+//! let g = extend(&b.finish(p.boundary()), &p, &ExtendParams::default());
+//! assert_eq!(g.total_length(), 10.0); // from (0, 2) to (10, 2)
+//! ```
 
-use super::SkeletonGraph;
-use crate::geometry::PreparedPolygon;
+use super::{polyline_length, SkeletonGraph};
+use crate::geometry::{Boundary, PreparedPolygon};
+use geo::Coord;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
@@ -34,12 +68,180 @@ impl Default for ExtendParams {
     }
 }
 
-/// Extends the legs of `graph` to ∂P (not yet implemented).
+/// Relative tolerance (× polygon extent) below which a leaf is on ∂P.
+pub const ON_BOUNDARY: f64 = 1e-9;
+
+/// Extends the legs of `graph` to ∂P (see the module documentation).
 pub fn extend(
     graph: &SkeletonGraph,
     polygon: &PreparedPolygon,
     params: &ExtendParams,
 ) -> SkeletonGraph {
-    let _ = (polygon, params);
-    graph.clone()
+    if params.mode == ExtendMode::None {
+        return graph.clone();
+    }
+    let boundary = polygon.boundary();
+    let tol = ON_BOUNDARY * polygon.extent();
+    let deg = graph.degrees();
+    let mut out = graph.clone();
+    for b in graph.branches() {
+        if b.start == b.end {
+            continue;
+        }
+        for (leaf, from_leaf) in [(b.start, false), (b.end, true)] {
+            if deg[leaf.0 as usize] != 1 {
+                continue;
+            }
+            let p = graph.node(leaf).pos;
+            let r = boundary.distance(p);
+            if r <= tol {
+                continue;
+            }
+            let target = match params.mode {
+                ExtendMode::Ray => {
+                    let leg: Vec<Coord<f64>> = if from_leaf {
+                        b.coords.iter().rev().copied().collect()
+                    } else {
+                        b.coords.clone()
+                    };
+                    ray_target(boundary, &leg, r, tol)
+                }
+                _ => None,
+            }
+            .or_else(|| boundary.nearest(p).map(|(q, _, _)| q));
+            if let Some(q) = target.filter(|&q| q != p) {
+                let n = out.add_node(q, 0.0, None);
+                out.add_edge(leaf, n, Vec::new());
+            }
+        }
+    }
+    out
+}
+
+/// The point at arc length `s` along `line` (its end when `s` ≥ its length).
+fn point_at(line: &[Coord<f64>], s: f64) -> Coord<f64> {
+    let mut left = s;
+    for w in line.windows(2) {
+        let d = w[1] - w[0];
+        let l = d.x.hypot(d.y);
+        if l >= left && l > 0.0 {
+            return w[0] + d * (left / l);
+        }
+        left -= l;
+    }
+    *line.last().expect("a leg has at least two points")
+}
+
+/// The `ray` target for the leaf `leg[0]` at distance `r` from ∂P, or `None`
+/// when the ray is undefined or its segment would leave P.
+fn ray_target(boundary: &Boundary, leg: &[Coord<f64>], r: f64, tol: f64) -> Option<Coord<f64>> {
+    let p = leg[0];
+    let q = point_at(leg, (2.0 * r).min(polyline_length(leg)));
+    let d = p - q;
+    let norm = d.x.hypot(d.y);
+    if norm.is_nan() || norm <= 0.0 || !boundary.contains_with_tolerance(p, tol) {
+        return None;
+    }
+    let dir = d / norm;
+    // Any hit lies within the bounding box, so its diagonal bounds t.
+    let span = boundary.bbox_max() - boundary.bbox_min();
+    let max_t = 2.0 * (span.x.hypot(span.y) + r);
+    let hit = boundary.first_hit(p, dir, 0.0, max_t)?;
+    let mid = (p + hit.point) * 0.5;
+    if boundary.crosses(p, hit.point) || !boundary.contains_with_tolerance(mid, tol) {
+        return None;
+    }
+    Some(hit.point)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::graph::GraphBuilder;
+    use geo::polygon;
+
+    fn c(x: f64, y: f64) -> Coord<f64> {
+        Coord { x, y }
+    }
+
+    fn leaves(g: &SkeletonGraph) -> Vec<Coord<f64>> {
+        let deg = g.degrees();
+        g.nodes()
+            .iter()
+            .zip(&deg)
+            .filter(|(_, &d)| d == 1)
+            .map(|(n, _)| n.pos)
+            .collect()
+    }
+
+    #[test]
+    fn point_at_walks_the_polyline() {
+        let l = [c(0., 0.), c(1., 0.), c(1., 2.)];
+        assert_eq!(point_at(&l, 0.5), c(0.5, 0.));
+        assert_eq!(point_at(&l, 2.0), c(1., 1.));
+        assert_eq!(point_at(&l, 9.0), c(1., 2.));
+    }
+
+    #[test]
+    fn ray_follows_the_legs_direction_and_nearest_the_closest_point() {
+        // An L-shaped leg in a 20 × 20 square: its last part runs east.
+        let p = PreparedPolygon::new(&polygon![(x: 0., y: 0.), (x: 20., y: 0.),
+            (x: 20., y: 20.), (x: 0., y: 20.)])
+        .unwrap();
+        let mut b = GraphBuilder::new();
+        b.polyline(&[c(10., 3.), c(10., 10.), c(18., 10.)]);
+        let g = b.finish(p.boundary());
+        let ray = extend(&g, &p, &ExtendParams::default());
+        let mut l = leaves(&ray);
+        l.sort_by(|a, b| a.x.total_cmp(&b.x));
+        // Leaf (10, 3), r = 3: the direction comes from (10, 9), so south;
+        // leaf (18, 10), r = 2: from (14, 10), so east.
+        assert_eq!(l, vec![c(10., 0.), c(20., 10.)]);
+        let near = extend(
+            &g,
+            &p,
+            &ExtendParams {
+                mode: ExtendMode::Nearest,
+            },
+        );
+        let mut l = leaves(&near);
+        l.sort_by(|a, b| a.x.total_cmp(&b.x));
+        assert_eq!(l, vec![c(10., 0.), c(20., 10.)]);
+        let none = extend(
+            &g,
+            &p,
+            &ExtendParams {
+                mode: ExtendMode::None,
+            },
+        );
+        assert_eq!(none, g);
+    }
+
+    #[test]
+    fn ray_stops_at_the_first_wall() {
+        // A U shape: the leaf in the left arm pointing east stops at the
+        // notch wall, never reaching the right arm.
+        let p = PreparedPolygon::new(&polygon![(x: 0., y: 0.), (x: 30., y: 0.),
+            (x: 30., y: 30.), (x: 20., y: 30.), (x: 20., y: 10.), (x: 10., y: 10.),
+            (x: 10., y: 30.), (x: 0., y: 30.)])
+        .unwrap();
+        let mut b = GraphBuilder::new();
+        b.segment(c(5., 25.), c(6., 25.));
+        let g = b.finish(p.boundary());
+        let e = extend(&g, &p, &ExtendParams::default());
+        let mut l = leaves(&e);
+        l.sort_by(|a, b| a.x.total_cmp(&b.x));
+        assert_eq!(l, vec![c(0., 25.), c(10., 25.)]);
+    }
+
+    #[test]
+    fn leaves_on_the_boundary_are_left_alone() {
+        let p = PreparedPolygon::new(&polygon![(x: 0., y: 0.), (x: 10., y: 0.),
+            (x: 10., y: 4.), (x: 0., y: 4.)])
+        .unwrap();
+        let mut b = GraphBuilder::new();
+        b.segment(c(0., 2.), c(10., 2.));
+        let g = b.finish(p.boundary());
+        assert_eq!(extend(&g, &p, &ExtendParams::default()), g);
+    }
 }

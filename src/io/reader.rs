@@ -237,7 +237,6 @@ impl Reader {
             total,
             selected,
         };
-        drop(layer);
         Ok(Self {
             dataset,
             layer_index,
@@ -418,12 +417,12 @@ fn collect_polygons(g: &Geometry, out: &mut Geometry) -> Result<(), String> {
     Ok(())
 }
 
+/// A source FID and its geometry.
+pub type FidGeometry = (Option<u64>, geo::Geometry<f64>);
+
 /// Reads every feature of one layer of a file as `(fid, geometry)`, skipping
 /// NULL geometries: for benchmarks, examples and tests.
-pub fn read_layer_polygons(
-    source: &str,
-    layer: &str,
-) -> Result<Vec<(Option<u64>, geo::Geometry<f64>)>, IoError> {
+pub fn read_layer_polygons(source: &str, layer: &str) -> Result<Vec<FidGeometry>, IoError> {
     let mut r = Reader::open(&InputSpec {
         source: source.into(),
         layer: Some(LayerRef::Name(layer.into())),

@@ -19,7 +19,8 @@
 //! ```
 //! use skeletonise::geometry::PreparedPolygon;
 //! use skeletonise::methods::{cdt::Cdt, SkeletonMethod};
-//! let p = geo::polygon![(x: 0., y: 0.), (x: 10., y: 0.), (x: 10., y: 2.), (x: 0., y: 2.)];
+//! use geo::polygon;
+//! let p = polygon![(x: 0., y: 0.), (x: 10., y: 0.), (x: 10., y: 2.), (x: 0., y: 2.)];
 //! let g = Cdt.skeletonise(&PreparedPolygon::new(&p).unwrap()).unwrap();
 //! assert!(g.edges().len() >= 2);
 //! ```
@@ -114,7 +115,7 @@ pub fn inside_triangles(polygon: &PreparedPolygon) -> Result<Vec<InsideTriangle>
     }
     let mut out = Vec::new();
     for face in cdt.inner_faces() {
-        if depth[face.fix().index()].unwrap_or(0) % 2 == 0 {
+        if depth[face.fix().index()].unwrap_or(0).is_multiple_of(2) {
             continue;
         }
         let edges = face.adjacent_edges();

@@ -1,0 +1,157 @@
+//! Writes the README pictures: one training river and one island, the raw
+//! skeleton of every method that succeeds beside the same skeleton after the
+//! default `prune` (significance) and `extend` (ray) steps.
+//!
+//! ```text
+//! cargo run --release --example figures [-- path/to/gshhg-train.gpkg [out_dir]]
+//! ```
+//!
+//! Writes `docs/img/skeletons-river.svg` and `docs/img/skeletons-island.svg`
+//! (polygon grey, skeleton red, one row per method). Methods that fail on a
+//! polygon are skipped, so the pictures can be regenerated as methods land.
+
+use geo::{Area, Coord, Geometry, LineString, Polygon};
+use skeletonise::geometry::PreparedPolygon;
+use skeletonise::graph::extend::{extend, ExtendParams};
+use skeletonise::graph::prune::{prune, PruneParams};
+use skeletonise::graph::SkeletonGraph;
+use skeletonise::io::read_layer_polygons;
+use skeletonise::methods::{build, MethodId, SkeletonParams};
+use std::fmt::Write as _;
+
+/// Width of one panel in SVG units.
+const PANEL_W: f64 = 360.0;
+/// Margin around and between panels.
+const GAP: f64 = 12.0;
+/// Height of a panel's caption line.
+const CAPTION: f64 = 16.0;
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().collect();
+    let source = args
+        .get(1)
+        .cloned()
+        .unwrap_or_else(|| "../shared/data/gshhg-train.gpkg".into());
+    let out_dir = args.get(2).cloned().unwrap_or_else(|| "docs/img".into());
+    std::fs::create_dir_all(&out_dir)?;
+    for (layer, name) in [
+        ("river_danube", "skeletons-river"),
+        ("islands_hebrides", "skeletons-island"),
+    ] {
+        // The largest polygon of the layer: the river itself, the largest island.
+        let polygon = read_layer_polygons(&source, layer)?
+            .into_iter()
+            .flat_map(|(_, g)| match g {
+                Geometry::Polygon(p) => vec![p],
+                Geometry::MultiPolygon(mp) => mp.0,
+                _ => Vec::new(),
+            })
+            .max_by(|a, b| a.unsigned_area().total_cmp(&b.unsigned_area()))
+            .ok_or("layer has no polygon")?;
+        let svg = figure(&polygon, layer)?;
+        let path = format!("{out_dir}/{name}.svg");
+        std::fs::write(&path, svg)?;
+        println!("wrote {path}");
+    }
+    Ok(())
+}
+
+/// Maps CRS coordinates to panel coordinates (local frame, y down).
+struct Frame {
+    min: Coord<f64>,
+    max_y: f64,
+    scale: f64,
+}
+
+impl Frame {
+    fn xy(&self, c: Coord<f64>) -> (f64, f64) {
+        (
+            (c.x - self.min.x) * self.scale,
+            (self.max_y - c.y) * self.scale,
+        )
+    }
+
+    fn path(&self, line: &[Coord<f64>], close: bool) -> String {
+        let mut s = String::new();
+        for (i, &c) in line.iter().enumerate() {
+            let (x, y) = self.xy(c);
+            let _ = write!(s, "{}{x:.1} {y:.1}", if i == 0 { "M" } else { "L" });
+        }
+        if close {
+            s.push('Z');
+        }
+        s
+    }
+}
+
+fn figure(polygon: &Polygon<f64>, layer: &str) -> Result<String, Box<dyn std::error::Error>> {
+    let p = PreparedPolygon::new(polygon)?;
+    let (lo, hi) = (p.boundary().bbox_min(), p.boundary().bbox_max());
+    let scale = PANEL_W / (hi.x - lo.x).max(hi.y - lo.y);
+    let frame = Frame {
+        min: lo,
+        max_y: hi.y,
+        scale,
+    };
+    let (pw, ph) = ((hi.x - lo.x) * scale, (hi.y - lo.y) * scale);
+    let rings: String = p
+        .rings()
+        .map(|r: &LineString<f64>| frame.path(&r.0, true))
+        .collect();
+
+    let mut rows: Vec<(MethodId, SkeletonGraph, SkeletonGraph)> = Vec::new();
+    for m in MethodId::ALL {
+        match build(m, &SkeletonParams::default()).skeletonise(&p) {
+            Ok(raw) => {
+                let pruned = prune(&raw, &PruneParams::default());
+                let done = extend(&pruned, &p, &ExtendParams::default());
+                rows.push((m, raw, done));
+            }
+            Err(e) => eprintln!("{layer}: {m} skipped: {e}"),
+        }
+    }
+
+    let row_h = CAPTION + ph + GAP;
+    let (w, h) = (2.0 * pw + 3.0 * GAP, GAP + rows.len() as f64 * row_h);
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w:.0}" height="{h:.0}" viewBox="0 0 {w:.0} {h:.0}" font-family="sans-serif" font-size="12">"#
+    );
+    let _ = writeln!(s, r#"<rect width="100%" height="100%" fill="white"/>"#);
+    for (i, (m, raw, done)) in rows.iter().enumerate() {
+        for (k, (g, label)) in [(raw, "raw"), (done, "pruned + extended")]
+            .into_iter()
+            .enumerate()
+        {
+            let (x0, y0) = (GAP + k as f64 * (pw + GAP), GAP + i as f64 * row_h);
+            let _ = writeln!(
+                s,
+                r#"<text x="{x0:.1}" y="{:.1}">{layer} · {m} · {label} · {} legs</text>"#,
+                y0 + CAPTION - 4.0,
+                g.leg_count()
+            );
+            let _ = writeln!(
+                s,
+                r#"<g transform="translate({x0:.1} {:.1})">"#,
+                y0 + CAPTION
+            );
+            let _ = writeln!(
+                s,
+                r##"<path d="{rings}" fill="#ddd" stroke="#999" stroke-width="0.5" fill-rule="evenodd"/>"##
+            );
+            let lines: String = g
+                .branches()
+                .iter()
+                .map(|b| frame.path(&b.coords, false))
+                .collect();
+            let _ = writeln!(
+                s,
+                r##"<path d="{lines}" fill="none" stroke="#d00" stroke-width="1" stroke-linejoin="round"/>"##
+            );
+            s.push_str("</g>\n");
+        }
+    }
+    s.push_str("</svg>\n");
+    Ok(s)
+}
