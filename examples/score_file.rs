@@ -162,7 +162,7 @@ fn main() -> Result<(), Error> {
                 .collect();
             (format!("{src}:{layer}"), s)
         } else if let Some(m) = opt("--method", 1) {
-            let id: MethodId = m.parse().map_err(|e| format!("{e}"))?;
+            let id: MethodId = m.parse()?;
             let raw = args.iter().any(|a| a == "--raw");
             let s = polygons
                 .iter()

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Peer scores (issue 7): skeletons of lakes_scotland and islands_hebrides made
 # by two other tools — pygeoops.centerline (PyPI) and GRASS `v.voronoi -s`
-# (Debian grass-core) — written to one GeoPackage per tool with the source
-# FID (GRASS: one file per layer), then scored with skeletonise's metrics next to our own methods.
+# (Debian grass-core) — written to GeoPackages with the source FID, then
+# scored with skeletonise's metrics next to our own methods.
 #
 # usage: scripts/score-peers.sh            (installs what it needs; root for apt)
 # env:   DATA=…gshhg-train.gpkg  OUT=target/score-peers  LAYERS="…"  METHODS="CDT MA"
