@@ -1,0 +1,262 @@
+//! Bars, hits and sides (SPEC §6.1–6.3).
+
+use super::{metrics, Bar, BarHit, Scores};
+use crate::geometry::{boundary::orient, Boundary, BoundarySegment, PreparedPolygon};
+use crate::graph::{GraphBuilder, SkeletonGraph};
+use geo::{Coord, MultiLineString};
+use std::collections::HashMap;
+
+/// Relative tolerance: hits closer than this × extent to the bar's origin are
+/// the origin itself (SPEC §6.2).
+const REL_EPS: f64 = 1e-6;
+
+fn dot(a: Coord<f64>, b: Coord<f64>) -> f64 {
+    a.x * b.x + a.y * b.y
+}
+
+fn norm(a: Coord<f64>) -> f64 {
+    a.x.hypot(a.y)
+}
+
+/// Left unit normal of the direction `d` (inward for a ring edge, since the
+/// interior lies on the left of every ring edge).
+fn left_normal(d: Coord<f64>) -> Coord<f64> {
+    let l = norm(d);
+    Coord {
+        x: -d.y / l,
+        y: d.x / l,
+    }
+}
+
+/// True when the interior angle at vertex `v` (between the edges to `prev`
+/// and `next`, interior on the left of `prev → v → next`) exceeds 90°: only
+/// then do both edges' inward normals at `v` point strictly into the
+/// interior. The angle is measured counter-clockwise from `next − v` to
+/// `prev − v`; it is at most 90° exactly when `prev` lies in the closed
+/// quadrant left of and ahead of `next − v`.
+fn vertex_bar_valid(prev: Coord<f64>, v: Coord<f64>, next: Coord<f64>) -> bool {
+    let left = orient(v, next, prev) >= 0.0;
+    let ahead = dot(next - v, prev - v) >= 0.0;
+    !(left && ahead)
+}
+
+/// The skeleton's segments in an R-tree, each tagged with its part.
+///
+/// [`Boundary`] is a general segment index (ray casts, nearest points); here
+/// it indexes the skeleton: `ring` holds the part (branch) index.
+struct SkeletonIndex {
+    index: Boundary,
+    /// Segments incident to each segment end point (keyed by coordinate bits).
+    at_vertex: HashMap<(u64, u64), Vec<u32>>,
+}
+
+fn key(p: Coord<f64>) -> (u64, u64) {
+    ((p.x + 0.0).to_bits(), (p.y + 0.0).to_bits())
+}
+
+impl SkeletonIndex {
+    fn new(skeleton: &SkeletonGraph) -> Self {
+        let mut segments = Vec::new();
+        for (k, branch) in skeleton.branches().iter().enumerate() {
+            for w in branch.coords.windows(2) {
+                if w[0] != w[1] {
+                    segments.push(BoundarySegment {
+                        a: w[0],
+                        b: w[1],
+                        ring: k as u32,
+                        index: segments.len() as u32,
+                    });
+                }
+            }
+        }
+        let mut at_vertex: HashMap<(u64, u64), Vec<u32>> = HashMap::new();
+        for (i, s) in segments.iter().enumerate() {
+            at_vertex.entry(key(s.a)).or_default().push(i as u32);
+            at_vertex.entry(key(s.b)).or_default().push(i as u32);
+        }
+        Self {
+            index: Boundary::from_segments(segments),
+            at_vertex,
+        }
+    }
+
+    /// The first skeleton point on `origin + t·u`, `eps < t ≤ max_t`, and the
+    /// segment σ the sides are measured against.
+    fn hit(
+        &self,
+        origin: Coord<f64>,
+        u: Coord<f64>,
+        eps: f64,
+        max_t: f64,
+    ) -> Option<(Coord<f64>, &BoundarySegment)> {
+        let h = self.index.first_hit(origin, u, eps, max_t)?;
+        let segs = self.index.segments();
+        let s = &segs[h.segment];
+        // At a skeleton vertex, the incident segment most nearly
+        // perpendicular to the bar (largest angle to u).
+        let vertex = [s.a, s.b].into_iter().find(|&v| norm(v - h.point) <= eps);
+        let sigma = match vertex.and_then(|v| self.at_vertex.get(&key(v))) {
+            Some(incident) => incident
+                .iter()
+                .map(|&i| &segs[i as usize])
+                .min_by(|x, y| {
+                    let cx = dot(x.b - x.a, u).abs() / norm(x.b - x.a);
+                    let cy = dot(y.b - y.a, u).abs() / norm(y.b - y.a);
+                    cx.total_cmp(&cy)
+                })
+                .unwrap_or(s),
+            None => s,
+        };
+        Some((h.point, sigma))
+    }
+}
+
+/// The valid bars of `polygon` cast against `skeleton`, with their hits and
+/// sides (SPEC §6.1–6.3). Order: ring by ring, edge by edge, and per edge
+/// start vertex, midpoint, end vertex (invalid vertex bars left out).
+/// `BarHit::part` indexes `skeleton.branches()`.
+pub fn bars(polygon: &PreparedPolygon, skeleton: &SkeletonGraph) -> Vec<Bar> {
+    let boundary = polygon.boundary();
+    let eps = REL_EPS * polygon.extent();
+    // No ray stays inside P for longer than the bounding box's diagonal.
+    let diagonal = norm(boundary.bbox_max() - boundary.bbox_min());
+    let sk = SkeletonIndex::new(skeleton);
+    let mut out = Vec::with_capacity(3 * polygon.vertex_count());
+    for ring in polygon.rings() {
+        let v = &ring.0[..ring.0.len() - 1];
+        let m = v.len();
+        let valid: Vec<bool> = (0..m)
+            .map(|i| vertex_bar_valid(v[(i + m - 1) % m], v[i], v[(i + 1) % m]))
+            .collect();
+        for i in 0..m {
+            let (a, b) = (v[i], v[(i + 1) % m]);
+            let u = left_normal(b - a);
+            let origins = [
+                (a, valid[i]),
+                ((a + b) * 0.5, true),
+                (b, valid[(i + 1) % m]),
+            ];
+            for (origin, ok) in origins {
+                if ok {
+                    let reach = Reach {
+                        start: norm(b - a),
+                        max: diagonal,
+                    };
+                    out.push(cast(boundary, &sk, origin, u, eps, reach));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// How far to look for the ray's exit from P: first up to `start`, then
+/// four times as far, up to `max` (no ray stays in P longer than the
+/// bounding box's diagonal).
+#[derive(Clone, Copy)]
+struct Reach {
+    start: f64,
+    max: f64,
+}
+
+/// Where the ray `origin + t·u`, t > eps, leaves P. A search growing from the
+/// local scale: an unbounded ray would test every boundary segment along it
+/// across the whole polygon (a wide river, a long coast), while the exit is
+/// usually near.
+fn exit(boundary: &Boundary, origin: Coord<f64>, u: Coord<f64>, eps: f64, reach: Reach) -> f64 {
+    let mut t = reach.start.max(eps);
+    loop {
+        let last = t >= reach.max;
+        let limit = if last { f64::INFINITY } else { t };
+        if let Some(h) = boundary.first_hit(origin, u, eps, limit) {
+            return h.t;
+        }
+        if last {
+            return reach.max;
+        }
+        t *= 4.0;
+    }
+}
+
+/// One bar: its exit from P, its hit on the skeleton and the sides there.
+fn cast(
+    boundary: &Boundary,
+    sk: &SkeletonIndex,
+    origin: Coord<f64>,
+    u: Coord<f64>,
+    eps: f64,
+    reach: Reach,
+) -> Bar {
+    let t_exit = exit(boundary, origin, u, eps, reach);
+    let hit = sk.hit(origin, u, eps, t_exit).and_then(|(q, sigma)| {
+        let nu = left_normal(sigma.b - sigma.a);
+        let (_, d_left) = boundary.nearest_in_half_plane(q, nu)?;
+        let (_, d_right) = boundary.nearest_in_half_plane(q, -nu)?;
+        Some(BarHit {
+            point: q,
+            d_left,
+            d_right,
+            part: sigma.ring as usize,
+        })
+    });
+    Bar {
+        origin,
+        dir: u,
+        hit,
+    }
+}
+
+/// Scores skeleton linework made by any tool against `polygon`: the lines
+/// become a [`SkeletonGraph`] (end points shared bit for bit become nodes;
+/// others stay apart, which is harmless for scoring), whose branches are
+/// the parts of eqs. 3–4.
+pub fn score_skeleton(
+    polygon: &PreparedPolygon,
+    skeleton: &MultiLineString<f64>,
+) -> (Scores, Vec<Bar>) {
+    let mut gb = GraphBuilder::new();
+    for line in &skeleton.0 {
+        gb.polyline(&line.0);
+    }
+    let graph = gb.finish(polygon.boundary());
+    let b = bars(polygon, &graph);
+    (metrics(&b), b)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use geo::polygon;
+
+    #[test]
+    fn vertex_validity_by_interior_angle() {
+        let o = Coord { x: 0.0, y: 0.0 };
+        let next = Coord { x: 1.0, y: 0.0 };
+        let at = |deg: f64| {
+            let r = deg.to_radians();
+            Coord {
+                x: r.cos(),
+                y: r.sin(),
+            }
+        };
+        assert!(!vertex_bar_valid(at(45.0), o, next));
+        assert!(!vertex_bar_valid(at(90.0), o, next));
+        assert!(vertex_bar_valid(at(91.0), o, next));
+        assert!(vertex_bar_valid(at(180.0), o, next));
+        assert!(vertex_bar_valid(at(270.0), o, next));
+        assert!(vertex_bar_valid(at(359.0), o, next));
+    }
+
+    #[test]
+    fn square_has_only_midpoint_bars() {
+        let p = PreparedPolygon::new(&polygon![
+            (x: 0., y: 0.), (x: 4., y: 0.), (x: 4., y: 4.), (x: 0., y: 4.)
+        ])
+        .unwrap();
+        let b = bars(&p, &SkeletonGraph::new());
+        assert_eq!(b.len(), 4);
+        assert!(b.iter().all(|b| b.hit.is_none()));
+        assert_eq!(b[0].origin, Coord { x: 2.0, y: 0.0 });
+        assert_eq!(b[0].dir, Coord { x: 0.0, y: 1.0 });
+    }
+}
