@@ -125,6 +125,7 @@ struct Propagation<'a> {
     max_pops: usize,
     max_vertices: usize,
     stats: Stats,
+    inconsistent: Option<Coord<f64>>,
 }
 
 impl<'a> Propagation<'a> {
@@ -181,6 +182,7 @@ impl<'a> Propagation<'a> {
                 input_vertices: n,
                 ..Stats::default()
             },
+            inconsistent: None,
         }
     }
 
@@ -194,6 +196,17 @@ impl<'a> Propagation<'a> {
     fn finish(&mut self, v: VertexId, p: Coord<f64>) {
         let from = self.abs_start(v);
         let from_t = self.w.v(v).t0;
+        // The trace must end on both of the vertex's offset lines.
+        let (l, r) = (self.w.v(v).left, self.w.v(v).right);
+        let off = self
+            .w
+            .line(l)
+            .ahead(p, self.now)
+            .abs()
+            .max(self.w.line(r).ahead(p, self.now).abs());
+        if off > 1e5 * self.tol {
+            self.inconsistent = Some(p + self.origin);
+        }
         self.arcs.push(Arc {
             from,
             from_t,
@@ -252,6 +265,12 @@ impl<'a> Propagation<'a> {
                 }
             }
             self.drain_work()?;
+            if let Some(p) = self.inconsistent {
+                return Err(fail(format!(
+                    "straight skeleton event off its offset lines near ({}, {}) (degenerate simultaneous events)",
+                    p.x, p.y
+                )));
+            }
         }
         if let Some(v) = self.w.vertices.iter().find(|v| v.active) {
             let p = v.start + self.origin;
@@ -388,8 +407,18 @@ impl<'a> Propagation<'a> {
             if x == v || y == v {
                 return false;
             }
-            let sx = dot(l.dir, w.pos(x, t));
-            let sy = dot(l.dir, w.pos(y, t));
+            let (px, py) = (w.pos(x, t), w.pos(y, t));
+            let (sx, sy) = (dot(l.dir, px), dot(l.dir, py));
+            let at_x = (px - p).x.hypot((px - p).y) <= tol;
+            let at_y = (py - p).x.hypot((py - p).y) <= tol;
+            // Touching a zero-length piece, or a piece end that already
+            // carries one of v's own lines, changes nothing: not a split.
+            if (at_x && at_y)
+                || (at_y && w.v(y).right == w.v(v).right)
+                || (at_x && w.v(x).left == w.v(v).left)
+            {
+                return false;
+            }
             sx - tol <= sp && sp <= sy + tol
         });
         w.pieces[line.0 as usize] = pieces;
@@ -459,6 +488,17 @@ pub fn straight_skeleton_with_stats(
         Ok(r) => r?,
         Err(_) => return Err(fail("internal error (panic) in the straight skeleton")),
     };
+    // Last line of defence: a missed event shows as a trace leaving P.
+    let tol = 1e-6 * polygon.extent();
+    if let Some(a) = arcs
+        .iter()
+        .find(|a| !polygon.boundary().contains_with_tolerance(a.to, tol))
+    {
+        return Err(fail(format!(
+            "straight skeleton left the polygon near ({}, {}) (a missed event in a degenerate configuration)",
+            a.to.x, a.to.y
+        )));
+    }
     let mut b = GraphBuilder::new();
     for a in &arcs {
         if b.segment(a.from, a.to).is_some() {
