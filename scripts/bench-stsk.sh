@@ -36,7 +36,7 @@ for L in "${LAYERS[@]}"; do
     CREATE OR REPLACE FUNCTION pg_temp.sk(g geometry) RETURNS int AS \$\$
     BEGIN PERFORM ST_StraightSkeleton(g); RETURN 0;
     EXCEPTION WHEN OTHERS THEN RETURN 1; END \$\$ LANGUAGE plpgsql;
-    SELECT sum(pg_temp.sk((ST_Dump(geom)).geom)) FROM \"$L\";")
+    SELECT sum(pg_temp.sk(d.geom)) FROM \"$L\", LATERAL ST_Dump(geom) d;")
   END=$(date +%s.%N)
   PG_S=$(echo "$END - $START" | bc -l)
   RATIO=$(echo "$PG_S / $OURS_S" | bc -l)

@@ -413,10 +413,12 @@ impl<'a> Propagation<'a> {
             let at_y = (py - p).x.hypot((py - p).y) <= tol;
             // Touching a zero-length piece, or a piece end that already
             // carries one of v's own lines, changes nothing: not a split.
-            if (at_x && at_y)
-                || (at_y && w.v(y).right == w.v(v).right)
-                || (at_x && w.v(x).left == w.v(v).left)
-            {
+            let no_op = if at_y {
+                at_x || w.v(y).right == w.v(v).right
+            } else {
+                at_x && w.v(x).left == w.v(v).left
+            };
+            if no_op {
                 return false;
             }
             sx - tol <= sp && sp <= sy + tol
