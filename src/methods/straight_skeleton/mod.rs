@@ -1,0 +1,557 @@
+//! `StSk` — the interior straight skeleton of a polygon with holes (SPEC §3,
+//! paper "Straight Skeleton", Fig. 2e; Aichholzer et al. 1995).
+//!
+//! *Definition (SPEC §3):* every boundary edge of P moves inward, parallel to
+//! itself, at unit speed; the straight skeleton is the trace of the
+//! wavefront vertices. Each node keeps its event time (offset distance)
+//! besides its radius (distance to ∂P).
+//!
+//! # Algorithm
+//!
+//! Event-driven wavefront propagation ([`wavefront`], [`events`]):
+//!
+//! * Every ring becomes a circular list of wavefront vertices (exterior
+//!   counter-clockwise, holes clockwise, so P is always on the left). A
+//!   vertex moves at velocity `(n1 + n2) / (1 + n1·n2)` along the bisector of
+//!   its two edges' inward normals.
+//! * Edge events (an edge shrinks to a point) merge its two vertices; split
+//!   events (a reflex vertex reaches a non-adjacent wavefront edge) cut one
+//!   list into two, or join two lists — that is how holes merge with the
+//!   outer wavefront. Lists are re-linked through index handles only.
+//! * Degenerate cases: simultaneous events at one point become chains of
+//!   events at the same time joined by zero-length traces (merged by the
+//!   graph builder); a reflex vertex reaching another vertex (vertex event)
+//!   is a split whose new edge has zero length and collapses at once, or
+//!   grows; collinear consecutive edges give a vertex moving along the
+//!   common normal; two parallel edges meeting (a rectangle's long sides)
+//!   create a *fold* — a vertex between antiparallel coincident lines — which
+//!   is zipped up immediately towards the nearer neighbour, tracing the
+//!   collapsed strip's centre line; a list of two vertices is a collapsed
+//!   segment and one of three a collapsing triangle.
+//! * Split candidates of a reflex vertex are looked up in an R-tree of the
+//!   original edges near its ray (bounded by where the ray leaves P),
+//!   sorted by time and validated against the current wavefront when
+//!   popped; events are kept in a binary heap with lazy invalidation (an
+//!   event naming an inactive vertex is dropped). The cost is about
+//!   O(n log n) on real data.
+//!
+//! # Tolerance policy
+//!
+//! Coordinates are shifted by [`PreparedPolygon::origin`] before any
+//! arithmetic. One absolute tolerance `tol = 1e-9 · extent` (the larger side
+//! of the bounding box) is used for every "same place / same time" decision:
+//! whether a split point lies on a wavefront piece, whether a vertex is
+//! ahead of a line, whether a fold's two neighbours are equally far. Input
+//! orientation is exact (normalised rings, robust predicates in
+//! [`crate::geometry`]); two lines are antiparallel (a fold) when
+//! `1 + n1·n2 < 1e-8`.
+//!
+//! # Termination and failure
+//!
+//! Every popped event is counted; more than `1000 · n + 10 000` pops, more
+//! than `16 · n + 64` vertices, or a wavefront that does not collapse
+//! completely is a [`MethodError`] for that polygon, never a hang. A panic
+//! inside the propagation is caught and reported the same way.
+//!
+//! ```
+//! use skeletonise::geometry::PreparedPolygon;
+//! use skeletonise::methods::{straight_skeleton::StraightSkeleton, SkeletonMethod};
+//! let p = geo::polygon![(x: 0., y: 0.), (x: 10., y: 0.), (x: 10., y: 2.), (x: 0., y: 2.)];
+//! let g = StraightSkeleton.skeletonise(&PreparedPolygon::new(&p).unwrap()).unwrap();
+//! // The centre segment from (1, 1) to (9, 1) and four legs to the corners.
+//! assert_eq!(g.leg_count(), 4);
+//! assert!(g.nodes().iter().all(|n| n.time.is_some()));
+//! ```
+
+pub mod events;
+pub mod wavefront;
+
+use super::{MethodError, MethodId, SkeletonMethod};
+use crate::geometry::{Boundary, PreparedPolygon};
+use crate::graph::{GraphBuilder, SkeletonGraph};
+use events::{edge_collapse_time, split_candidates, EventKind, EventQueue, SplitCandidate};
+use geo::Coord;
+use rstar::{primitives::GeomWithData, primitives::Line as RLine, RTree, AABB};
+use wavefront::{dot, Line, LineId, VertexId, Wavefront};
+
+/// The straight-skeleton method.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct StraightSkeleton;
+
+/// Relative tolerance: `tol = REL_TOL · extent` (see the module doc).
+pub const REL_TOL: f64 = 1e-9;
+
+/// Counts of one propagation, for tests and benchmarks.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Stats {
+    /// Input vertices.
+    pub input_vertices: usize,
+    /// Wavefront vertices created (input vertices included).
+    pub vertices: usize,
+    /// Events popped from the queue (stale ones included).
+    pub pops: usize,
+}
+
+/// One traced arc: a wavefront vertex's path from creation to its end.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Arc {
+    from: Coord<f64>,
+    from_t: f64,
+    to: Coord<f64>,
+    to_t: f64,
+}
+
+fn fail(reason: impl Into<String>) -> MethodError {
+    MethodError::Failed {
+        method: MethodId::StSk,
+        reason: reason.into(),
+    }
+}
+
+type EdgeTree = RTree<GeomWithData<RLine<[f64; 2]>, u32>>;
+
+struct Propagation<'a> {
+    w: Wavefront,
+    q: EventQueue,
+    tree: EdgeTree,
+    boundary: &'a Boundary,
+    origin: Coord<f64>,
+    candidates: Vec<Vec<SplitCandidate>>,
+    arcs: Vec<Arc>,
+    work: Vec<VertexId>,
+    now: f64,
+    tol: f64,
+    extent: f64,
+    max_pops: usize,
+    max_vertices: usize,
+    stats: Stats,
+    inconsistent: Option<Coord<f64>>,
+}
+
+impl<'a> Propagation<'a> {
+    fn new(polygon: &'a PreparedPolygon) -> Self {
+        let origin = polygon.origin();
+        let n = polygon.vertex_count();
+        let extent = polygon.extent().max(f64::MIN_POSITIVE);
+        let mut w = Wavefront::default();
+        let mut entries = Vec::with_capacity(n);
+        let mut work = Vec::with_capacity(n);
+        for ring in polygon.rings() {
+            let abs = &ring.0[..ring.0.len() - 1];
+            let pts: Vec<Coord<f64>> = abs.iter().map(|&p| p - origin).collect();
+            let m = pts.len();
+            let base = w.lines.len();
+            for i in 0..m {
+                let (a, b) = (pts[i], pts[(i + 1) % m]);
+                w.lines.push(Line::new(a, b));
+                w.pieces.push(Vec::new());
+                entries.push(GeomWithData::new(
+                    RLine::new([a.x, a.y], [b.x, b.y]),
+                    (base + i) as u32,
+                ));
+            }
+            let first = w.vertices.len();
+            for i in 0..m {
+                let left = LineId((base + (i + m - 1) % m) as u32);
+                let right = LineId((base + i) as u32);
+                let id = w.add_vertex(pts[i], 0.0, left, right, Some(abs[i]));
+                work.push(id);
+            }
+            for i in 0..m {
+                let a = VertexId((first + i) as u32);
+                let b = VertexId((first + (i + 1) % m) as u32);
+                w.link(a, b);
+            }
+        }
+        work.reverse();
+        Self {
+            candidates: vec![Vec::new(); w.vertices.len()],
+            w,
+            q: EventQueue::default(),
+            tree: RTree::bulk_load(entries),
+            boundary: polygon.boundary(),
+            origin,
+            arcs: Vec::with_capacity(2 * n),
+            work,
+            now: 0.0,
+            tol: REL_TOL * extent,
+            extent,
+            max_pops: 1000 * n + 10_000,
+            max_vertices: 16 * n + 64,
+            stats: Stats {
+                input_vertices: n,
+                ..Stats::default()
+            },
+            inconsistent: None,
+        }
+    }
+
+    /// Absolute start point of a vertex's trace.
+    fn abs_start(&self, v: VertexId) -> Coord<f64> {
+        let x = self.w.v(v);
+        x.exact.unwrap_or(x.start + self.origin)
+    }
+
+    /// Ends vertex `v` at local point `p` at the current time.
+    fn finish(&mut self, v: VertexId, p: Coord<f64>) {
+        let from = self.abs_start(v);
+        let from_t = self.w.v(v).t0;
+        // The trace must end on both of the vertex's offset lines.
+        let (l, r) = (self.w.v(v).left, self.w.v(v).right);
+        let off = self
+            .w
+            .line(l)
+            .ahead(p, self.now)
+            .abs()
+            .max(self.w.line(r).ahead(p, self.now).abs());
+        if off > 1e5 * self.tol {
+            self.inconsistent = Some(p + self.origin);
+        }
+        self.arcs.push(Arc {
+            from,
+            from_t,
+            to: p + self.origin,
+            to_t: self.now,
+        });
+        self.w.kill(v);
+    }
+
+    fn new_vertex(
+        &mut self,
+        p: Coord<f64>,
+        left: LineId,
+        right: LineId,
+    ) -> Result<VertexId, MethodError> {
+        if self.w.vertices.len() >= self.max_vertices {
+            return Err(fail(format!(
+                "straight skeleton created more than {} wavefront vertices; the polygon is too degenerate",
+                self.max_vertices
+            )));
+        }
+        let id = self.w.add_vertex(p, self.now, left, right, None);
+        self.candidates.push(Vec::new());
+        self.work.push(id);
+        Ok(id)
+    }
+
+    fn run(mut self) -> Result<(Vec<Arc>, Stats), MethodError> {
+        self.drain_work()?;
+        while let Some(ev) = self.q.pop() {
+            self.stats.pops += 1;
+            if self.stats.pops > self.max_pops {
+                return Err(fail(format!(
+                    "straight skeleton did not finish within {} events",
+                    self.max_pops
+                )));
+            }
+            match ev.kind {
+                EventKind::Edge { x, y } => {
+                    if !self.w.v(x).active || !self.w.v(y).active || self.w.v(x).next != y {
+                        continue;
+                    }
+                    self.now = self.now.max(ev.t);
+                    self.edge_event(x, y)?;
+                }
+                EventKind::Split { v, candidate } => {
+                    if !self.w.v(v).active {
+                        continue;
+                    }
+                    self.now = self.now.max(ev.t);
+                    let c = self.candidates[v.0 as usize][candidate as usize];
+                    match self.find_piece(v, c.line) {
+                        Some(x) => self.split_event(v, x, c.line)?,
+                        None => self.push_candidate(v, candidate + 1),
+                    }
+                }
+            }
+            self.drain_work()?;
+            if let Some(p) = self.inconsistent {
+                return Err(fail(format!(
+                    "straight skeleton event off its offset lines near ({}, {}) (degenerate simultaneous events)",
+                    p.x, p.y
+                )));
+            }
+        }
+        if let Some(v) = self.w.vertices.iter().find(|v| v.active) {
+            let p = v.start + self.origin;
+            return Err(fail(format!(
+                "straight skeleton wavefront did not collapse (vertex near ({}, {}))",
+                p.x, p.y
+            )));
+        }
+        self.stats.vertices = self.w.vertices.len();
+        Ok((self.arcs, self.stats))
+    }
+
+    fn drain_work(&mut self) -> Result<(), MethodError> {
+        while let Some(z) = self.work.pop() {
+            self.settle(z)?;
+        }
+        Ok(())
+    }
+
+    /// Resolves small lists and folds at `z`, then queues its events.
+    fn settle(&mut self, z: VertexId) -> Result<(), MethodError> {
+        if !self.w.v(z).active {
+            return Ok(());
+        }
+        let t = self.now;
+        let (prev, next) = (self.w.v(z).prev, self.w.v(z).next);
+        if next == z {
+            let p = self.w.pos(z, t);
+            self.finish(z, p);
+            return Ok(());
+        }
+        if self.w.v(next).next == z {
+            // Two vertices: a collapsed segment.
+            let (pz, pn) = (self.w.pos(z, t), self.w.pos(next, t));
+            self.finish(z, pz);
+            self.finish(next, pn);
+            self.arcs.push(Arc {
+                from: pz + self.origin,
+                from_t: t,
+                to: pn + self.origin,
+                to_t: t,
+            });
+            return Ok(());
+        }
+        if self.w.v(z).vel.is_none() {
+            return self.zip_fold(z, prev, next);
+        }
+        if let Some(te) = edge_collapse_time(&self.w, prev, z, t) {
+            self.q.push(te, EventKind::Edge { x: prev, y: z });
+        }
+        if let Some(te) = edge_collapse_time(&self.w, z, next, t) {
+            self.q.push(te, EventKind::Edge { x: z, y: next });
+        }
+        if self.w.v(z).reflex {
+            self.compute_candidates(z);
+            self.push_candidate(z, 0);
+        }
+        Ok(())
+    }
+
+    /// A fold: `z` lies between two antiparallel coincident lines, so the
+    /// overlapping parts of its two edges cancel at once; `z` slides to the
+    /// nearer neighbour (or both, when equally far) and merges with it.
+    fn zip_fold(&mut self, z: VertexId, w: VertexId, u: VertexId) -> Result<(), MethodError> {
+        let t = self.now;
+        let pz = self.w.pos(z, t);
+        let (pw, pu) = (self.w.pos(w, t), self.w.pos(u, t));
+        let dw = (pw - pz).x.hypot((pw - pz).y);
+        let du = (pu - pz).x.hypot((pu - pz).y);
+        let (zl, zr) = (self.w.v(z).left, self.w.v(z).right);
+        if (dw - du).abs() <= self.tol {
+            let (before, after) = (self.w.v(w).prev, self.w.v(u).next);
+            self.finish(z, pw);
+            self.finish(w, pw);
+            self.finish(u, pw);
+            if before == u {
+                return Ok(());
+            }
+            let m = self.new_vertex(pw, self.w.v(w).left, self.w.v(u).right)?;
+            self.w.link(before, m);
+            self.w.link(m, after);
+        } else if dw < du {
+            let before = self.w.v(w).prev;
+            self.finish(z, pw);
+            self.finish(w, pw);
+            let m = self.new_vertex(pw, self.w.v(w).left, zr)?;
+            self.w.link(before, m);
+            self.w.link(m, u);
+        } else {
+            let after = self.w.v(u).next;
+            self.finish(z, pu);
+            self.finish(u, pu);
+            let m = self.new_vertex(pu, zl, self.w.v(u).right)?;
+            self.w.link(w, m);
+            self.w.link(m, after);
+        }
+        Ok(())
+    }
+
+    fn edge_event(&mut self, x: VertexId, y: VertexId) -> Result<(), MethodError> {
+        let t = self.now;
+        let (px, py) = (self.w.pos(x, t), self.w.pos(y, t));
+        let p = (px + py) * 0.5;
+        let (before, after) = (self.w.v(x).prev, self.w.v(y).next);
+        self.finish(x, p);
+        self.finish(y, p);
+        if after == x {
+            return Ok(());
+        }
+        if after == before {
+            // A triangle collapses to its incentre.
+            self.finish(after, p);
+            return Ok(());
+        }
+        let m = self.new_vertex(p, self.w.v(x).left, self.w.v(y).right)?;
+        self.w.link(before, m);
+        self.w.link(m, after);
+        Ok(())
+    }
+
+    /// The start vertex of the piece of `line`'s wavefront that reflex
+    /// vertex `v` touches now, if any.
+    fn find_piece(&mut self, v: VertexId, line: LineId) -> Option<VertexId> {
+        let t = self.now;
+        let p = self.w.pos(v, t);
+        let l = *self.w.line(line);
+        let sp = dot(l.dir, p);
+        let w = &mut self.w;
+        let mut pieces = std::mem::take(&mut w.pieces[line.0 as usize]);
+        pieces.retain(|&x| w.v(x).active);
+        let tol = self.tol;
+        let found = pieces.iter().copied().find(|&x| {
+            let y = w.v(x).next;
+            if x == v || y == v {
+                return false;
+            }
+            let (px, py) = (w.pos(x, t), w.pos(y, t));
+            let (sx, sy) = (dot(l.dir, px), dot(l.dir, py));
+            let at_x = (px - p).x.hypot((px - p).y) <= tol;
+            let at_y = (py - p).x.hypot((py - p).y) <= tol;
+            // Touching a zero-length piece, or a piece end that already
+            // carries one of v's own lines, changes nothing: not a split.
+            let no_op = if at_y {
+                at_x || w.v(y).right == w.v(v).right
+            } else {
+                at_x && w.v(x).left == w.v(v).left
+            };
+            if no_op {
+                return false;
+            }
+            sx - tol <= sp && sp <= sy + tol
+        });
+        w.pieces[line.0 as usize] = pieces;
+        found
+    }
+
+    fn split_event(&mut self, v: VertexId, x: VertexId, line: LineId) -> Result<(), MethodError> {
+        let t = self.now;
+        let p = self.w.pos(v, t);
+        let y = self.w.v(x).next;
+        let (a, b) = (self.w.v(v).prev, self.w.v(v).next);
+        let (vl, vr) = (self.w.v(v).left, self.w.v(v).right);
+        self.finish(v, p);
+        let v1 = self.new_vertex(p, vl, line)?;
+        let v2 = self.new_vertex(p, line, vr)?;
+        self.w.link(a, v1);
+        self.w.link(v1, y);
+        self.w.link(x, v2);
+        self.w.link(v2, b);
+        Ok(())
+    }
+
+    /// Split candidates of reflex vertex `z` from the R-tree of original
+    /// edges within reach of its ray.
+    fn compute_candidates(&mut self, z: VertexId) {
+        let vx = *self.w.v(z);
+        let Some(s) = vx.vel else { return };
+        let speed = s.x.hypot(s.y);
+        let dir = s / speed;
+        let start = vx.start + self.origin;
+        let reach = self
+            .boundary
+            .first_hit(start, dir, self.tol, 4.0 * self.extent)
+            .map_or(2.0 * self.extent, |h| h.t);
+        let t_max = vx.t0 + reach / speed;
+        let end = vx.start + dir * reach;
+        // Faces of edges whose ends are reflex widen away from the edge:
+        // search a margin of twice the reach around the ray.
+        let m = 2.0 * reach + self.tol;
+        let env = AABB::from_corners(
+            [vx.start.x.min(end.x) - m, vx.start.y.min(end.y) - m],
+            [vx.start.x.max(end.x) + m, vx.start.y.max(end.y) + m],
+        );
+        let lines = self
+            .tree
+            .locate_in_envelope_intersecting(&env)
+            .map(|g| LineId(g.data));
+        self.candidates[z.0 as usize] = split_candidates(&self.w, z, lines, t_max, self.tol);
+    }
+
+    fn push_candidate(&mut self, v: VertexId, i: u32) {
+        if let Some(c) = self.candidates[v.0 as usize].get(i as usize) {
+            let t = c.t.max(self.now);
+            self.q.push(t, EventKind::Split { v, candidate: i });
+        }
+    }
+}
+
+/// The straight skeleton of `polygon` and the propagation's counts.
+pub fn straight_skeleton_with_stats(
+    polygon: &PreparedPolygon,
+) -> Result<(SkeletonGraph, Stats), MethodError> {
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        Propagation::new(polygon).run()
+    }));
+    let (arcs, stats) = match result {
+        Ok(r) => r?,
+        Err(_) => return Err(fail("internal error (panic) in the straight skeleton")),
+    };
+    // Last line of defence: a missed event shows as a trace leaving P.
+    let tol = 1e-6 * polygon.extent();
+    if let Some(a) = arcs
+        .iter()
+        .find(|a| !polygon.boundary().contains_with_tolerance(a.to, tol))
+    {
+        return Err(fail(format!(
+            "straight skeleton left the polygon near ({}, {}) (a missed event in a degenerate configuration)",
+            a.to.x, a.to.y
+        )));
+    }
+    let mut b = GraphBuilder::new();
+    for a in &arcs {
+        if b.segment(a.from, a.to).is_some() {
+            let (na, nb) = (b.node(a.from), b.node(a.to));
+            b.set_time(na, a.from_t);
+            b.set_time(nb, a.to_t);
+        }
+    }
+    Ok((b.finish(polygon.boundary()), stats))
+}
+
+impl SkeletonMethod for StraightSkeleton {
+    fn id(&self) -> MethodId {
+        MethodId::StSk
+    }
+
+    fn skeletonise(&self, polygon: &PreparedPolygon) -> Result<SkeletonGraph, MethodError> {
+        straight_skeleton_with_stats(polygon).map(|(g, _)| g)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use geo::polygon;
+
+    fn run(p: geo::Polygon<f64>) -> SkeletonGraph {
+        StraightSkeleton
+            .skeletonise(&PreparedPolygon::new(&p).unwrap())
+            .unwrap()
+    }
+
+    #[test]
+    fn square_is_an_x() {
+        let g = run(polygon![(x: 0., y: 0.), (x: 4., y: 0.), (x: 4., y: 4.), (x: 0., y: 4.)]);
+        let g = g.merged();
+        assert_eq!(g.leg_count(), 4);
+        let centre = g
+            .nodes()
+            .iter()
+            .find(|n| n.pos == Coord { x: 2.0, y: 2.0 })
+            .unwrap();
+        assert_eq!(centre.time, Some(2.0));
+        assert_eq!(g.components(), 1);
+    }
+
+    #[test]
+    fn rectangle_is_a_segment_with_four_legs() {
+        let g = run(polygon![(x: 0., y: 0.), (x: 10., y: 0.), (x: 10., y: 2.), (x: 0., y: 2.)]);
+        assert_eq!(g.leg_count(), 4);
+        assert_eq!(g.components(), 1);
+        assert!((g.total_length() - (8.0 + 4.0 * 2f64.sqrt())).abs() < 1e-9);
+    }
+}
