@@ -236,9 +236,8 @@ pub fn process(geom: Option<&Geometry<f64>>, params: &ProcessParams) -> Processe
 /// The reason a prepared polygon is invalid, if it is (self-intersection,
 /// crossing or touching rings, holes outside the shell).
 fn invalidity(parts: &[PreparedPolygon]) -> Option<String> {
-    use geo::algorithm::Validation;
     for (i, p) in parts.iter().enumerate() {
-        if let Some(err) = p.polygon().validation_errors().into_iter().next() {
+        if let Some(err) = crate::geometry::validity::problem(p) {
             let prefix = if parts.len() > 1 {
                 format!("part {i}: ")
             } else {

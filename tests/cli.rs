@@ -1,14 +1,21 @@
 //! End-to-end tests through the real binary on real GeoPackage files.
 
 mod common;
-use gdal::vector::LayerAccess;
 use common::*;
+use gdal::vector::LayerAccess;
 
 #[test]
 fn demo_pipeline_runs_and_writes_every_layer() {
     let d = tmp();
     let out = d.path().join("demo.gpkg");
-    let o = skeletonise(&["run", "pipelines/demo.yaml", "-o", out.to_str().unwrap(), "--threads", "2"]);
+    let o = skeletonise(&[
+        "run",
+        "pipelines/demo.yaml",
+        "-o",
+        out.to_str().unwrap(),
+        "--threads",
+        "2",
+    ]);
     let (code, err) = code_and_err(&o);
     assert_eq!(code, 0, "{err}");
     assert!(err.contains("17 read, 17 written, 0 rejected"), "{err}");
@@ -23,15 +30,26 @@ fn demo_pipeline_runs_and_writes_every_layer() {
         l.features().map(|f| f.fid().map(|x| x as i64)).collect()
     };
     assert_eq!(ints(&ds, "skeletons", "src_fid"), source_fids);
-    assert!(strings(&ds, "skeletons", "method").iter().all(|m| m.as_deref() == Some("CDT")));
-    assert!(wkts(&ds, "skeletons").iter().all(|w| w.as_deref().is_some_and(|w| w.starts_with("MULTILINESTRING"))));
+    assert!(strings(&ds, "skeletons", "method")
+        .iter()
+        .all(|m| m.as_deref() == Some("CDT")));
+    assert!(wkts(&ds, "skeletons").iter().all(|w| w
+        .as_deref()
+        .is_some_and(|w| w.starts_with("MULTILINESTRING"))));
     // The output keeps the source CRS.
-    let srs = ds.layer_by_name("skeletons").unwrap().spatial_ref().unwrap();
+    let srs = ds
+        .layer_by_name("skeletons")
+        .unwrap()
+        .spatial_ref()
+        .unwrap();
     assert_eq!(srs.auth_code().unwrap(), 3035);
     // Provenance.
     assert_eq!(count(&ds, "skeletonise_runs"), 1);
     assert_eq!(ints(&ds, "skeletonise_runs", "features_read"), [Some(17)]);
-    assert!(strings(&ds, "skeletonise_runs", "pipeline")[0].as_deref().unwrap().contains("name: demo"));
+    assert!(strings(&ds, "skeletonise_runs", "pipeline")[0]
+        .as_deref()
+        .unwrap()
+        .contains("name: demo"));
     assert_eq!(count(&ds, "rejected"), 0);
     assert_eq!(count(&ds, "candidates"), 17);
 }
@@ -42,10 +60,29 @@ fn invalid_pipeline_files_exit_78_with_line_and_column_and_write_nothing() {
     let out = d.path().join("o.gpkg");
     let good = basic_pipeline(&root(DEMO), "demo", &out, "  - prune: { ratio: 1.0 }\n");
     let cases = [
-        (good.replace("ratio: 1.0", "ratoi: 1.0"), "6:14", "unknown field `ratoi`"),
-        (good.replace("ratio: 1.0", "ratio: lots"), "6:21", "invalid type"),
-        (good.replace("  - prune: { ratio: 1.0 }\n", "  - prune: {}\n  - prepare: {}\n"), "7:5", "must come before"),
-        (good.replace("layer: demo", "layer: [demo"), "", "invalid YAML"),
+        (
+            good.replace("ratio: 1.0", "ratoi: 1.0"),
+            "6:14",
+            "unknown field `ratoi`",
+        ),
+        (
+            good.replace("ratio: 1.0", "ratio: lots"),
+            "6:21",
+            "invalid type",
+        ),
+        (
+            good.replace(
+                "  - prune: { ratio: 1.0 }\n",
+                "  - prune: {}\n  - prepare: {}\n",
+            ),
+            "7:5",
+            "must come before",
+        ),
+        (
+            good.replace("layer: demo", "layer: [demo"),
+            "",
+            "invalid YAML",
+        ),
     ];
     for (i, (text, pos, msg)) in cases.iter().enumerate() {
         let p = pipeline(d.path(), &format!("p{i}.yaml"), text);
@@ -56,7 +93,12 @@ fn invalid_pipeline_files_exit_78_with_line_and_column_and_write_nothing() {
         assert!(err.contains(msg), "case {i}: {err}");
         assert!(!out.exists());
         // validate shares the checks.
-        assert_eq!(skeletonise(&["validate", p.to_str().unwrap()]).status.code(), Some(78));
+        assert_eq!(
+            skeletonise(&["validate", p.to_str().unwrap()])
+                .status
+                .code(),
+            Some(78)
+        );
     }
 }
 
@@ -64,14 +106,28 @@ fn invalid_pipeline_files_exit_78_with_line_and_column_and_write_nothing() {
 fn missing_input_and_missing_layer_are_clear_errors() {
     let d = tmp();
     let out = d.path().join("o.gpkg");
-    let p = pipeline(d.path(), "a.yaml", &basic_pipeline("/nonexistent/rivers.gpkg", "x", &out, ""));
+    let p = pipeline(
+        d.path(),
+        "a.yaml",
+        &basic_pipeline("/nonexistent/rivers.gpkg", "x", &out, ""),
+    );
     let (code, err) = code_and_err(&skeletonise(&["run", p.to_str().unwrap()]));
     assert_eq!(code, 1);
-    assert!(err.contains("cannot open input `/nonexistent/rivers.gpkg`"), "{err}");
-    let p = pipeline(d.path(), "b.yaml", &basic_pipeline(&root(TRAIN), "rivers", &out, ""));
+    assert!(
+        err.contains("cannot open input `/nonexistent/rivers.gpkg`"),
+        "{err}"
+    );
+    let p = pipeline(
+        d.path(),
+        "b.yaml",
+        &basic_pipeline(&root(TRAIN), "rivers", &out, ""),
+    );
     let (code, err) = code_and_err(&skeletonise(&["run", p.to_str().unwrap()]));
     assert_eq!(code, 1);
-    assert!(err.contains("layer `rivers` not found") && err.contains("river_lena"), "{err}");
+    assert!(
+        err.contains("layer `rivers` not found") && err.contains("river_lena"),
+        "{err}"
+    );
     assert!(!out.exists());
 }
 
@@ -79,23 +135,46 @@ fn missing_input_and_missing_layer_are_clear_errors() {
 fn geographic_crs_needs_reproject() {
     let d = tmp();
     let src = d.path().join("geo.gpkg");
-    make_layer(&src, "lakes", 4326, &[Some("POLYGON ((10 50, 10.02 50, 10.02 50.005, 10 50.005, 10 50))")]);
+    make_layer(
+        &src,
+        "lakes",
+        4326,
+        &[Some(
+            "POLYGON ((10 50, 10.02 50, 10.02 50.005, 10 50.005, 10 50))",
+        )],
+    );
     let out = d.path().join("o.gpkg");
     let text = basic_pipeline(src.to_str().unwrap(), "lakes", &out, "");
     let p = pipeline(d.path(), "p.yaml", &text);
     let (code, err) = code_and_err(&skeletonise(&["run", p.to_str().unwrap()]));
     assert_eq!(code, 1);
-    assert!(err.contains("geographic CRS") && err.contains("input.reproject"), "{err}");
+    assert!(
+        err.contains("geographic CRS") && err.contains("input.reproject"),
+        "{err}"
+    );
     assert!(!out.exists());
     // With reproject the same file works, in metres.
-    let o = skeletonise(&["run", p.to_str().unwrap(), "--set", "input.reproject=EPSG:32632"]);
+    let o = skeletonise(&[
+        "run",
+        p.to_str().unwrap(),
+        "--set",
+        "input.reproject=EPSG:32632",
+    ]);
     let (code, err) = code_and_err(&o);
     assert_eq!(code, 0, "{err}");
     let ds = open(&out);
     let w = wkts(&ds, "skeletons")[0].clone().unwrap();
     // UTM eastings near 10°E are around 500 km.
     assert!(w.contains("(5") || w.contains("(4"), "{w}");
-    assert_eq!(ds.layer_by_name("skeletons").unwrap().spatial_ref().unwrap().auth_code().unwrap(), 32632);
+    assert_eq!(
+        ds.layer_by_name("skeletons")
+            .unwrap()
+            .spatial_ref()
+            .unwrap()
+            .auth_code()
+            .unwrap(),
+        32632
+    );
 }
 
 #[test]
@@ -103,12 +182,23 @@ fn existing_output_without_overwrite_is_left_untouched() {
     let d = tmp();
     let out = d.path().join("o.gpkg");
     std::fs::write(&out, b"precious").unwrap();
-    let p = pipeline(d.path(), "p.yaml", &basic_pipeline(&root(DEMO), "demo", &out, ""));
+    let p = pipeline(
+        d.path(),
+        "p.yaml",
+        &basic_pipeline(&root(DEMO), "demo", &out, ""),
+    );
     let (code, err) = code_and_err(&skeletonise(&["run", p.to_str().unwrap()]));
     assert_eq!(code, 1);
-    assert!(err.contains("already exists") && err.contains("overwrite"), "{err}");
+    assert!(
+        err.contains("already exists") && err.contains("overwrite"),
+        "{err}"
+    );
     assert_eq!(std::fs::read(&out).unwrap(), b"precious");
-    assert_eq!(std::fs::read_dir(d.path()).unwrap().count(), 2, "no temporary file left behind");
+    assert_eq!(
+        std::fs::read_dir(d.path()).unwrap().count(),
+        2,
+        "no temporary file left behind"
+    );
     // The same run with overwrite replaces it.
     let o = skeletonise(&["run", p.to_str().unwrap(), "--set", "output.overwrite=true"]);
     assert_eq!(o.status.code(), Some(0));
@@ -119,7 +209,11 @@ fn existing_output_without_overwrite_is_left_untouched() {
 fn unwritable_output_fails_before_any_work() {
     let d = tmp();
     let out = d.path().join("no/such/dir/o.gpkg");
-    let p = pipeline(d.path(), "p.yaml", &basic_pipeline(&root(DEMO), "demo", &out, ""));
+    let p = pipeline(
+        d.path(),
+        "p.yaml",
+        &basic_pipeline(&root(DEMO), "demo", &out, ""),
+    );
     let (code, err) = code_and_err(&skeletonise(&["run", p.to_str().unwrap()]));
     assert_eq!(code, 1);
     assert!(err.contains("does not exist"), "{err}");
@@ -148,32 +242,48 @@ fn bad_geometries_are_rejected_with_reasons_and_nothing_is_lost() {
     make_layer(&src, "bad", 32630, BAD);
     let out = d.path().join("o.gpkg");
     let extra = "  - prune: {}\n  - extend: {}\n  - score: {}\n  - select: {}\n";
-    let text = basic_pipeline(src.to_str().unwrap(), "bad", &out, extra).replace("steps:\n", "steps:\n  - prepare: { make_valid: false }\n");
+    let text = basic_pipeline(src.to_str().unwrap(), "bad", &out, extra)
+        .replace("steps:\n", "steps:\n  - prepare: { make_valid: false }\n");
     let p = pipeline(d.path(), "p.yaml", &text);
     let (code, err) = code_and_err(&skeletonise(&["run", p.to_str().unwrap()]));
     assert_eq!(code, 0, "{err}");
     let ds = open(&out);
     let written = count(&ds, "skeletons");
     let rejected = count(&ds, "rejected");
-    assert_eq!(written + rejected, BAD.len() as u64, "read = written + rejected");
+    assert_eq!(
+        written + rejected,
+        BAD.len() as u64,
+        "read = written + rejected"
+    );
     let reasons: Vec<(i64, String)> = ints(&ds, "rejected", "src_fid")
         .into_iter()
         .zip(strings(&ds, "rejected", "reason"))
         .map(|(f, r)| (f.unwrap(), r.unwrap()))
         .collect();
-    let reason = |fid: i64| reasons.iter().find(|(f, _)| *f == fid).map(|(_, r)| r.clone()).unwrap_or_default();
+    let reason = |fid: i64| {
+        reasons
+            .iter()
+            .find(|(f, _)| *f == fid)
+            .map(|(_, r)| r.clone())
+            .unwrap_or_default()
+    };
     assert!(reason(1).contains("NULL geometry"), "{reasons:?}");
     assert!(reason(2).contains("empty"), "{reasons:?}");
     assert!(reason(3).contains("point geometry"), "{reasons:?}");
     assert!(reason(4).contains("line geometry"), "{reasons:?}");
-    assert!(reason(6).contains("invalid polygon") && reason(6).contains("make_valid"), "{reasons:?}");
+    assert!(
+        reason(6).contains("invalid polygon") && reason(6).contains("make_valid"),
+        "{reasons:?}"
+    );
     assert_eq!(rejected, 5, "{reasons:?}");
     // Z dropped, curve linearised, multipolygon processed part by part, duplicate vertex cleaned.
     let fids = ints(&ds, "skeletons", "src_fid");
     assert_eq!(fids, [Some(5), Some(7), Some(8), Some(9), Some(10)]);
     // The rejected layer keeps the input geometry.
     let geoms = wkts(&ds, "rejected");
-    assert!(geoms.iter().any(|g| g.as_deref().is_some_and(|g| g.starts_with("POINT"))));
+    assert!(geoms
+        .iter()
+        .any(|g| g.as_deref().is_some_and(|g| g.starts_with("POINT"))));
     // With make_valid the bow-tie is repaired instead.
     let text = text.replace("make_valid: false", "make_valid: true");
     let p = pipeline(d.path(), "q.yaml", &text);
@@ -183,7 +293,10 @@ fn bad_geometries_are_rejected_with_reasons_and_nothing_is_lost() {
     assert_eq!(count(&ds, "rejected"), 4);
     let repaired = ints(&ds, "skeletons", "repaired");
     let fids = ints(&ds, "skeletons", "src_fid");
-    let i = fids.iter().position(|f| *f == Some(6)).expect("bow-tie written");
+    let i = fids
+        .iter()
+        .position(|f| *f == Some(6))
+        .expect("bow-tie written");
     assert_eq!(repaired[i], Some(1));
 }
 
@@ -197,9 +310,16 @@ fn on_error_fail_exits_65_and_writes_nothing() {
     let p = pipeline(d.path(), "p.yaml", &text);
     let (code, err) = code_and_err(&skeletonise(&["run", p.to_str().unwrap()]));
     assert_eq!(code, 65, "{err}");
-    assert!(err.contains("feature 1 was rejected: NULL geometry"), "{err}");
+    assert!(
+        err.contains("feature 1 was rejected: NULL geometry"),
+        "{err}"
+    );
     assert!(!out.exists());
-    assert_eq!(std::fs::read_dir(d.path()).unwrap().count(), 2, "no temporary file left behind");
+    assert_eq!(
+        std::fs::read_dir(d.path()).unwrap().count(),
+        2,
+        "no temporary file left behind"
+    );
 }
 
 #[test]
@@ -211,7 +331,12 @@ fn output_is_identical_for_one_and_two_threads() {
         let p = pipeline(
             d.path(),
             &format!("p{t}.yaml"),
-            &basic_pipeline(&root(TRAIN), "lakes_scotland", &out, "  - prune: {}\n  - extend: {}\n"),
+            &basic_pipeline(
+                &root(TRAIN),
+                "lakes_scotland",
+                &out,
+                "  - prune: {}\n  - extend: {}\n",
+            ),
         );
         let o = skeletonise(&["run", p.to_str().unwrap(), "--threads", t]);
         assert_eq!(o.status.code(), Some(0));
@@ -225,15 +350,26 @@ fn output_is_identical_for_one_and_two_threads() {
 fn validate_checks_without_writing_and_json_logs_for_scheduled_jobs() {
     let d = tmp();
     let out = d.path().join("o.gpkg");
-    let p = pipeline(d.path(), "p.yaml", &basic_pipeline(&root(TRAIN), "river_danube", &out, ""));
+    let p = pipeline(
+        d.path(),
+        "p.yaml",
+        &basic_pipeline(&root(TRAIN), "river_danube", &out, ""),
+    );
     let o = skeletonise(&["validate", p.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(0));
     let s = String::from_utf8_lossy(&o.stdout);
-    assert!(s.contains("valid") && s.contains("EPSG:32634") && s.contains("area_m2"), "{s}");
+    assert!(
+        s.contains("valid") && s.contains("EPSG:32634") && s.contains("area_m2"),
+        "{s}"
+    );
     assert!(!out.exists());
     let o = skeletonise(&["run", p.to_str().unwrap(), "--log-format", "json"]);
     assert_eq!(o.status.code(), Some(0));
-    let last = String::from_utf8_lossy(&o.stderr).lines().last().unwrap().to_string();
+    let last = String::from_utf8_lossy(&o.stderr)
+        .lines()
+        .last()
+        .unwrap()
+        .to_string();
     let v: serde_json::Value = serde_json::from_str(&last).expect("JSON log line");
     assert_eq!(v["read"], 1);
     assert_eq!(v["written"], 1);
@@ -250,5 +386,9 @@ fn schema_and_methods_describe_the_pipeline_file() {
     for m in ["VD", "DVD", "CDT", "StSk", "MA", "prune", "min_coverage"] {
         assert!(s.contains(m), "{m}");
     }
-    assert_eq!(skeletonise(&["run"]).status.code(), Some(2), "usage errors exit 2");
+    assert_eq!(
+        skeletonise(&["run"]).status.code(),
+        Some(2),
+        "usage errors exit 2"
+    );
 }

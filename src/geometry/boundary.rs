@@ -356,6 +356,20 @@ impl Boundary {
     /// (half-open rule on vertices). Points exactly on ∂P may go either way:
     /// use [`Boundary::distance`] for a tolerance.
     pub fn contains(&self, p: Coord<f64>) -> bool {
+        self.contains_with_rings(p, |_| true)
+    }
+
+    /// Indices of the segments whose bounding box meets that of segment `pq`.
+    pub fn segments_near(&self, p: Coord<f64>, q: Coord<f64>) -> impl Iterator<Item = usize> + '_ {
+        let env = AABB::from_corners([p.x.min(q.x), p.y.min(q.y)], [p.x.max(q.x), p.y.max(q.y)]);
+        self.tree
+            .locate_in_envelope_intersecting(&env)
+            .map(|i| i.data as usize)
+    }
+
+    /// Crossing parity of the ray from `p` towards +x against the segments of
+    /// the rings for which `ring` is true: `p` is inside the region those rings bound.
+    pub fn contains_with_rings(&self, p: Coord<f64>, ring: impl Fn(u32) -> bool) -> bool {
         let sel = RaySelect {
             o: p,
             d: Coord { x: 1.0, y: 0.0 },
@@ -364,9 +378,11 @@ impl Boundary {
         let mut inside = false;
         for item in self.tree.locate_with_selection_function(sel) {
             let s = &self.segments[item.data as usize];
+            if !ring(s.ring) {
+                continue;
+            }
             let (a, b) = (s.a, s.b);
             if (a.y > p.y) != (b.y > p.y) {
-                // Robust side test instead of computing the crossing abscissa.
                 let o = orient(a, b, p);
                 let upward = b.y > a.y;
                 if (upward && o > 0.0) || (!upward && o < 0.0) {

@@ -8,6 +8,7 @@
 pub mod boundary;
 pub mod densify;
 pub mod ring;
+pub mod validity;
 
 pub use boundary::{Boundary, BoundarySegment, RayHit};
 

@@ -302,7 +302,9 @@ impl Reader {
             };
             // gdal hands out a wrapper around a null handle for NULL geometries.
             // SAFETY: the handle is only compared with null.
-            let geometry = f.geometry().filter(|g| unsafe { !g.c_geometry().is_null() });
+            let geometry = f
+                .geometry()
+                .filter(|g| unsafe { !g.c_geometry().is_null() });
             if let Some(g) = geometry {
                 match convert(g, transform.as_ref(), make_valid) {
                     Ok((geom, wkb, repaired)) => {

@@ -3,7 +3,9 @@
 #![allow(dead_code)]
 
 use gdal::spatial_ref::SpatialRef;
-use gdal::vector::{Feature, FieldDefn, Geometry, LayerAccess, LayerOptions, OGRFieldType, OGRwkbGeometryType};
+use gdal::vector::{
+    Feature, FieldDefn, Geometry, LayerAccess, LayerOptions, OGRFieldType, OGRwkbGeometryType,
+};
 use gdal::{Dataset, DriverManager};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -24,7 +26,10 @@ pub fn skeletonise(args: &[&str]) -> Output {
 
 /// Exit code and stderr as text.
 pub fn code_and_err(o: &Output) -> (i32, String) {
-    (o.status.code().unwrap_or(-1), String::from_utf8_lossy(&o.stderr).to_string())
+    (
+        o.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&o.stderr).to_string(),
+    )
 }
 
 /// A fresh temporary directory.
@@ -49,7 +54,10 @@ pub fn basic_pipeline(source: &str, layer: &str, out: &Path, extra_steps: &str) 
 
 /// Absolute path of a file in the crate root.
 pub fn root(p: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join(p).display().to_string()
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join(p)
+        .display()
+        .to_string()
 }
 
 /// Creates a GeoPackage layer `layer` in `srs` holding the given WKT
@@ -57,15 +65,31 @@ pub fn root(p: &str) -> String {
 pub fn make_layer(path: &Path, layer: &str, epsg: u32, wkts: &[Option<&str>]) {
     let drv = DriverManager::get_driver_by_name("GPKG").unwrap();
     let mut ds = if path.exists() {
-        Dataset::open_ex(path, gdal::DatasetOptions { open_flags: gdal::GdalOpenFlags::GDAL_OF_UPDATE | gdal::GdalOpenFlags::GDAL_OF_VECTOR, ..Default::default() }).unwrap()
+        Dataset::open_ex(
+            path,
+            gdal::DatasetOptions {
+                open_flags: gdal::GdalOpenFlags::GDAL_OF_UPDATE
+                    | gdal::GdalOpenFlags::GDAL_OF_VECTOR,
+                ..Default::default()
+            },
+        )
+        .unwrap()
     } else {
         drv.create_vector_only(path).unwrap()
     };
     let srs = SpatialRef::from_epsg(epsg).unwrap();
     let l = ds
-        .create_layer(LayerOptions { name: layer, srs: Some(&srs), ty: OGRwkbGeometryType::wkbUnknown, options: None })
+        .create_layer(LayerOptions {
+            name: layer,
+            srs: Some(&srs),
+            ty: OGRwkbGeometryType::wkbUnknown,
+            options: None,
+        })
         .unwrap();
-    FieldDefn::new("id", OGRFieldType::OFTInteger).unwrap().add_to_layer(&l).unwrap();
+    FieldDefn::new("id", OGRFieldType::OFTInteger)
+        .unwrap()
+        .add_to_layer(&l)
+        .unwrap();
     for (i, w) in wkts.iter().enumerate() {
         let mut f = Feature::new(l.defn()).unwrap();
         if let Some(w) = w {
@@ -90,25 +114,33 @@ pub fn count(ds: &Dataset, layer: &str) -> u64 {
 pub fn strings(ds: &Dataset, layer: &str, field: &str) -> Vec<Option<String>> {
     let mut l = ds.layer_by_name(layer).unwrap();
     let idx = l.defn().field_index(field).unwrap();
-    l.features().map(|f| f.field_as_string(idx).unwrap()).collect()
+    l.features()
+        .map(|f| f.field_as_string(idx).unwrap())
+        .collect()
 }
 
 /// One integer field of every feature of a layer.
 pub fn ints(ds: &Dataset, layer: &str, field: &str) -> Vec<Option<i64>> {
     let mut l = ds.layer_by_name(layer).unwrap();
     let idx = l.defn().field_index(field).unwrap();
-    l.features().map(|f| f.field_as_integer64(idx).unwrap()).collect()
+    l.features()
+        .map(|f| f.field_as_integer64(idx).unwrap())
+        .collect()
 }
 
 /// One real field of every feature of a layer.
 pub fn reals(ds: &Dataset, layer: &str, field: &str) -> Vec<Option<f64>> {
     let mut l = ds.layer_by_name(layer).unwrap();
     let idx = l.defn().field_index(field).unwrap();
-    l.features().map(|f| f.field_as_double(idx).unwrap()).collect()
+    l.features()
+        .map(|f| f.field_as_double(idx).unwrap())
+        .collect()
 }
 
 /// WKT of every geometry of a layer.
 pub fn wkts(ds: &Dataset, layer: &str) -> Vec<Option<String>> {
     let mut l = ds.layer_by_name(layer).unwrap();
-    l.features().map(|f| f.geometry().and_then(|g| g.wkt().ok())).collect()
+    l.features()
+        .map(|f| f.geometry().and_then(|g| g.wkt().ok()))
+        .collect()
 }

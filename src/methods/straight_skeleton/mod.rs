@@ -56,7 +56,8 @@
 //! ```
 //! use skeletonise::geometry::PreparedPolygon;
 //! use skeletonise::methods::{straight_skeleton::StraightSkeleton, SkeletonMethod};
-//! let p = geo::polygon![(x: 0., y: 0.), (x: 10., y: 0.), (x: 10., y: 2.), (x: 0., y: 2.)];
+//! use geo::polygon;
+//! let p = polygon![(x: 0., y: 0.), (x: 10., y: 0.), (x: 10., y: 2.), (x: 0., y: 2.)];
 //! let g = StraightSkeleton.skeletonise(&PreparedPolygon::new(&p).unwrap()).unwrap();
 //! // The centre segment from (1, 1) to (9, 1) and four legs to the corners.
 //! assert_eq!(g.leg_count(), 4);

@@ -1,0 +1,204 @@
+//! Polygon validity (OGC simple-feature rules that matter for skeletons),
+//! checked with the boundary's R-tree in O(n log n) so that a polygon of a
+//! million vertices is checked in about a second, not hours.
+//!
+//! A prepared polygon is invalid when two boundary edges cross, overlap, or
+//! touch anywhere other than at a vertex shared by two *different* rings; when
+//! a ring doubles back on itself (a spike); when a hole lies outside the
+//! exterior ring or inside another hole. Each problem is reported with its
+//! position so that the user can find it.
+
+use super::boundary::{orient, BoundarySegment};
+use super::PreparedPolygon;
+use geo::Coord;
+
+fn on_segment(a: Coord<f64>, b: Coord<f64>, p: Coord<f64>) -> bool {
+    orient(a, b, p) == 0.0
+        && p.x >= a.x.min(b.x)
+        && p.x <= a.x.max(b.x)
+        && p.y >= a.y.min(b.y)
+        && p.y <= a.y.max(b.y)
+}
+
+fn at(c: Coord<f64>) -> String {
+    format!("({}, {})", c.x, c.y)
+}
+
+/// What is wrong with segments `s` and `t` (which are not consecutive in one
+/// ring), if anything.
+fn pair_problem(s: &BoundarySegment, t: &BoundarySegment) -> Option<String> {
+    let (o1, o2) = (orient(s.a, s.b, t.a), orient(s.a, s.b, t.b));
+    let (o3, o4) = (orient(t.a, t.b, s.a), orient(t.a, t.b, s.b));
+    let what = if s.ring == t.ring {
+        if s.ring == 0 {
+            "the exterior ring"
+        } else {
+            "a hole"
+        }
+    } else {
+        "two rings"
+    };
+    if o1 * o2 < 0.0 && o3 * o4 < 0.0 {
+        // Proper crossing: report the crossing point.
+        let d = s.b - s.a;
+        let e = t.b - t.a;
+        let den = d.x * e.y - d.y * e.x;
+        let u = ((t.a - s.a).x * e.y - (t.a - s.a).y * e.x) / den;
+        return Some(format!("{what} cross at {}", at(s.a + d * u)));
+    }
+    if o1 == 0.0 && o2 == 0.0 {
+        // Collinear: an overlap of positive length is invalid.
+        let d = s.b - s.a;
+        let proj = |p: Coord<f64>| (p - s.a).x * d.x + (p - s.a).y * d.y;
+        let l2 = d.x * d.x + d.y * d.y;
+        let (lo, hi) = {
+            let (x, y) = (proj(t.a), proj(t.b));
+            (x.min(y), x.max(y))
+        };
+        if lo.max(0.0) < hi.min(l2) {
+            let p = if (0.0..=l2).contains(&proj(t.a)) {
+                t.a
+            } else {
+                s.a
+            };
+            return Some(format!("{what} overlap along an edge near {}", at(p)));
+        }
+    }
+    // Touching: an end point of one on the other.
+    for (p, seg) in [(t.a, s), (t.b, s), (s.a, t), (s.b, t)] {
+        if on_segment(seg.a, seg.b, p) {
+            let at_vertex = p == seg.a || p == seg.b;
+            if at_vertex && s.ring != t.ring {
+                continue; // rings may touch at a shared vertex
+            }
+            let how = if s.ring == t.ring {
+                "touches itself"
+            } else {
+                "touch"
+            };
+            let what = if s.ring == t.ring { what } else { "two rings" };
+            return Some(format!("{what} {how} at {}", at(p)));
+        }
+    }
+    None
+}
+
+/// The first validity problem of `p`, or `None` when it is valid.
+pub fn problem(p: &PreparedPolygon) -> Option<String> {
+    let b = p.boundary();
+    let segs = b.segments();
+    let mut ring_len: Vec<u32> = Vec::new();
+    for s in segs {
+        let r = s.ring as usize;
+        if ring_len.len() <= r {
+            ring_len.resize(r + 1, 0);
+        }
+        ring_len[r] += 1;
+    }
+    let consecutive = |s: &BoundarySegment, t: &BoundarySegment| {
+        s.ring == t.ring && {
+            let n = ring_len[s.ring as usize];
+            (s.index + 1) % n == t.index || (t.index + 1) % n == s.index
+        }
+    };
+    for (i, s) in segs.iter().enumerate() {
+        for j in b.segments_near(s.a, s.b) {
+            if j <= i {
+                continue;
+            }
+            let t = &segs[j];
+            if consecutive(s, t) {
+                // A spike: the next edge runs straight back along this one.
+                let (shared, far_s, far_t) = if s.b == t.a {
+                    (s.b, s.a, t.b)
+                } else {
+                    (s.a, s.b, t.a)
+                };
+                let (u, v) = (far_s - shared, far_t - shared);
+                let rings_of_3 = ring_len[s.ring as usize] < 3;
+                if !rings_of_3 && orient(far_s, shared, far_t) == 0.0 && u.x * v.x + u.y * v.y > 0.0
+                {
+                    return Some(format!(
+                        "spike: the ring doubles back on itself at {}",
+                        at(shared)
+                    ));
+                }
+                continue;
+            }
+            if let Some(m) = pair_problem(s, t) {
+                return Some(m);
+            }
+        }
+    }
+    // With no crossings, a hole lies wholly inside or outside every other ring:
+    // test the midpoint of its first edge (never on another ring, since touching
+    // edges were rejected above).
+    for (hi, hole) in p.polygon().interiors().iter().enumerate() {
+        let ring = hi as u32 + 1;
+        let m = Coord {
+            x: (hole.0[0].x + hole.0[1].x) * 0.5,
+            y: (hole.0[0].y + hole.0[1].y) * 0.5,
+        };
+        if !b.contains_with_rings(m, |r| r == 0) {
+            return Some(format!(
+                "hole {hi} lies outside the exterior ring (near {})",
+                at(m)
+            ));
+        }
+        if b.contains_with_rings(m, |r| r != 0 && r != ring) {
+            return Some(format!(
+                "hole {hi} lies inside another hole (near {})",
+                at(m)
+            ));
+        }
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use geo::polygon;
+
+    fn check(p: geo::Polygon<f64>) -> Option<String> {
+        problem(&PreparedPolygon::new(&p).unwrap())
+    }
+
+    #[test]
+    fn valid_polygons_pass() {
+        assert_eq!(
+            check(polygon![(x: 0., y: 0.), (x: 4., y: 0.), (x: 4., y: 4.), (x: 0., y: 4.)]),
+            None
+        );
+        // A hole touching the exterior at one vertex is valid.
+        let p = polygon!(
+            exterior: [(x: 0., y: 0.), (x: 10., y: 0.), (x: 10., y: 10.), (x: 0., y: 10.)],
+            interiors: [[(x: 0., y: 0.), (x: 4., y: 2.), (x: 2., y: 4.)]],
+        );
+        assert_eq!(check(p), None);
+    }
+
+    #[test]
+    fn problems_are_found_and_located() {
+        let bow = polygon![(x: 0., y: 0.), (x: 4., y: 4.), (x: 4., y: 0.), (x: 0., y: 6.)];
+        assert!(check(bow).unwrap().contains("cross at"));
+        let spike = polygon![(x: 0., y: 0.), (x: 4., y: 0.), (x: 4., y: 4.), (x: 6., y: 4.), (x: 4., y: 4.), (x: 0., y: 4.)];
+        let m = check(spike).unwrap();
+        assert!(m.contains("spike") || m.contains("touches itself"), "{m}");
+        let outside = polygon!(
+            exterior: [(x: 0., y: 0.), (x: 10., y: 0.), (x: 10., y: 10.), (x: 0., y: 10.)],
+            interiors: [[(x: 20., y: 20.), (x: 22., y: 20.), (x: 22., y: 22.)]],
+        );
+        assert!(check(outside).unwrap().contains("outside the exterior"));
+        let nested = polygon!(
+            exterior: [(x: 0., y: 0.), (x: 10., y: 0.), (x: 10., y: 10.), (x: 0., y: 10.)],
+            interiors: [
+                [(x: 1., y: 1.), (x: 9., y: 1.), (x: 9., y: 9.), (x: 1., y: 9.)],
+                [(x: 4., y: 4.), (x: 5., y: 4.), (x: 5., y: 5.)],
+            ],
+        );
+        assert!(check(nested).unwrap().contains("inside another hole"));
+        let self_touch = polygon![(x: 0., y: 0.), (x: 10., y: 0.), (x: 5., y: 5.), (x: 10., y: 10.), (x: 0., y: 10.), (x: 5., y: 5.)];
+        assert!(check(self_touch).unwrap().contains("touches itself"));
+    }
+}
