@@ -10,6 +10,7 @@
 //! GDAL is touched only by [`io`].
 
 pub mod config;
+pub mod external;
 pub mod geometry;
 pub mod graph;
 pub mod io;

@@ -73,6 +73,42 @@ enum Command {
         #[arg(short = 'o', long = "output", value_name = "OUT.gpkg")]
         output: Option<PathBuf>,
     },
+    /// Score skeletons made by any tool with the paper's metrics.
+    Score {
+        /// Polygon source (any OGR data source).
+        #[arg(long, value_name = "SRC")]
+        polygons: String,
+        /// Polygon layer (default: the first).
+        #[arg(long, value_name = "LAYER")]
+        polygons_layer: Option<String>,
+        /// Skeleton source (lines; any OGR data source).
+        #[arg(long, value_name = "SRC")]
+        skeletons: String,
+        /// Skeleton layer (default: the first).
+        #[arg(long, value_name = "LAYER")]
+        skeletons_layer: Option<String>,
+        /// Join by key: the skeleton field holding the polygon's key (FID, or `--polygon-key`); without it, join by location.
+        #[arg(long, value_name = "FIELD")]
+        skeleton_key: Option<String>,
+        /// Polygon field matched by `--skeleton-key` (default: the polygon FID).
+        #[arg(long, value_name = "FIELD", requires = "skeleton_key")]
+        polygon_key: Option<String>,
+        /// Label for the `method` attribute (e.g. the tool's name).
+        #[arg(long, default_value = "external")]
+        label: String,
+        /// Output GeoPackage.
+        #[arg(short = 'o', long = "output", value_name = "OUT.gpkg")]
+        output: PathBuf,
+        /// Replace an existing output.
+        #[arg(long)]
+        overwrite: bool,
+        /// Also write the bars layer.
+        #[arg(long)]
+        bars: bool,
+        /// Target CRS for both sources (required when they are geographic).
+        #[arg(long, value_name = "CRS")]
+        reproject: Option<String>,
+    },
     /// List the methods and steps with their options.
     Methods,
     /// Print the JSON Schema of the pipeline file.
@@ -204,6 +240,62 @@ fn main() -> ExitCode {
                     println!(
                         "{}: valid. input `{}` layer `{}`: {} features ({} after filters), CRS {}, fields: {}; output {}",
                         p.origin, info.source, info.layer, info.total, info.selected, info.crs_name, fields, p.file.output.path
+                    );
+                    ExitCode::SUCCESS
+                }
+                Err(e) => run_error(e),
+            }
+        }
+        Command::Score {
+            polygons,
+            polygons_layer,
+            skeletons,
+            skeletons_layer,
+            skeleton_key,
+            polygon_key,
+            label,
+            output,
+            overwrite,
+            bars,
+            reproject,
+        } => {
+            let spec = |source: &String, layer: &Option<String>| skeletonise::io::InputSpec {
+                source: source.clone(),
+                layer: layer.clone().map(skeletonise::io::LayerRef::Name),
+                where_: None,
+                bbox: None,
+                reproject: reproject.clone(),
+            };
+            let job = skeletonise::external::ScoreJob {
+                polygons: spec(polygons, polygons_layer),
+                skeletons: spec(skeletons, skeletons_layer),
+                join: match skeleton_key {
+                    Some(k) => skeletonise::external::Join::Key {
+                        polygon_field: polygon_key.clone(),
+                        skeleton_field: k.clone(),
+                    },
+                    None => skeletonise::external::Join::Location,
+                },
+                label: label.clone(),
+                output: skeletonise::io::writer::OutputSpec {
+                    path: output.display().to_string(),
+                    layer: "skeletons".into(),
+                    overwrite: *overwrite,
+                    candidates: false,
+                    bars: *bars,
+                    explode: false,
+                },
+            };
+            match skeletonise::external::score_external(&job, *bars) {
+                Ok(s) => {
+                    tracing::info!(
+                        read = s.read,
+                        written = s.written,
+                        rejected = s.rejected,
+                        seconds = format!("{:.2}", s.elapsed_s),
+                        output = %s.output,
+                        "scored: {} polygons, {} with a skeleton, {} without → {}",
+                        s.read, s.written, s.rejected, s.output
                     );
                     ExitCode::SUCCESS
                 }

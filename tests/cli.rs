@@ -392,3 +392,73 @@ fn schema_and_methods_describe_the_pipeline_file() {
         "usage errors exit 2"
     );
 }
+
+#[test]
+fn score_subcommand_scores_another_tools_skeletons_by_key_and_by_location() {
+    let d = tmp();
+    let polys = d.path().join("p.gpkg");
+    // A 100 × 20 rectangle and a 100 × 20 rectangle far away.
+    make_layer(
+        &polys,
+        "polys",
+        32630,
+        &[
+            Some("POLYGON ((0 0, 100 0, 100 20, 0 20, 0 0))"),
+            Some("POLYGON ((1000 0, 1100 0, 1100 20, 1000 20, 1000 0))"),
+        ],
+    );
+    let lines = d.path().join("s.gpkg");
+    // Centre line of the first (Δd = 0), a line offset by 5 in the second.
+    make_layer(
+        &lines,
+        "lines",
+        32630,
+        &[
+            Some("LINESTRING (10 10, 90 10)"),
+            Some("LINESTRING (1010 15, 1090 15)"),
+        ],
+    );
+    let out = d.path().join("o.gpkg");
+    let o = skeletonise(&[
+        "score",
+        "--polygons",
+        polys.to_str().unwrap(),
+        "--skeletons",
+        lines.to_str().unwrap(),
+        "--label",
+        "other",
+        "-o",
+        out.to_str().unwrap(),
+        "--bars",
+    ]);
+    let (code, err) = code_and_err(&o);
+    assert_eq!(code, 0, "{err}");
+    let ds = open(&out);
+    assert_eq!(
+        strings(&ds, "skeletons", "method"),
+        [Some("other".into()), Some("other".into())]
+    );
+    let z = reals(&ds, "skeletons", "distortion");
+    assert_eq!(z[0], Some(0.0));
+    // Offset by 5 in a 20-wide strip: d = 15 and 5 → z = 10 / 20.
+    assert!((z[1].unwrap() - 0.5).abs() < 1e-9, "{z:?}");
+    assert!(count(&ds, "bars") > 0);
+    // By key: the `id` field of the lines holds 0 and 1, the polygons' `id` too.
+    let o = skeletonise(&[
+        "score",
+        "--polygons",
+        polys.to_str().unwrap(),
+        "--skeletons",
+        lines.to_str().unwrap(),
+        "--skeleton-key",
+        "id",
+        "--polygon-key",
+        "id",
+        "-o",
+        out.to_str().unwrap(),
+        "--overwrite",
+    ]);
+    assert_eq!(o.status.code(), Some(0));
+    let z2 = reals(&open(&out), "skeletons", "distortion");
+    assert_eq!(z, z2);
+}
