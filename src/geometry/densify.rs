@@ -27,7 +27,7 @@ impl Density {
 pub fn densified_len(ring: &LineString<f64>, density: Density) -> usize {
     ring.lines()
         .map(|l| density.pieces((l.end - l.start).x.hypot((l.end - l.start).y)))
-        .sum()
+        .fold(0usize, usize::saturating_add)
 }
 
 /// The ring's points with pseudo-nodes inserted, not closed: each original

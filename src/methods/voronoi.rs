@@ -57,6 +57,7 @@
 
 use super::{MethodError, MethodId, SkeletonMethod};
 use crate::geometry::{boundary::orient, densify, densify::Density, PreparedPolygon};
+use crate::graph::UnionFind;
 use crate::graph::{GraphBuilder, SkeletonGraph};
 use geo::{Coord, LineString};
 use spade::{DelaunayTriangulation, InsertionError, Point2, Triangulation};
@@ -328,35 +329,6 @@ fn circumcentre([a, b, c]: [Point2<f64>; 3]) -> Coord<f64> {
     Coord {
         x: a.x + (cy * lb - by * lc) / d,
         y: a.y + (bx * lc - cx * lb) / d,
-    }
-}
-
-/// Union–find whose class root is always the smallest member.
-struct UnionFind {
-    parent: Vec<usize>,
-}
-
-impl UnionFind {
-    fn new(n: usize) -> Self {
-        Self {
-            parent: (0..n).collect(),
-        }
-    }
-
-    fn find(&mut self, mut x: usize) -> usize {
-        while self.parent[x] != x {
-            self.parent[x] = self.parent[self.parent[x]];
-            x = self.parent[x];
-        }
-        x
-    }
-
-    fn union(&mut self, a: usize, b: usize) {
-        let (ra, rb) = (self.find(a), self.find(b));
-        if ra != rb {
-            let (lo, hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
-            self.parent[hi] = lo;
-        }
     }
 }
 
