@@ -1,0 +1,560 @@
+//! `MA` — the medial axis (transform) from the Voronoi diagram of the
+//! boundary segments (SPEC §3, paper "Medial Axis (Transform)", Fig. 2f).
+//!
+//! The medial axis of P is the locus of the centres of maximal inscribed
+//! discs. It is the part inside P of the Voronoi diagram of the *segments* of
+//! ∂P (all rings) and their endpoints, without the edges that come out of
+//! concave (reflex) vertices — in the segment Voronoi diagram those are
+//! exactly the *secondary* edges, between a segment and its own endpoint.
+//! Every node carries its disc radius, so the graph with its radii is the
+//! Medial Axis Transform; [`medial_axis_transform`] lists it segment by
+//! segment with the local width.
+//!
+//! # How
+//!
+//! 1. **Grid.** The diagram is built by [`boostvoronoi`] (Boost.Polygon's
+//!    robust sweep), which takes integer input. Coordinates are quantised
+//!    relative to the polygon's bounding-box corner on a grid of spacing
+//!    `2^-k < extent / 2^26` (**resolution < 1.5e-8 × extent**,
+//!    independent of where the polygon lies — 1e7 m coordinates are as exact
+//!    as 0). Touches, near-touches and sub-grid slivers that rounding could
+//!    turn into crossings are repaired on the grid first (see `quantise`);
+//!    input that still self-intersects is rejected with its location.
+//! 2. **Diagram.** Infinite edges and secondary edges are dropped. Whether an
+//!    edge lies inside P is decided from its sites, not by a point-in-polygon
+//!    test: a Voronoi edge of a valid polygon never crosses ∂P, the part of a
+//!    segment's cell left of the segment is inside P (interior is left of
+//!    every normalised ring), and the cell of a vertex lies wholly inside or
+//!    wholly outside. The bisector of two collinear neighbouring segments (the
+//!    normal at a straight-angle vertex) is dropped too: its discs touch ∂P
+//!    at one point only, so it is not medial.
+//! 3. **Arcs.** Edges between a vertex and a segment are parabolic. They are
+//!    replaced by polylines whose Hausdorff distance to the exact parabola is
+//!    at most the [`ArcTolerance`] (by default 1 % of the local disc radius,
+//!    so the quality does not depend on the feature's size); every polyline
+//!    vertex is a node with its exact disc radius.
+//! 4. **Radii.** A node's radius is its distance to its Voronoi sites (the
+//!    quantised ∂P), which equals its distance to ∂P within the resolution.
+//!
+//! ```
+//! use geo::polygon;
+//! use skeletonise::geometry::PreparedPolygon;
+//! use skeletonise::methods::medial_axis::{ArcTolerance, MedialAxis};
+//! use skeletonise::methods::SkeletonMethod;
+//! // A 10 × 4 rectangle: centre segment plus four 45° corner legs.
+//! let p = polygon![(x: 0., y: 0.), (x: 10., y: 0.), (x: 10., y: 4.), (x: 0., y: 4.)];
+//! let g = MedialAxis::new(ArcTolerance::default())
+//!     .skeletonise(&PreparedPolygon::new(&p).unwrap())
+//!     .unwrap();
+//! assert_eq!(g.edges().len(), 5);
+//! assert_eq!(g.leg_count(), 4);
+//! let widest = g.nodes().iter().map(|n| n.radius).fold(0.0, f64::max);
+//! assert!((widest - 2.0).abs() < 1e-8);
+//! ```
+
+mod arc;
+mod quantise;
+
+use super::{MethodError, MethodId, SkeletonMethod};
+use crate::geometry::{Boundary, PreparedPolygon};
+use crate::graph::{NodeId, SkeletonGraph};
+use arc::Parabola;
+use boostvoronoi::prelude::{Builder, Cell, Diagram, SourceCategory, VertexIndex};
+use geo::Line;
+use quantise::{orient, Grid, Pt, Seg};
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+/// Largest allowed deviation of a polyline from the parabolic arc it
+/// approximates (pipeline key `skeleton.arc_tolerance`).
+///
+/// Written `{relative: 0.01}` or `{absolute: 0.5}`. Tolerances finer than a
+/// thousandth of the grid spacing (≈ 1.5e-11 × extent) are raised to it.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, rename_all = "lowercase")]
+pub enum ArcTolerance {
+    /// A fraction of the local disc radius (scale-free; default 0.01).
+    Relative(f64),
+    /// CRS units.
+    Absolute(f64),
+}
+
+impl Default for ArcTolerance {
+    fn default() -> Self {
+        ArcTolerance::Relative(0.01)
+    }
+}
+
+impl ArcTolerance {
+    /// Checks the value: finite and positive.
+    pub fn validate(&self) -> Result<(), String> {
+        let (name, v) = match *self {
+            ArcTolerance::Relative(v) => ("relative", v),
+            ArcTolerance::Absolute(v) => ("absolute", v),
+        };
+        if v.is_finite() && v > 0.0 {
+            Ok(())
+        } else {
+            Err(format!(
+                "`arc_tolerance: {{{name}: {v}}}` must be a positive number, e.g. {{relative: 0.01}} (1 % of the local radius)"
+            ))
+        }
+    }
+
+    /// The allowed deviation (grid units) where the disc radius is `r` (grid units).
+    fn at(&self, r: f64, grid: &Grid) -> f64 {
+        let t = match *self {
+            ArcTolerance::Relative(f) => f * r,
+            ArcTolerance::Absolute(d) => d * grid.scale(),
+        };
+        t.max(TOLERANCE_FLOOR)
+    }
+}
+
+/// Finest arc tolerance, in grid units: below the grid spacing the input
+/// itself is not known, and this keeps the number of pieces bounded.
+const TOLERANCE_FLOOR: f64 = 1e-3;
+
+/// Medial axis from the segment Voronoi diagram.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MedialAxis {
+    tolerance: ArcTolerance,
+}
+
+impl MedialAxis {
+    /// A medial axis with the given arc tolerance.
+    pub fn new(tolerance: ArcTolerance) -> Self {
+        Self { tolerance }
+    }
+}
+
+impl Default for MedialAxis {
+    fn default() -> Self {
+        Self::new(ArcTolerance::default())
+    }
+}
+
+/// The coordinate resolution MA works at for `polygon`: the spacing of the
+/// integer grid ∂P is quantised to (CRS units, < 1.5e-8 × extent).
+pub fn resolution(polygon: &PreparedPolygon) -> f64 {
+    Grid::new(polygon.origin(), polygon.extent())
+        .map(|g| g.resolution())
+        .unwrap_or(f64::NAN)
+}
+
+fn fail(reason: impl Into<String>) -> MethodError {
+    MethodError::Failed {
+        method: MethodId::Ma,
+        reason: reason.into(),
+    }
+}
+
+impl SkeletonMethod for MedialAxis {
+    fn id(&self) -> MethodId {
+        MethodId::Ma
+    }
+
+    fn skeletonise(&self, polygon: &PreparedPolygon) -> Result<SkeletonGraph, MethodError> {
+        self.tolerance.validate().map_err(fail)?;
+        let grid = Grid::new(polygon.origin(), polygon.extent()).ok_or_else(|| {
+            fail(format!(
+                "the polygon's extent {} cannot be quantised",
+                polygon.extent()
+            ))
+        })?;
+        let segs = quantise::segments(&grid, polygon.rings()).map_err(|c| {
+            let w = grid.world(c.at[0] as f64, c.at[1] as f64);
+            fail(format!(
+                "the boundary intersects itself near ({}, {}) at the method's resolution of {:e} CRS units; repair the polygon (`prepare: {{ make_valid: true }}`)",
+                w.x,
+                w.y,
+                grid.resolution()
+            ))
+        })?;
+        if segs.len() < 3 {
+            return Ok(SkeletonGraph::new());
+        }
+        let diagram = voronoi(&segs)?;
+        Extractor::new(&diagram, &segs, &grid, self.tolerance).run()
+    }
+}
+
+/// The segment Voronoi diagram; boostvoronoi's errors and panics become a
+/// [`MethodError`].
+fn voronoi(segs: &[Seg]) -> Result<Diagram, MethodError> {
+    let lines: Vec<[i32; 4]> = segs
+        .iter()
+        .map(|s| [s.a[0], s.a[1], s.b[0], s.b[1]].map(|v| v as i32))
+        .collect();
+    let built = std::panic::catch_unwind(|| {
+        Builder::<i32>::default()
+            .with_segments(lines.iter())
+            .and_then(|b| b.build())
+    });
+    match built {
+        Ok(Ok(d)) => Ok(d),
+        Ok(Err(e)) => Err(fail(format!(
+            "the segment Voronoi diagram failed: {e} ({e:?})"
+        ))),
+        Err(panic) => {
+            let msg = panic
+                .downcast_ref::<String>()
+                .map(String::as_str)
+                .or_else(|| panic.downcast_ref::<&str>().copied())
+                .unwrap_or("unknown panic");
+            Err(fail(format!(
+                "the segment Voronoi diagram panicked ({msg}); please report the feature"
+            )))
+        }
+    }
+}
+
+/// The site of a Voronoi cell.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Site {
+    Point(Pt),
+    Segment(usize),
+}
+
+fn fpt(p: Pt) -> [f64; 2] {
+    [p[0] as f64, p[1] as f64]
+}
+
+/// Signed distance-like side of `q` relative to `a → b` (positive = left).
+fn side(s: &Seg, q: [f64; 2]) -> f64 {
+    let (a, b) = (fpt(s.a), fpt(s.b));
+    (b[0] - a[0]) * (q[1] - a[1]) - (b[1] - a[1]) * (q[0] - a[0])
+}
+
+/// Distance from `q` to a site (grid units).
+fn site_distance(site: Site, segs: &[Seg], q: [f64; 2]) -> f64 {
+    match site {
+        Site::Point(p) => {
+            let p = fpt(p);
+            (q[0] - p[0]).hypot(q[1] - p[1])
+        }
+        Site::Segment(i) => {
+            let (a, b) = (fpt(segs[i].a), fpt(segs[i].b));
+            let d = [b[0] - a[0], b[1] - a[1]];
+            let l2 = d[0] * d[0] + d[1] * d[1];
+            let t = (((q[0] - a[0]) * d[0] + (q[1] - a[1]) * d[1]) / l2).clamp(0.0, 1.0);
+            (q[0] - a[0] - t * d[0]).hypot(q[1] - a[1] - t * d[1])
+        }
+    }
+}
+
+/// Voronoi edges shorter than this (grid units) are contracted to a point:
+/// rounding to the grid perturbs junctions by about one unit.
+const CONTRACT: f64 = 4.0;
+
+/// A Voronoi edge kept for the medial axis.
+#[derive(Debug, Clone, Copy)]
+struct Kept {
+    v0: VertexIndex,
+    v1: VertexIndex,
+    s0: Site,
+    s1: Site,
+    curved: bool,
+}
+
+/// Walks the diagram once and builds the skeleton graph.
+struct Extractor<'a> {
+    diagram: &'a Diagram,
+    segs: &'a [Seg],
+    grid: &'a Grid,
+    tolerance: ArcTolerance,
+    graph: SkeletonGraph,
+    /// Graph node of each Voronoi vertex, once used.
+    node_of: Vec<Option<NodeId>>,
+    /// Whether a vertex's cell lies inside P, once known.
+    point_cell_inside: Vec<Option<bool>>,
+}
+
+impl<'a> Extractor<'a> {
+    fn new(diagram: &'a Diagram, segs: &'a [Seg], grid: &'a Grid, tolerance: ArcTolerance) -> Self {
+        Self {
+            diagram,
+            segs,
+            grid,
+            tolerance,
+            graph: SkeletonGraph::new(),
+            node_of: vec![None; diagram.vertices().len()],
+            point_cell_inside: vec![None; diagram.cells().len()],
+        }
+    }
+
+    fn site(&self, cell: &Cell) -> Site {
+        let i = cell.source_index().usize();
+        match cell.source_category() {
+            SourceCategory::Segment => Site::Segment(i),
+            SourceCategory::SegmentStart => Site::Point(self.segs[i].a),
+            SourceCategory::SegmentEnd => Site::Point(self.segs[i].b),
+            // Only segments are fed to the builder.
+            SourceCategory::SinglePoint => Site::Point(self.segs[i].a),
+        }
+    }
+
+    fn vertex(&self, v: VertexIndex) -> [f64; 2] {
+        self.vertex_at(v.usize())
+    }
+
+    fn vertex_at(&self, v: usize) -> [f64; 2] {
+        let v = &self.diagram.vertices()[v];
+        [v.x(), v.y()]
+    }
+
+    fn run(mut self) -> Result<SkeletonGraph, MethodError> {
+        let kept = self.medial_edges()?;
+        // Contract edges shorter than the grid can resolve (the several
+        // Voronoi vertices a near-regular junction splits into), never moving
+        // a vertex more than CONTRACT from its cluster's representative.
+        let mut rep: Vec<usize> = (0..self.diagram.vertices().len()).collect();
+        fn find(rep: &mut [usize], mut x: usize) -> usize {
+            while rep[x] != x {
+                rep[x] = rep[rep[x]];
+                x = rep[x];
+            }
+            x
+        }
+        for k in &kept {
+            let (a, b) = (find(&mut rep, k.v0.usize()), find(&mut rep, k.v1.usize()));
+            if a != b {
+                let (pa, pb) = (self.vertex_at(a), self.vertex_at(b));
+                if (pa[0] - pb[0]).hypot(pa[1] - pb[1]) < CONTRACT {
+                    let (lo, hi) = if a < b { (a, b) } else { (b, a) };
+                    rep[hi] = lo;
+                }
+            }
+        }
+        for k in &kept {
+            let (r0, r1) = (find(&mut rep, k.v0.usize()), find(&mut rep, k.v1.usize()));
+            if r0 == r1 {
+                continue;
+            }
+            let n0 = self.node(r0, k.s0);
+            let n1 = self.node(r1, k.s0);
+            if k.curved {
+                let (p0, p1) = (self.vertex_at(r0), self.vertex_at(r1));
+                self.add_arc(n0, n1, p0, p1, k.s0, k.s1);
+            } else {
+                self.graph.add_edge(n0, n1, Vec::new());
+            }
+        }
+        Ok(self.graph)
+    }
+
+    /// The finite primary edges inside P, once each.
+    fn medial_edges(&mut self) -> Result<Vec<Kept>, MethodError> {
+        let d = self.diagram;
+        let edges = d.edges();
+        let mut kept = Vec::new();
+        for (i, e) in edges.iter().enumerate() {
+            let twin = e
+                .twin()
+                .map_err(|err| fail(format!("malformed Voronoi diagram: {err}")))?;
+            if twin.usize() < i || !e.is_primary() {
+                continue;
+            }
+            let (Some(v0), Some(v1)) = (e.vertex0(), edges[twin.usize()].vertex0()) else {
+                continue; // infinite: outside P
+            };
+            let (Ok(c0), Ok(c1)) = (e.cell(), edges[twin.usize()].cell()) else {
+                return Err(fail("malformed Voronoi diagram: edge without cell"));
+            };
+            let (cell0, cell1) = (&d.cells()[c0.usize()], &d.cells()[c1.usize()]);
+            let (s0, s1) = (self.site(cell0), self.site(cell1));
+            let (p0, p1) = (self.vertex(v0), self.vertex(v1));
+            if p0 == p1 {
+                continue;
+            }
+            let mid = [0.5 * (p0[0] + p1[0]), 0.5 * (p0[1] + p1[1])];
+            let inside = match (s0, s1) {
+                (Site::Segment(s), _) | (_, Site::Segment(s)) => side(&self.segs[s], mid) > 0.0,
+                _ => self.point_cell_is_inside(cell0) || self.point_cell_is_inside(cell1),
+            };
+            if !inside {
+                continue;
+            }
+            if let (Site::Segment(a), Site::Segment(b)) = (s0, s1) {
+                if self.straight_angle(a, b) {
+                    continue;
+                }
+            }
+            kept.push(Kept {
+                v0,
+                v1,
+                s0,
+                s1,
+                curved: e.is_curved(),
+            });
+        }
+        Ok(kept)
+    }
+
+    /// True for two neighbouring collinear segments: their bisector is the
+    /// normal at the straight-angle vertex between them.
+    fn straight_angle(&self, a: usize, b: usize) -> bool {
+        let (s, t) = (self.segs[a], self.segs[b]);
+        let shares = s.a == t.a || s.a == t.b || s.b == t.a || s.b == t.b;
+        shares && orient(s.a, s.b, t.a) == 0 && orient(s.a, s.b, t.b) == 0
+    }
+
+    /// Whether the cell of a point site lies inside P, from any of its edges
+    /// shared with a segment cell (the cell never straddles ∂P).
+    fn point_cell_is_inside(&mut self, cell: &Cell) -> bool {
+        if let Some(known) = self.point_cell_inside[cell.id().usize()] {
+            return known;
+        }
+        let d = self.diagram;
+        let mut verdict = false;
+        for e in d.cell_edge_iterator(cell.id()) {
+            let edge = &d.edges()[e.usize()];
+            let Ok(twin) = edge.twin() else { continue };
+            let twin_edge = &d.edges()[twin.usize()];
+            let Ok(tc) = twin_edge.cell() else { continue };
+            let Site::Segment(s) = self.site(&d.cells()[tc.usize()]) else {
+                continue;
+            };
+            let (Some(v0), Some(v1)) = (edge.vertex0(), twin_edge.vertex0()) else {
+                // Reaches infinity: the cell is outside.
+                verdict = false;
+                break;
+            };
+            let (p0, p1) = (self.vertex(v0), self.vertex(v1));
+            let m = [0.5 * (p0[0] + p1[0]), 0.5 * (p0[1] + p1[1])];
+            let sd = side(&self.segs[s], m);
+            if sd != 0.0 {
+                verdict = sd > 0.0;
+                break;
+            }
+        }
+        self.point_cell_inside[cell.id().usize()] = Some(verdict);
+        verdict
+    }
+
+    /// The graph node of Voronoi vertex `v`, whose disc touches `site`.
+    fn node(&mut self, v: usize, site: Site) -> NodeId {
+        if let Some(n) = self.node_of[v] {
+            return n;
+        }
+        let p = self.vertex_at(v);
+        let r = site_distance(site, self.segs, p);
+        let pos = match (r == 0.0, site) {
+            // On ∂P (a convex corner): the input vertex itself, not its rounding.
+            (true, Site::Segment(s)) if p == fpt(self.segs[s].a) => self.segs[s].wa,
+            (true, Site::Segment(s)) if p == fpt(self.segs[s].b) => self.segs[s].wb,
+            _ => self.grid.world(p[0], p[1]),
+        };
+        let n = self.graph.add_node(pos, self.grid.length(r), None);
+        self.node_of[v] = Some(n);
+        n
+    }
+
+    /// A parabolic edge as a chain of nodes on the exact arc.
+    fn add_arc(&mut self, n0: NodeId, n1: NodeId, p0: [f64; 2], p1: [f64; 2], s0: Site, s1: Site) {
+        let (point, seg) = match (s0, s1) {
+            (Site::Point(p), Site::Segment(s)) | (Site::Segment(s), Site::Point(p)) => (p, s),
+            _ => {
+                self.graph.add_edge(n0, n1, Vec::new());
+                return;
+            }
+        };
+        let s = self.segs[seg];
+        let Some(par) = Parabola::new(fpt(point), fpt(s.a), fpt(s.b)) else {
+            self.graph.add_edge(n0, n1, Vec::new());
+            return;
+        };
+        let (grid, tol) = (*self.grid, self.tolerance);
+        let samples = par.samples(par.abscissa(p0), par.abscissa(p1), |r| tol.at(r, &grid));
+        let mut prev = n0;
+        for smp in samples {
+            let n = self
+                .graph
+                .add_node(grid.world(smp.x, smp.y), grid.length(smp.r), None);
+            self.graph.add_edge(prev, n, Vec::new());
+            prev = n;
+        }
+        self.graph.add_edge(prev, n1, Vec::new());
+    }
+}
+
+/// One straight piece of a Medial Axis Transform: a skeleton segment and the
+/// disc radius (local half-width of P) at each end.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MatSegment {
+    /// The segment, in the direction of its edge.
+    pub line: Line<f64>,
+    /// Disc radius at `line.start`.
+    pub r_start: f64,
+    /// Disc radius at `line.end`.
+    pub r_end: f64,
+}
+
+impl MatSegment {
+    /// Local width of P (2 × radius) at the start.
+    pub fn width_start(&self) -> f64 {
+        2.0 * self.r_start
+    }
+
+    /// Local width of P (2 × radius) at the end.
+    pub fn width_end(&self) -> f64 {
+        2.0 * self.r_end
+    }
+
+    /// Mean width along the segment (radius varies linearly to first order).
+    pub fn mean_width(&self) -> f64 {
+        self.r_start + self.r_end
+    }
+}
+
+/// The Medial Axis Transform of a skeleton, segment by segment: every
+/// straight piece of every edge with the disc radius at both ends — what a
+/// writer needs for a `width` attribute or M values, and what a cartographer
+/// uses to decide what is narrow enough to collapse.
+///
+/// End nodes carry their radius. Interior polyline vertices (edges merged by
+/// pruning, for instance) get their distance to ∂P from `boundary` when given
+/// (exact on the medial axis), otherwise a radius interpolated linearly by
+/// length between the edge's end nodes. On MA's raw output every polyline
+/// vertex is a node, so no boundary is needed.
+pub fn medial_axis_transform(
+    graph: &SkeletonGraph,
+    boundary: Option<&Boundary>,
+) -> Vec<MatSegment> {
+    let mut out = Vec::new();
+    for (i, e) in graph.edges().iter().enumerate() {
+        let coords = graph.edge_coords(crate::graph::EdgeId(i as u32));
+        let (ra, rb) = (graph.node(e.a).radius, graph.node(e.b).radius);
+        let radii: Vec<f64> = match boundary {
+            Some(b) => {
+                let mut r: Vec<f64> = coords.iter().map(|&c| b.distance(c)).collect();
+                let n = r.len();
+                r[0] = ra;
+                r[n - 1] = rb;
+                r
+            }
+            None => {
+                let total = crate::graph::polyline_length(&coords);
+                let mut acc = 0.0;
+                let mut r = Vec::with_capacity(coords.len());
+                for (k, c) in coords.iter().enumerate() {
+                    if k > 0 {
+                        let d = *c - coords[k - 1];
+                        acc += d.x.hypot(d.y);
+                    }
+                    let t = if total > 0.0 { acc / total } else { 0.0 };
+                    r.push(ra + (rb - ra) * t);
+                }
+                r
+            }
+        };
+        for k in 1..coords.len() {
+            out.push(MatSegment {
+                line: Line::new(coords[k - 1], coords[k]),
+                r_start: radii[k - 1],
+                r_end: radii[k],
+            });
+        }
+    }
+    out
+}
