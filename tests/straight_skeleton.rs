@@ -312,18 +312,32 @@ fn star(radii: &[f64], hole: bool) -> Polygon<f64> {
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
 
-    // Known failure: stars with many vertices on one circle (many
-    // near-simultaneous events) give nodes up to ~1e-5·extent off the
-    // exact time/radius; run with `--ignored` while fixing it.
+    // Random star polygons, many with several vertices on one circle
+    // (simultaneous events), with and without a hole: every one gives a
+    // skeleton that passes the invariants, with no panic and no hang.
+    // Known failure (run with `--ignored`): with a hole, a node can end
+    // off its offset lines (e.g. the saved case radii = [1, 9.2, 6.67,
+    // 4.64, 9.22, 1, 1]: a node on one offset line only).
     #[test]
     #[ignore]
     fn random_star_polygons(radii in prop::collection::vec(1.0f64..10.0, 3..60), hole in any::<bool>()) {
-        // Either a valid skeleton or a clear error, never a panic or a hang.
-        let p = star(&radii, hole);
-        let pp = PreparedPolygon::new(&p).unwrap();
-        if StraightSkeleton.skeletonise(&pp).is_ok() {
-            check(&p);
-        }
+        check(&star(&radii, hole));
+    }
+
+    // Stars whose radii take only three values put many vertices on one
+    // circle at once, so many events fall at one time.
+    // Known failure (run with `--ignored`): simultaneous events at one
+    // point are not merged into one vertex event, so the propagation keeps
+    // creating vertices there until its vertex bound stops it with a clear
+    // MethodError (no hang, no panic).
+    #[test]
+    #[ignore]
+    fn stars_with_vertices_on_common_circles(
+        picks in prop::collection::vec(0usize..3, 3..60),
+        hole in any::<bool>(),
+    ) {
+        let radii: Vec<f64> = picks.iter().map(|&k| [4.0, 7.0, 9.0][k]).collect();
+        check(&star(&radii, hole));
     }
 }
 
