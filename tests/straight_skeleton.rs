@@ -312,18 +312,32 @@ fn star(radii: &[f64], hole: bool) -> Polygon<f64> {
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
 
-    // Known failure: stars with many vertices on one circle (many
-    // near-simultaneous events) give nodes up to ~1e-5·extent off the
-    // exact time/radius; run with `--ignored` while fixing it.
+    // Random star polygons, many with several vertices on one circle
+    // (simultaneous events), with and without a hole: every one gives a
+    // skeleton that passes the invariants, with no panic and no hang.
+    // Known failure (run with `--ignored`): with a hole, a node can end
+    // off its offset lines (e.g. the saved case radii = [1, 9.2, 6.67,
+    // 4.64, 9.22, 1, 1]: a node on one offset line only).
     #[test]
     #[ignore]
     fn random_star_polygons(radii in prop::collection::vec(1.0f64..10.0, 3..60), hole in any::<bool>()) {
-        // Either a valid skeleton or a clear error, never a panic or a hang.
-        let p = star(&radii, hole);
-        let pp = PreparedPolygon::new(&p).unwrap();
-        if StraightSkeleton.skeletonise(&pp).is_ok() {
-            check(&p);
-        }
+        check(&star(&radii, hole));
+    }
+
+    // Stars whose radii take only three values put many vertices on one
+    // circle at once, so many events fall at one time.
+    // Known failure (run with `--ignored`): simultaneous events at one
+    // point are not merged into one vertex event, so the propagation keeps
+    // creating vertices there until its vertex bound stops it with a clear
+    // MethodError (no hang, no panic).
+    #[test]
+    #[ignore]
+    fn stars_with_vertices_on_common_circles(
+        picks in prop::collection::vec(0usize..3, 3..60),
+        hole in any::<bool>(),
+    ) {
+        let radii: Vec<f64> = picks.iter().map(|&k| [4.0, 7.0, 9.0][k]).collect();
+        check(&star(&radii, hole));
     }
 }
 
@@ -366,15 +380,52 @@ fn every_training_layer() {
             .collect();
         failures.extend(bad);
     }
-    // Known: one river_lena reach (near-parallel banks) still ends with a
-    // clear MethodError; every other training feature must succeed.
     for f in &failures {
         eprintln!("{f}");
     }
     assert!(
-        failures.len() <= 1,
+        failures.is_empty(),
         "{} failures: {:?}",
         failures.len(),
         &failures[..failures.len().min(10)]
     );
+}
+
+/// The largest river_lena reach (about 11 000 vertices, nearly parallel
+/// banks whose fast reflex vertices split faces far from their own ray)
+/// yields a skeleton whose nodes lie in P, whose edges do not cross ∂P and
+/// whose node times never exceed the radius.
+#[test]
+fn largest_lena_reach() {
+    let feats =
+        skeletonise::io::read_layer_polygons("../shared/data/gshhg-train.gpkg", "river_lena")
+            .unwrap();
+    let p = feats
+        .into_iter()
+        .flat_map(|(_, g)| match g {
+            geo::Geometry::Polygon(p) => vec![p],
+            geo::Geometry::MultiPolygon(m) => m.0,
+            _ => Vec::new(),
+        })
+        .max_by_key(|p| {
+            p.exterior().0.len() + p.interiors().iter().map(|r| r.0.len()).sum::<usize>()
+        })
+        .unwrap();
+    let pp = PreparedPolygon::new(&p).unwrap();
+    assert!(pp.vertex_count() > 10_000);
+    let (g, stats) = straight_skeleton_with_stats(&pp).unwrap();
+    assert!(stats.pops <= 1000 * stats.input_vertices + 10_000);
+    let tol = 1e-6 * pp.extent();
+    for n in g.nodes() {
+        assert!(pp.boundary().contains_with_tolerance(n.pos, tol));
+        let t = n.time.unwrap();
+        assert!(
+            t >= -tol && t <= n.radius + tol,
+            "time {t} radius {}",
+            n.radius
+        );
+    }
+    for e in g.edges() {
+        assert!(!pp.boundary().crosses(g.node(e.a).pos, g.node(e.b).pos));
+    }
 }

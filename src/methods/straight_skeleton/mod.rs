@@ -34,6 +34,15 @@
 //!   popped; events are kept in a binary heap with lazy invalidation (an
 //!   event naming an inactive vertex is dropped). The cost is about
 //!   O(n log n) on real data.
+//! * "Near its ray" is not a proven bound: a face widens without limit
+//!   next to a fast reflex vertex (nearly parallel banks), so a split can
+//!   come from an edge far from the ray. Every result is therefore
+//!   verified — the wavefront collapses completely, every trace stays in
+//!   P, no two traces cross (a vertex that ran through a wavefront edge
+//!   leaves its face and crosses its traces) — and a pass that fails is
+//!   repeated with a wider search (search passes: 2× and 16× the reach,
+//!   then every edge; the exhaustive pass takes every edge whose offset
+//!   line the ray reaches before it leaves P, a proven superset).
 //!
 //! # Tolerance policy
 //!
@@ -44,13 +53,16 @@
 //! ahead of a line, whether a fold's two neighbours are equally far. Input
 //! orientation is exact (normalised rings, robust predicates in
 //! [`crate::geometry`]); two lines are antiparallel (a fold) when
-//! `1 + n1·n2 < 1e-8`.
+//! `1 + n1·n2 < 1e-8`. Verification uses `1e-6 · extent`: a trace end
+//! that far outside P, or two traces crossing that far from their ends and
+//! from each other's lines, rejects a pass.
 //!
 //! # Termination and failure
 //!
 //! Every popped event is counted; more than `1000 · n + 10 000` pops, more
 //! than `16 · n + 64` vertices, or a wavefront that does not collapse
-//! completely is a [`MethodError`] for that polygon, never a hang. A panic
+//! completely fails a pass; when the exhaustive pass fails too, that is a
+//! [`MethodError`] for the polygon, never a hang. A panic
 //! inside the propagation is caught and reported the same way.
 //!
 //! ```
@@ -111,10 +123,27 @@ fn fail(reason: impl Into<String>) -> MethodError {
 
 type EdgeTree = RTree<GeomWithData<RLine<[f64; 2]>, u32>>;
 
+/// Which original edges a reflex vertex's split candidates are taken from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Search {
+    /// Edges within `factor · reach` of the vertex's path (reach = length
+    /// of its ray inside P): fast, but not a proven bound, since faces
+    /// widen without limit next to fast reflex vertices.
+    Near(f64),
+    /// Every original edge: the proven superset (a split candidate must
+    /// be reached before the ray leaves P, which `split_candidates` checks).
+    All,
+}
+
+/// The search passes tried in turn; a pass whose result fails
+/// [`verify`] is repeated with the next, wider one. The last is exhaustive.
+const SEARCH_PASSES: [Search; 3] = [Search::Near(2.0), Search::Near(16.0), Search::All];
+
 struct Propagation<'a> {
     w: Wavefront,
     q: EventQueue,
     tree: EdgeTree,
+    search: Search,
     boundary: &'a Boundary,
     origin: Coord<f64>,
     candidates: Vec<Vec<SplitCandidate>>,
@@ -130,7 +159,7 @@ struct Propagation<'a> {
 }
 
 impl<'a> Propagation<'a> {
-    fn new(polygon: &'a PreparedPolygon) -> Self {
+    fn new(polygon: &'a PreparedPolygon, search: Search) -> Self {
         let origin = polygon.origin();
         let n = polygon.vertex_count();
         let extent = polygon.extent().max(f64::MIN_POSITIVE);
@@ -170,6 +199,7 @@ impl<'a> Propagation<'a> {
             w,
             q: EventQueue::default(),
             tree: RTree::bulk_load(entries),
+            search,
             boundary: polygon.boundary(),
             origin,
             arcs: Vec::with_capacity(2 * n),
@@ -457,19 +487,27 @@ impl<'a> Propagation<'a> {
             .first_hit(start, dir, self.tol, 4.0 * self.extent)
             .map_or(2.0 * self.extent, |h| h.t);
         let t_max = vx.t0 + reach / speed;
-        let end = vx.start + dir * reach;
-        // Faces of edges whose ends are reflex widen away from the edge:
-        // search a margin of twice the reach around the ray.
-        let m = 2.0 * reach + self.tol;
-        let env = AABB::from_corners(
-            [vx.start.x.min(end.x) - m, vx.start.y.min(end.y) - m],
-            [vx.start.x.max(end.x) + m, vx.start.y.max(end.y) + m],
-        );
-        let lines = self
-            .tree
-            .locate_in_envelope_intersecting(&env)
-            .map(|g| LineId(g.data));
-        self.candidates[z.0 as usize] = split_candidates(&self.w, z, lines, t_max, self.tol);
+        self.candidates[z.0 as usize] = match self.search {
+            Search::Near(factor) => {
+                // Faces of edges whose ends are reflex widen away from the
+                // edge: search a margin proportional to the reach.
+                let end = vx.start + dir * reach;
+                let m = factor * reach + self.tol;
+                let env = AABB::from_corners(
+                    [vx.start.x.min(end.x) - m, vx.start.y.min(end.y) - m],
+                    [vx.start.x.max(end.x) + m, vx.start.y.max(end.y) + m],
+                );
+                let lines = self
+                    .tree
+                    .locate_in_envelope_intersecting(&env)
+                    .map(|g| LineId(g.data));
+                split_candidates(&self.w, z, lines, t_max, self.tol)
+            }
+            Search::All => {
+                let lines = (0..self.w.lines.len() as u32).map(LineId);
+                split_candidates(&self.w, z, lines, t_max, self.tol)
+            }
+        };
     }
 
     fn push_candidate(&mut self, v: VertexId, i: u32) {
@@ -480,18 +518,25 @@ impl<'a> Propagation<'a> {
     }
 }
 
-/// The straight skeleton of `polygon` and the propagation's counts.
-pub fn straight_skeleton_with_stats(
-    polygon: &PreparedPolygon,
-) -> Result<(SkeletonGraph, Stats), MethodError> {
+/// One propagation with the given split-candidate search, verified.
+fn propagate(polygon: &PreparedPolygon, search: Search) -> Result<(Vec<Arc>, Stats), MethodError> {
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        Propagation::new(polygon).run()
+        Propagation::new(polygon, search).run()
     }));
     let (arcs, stats) = match result {
         Ok(r) => r?,
         Err(_) => return Err(fail("internal error (panic) in the straight skeleton")),
     };
-    // Last line of defence: a missed event shows as a trace leaving P.
+    verify(polygon, &arcs)?;
+    Ok((arcs, stats))
+}
+
+/// Checks that hold for every straight skeleton and that a missed split
+/// event breaks: every trace stays in P and no two traces cross (a vertex
+/// that ran through a wavefront edge leaves its face, so its trace crosses
+/// the traces bounding that face or leaves P). Crossings closer than
+/// `1e-6 · extent` to an end of either trace are rounding, not misses.
+fn verify(polygon: &PreparedPolygon, arcs: &[Arc]) -> Result<(), MethodError> {
     let tol = 1e-6 * polygon.extent();
     if let Some(a) = arcs
         .iter()
@@ -502,6 +547,82 @@ pub fn straight_skeleton_with_stats(
             a.to.x, a.to.y
         )));
     }
+    let tree: EdgeTree = RTree::bulk_load(
+        arcs.iter()
+            .enumerate()
+            .filter(|(_, a)| a.from != a.to)
+            .map(|(i, a)| {
+                GeomWithData::new(RLine::new([a.from.x, a.from.y], [a.to.x, a.to.y]), i as u32)
+            })
+            .collect(),
+    );
+    for (i, a) in arcs.iter().enumerate() {
+        let env = AABB::from_corners(
+            [a.from.x.min(a.to.x), a.from.y.min(a.to.y)],
+            [a.from.x.max(a.to.x), a.from.y.max(a.to.y)],
+        );
+        for g in tree.locate_in_envelope_intersecting(&env) {
+            let b = &arcs[g.data as usize];
+            if (g.data as usize) > i {
+                if let Some(x) = crossing(a.from, a.to, b.from, b.to, tol) {
+                    return Err(fail(format!(
+                        "straight skeleton traces cross near ({}, {}) (a missed split event)",
+                        x.x, x.y
+                    )));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The point where segments `pq` and `ab` cross, when it is farther than
+/// `tol` from all four ends and neither segment lies within `tol` of the
+/// other's line (near-collinear overlaps, as collapsed strips of nearly
+/// parallel banks give, are rounding too).
+fn crossing(
+    p: Coord<f64>,
+    q: Coord<f64>,
+    a: Coord<f64>,
+    b: Coord<f64>,
+    tol: f64,
+) -> Option<Coord<f64>> {
+    if !crate::geometry::boundary::properly_cross(p, q, a, b) {
+        return None;
+    }
+    let (d, e) = (q - p, b - a);
+    let den = wavefront::cross(d, e);
+    if den == 0.0 {
+        return None;
+    }
+    let s = wavefront::cross(a - p, e) / den;
+    let x = p + d * s;
+    let far = |c: Coord<f64>| (c - x).x.hypot((c - x).y) > tol;
+    let off = |u: Coord<f64>, v: Coord<f64>, c: Coord<f64>| {
+        let w = v - u;
+        wavefront::cross(w, c - u).abs() / w.x.hypot(w.y)
+    };
+    let apart = off(p, q, a).max(off(p, q, b)) > tol && off(a, b, p).max(off(a, b, q)) > tol;
+    (apart && far(p) && far(q) && far(a) && far(b)).then_some(x)
+}
+
+/// The straight skeleton of `polygon` and the propagation's counts.
+///
+/// The first pass takes split candidates from edges near each reflex
+/// vertex's path; when its result fails verification (no collapse,
+/// a trace outside P, crossing traces), wider passes follow, the last
+/// one exhaustive.
+pub fn straight_skeleton_with_stats(
+    polygon: &PreparedPolygon,
+) -> Result<(SkeletonGraph, Stats), MethodError> {
+    let mut result = Err(fail("no search pass"));
+    for search in SEARCH_PASSES {
+        result = propagate(polygon, search);
+        if result.is_ok() {
+            break;
+        }
+    }
+    let (arcs, stats) = result?;
     let mut b = GraphBuilder::new();
     for a in &arcs {
         if b.segment(a.from, a.to).is_some() {
@@ -554,5 +675,46 @@ mod tests {
         assert_eq!(g.leg_count(), 4);
         assert_eq!(g.components(), 1);
         assert!((g.total_length() - (8.0 + 4.0 * 2f64.sqrt())).abs() < 1e-9);
+    }
+
+    fn c(x: f64, y: f64) -> Coord<f64> {
+        Coord { x, y }
+    }
+
+    #[test]
+    fn verification_rejects_crossing_traces_only() {
+        let pp = PreparedPolygon::new(
+            &polygon![(x: 0., y: 0.), (x: 10., y: 0.), (x: 10., y: 10.), (x: 0., y: 10.)],
+        )
+        .unwrap();
+        let arc = |a: Coord<f64>, b: Coord<f64>| Arc {
+            from: a,
+            from_t: 0.0,
+            to: b,
+            to_t: 1.0,
+        };
+        // The X of the square: traces meet at their ends only.
+        let x = [
+            arc(c(0., 0.), c(5., 5.)),
+            arc(c(10., 0.), c(5., 5.)),
+            arc(c(10., 10.), c(5., 5.)),
+            arc(c(0., 10.), c(5., 5.)),
+        ];
+        assert!(verify(&pp, &x).is_ok());
+        // A trace running through a neighbour's trace is a missed event.
+        let mut bad = x;
+        bad[0].to = c(7., 4.);
+        assert!(verify(&pp, &bad).is_err());
+        // A trace leaving P.
+        bad = x;
+        bad[0].to = c(-1., 5.);
+        assert!(verify(&pp, &bad).is_err());
+        // Two nearly collinear overlapping traces (a collapsed strip) are
+        // rounding, not a crossing.
+        let strip = [
+            arc(c(1., 5.), c(6., 5.)),
+            arc(c(8., 5.0 + 1e-9), c(4., 5.0 - 1e-9)),
+        ];
+        assert!(verify(&pp, &strip).is_ok());
     }
 }
