@@ -281,7 +281,7 @@ pub fn score_external(job: &ScoreJob, keep_bars: bool) -> Result<RunSummary, Run
             }),
         }
     }
-    writer.write_batch(&rows, &[], &bars, &rejected)?;
+    writer.write_batch(&rows, &[], &bars, &[], &rejected)?;
     let elapsed_s = clock.elapsed().as_secs_f64();
     let record = RunRecord {
         name: format!("score {}", job.label),

@@ -7,7 +7,8 @@
 use crate::config::{OnError, Pipeline};
 use crate::io::reader::{InputFeature, Reader};
 use crate::io::writer::{
-    check_output, BarRow, CandidateRow, RejectedRow, RunRecord, ScoreColumns, SkeletonRow, Writer,
+    check_output, BarRow, CandidateRow, RejectedRow, RunRecord, ScoreColumns, SkeletonRow,
+    WidthRow, Writer,
 };
 use crate::io::IoError;
 use crate::process::{process, ProcessParams, Processed};
@@ -95,6 +96,7 @@ struct Rows {
     skeletons: Vec<SkeletonRow>,
     candidates: Vec<CandidateRow>,
     bars: Vec<BarRow>,
+    widths: Vec<WidthRow>,
     rejected: Vec<RejectedRow>,
     filtered: bool,
 }
@@ -138,6 +140,13 @@ fn feature_rows(f: &InputFeature, params: &ProcessParams, p: &Pipeline) -> Rows 
                     repaired: f.repaired,
                 });
                 any_written = true;
+                rows.widths.extend(chosen.widths.iter().map(|w| WidthRow {
+                    src_fid: f.fid,
+                    method: method.to_string(),
+                    geometry: w.line,
+                    width_start: w.width_start(),
+                    width_end: w.width_end(),
+                }));
                 for (i, c) in o.candidates.iter().enumerate() {
                     if p.file.output.candidates {
                         rows.candidates.push(CandidateRow {
@@ -246,6 +255,7 @@ pub fn run(p: &Pipeline, opts: &RunOptions) -> Result<RunSummary, RunError> {
         let mut ca = Vec::new();
         let mut ba = Vec::new();
         let mut rj = Vec::new();
+        let mut wi = Vec::new();
         for (f, r) in features.iter().zip(rows) {
             if p.file.on_error == OnError::Fail {
                 if let Some(rej) = r.rejected.first() {
@@ -278,8 +288,9 @@ pub fn run(p: &Pipeline, opts: &RunOptions) -> Result<RunSummary, RunError> {
             ca.extend(r.candidates);
             ba.extend(r.bars);
             rj.extend(r.rejected);
+            wi.extend(r.widths);
         }
-        writer.write_batch(&sk, &ca, &ba, &rj)?;
+        writer.write_batch(&sk, &ca, &ba, &wi, &rj)?;
         bar.inc(features.len() as u64);
         Ok(())
     });

@@ -6,6 +6,7 @@
 use crate::geometry::PreparedPolygon;
 use crate::graph::extend::{extend, ExtendParams};
 use crate::graph::prune::{prune, PruneParams};
+use crate::methods::medial_axis::{medial_axis_transform, MatSegment};
 use crate::methods::{build, MethodId, SkeletonParams};
 use crate::score::select::{select, SelectParams};
 use crate::score::{bars, metrics, Bar, ScoreParams, Scores};
@@ -51,6 +52,8 @@ pub struct ProcessParams {
     pub select: Option<SelectParams>,
     /// Keep every bar (for the diagnostic `bars` layer).
     pub keep_bars: bool,
+    /// Keep the local widths of the skeleton (for the `widths` layer).
+    pub keep_widths: bool,
 }
 
 /// One method's result for one feature.
@@ -77,6 +80,9 @@ pub struct CandidateSkeleton {
     pub legs: usize,
     /// Bars, when requested (`part` indices are unique across polygon parts).
     pub bars: Vec<Bar>,
+    /// The skeleton's segments with the disc radius at both ends (the medial
+    /// axis transform for MA), when requested.
+    pub widths: Vec<MatSegment>,
 }
 
 /// What the pipeline writes for one feature.
@@ -259,6 +265,7 @@ fn run_method(
     let method = build(m, &params.skeleton);
     let mut lines = Vec::new();
     let mut all_bars = Vec::new();
+    let mut widths = Vec::new();
     let (mut components, mut legs_raw, mut legs) = (0, 0, 0);
     let mut part_offset = 0;
     for (i, p) in parts.iter().enumerate() {
@@ -290,6 +297,9 @@ fn run_method(
             part_offset += n_parts;
             all_bars.extend(b);
         }
+        if params.keep_widths {
+            widths.extend(medial_axis_transform(&g, Some(p.boundary())));
+        }
         lines.extend(g.to_multilinestring().0);
     }
     let scores = params.score.map(|_| metrics(&all_bars));
@@ -303,6 +313,7 @@ fn run_method(
         legs_raw,
         legs,
         bars: all_bars,
+        widths,
     })
 }
 

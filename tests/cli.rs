@@ -30,9 +30,13 @@ fn demo_pipeline_runs_and_writes_every_layer() {
         l.features().map(|f| f.fid().map(|x| x as i64)).collect()
     };
     assert_eq!(ints(&ds, "skeletons", "src_fid"), source_fids);
-    assert!(strings(&ds, "skeletons", "method")
-        .iter()
-        .all(|m| m.as_deref() == Some("CDT")));
+    let methods = strings(&ds, "skeletons", "method");
+    assert!(
+        methods
+            .iter()
+            .all(|m| ["MA", "StSk", "DVD", "CDT", "VD"].contains(&m.as_deref().unwrap_or(""))),
+        "{methods:?}"
+    );
     assert!(wkts(&ds, "skeletons").iter().all(|w| w
         .as_deref()
         .is_some_and(|w| w.starts_with("MULTILINESTRING"))));
@@ -51,7 +55,24 @@ fn demo_pipeline_runs_and_writes_every_layer() {
         .unwrap()
         .contains("name: demo"));
     assert_eq!(count(&ds, "rejected"), 0);
-    assert_eq!(count(&ds, "candidates"), 17);
+    assert_eq!(count(&ds, "candidates"), 17 * 5);
+    // Every feature has exactly one chosen candidate, and it is the method written.
+    assert_eq!(
+        ints(&ds, "candidates", "chosen")
+            .iter()
+            .filter(|c| **c == Some(1))
+            .count(),
+        17
+    );
+    // The widths layer: the chosen skeletons segment by segment with positive widths.
+    assert!(count(&ds, "widths") > 17);
+    assert!(reals(&ds, "widths", "width")
+        .iter()
+        .all(|w| w.is_some_and(|w| w >= 0.0)));
+    // Scores are written and the distortion is in [0, 1].
+    assert!(reals(&ds, "skeletons", "distortion")
+        .iter()
+        .all(|z| z.is_some_and(|z| (0.0..=1.0).contains(&z))));
 }
 
 #[test]

@@ -122,6 +122,7 @@ impl Pipeline {
             }
         }
         p.keep_bars = self.file.output.bars;
+        p.keep_widths = self.file.output.widths;
         p
     }
 
@@ -319,6 +320,9 @@ fn validate(f: &PipelineFile, _locs: &Locations) -> Result<(), (String, String)>
                     }
                     _ => {}
                 }
+                p.arc_tolerance
+                    .validate()
+                    .map_err(|m| (at("arc_tolerance"), m))?;
                 let _ = sk;
             }
             Step::Prune(p) => {

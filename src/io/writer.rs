@@ -44,6 +44,11 @@ pub struct OutputSpec {
     /// One row per polygon part instead of per feature.
     #[serde(default)]
     pub explode: bool,
+    /// Also write the chosen skeleton segment by segment with the local width
+    /// of the polygon (2 × disc radius) at both ends (layer `widths`): the
+    /// medial axis transform, for deciding what is narrow enough to collapse.
+    #[serde(default)]
+    pub widths: bool,
 }
 
 /// The metric columns of `skeletons` and `candidates`.
@@ -132,6 +137,21 @@ pub struct BarRow {
     pub z: Option<f64>,
     /// Part index.
     pub part: Option<i64>,
+}
+
+/// One row of the `widths` layer.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WidthRow {
+    /// Source FID.
+    pub src_fid: Option<u64>,
+    /// Method id.
+    pub method: String,
+    /// The segment.
+    pub geometry: geo::Line<f64>,
+    /// Width (2 r) at the start.
+    pub width_start: f64,
+    /// Width (2 r) at the end.
+    pub width_end: f64,
 }
 
 /// One row of the `rejected` layer.
@@ -413,6 +433,16 @@ impl Writer {
                 }
                 field(&l, "part", OGRFieldType::OFTInteger64)?;
             }
+            if spec.widths {
+                let l = ds
+                    .create_layer(opts("widths", srs, OGRwkbGeometryType::wkbLineString))
+                    .map_err(|e| IoError::gdal("creating layer `widths`", e))?;
+                field(&l, "src_fid", OGRFieldType::OFTInteger64)?;
+                field(&l, "method", OGRFieldType::OFTString)?;
+                for n in ["width_start", "width_end", "width"] {
+                    field(&l, n, OGRFieldType::OFTReal)?;
+                }
+            }
             {
                 let l = ds
                     .create_layer(opts("rejected", srs, OGRwkbGeometryType::wkbUnknown))
@@ -470,6 +500,7 @@ impl Writer {
         skeletons: &[SkeletonRow],
         candidates: &[CandidateRow],
         bars: &[BarRow],
+        widths: &[WidthRow],
         rejected: &[RejectedRow],
     ) -> Result<(), IoError> {
         let layer_name = self.spec.layer.clone();
@@ -582,6 +613,27 @@ impl Writer {
                 set(&mut f, "part", r.part.and_then(int))?;
                 f.create(&l)
                     .map_err(|e| IoError::gdal("writing a bar", e))?;
+            }
+        }
+        if !widths.is_empty() {
+            let l = txn
+                .layer_by_name("widths")
+                .map_err(|e| IoError::gdal("opening `widths`", e))?;
+            for r in widths {
+                let mut f =
+                    Feature::new(l.defn()).map_err(|e| IoError::gdal("creating a feature", e))?;
+                f.set_geometry(to_gdal(&geo::LineString(vec![
+                    r.geometry.start,
+                    r.geometry.end,
+                ]))?)
+                .map_err(|e| IoError::gdal("setting a geometry", e))?;
+                set(&mut f, "src_fid", fid(r.src_fid))?;
+                set(&mut f, "method", text(&r.method))?;
+                set(&mut f, "width_start", real(r.width_start))?;
+                set(&mut f, "width_end", real(r.width_end))?;
+                set(&mut f, "width", real((r.width_start + r.width_end) / 2.0))?;
+                f.create(&l)
+                    .map_err(|e| IoError::gdal("writing a width", e))?;
             }
         }
         if !rejected.is_empty() {

@@ -140,8 +140,15 @@ impl From<DensifyParams> for crate::geometry::densify::Density {
     }
 }
 
+/// The paper's recommendation first: ties in selection go to the earlier method.
 fn default_methods() -> Vec<MethodId> {
-    vec![MethodId::Cdt]
+    vec![
+        MethodId::Ma,
+        MethodId::StSk,
+        MethodId::Dvd,
+        MethodId::Cdt,
+        MethodId::Vd,
+    ]
 }
 
 fn default_max_points() -> usize {
