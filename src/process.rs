@@ -257,6 +257,45 @@ fn invalidity(parts: &[PreparedPolygon]) -> Option<String> {
     None
 }
 
+/// Most prune → extend rounds: the first does the work, later ones only
+/// remove legs that turned out short once extended (rarely more than one).
+const MAX_PRUNE_ROUNDS: usize = 4;
+
+/// Prunes, extends, and — for the leg-removing modes — prunes again what the
+/// extension revealed as insignificant (a leg kept for the reach of what was
+/// cut behind its leaf can end up short once extended along its own
+/// direction), until stable. The result has every leaf on ∂P (with `ray` or
+/// `nearest`) and no leg insignificant by the SPEC rule.
+pub fn prune_and_extend(
+    raw: crate::graph::SkeletonGraph,
+    polygon: &PreparedPolygon,
+    pr: Option<&PruneParams>,
+    ex: Option<&ExtendParams>,
+) -> crate::graph::SkeletonGraph {
+    use crate::graph::prune::PruneMode;
+    let mut g = raw;
+    if let Some(pr) = pr {
+        g = prune(&g, pr);
+    }
+    if let Some(ex) = ex {
+        g = extend(&g, polygon, ex);
+        if let Some(pr) =
+            pr.filter(|p| matches!(p.mode, PruneMode::Significance | PruneMode::Length))
+        {
+            for _ in 1..MAX_PRUNE_ROUNDS {
+                let again = prune(&g, pr);
+                if again.edges().len() == g.edges().len()
+                    && again.total_length() == g.total_length()
+                {
+                    break;
+                }
+                g = extend(&again, polygon, ex);
+            }
+        }
+    }
+    g
+}
+
 fn run_method(
     m: MethodId,
     parts: &[PreparedPolygon],
@@ -277,13 +316,7 @@ fn run_method(
             }
         })?;
         legs_raw += raw.leg_count();
-        let mut g = raw;
-        if let Some(pr) = &params.prune {
-            g = prune(&g, pr);
-        }
-        if let Some(ex) = &params.extend {
-            g = extend(&g, p, ex);
-        }
+        let g = prune_and_extend(raw, p, params.prune.as_ref(), params.extend.as_ref());
         legs += g.leg_count();
         components += g.components();
         if params.score.is_some() {

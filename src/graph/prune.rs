@@ -24,7 +24,12 @@
 //!   leg goes too (j becomes a leaf): a leg is judged at the junction where
 //!   it met the rest of the skeleton, so losing a sibling does not rescue it.
 //!   This is what turns the medial axis of a rectangle (a centre segment and
-//!   four corner legs) into its centre segment. When both remaining branches
+//!   four corner legs) into its centre segment. A junction that becomes a
+//!   leaf this way keeps the *reach* of what was cut behind it (the larger
+//!   extent of the two legs), and a leg's length is always counted with the
+//!   reach of its leaf (`length(leg) + reach(ℓ)`, reach = r_ℓ for an original
+//!   leaf, 0 on ∂P): without it a long arm whose junctions are closer than two
+//!   radii apart would be eroded junction by junction down to a stub. When both remaining branches
 //!   are insignificant legs they are merged instead, so a component is never
 //!   reduced below a simple path (two leaves); a component that already is a
 //!   path keeps both ends, and legs of a component with cycles (a polygon with
@@ -198,6 +203,10 @@ struct Work<'a> {
     alive: Vec<bool>,
     adj: Vec<Vec<u32>>,
     keep: Vec<bool>,
+    /// How far the skeleton (with its discs) reached beyond each leaf before
+    /// pruning: r_ℓ for an original leaf, the extent of the legs removed
+    /// behind a junction that became a leaf.
+    reach: Vec<f64>,
 }
 
 /// Heap entry; ordered by (key, leaf x, leaf y, piece id).
@@ -234,6 +243,7 @@ impl<'a> Work<'a> {
             alive: Vec::new(),
             adj: vec![Vec::new(); graph.nodes().len()],
             keep: vec![true; graph.edges().len()],
+            reach: graph.nodes().iter().map(|n| n.radius.max(0.0)).collect(),
         };
         for (i, e) in graph.edges().iter().enumerate() {
             let len = graph.edge_length(EdgeId(i as u32));
@@ -321,13 +331,17 @@ impl<'a> Work<'a> {
         Some(id)
     }
 
+    /// Extent of leg `p` seen from its junction: its length plus the reach
+    /// of its leaf.
+    fn extent(&self, p: u32, leaf: u32) -> f64 {
+        self.pieces[p as usize].len + self.reach[leaf as usize]
+    }
+
     /// Piece `p` is a leg whose leaf is not `j` and which is insignificant
     /// when judged at `j` (radius r_j).
     fn insignificant_at(&self, p: u32, j: u32, params: &PruneParams) -> bool {
         let o = self.other(p, j);
-        o != j
-            && self.deg(o) == 1
-            && params.is_insignificant(self.pieces[p as usize].len, self.radius(j))
+        o != j && self.deg(o) == 1 && params.is_insignificant(self.extent(p, o), self.radius(j))
     }
 
     fn radius(&self, n: u32) -> f64 {
@@ -336,7 +350,7 @@ impl<'a> Work<'a> {
 
     fn entry(&self, p: u32, params: &PruneParams) -> Option<Entry> {
         let (leaf, j) = self.leg(p)?;
-        let len = self.pieces[p as usize].len;
+        let len = self.extent(p, leaf);
         let rj = self.radius(j);
         if !params.is_insignificant(len, rj) {
             return None;
@@ -362,9 +376,10 @@ fn prune_legs(graph: &SkeletonGraph, params: &PruneParams) -> SkeletonGraph {
         if !w.alive[e.piece as usize] {
             continue;
         }
-        let Some((_, j)) = w.leg(e.piece) else {
+        let Some((leaf, j)) = w.leg(e.piece) else {
             continue;
         };
+        let removed_extent = w.extent(e.piece, leaf);
         w.remove(e.piece);
         if w.deg(j) != 2 {
             continue;
@@ -378,6 +393,10 @@ fn prune_legs(graph: &SkeletonGraph, params: &PruneParams) -> SkeletonGraph {
             // The sibling leg insignificant at j goes too; j becomes a leaf
             // of the other branch, which may now be an insignificant leg.
             let (gone, stays) = if ia { (a, b) } else { (b, a) };
+            let gone_leaf = w.other(gone, j);
+            // j keeps the reach of what was cut behind it, so that a long
+            // arm is not eroded junction by junction.
+            w.reach[j as usize] = removed_extent.max(w.extent(gone, gone_leaf));
             w.remove(gone);
             Some(stays)
         } else {
