@@ -376,7 +376,13 @@ mod tests {
 
     #[test]
     fn rectangle_gets_a_cdt_skeleton() {
-        let p = ProcessParams::default();
+        let p = ProcessParams {
+            skeleton: SkeletonParams {
+                methods: vec![MethodId::Cdt],
+                ..Default::default()
+            },
+            ..Default::default()
+        };
         let r = process(
             Some(&Geometry::Polygon(
                 polygon![(x: 0., y: 0.), (x: 10., y: 0.), (x: 10., y: 2.), (x: 0., y: 2.)],
