@@ -7,8 +7,9 @@
 //! ```
 //!
 //! Writes `docs/img/skeletons-river.svg` and `docs/img/skeletons-island.svg`
-//! (polygon grey, skeleton red, one row per method). Methods that fail on a
-//! polygon are skipped, so the pictures can be regenerated as methods land.
+//! (polygon grey, skeleton red, one row per method; each caption gives the
+//! number of legs and the skeleton's distortion Z). Methods that fail on a
+//! polygon are skipped.
 
 use geo::{Area, Coord, Geometry, LineString, Polygon};
 use skeletonise::geometry::PreparedPolygon;
@@ -17,6 +18,7 @@ use skeletonise::graph::prune::{prune, PruneParams};
 use skeletonise::graph::SkeletonGraph;
 use skeletonise::io::read_layer_polygons;
 use skeletonise::methods::{build, MethodId, SkeletonParams};
+use skeletonise::score::{bars, metrics};
 use std::fmt::Write as _;
 
 /// Width of one panel in SVG units.
@@ -125,11 +127,13 @@ fn figure(polygon: &Polygon<f64>, layer: &str) -> Result<String, Box<dyn std::er
             .enumerate()
         {
             let (x0, y0) = (GAP + k as f64 * (pw + GAP), GAP + i as f64 * row_h);
+            let legs = g.leg_count();
+            let z = metrics(&bars(&p, g)).distortion;
             let _ = writeln!(
                 s,
-                r#"<text x="{x0:.1}" y="{:.1}">{layer} · {m} · {label} · {} legs</text>"#,
+                r#"<text x="{x0:.1}" y="{:.1}">{layer} · {m} · {label} · {legs} leg{} · Z {z:.4}</text>"#,
                 y0 + CAPTION - 4.0,
-                g.leg_count()
+                if legs == 1 { "" } else { "s" }
             );
             let _ = writeln!(
                 s,
