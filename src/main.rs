@@ -311,7 +311,7 @@ fn main() -> ExitCode {
             println!(
                 "\nSteps (in this order; only `skeleton` is required):\n  \
                  prepare   make_valid (bool, default true), min_area (CRS units², default 0)\n  \
-                 skeleton  methods (list, default [MA, StSk, DVD, CDT, VD]), densify ({{factor: k}} default 4 | {{spacing: d}}), max_points (default 2000000), arc_tolerance ({{relative: f}} default 0.01 | {{absolute: d}})\n  \
+                 skeleton  methods (list, default [MA, StSk, DVD, CDT, VD]), densify ({{factor: k}} default 4 | {{spacing: d}}), max_points (default 2000000), arc_tolerance ({{relative: f}} default 0.001 | {{absolute: d}})\n  \
                  prune     mode (significance | length | trunk | none), ratio (default 1.0), min_length (default 0)\n  \
                  extend    mode (ray | nearest | none)\n  \
                  score     (no options)\n  \

@@ -544,7 +544,7 @@ fn arc_tolerance_serde() {
     assert_eq!(t, ArcTolerance::Relative(0.05));
     let t: ArcTolerance = serde_json::from_str(r#"{"absolute": 2.5}"#).unwrap();
     assert_eq!(t, ArcTolerance::Absolute(2.5));
-    assert_eq!(ArcTolerance::default(), ArcTolerance::Relative(0.01));
+    assert_eq!(ArcTolerance::default(), ArcTolerance::Relative(0.001));
 }
 
 #[test]

@@ -297,15 +297,18 @@ const LAYERS: [&str; 5] = [
 /// within δ ≤ f·r of the true medial axis, where d_L = d_P = r, so
 /// |Δd| ≤ 2δ and z ≤ δ / (r − δ) ≤ f / (1 − f) for every bar.
 ///
-/// With a fine tolerance (f = 0.001, SPEC §6 "MA with a fine arc_tolerance
-/// scores Z ≈ 0") every part of every training polygon scores Z ≤ 0.001. With
-/// the default f = 0.01 the per-bar bound still holds, but Z itself reaches
+/// With the default f = 0.001 every part of every training polygon scores
+/// Z ≤ 0.001 (SPEC §6: "MA with a fine arc_tolerance scores Z ≈ 0"). A
+/// coarser f = 0.01 still keeps every bar within its bound, but Z reaches
 /// ~0.0013 on a few small islands with few vertices and long arcs (most of
-/// their bars hit chords), so the Z ≤ 0.001 claim is checked at the fine
-/// tolerance and the default is checked against its own bound.
+/// their bars hit chords), which is why the default is 0.001.
 #[test]
 fn raw_medial_axis_scores_zero_distortion_on_every_training_polygon() {
     use skeletonise::methods::medial_axis::ArcTolerance;
+    assert_eq!(
+        SkeletonParams::default().arc_tolerance,
+        ArcTolerance::Relative(0.001)
+    );
     for (f, z_max) in [(0.001, 0.001), (0.01, f64::INFINITY)] {
         let params = SkeletonParams {
             arc_tolerance: ArcTolerance::Relative(f),
@@ -427,13 +430,11 @@ fn straight_skeleton_equals_medial_axis_on_convex_polygons() {
 }
 
 /// A square rotated by 0.3 rad: its corners are right angles only up to
-/// rounding. Fails: the scores differ (Z 0.084 vs 0.076, both should be 0)
-/// although the two skeletons agree to 2e-8. The interior angle at some
-/// corners computes as a hair over 90°, so their vertex bars count as valid;
-/// such a bar runs along the adjacent edge and hits the skeleton's leaf at
-/// the next corner, where d_L ≈ d_P ≈ 1e-15 and z is rounding noise in [0, 1].
+/// rounding. A corner whose angle computes as a hair over 90° must not get a
+/// vertex bar (it would run along the adjacent edge and hit the skeleton's
+/// leaf at the next corner, where d_L ≈ d_P ≈ 0 and z is rounding noise), so
+/// both skeletons score Z = 0.
 #[test]
-#[ignore = "score::bars: vertex bars at corners within rounding of 90° are valid and score noise"]
 fn straight_skeleton_equals_medial_axis_on_a_rotated_square() {
     assert_stsk_equals_ma("rotated square", &regular(4, 10.0, 0.3, c(0.0, 0.0)));
 }

@@ -35,10 +35,16 @@ fn left_normal(d: Coord<f64>) -> Coord<f64> {
 /// `prev − v`; it is at most 90° exactly when `prev` lies in the closed
 /// quadrant left of and ahead of `next − v`.
 fn vertex_bar_valid(prev: Coord<f64>, v: Coord<f64>, next: Coord<f64>) -> bool {
+    let (a, b) = (next - v, prev - v);
     let left = orient(v, next, prev) >= 0.0;
-    let ahead = dot(next - v, prev - v) >= 0.0;
+    // A right angle computed with rounding (a rotated rectangle) must not
+    // count as obtuse: its bar would run along the next edge.
+    let ahead = dot(a, b) >= -RIGHT_ANGLE_TOLERANCE * a.x.hypot(a.y) * b.x.hypot(b.y);
     !(left && ahead)
 }
+
+/// Cosine below which (in absolute value) an interior angle counts as 90°.
+const RIGHT_ANGLE_TOLERANCE: f64 = 1e-9;
 
 /// The skeleton's segments in an R-tree, each tagged with its part.
 ///
@@ -192,6 +198,11 @@ fn cast(
         let nu = left_normal(sigma.b - sigma.a);
         let (_, d_left) = boundary.nearest_in_half_plane(q, nu)?;
         let (_, d_right) = boundary.nearest_in_half_plane(q, -nu)?;
+        // A hit on ∂P itself (a leaf at a corner reached along the boundary)
+        // has no sides to compare: it is a miss.
+        if d_left + d_right <= eps {
+            return None;
+        }
         Some(BarHit {
             point: q,
             d_left,
