@@ -483,3 +483,92 @@ fn score_subcommand_scores_another_tools_skeletons_by_key_and_by_location() {
     let z2 = reals(&open(&out), "skeletons", "distortion");
     assert_eq!(z, z2);
 }
+
+/// SPEC §11: huge coordinates, tiny and sliver polygons, touching rings,
+/// spikes and duplicate vertices go through every method without a panic and
+/// without losing a feature.
+#[test]
+fn awkward_polygons_go_through_every_method() {
+    let d = tmp();
+    let src = d.path().join("awkward.gpkg");
+    let wkts: &[Option<&str>] = &[
+        // Huge coordinates (1e7 and more): a 300 × 40 m strip.
+        Some("POLYGON ((12345678 23456789, 12345978 23456789, 12345978 23456829, 12345678 23456829, 12345678 23456789))"),
+        // Tiny: a 1 mm triangle.
+        Some("POLYGON ((0 0, 0.001 0, 0 0.001, 0 0))"),
+        // Sliver: 1000 m long, 1 mm wide.
+        Some("POLYGON ((0 0, 1000 0, 1000 0.001, 0 0.001, 0 0))"),
+        // A hole touching the exterior at one vertex.
+        Some("POLYGON ((0 0, 100 0, 100 100, 0 100, 0 0), (0 0, 40 20, 20 40, 0 0))"),
+        // A spike (invalid; repaired by make_valid).
+        Some("POLYGON ((0 0, 100 0, 100 50, 150 50, 100 50, 100 100, 0 100, 0 0))"),
+        // Duplicate consecutive vertices.
+        Some("POLYGON ((0 0, 100 0, 100 0, 100 30, 0 30, 0 30, 0 0))"),
+        // Nearly collinear vertices.
+        Some("POLYGON ((0 0, 50 0.0000001, 100 0, 100 30, 0 30, 0 0))"),
+    ];
+    make_layer(&src, "awkward", 32630, wkts);
+    let out = d.path().join("o.gpkg");
+    let extra = "  - prune: {}\n  - extend: {}\n  - score: {}\n  - select: {}\n";
+    let text = basic_pipeline(src.to_str().unwrap(), "awkward", &out, extra)
+        .replace("methods: [CDT]", "methods: [MA, StSk, DVD, CDT, VD]")
+        .replace("path: ", "candidates: true\n  path: ");
+    let p = pipeline(d.path(), "p.yaml", &text);
+    let (code, err) = code_and_err(&skeletonise(&["run", p.to_str().unwrap()]));
+    assert_eq!(code, 0, "{err}");
+    let ds = open(&out);
+    let (written, rejected) = (count(&ds, "skeletons"), count(&ds, "rejected"));
+    assert_eq!(written + rejected, wkts.len() as u64);
+    assert_eq!(rejected, 0, "{:?}", strings(&ds, "rejected", "reason"));
+    // Huge coordinates keep their precision: the strip's centre line is at y = 23456809.
+    let w = wkts_of(&ds, 1);
+    assert!(w.contains("23456809"), "{w}");
+    // Every method either succeeded or says why.
+    for (ok, e) in ints(&ds, "candidates", "chosen")
+        .iter()
+        .zip(strings(&ds, "candidates", "error"))
+    {
+        assert!(ok.is_some() && (e.is_none() || !e.unwrap().is_empty()));
+    }
+}
+
+fn wkts_of(ds: &gdal::Dataset, fid: i64) -> String {
+    let fids = ints(ds, "skeletons", "src_fid");
+    let i = fids.iter().position(|f| *f == Some(fid)).unwrap();
+    wkts(ds, "skeletons")[i].clone().unwrap()
+}
+
+/// SPEC §11: a polygon of a million vertices is processed (CDT) without
+/// running out of memory or time.
+#[test]
+fn a_polygon_of_a_million_vertices() {
+    let d = tmp();
+    let src = d.path().join("big.gpkg");
+    let n = 1_000_000;
+    let mut w = String::from("POLYGON ((");
+    for i in 0..=n {
+        let t = (i % n) as f64 / n as f64 * std::f64::consts::TAU;
+        let r = 1000.0 + 30.0 * (t * 50.0).sin() + 5.0 * (t * 3000.0).sin();
+        if i > 0 {
+            w.push(',');
+        }
+        w.push_str(&format!(
+            "{:.4} {:.4}",
+            500000.0 + 3.0 * r * t.cos(),
+            6000000.0 + r * t.sin()
+        ));
+    }
+    w.push_str("))");
+    make_layer(&src, "big", 32630, &[Some(&w)]);
+    let out = d.path().join("o.gpkg");
+    let p = pipeline(
+        d.path(),
+        "p.yaml",
+        &basic_pipeline(src.to_str().unwrap(), "big", &out, ""),
+    );
+    let (code, err) = code_and_err(&skeletonise(&["run", p.to_str().unwrap()]));
+    assert_eq!(code, 0, "{err}");
+    let ds = open(&out);
+    assert_eq!(count(&ds, "skeletons"), 1);
+    assert_eq!(count(&ds, "rejected"), 0);
+}
