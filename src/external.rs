@@ -11,10 +11,8 @@
 
 use crate::geometry::PreparedPolygon;
 use crate::io::reader::{InputFeature, InputSpec, Reader};
-use crate::io::writer::{
-    BarRow, OutputSpec, RejectedRow, RunRecord, ScoreColumns, SkeletonRow, Writer,
-};
-use crate::pipeline::{RunError, RunSummary};
+use crate::io::writer::{BarRow, OutputSpec, RejectedRow, RunRecord, SkeletonRow, Writer};
+use crate::pipeline::{columns, RunError, RunSummary};
 use crate::process::polygon_parts;
 use crate::score::{metrics, score_skeleton};
 use geo::{BoundingRect, Coord, Geometry, LineString, MultiLineString};
@@ -248,15 +246,7 @@ pub fn score_external(job: &ScoreJob, keep_bars: bool) -> Result<RunSummary, Run
                     attributes: f.attributes.clone(),
                     geometry: ml,
                     method: job.label.clone(),
-                    scores: Some(ScoreColumns {
-                        bars: s.bars as i64,
-                        hits: s.hits as i64,
-                        coverage: s.coverage,
-                        deviation: s.deviation,
-                        deviation_parts: s.deviation_parts,
-                        distortion_sum: s.distortion_sum,
-                        distortion: s.distortion,
-                    }),
+                    scores: Some(columns(&s)),
                     components: 0,
                     legs: 0,
                     repaired: false,

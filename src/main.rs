@@ -40,38 +40,60 @@ enum LogFormat {
     Json,
 }
 
+/// A pipeline file and what the command line overrides in it.
+#[derive(clap::Args)]
+struct PipelineArgs {
+    /// The pipeline file (YAML).
+    pipeline: PathBuf,
+    /// Override a key, e.g. `--set steps.prune.ratio=2` (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    set: Vec<String>,
+    /// Override `input.source`.
+    #[arg(short = 'i', long = "input", value_name = "SOURCE")]
+    input: Option<String>,
+    /// Override `output.path`.
+    #[arg(short = 'o', long = "output", value_name = "OUT.gpkg")]
+    output: Option<PathBuf>,
+}
+
+impl PipelineArgs {
+    /// Loads the file with the overrides; an invalid file logs and exits 78.
+    fn load(&self) -> Result<config::Pipeline, ExitCode> {
+        let mut ov = self.set.clone();
+        // Quoted so that any path survives YAML parsing as a string.
+        if let Some(i) = &self.input {
+            ov.push(format!(
+                "input.source={}",
+                serde_json::to_string(i).unwrap_or_default()
+            ));
+        }
+        if let Some(o) = &self.output {
+            ov.push(format!(
+                "output.path={}",
+                serde_json::to_string(&o.display().to_string()).unwrap_or_default()
+            ));
+        }
+        config::load(&self.pipeline, &ov).map_err(|e| {
+            tracing::error!("{e}");
+            ExitCode::from(EXIT_CONFIG)
+        })
+    }
+}
+
 #[derive(Subcommand)]
 enum Command {
     /// Run a pipeline file.
     Run {
-        /// The pipeline file (YAML).
-        pipeline: PathBuf,
-        /// Override a key, e.g. `--set steps.prune.ratio=2` (repeatable).
-        #[arg(long = "set", value_name = "KEY=VALUE")]
-        set: Vec<String>,
-        /// Override `input.source`.
-        #[arg(short = 'i', long = "input", value_name = "SOURCE")]
-        input: Option<String>,
-        /// Override `output.path`.
-        #[arg(short = 'o', long = "output", value_name = "OUT.gpkg")]
-        output: Option<PathBuf>,
+        #[command(flatten)]
+        file: PipelineArgs,
         /// Worker threads (default: one per core).
         #[arg(long)]
         threads: Option<usize>,
     },
     /// Check a pipeline file and its input without processing anything.
     Validate {
-        /// The pipeline file (YAML).
-        pipeline: PathBuf,
-        /// Override a key (repeatable).
-        #[arg(long = "set", value_name = "KEY=VALUE")]
-        set: Vec<String>,
-        /// Override `input.source`.
-        #[arg(short = 'i', long = "input", value_name = "SOURCE")]
-        input: Option<String>,
-        /// Override `output.path`.
-        #[arg(short = 'o', long = "output", value_name = "OUT.gpkg")]
-        output: Option<PathBuf>,
+        #[command(flatten)]
+        file: PipelineArgs,
     },
     /// Score skeletons made by any tool with the paper's metrics.
     Score {
@@ -139,31 +161,6 @@ fn init_logging(cli: &Cli) {
     }
 }
 
-fn overrides(set: &[String], input: &Option<String>, output: &Option<PathBuf>) -> Vec<String> {
-    let mut v = set.to_vec();
-    // Quoted so that any path survives YAML parsing as a string.
-    if let Some(i) = input {
-        v.push(format!(
-            "input.source={}",
-            serde_json::to_string(i).unwrap_or_default()
-        ));
-    }
-    if let Some(o) = output {
-        v.push(format!(
-            "output.path={}",
-            serde_json::to_string(&o.display().to_string()).unwrap_or_default()
-        ));
-    }
-    v
-}
-
-fn load(path: &std::path::Path, ov: &[String]) -> Result<config::Pipeline, ExitCode> {
-    config::load(path, ov).map_err(|e| {
-        tracing::error!("{e}");
-        ExitCode::from(EXIT_CONFIG)
-    })
-}
-
 fn run_error(e: RunError) -> ExitCode {
     tracing::error!("{e}");
     match e {
@@ -176,14 +173,8 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     init_logging(&cli);
     match &cli.command {
-        Command::Run {
-            pipeline: path,
-            set,
-            input,
-            output,
-            threads,
-        } => {
-            let p = match load(path, &overrides(set, input, output)) {
+        Command::Run { file, threads } => {
+            let p = match file.load() {
                 Ok(p) => p,
                 Err(c) => return c,
             };
@@ -219,13 +210,8 @@ fn main() -> ExitCode {
                 Err(e) => run_error(e),
             }
         }
-        Command::Validate {
-            pipeline: path,
-            set,
-            input,
-            output,
-        } => {
-            let p = match load(path, &overrides(set, input, output)) {
+        Command::Validate { file } => {
+            let p = match file.load() {
                 Ok(p) => p,
                 Err(c) => return c,
             };

@@ -78,7 +78,8 @@ pub fn validate(p: &Pipeline) -> Result<crate::io::SourceInfo, RunError> {
     Ok(reader.info().clone())
 }
 
-fn columns(s: &Scores) -> ScoreColumns {
+/// The score columns of an output row.
+pub fn columns(s: &Scores) -> ScoreColumns {
     ScoreColumns {
         bars: s.bars as i64,
         hits: s.hits as i64,
