@@ -572,3 +572,28 @@ fn a_polygon_of_a_million_vertices() {
     assert_eq!(count(&ds, "skeletons"), 1);
     assert_eq!(count(&ds, "rejected"), 0);
 }
+
+/// Any OGR data source string: a GeoPackage inside a zip archive, read through
+/// GDAL's `/vsizip/` virtual file system, and a layer chosen by index.
+#[test]
+fn reads_a_zipped_source_by_layer_index() {
+    let d = tmp();
+    let zip = d.path().join("demo.zip");
+    let status = std::process::Command::new("python3")
+        .args([
+            "-c",
+            "import sys, zipfile; zipfile.ZipFile(sys.argv[1], 'w').write(sys.argv[2], 'demo.gpkg')",
+            zip.to_str().unwrap(),
+            &root(DEMO),
+        ])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let out = d.path().join("o.gpkg");
+    let source = format!("/vsizip/{}/demo.gpkg", zip.display());
+    let text = basic_pipeline(&source, "0", &out, "");
+    let p = pipeline(d.path(), "p.yaml", &text);
+    let (code, err) = code_and_err(&skeletonise(&["run", p.to_str().unwrap()]));
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(count(&open(&out), "skeletons"), 17);
+}
