@@ -79,7 +79,7 @@ REPORT="$OUT/bench-ma.md"
   echo "# MA vs PostGIS ST_ApproximateMedialAxis"
   echo
   echo "$(date -u +%Y-%m-%dT%H:%MZ), $(nproc) CPUs ($(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')), load before start: $(cut -d' ' -f1-3 /proc/loadavg)"
-  echo "$PG_VERSIONS; skeletonise MA $(git rev-parse --short HEAD 2>/dev/null || echo '?') with boostvoronoi 0.12, arc_tolerance relative 0.01"
+  echo "$PG_VERSIONS; skeletonise MA $(git rev-parse --short HEAD 2>/dev/null || echo '?') with boostvoronoi 0.12, default arc_tolerance (relative 0.001)"
   echo
   echo "| layer | features | vertices | MA serial (s) | MA rayon (s) | PostGIS (s) | PostGIS failed | ratio serial | ratio rayon | MA peak RSS (MB) | PostGIS backend peak (MB) |"
   echo "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
