@@ -9,6 +9,8 @@
 //! The per-feature path ([`process`]) is pure Rust on owned [`geo`] types;
 //! GDAL is touched only by [`io`].
 
+#![warn(missing_docs)]
+
 pub mod config;
 pub mod external;
 pub mod geometry;
