@@ -49,7 +49,7 @@ fn fail(reason: impl Into<String>) -> MethodError {
 pub struct InsideTriangle {
     /// Corners (counter-clockwise), in polygon coordinates.
     pub corners: [Coord<f64>; 3],
-    /// `on_boundary[i]`: edge corners[i] → corners[(i+1)%3] is a boundary edge.
+    /// `on_boundary[i]`: the edge `corners[i]` → `corners[(i + 1) % 3]` lies on ∂P.
     pub on_boundary: [bool; 3],
 }
 
