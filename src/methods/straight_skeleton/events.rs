@@ -95,6 +95,11 @@ impl EventQueue {
     pub fn pop(&mut self) -> Option<Event> {
         self.heap.pop()
     }
+
+    /// Time of the earliest event, without removing it.
+    pub fn peek_time(&self) -> Option<f64> {
+        self.heap.peek().map(|e| e.t)
+    }
 }
 
 /// Time at which the edge `x → y` collapses, if it shrinks. Clamped to be

@@ -18,16 +18,22 @@
 //!   events (a reflex vertex reaches a non-adjacent wavefront edge) cut one
 //!   list into two, or join two lists — that is how holes merge with the
 //!   outer wavefront. Lists are re-linked through index handles only.
-//! * Degenerate cases: simultaneous events at one point become chains of
-//!   events at the same time joined by zero-length traces (merged by the
-//!   graph builder); a reflex vertex reaching another vertex (vertex event)
-//!   is a split whose new edge has zero length and collapses at once, or
-//!   grows; collinear consecutive edges give a vertex moving along the
-//!   common normal; two parallel edges meeting (a rectangle's long sides)
-//!   create a *fold* — a vertex between antiparallel coincident lines — which
-//!   is zipped up immediately towards the nearer neighbour, tracing the
-//!   collapsed strip's centre line; a list of two vertices is a collapsed
-//!   segment and one of three a collapsing triangle.
+//! * Degenerate cases: when an event pops, every other valid event within
+//!   `tol` of its time and within `tol · (1 + speed)` of its point (both
+//!   ends of an edge event) joins it in one *vertex event*: the involved
+//!   vertices end there, the wavefront edges their reflex vertices reach
+//!   are cut there, and the wavefront is re-linked around the point — one
+//!   new vertex per pair of an arriving line and the next leaving line
+//!   clockwise (edges between involved vertices have zero length and
+//!   vanish); a vertex made by an event does not split at once at a piece
+//!   end at its own point (that contact was part of the event); collinear
+//!   consecutive edges give a vertex moving along the common normal; two
+//!   parallel edges meeting (a rectangle's long sides) create a *fold* — a
+//!   vertex between antiparallel coincident lines — which is zipped up
+//!   immediately towards the nearer neighbour, tracing the collapsed
+//!   strip's centre line; a list of two vertices is a collapsed segment and
+//!   one of three a collapsing triangle (also when a vertex event leaves a
+//!   single vertex between its two lines: it ends at the event point).
 //! * Split candidates of a reflex vertex are looked up in an R-tree of the
 //!   original edges near its ray (bounded by where the ray leaves P),
 //!   sorted by time and validated against the current wavefront when
@@ -53,7 +59,9 @@
 //! ahead of a line, whether a fold's two neighbours are equally far. Input
 //! orientation is exact (normalised rings, robust predicates in
 //! [`crate::geometry`]); two lines are antiparallel (a fold) when
-//! `1 + n1·n2 < 1e-8`. Verification uses `1e-6 · extent`: a trace end
+//! `1 + n1·n2 < 1e-12` (nearly antiparallel lines keep a fast vertex, so
+//! their events fall at the right time). Verification uses
+//! `1e-6 · extent`: a trace end
 //! that far outside P, or two traces crossing that far from their ends and
 //! from each other's lines, rejects a pass.
 //!
@@ -277,11 +285,10 @@ impl<'a> Propagation<'a> {
             }
             match ev.kind {
                 EventKind::Edge { x, y } => {
-                    if !self.w.v(x).active || !self.w.v(y).active || self.w.v(x).next != y {
+                    if !self.edge_valid(x, y) {
                         continue;
                     }
                     self.now = self.now.max(ev.t);
-                    self.edge_event(x, y)?;
                 }
                 EventKind::Split { v, candidate } => {
                     if !self.w.v(v).active {
@@ -289,12 +296,14 @@ impl<'a> Propagation<'a> {
                     }
                     self.now = self.now.max(ev.t);
                     let c = self.candidates[v.0 as usize][candidate as usize];
-                    match self.find_piece(v, c.line) {
-                        Some(x) => self.split_event(v, x, c.line)?,
-                        None => self.push_candidate(v, candidate + 1),
+                    if self.find_piece(v, c.line).is_none() {
+                        self.push_candidate(v, candidate + 1);
+                        self.drain_work()?;
+                        continue;
                     }
                 }
             }
+            self.event_group(ev)?;
             self.drain_work()?;
             if let Some(p) = self.inconsistent {
                 return Err(fail(format!(
@@ -312,6 +321,220 @@ impl<'a> Propagation<'a> {
         }
         self.stats.vertices = self.w.vertices.len();
         Ok((self.arcs, self.stats))
+    }
+
+    fn edge_valid(&self, x: VertexId, y: VertexId) -> bool {
+        self.w.v(x).active && self.w.v(y).active && self.w.v(x).next == y
+    }
+
+    /// Whether vertex `v` is at `p` now, within `tol · (1 + speed)`.
+    fn at(&self, v: VertexId, p: Coord<f64>) -> bool {
+        let speed = self.w.v(v).vel.map_or(0.0, |s| s.x.hypot(s.y));
+        let d = self.w.pos(v, self.now) - p;
+        d.x.hypot(d.y) <= self.tol * (1.0 + speed)
+    }
+
+    /// Handles the valid event `ev` (popped at time `now`) together with
+    /// every other valid event within `tol` of the same time and point:
+    /// one event alone is an edge or split event, several form a vertex
+    /// event (see [`Self::vertex_event`]).
+    fn event_group(&mut self, ev: events::Event) -> Result<(), MethodError> {
+        let t0 = self.now;
+        let p0 = match ev.kind {
+            EventKind::Edge { x, y } => (self.w.pos(x, t0) + self.w.pos(y, t0)) * 0.5,
+            EventKind::Split { v, .. } => self.w.pos(v, t0),
+        };
+        let mut group = vec![ev];
+        let mut elsewhere = Vec::new();
+        while self.q.peek_time().is_some_and(|t| t <= t0 + self.tol) {
+            let Some(e) = self.q.pop() else { break };
+            let here = match e.kind {
+                EventKind::Edge { x, y } => {
+                    if !self.edge_valid(x, y) {
+                        continue;
+                    }
+                    self.at(x, p0) && self.at(y, p0)
+                }
+                EventKind::Split { v, .. } => {
+                    if !self.w.v(v).active {
+                        continue;
+                    }
+                    self.at(v, p0)
+                }
+            };
+            if here {
+                group.push(e);
+            } else {
+                elsewhere.push(e);
+            }
+        }
+        for e in elsewhere {
+            self.q.push(e.t, e.kind);
+        }
+        if group.len() > 1 && self.vertex_event(&group, p0)? {
+            return Ok(());
+        }
+        // A single event, or a group whose wavefront pieces do not form a
+        // consistent vertex event: the first event alone, the others later.
+        for e in &group[1..] {
+            self.q.push(e.t, e.kind);
+        }
+        match ev.kind {
+            EventKind::Edge { x, y } => self.edge_event(x, y),
+            EventKind::Split { v, candidate } => {
+                let c = self.candidates[v.0 as usize][candidate as usize];
+                match self.find_piece(v, c.line) {
+                    Some(x) => self.split_event(v, x, c.line),
+                    None => {
+                        self.push_candidate(v, candidate + 1);
+                        Ok(())
+                    }
+                }
+            }
+        }
+    }
+
+    /// Several events at one time and point `p0`: every wavefront vertex
+    /// involved (and every neighbour already at `p0`) ends there, every
+    /// wavefront edge a reflex vertex reaches is cut at `p0`, and the
+    /// wavefront is re-linked around `p0`. Each maximal chain of involved
+    /// consecutive vertices (or a cut edge) arrives along one line and
+    /// leaves along another; sorted by angle around `p0`, arriving and
+    /// leaving directions alternate, and each arriving line is joined to
+    /// the next leaving line clockwise by one new vertex (none when both
+    /// are the same line). Edges between involved vertices have zero
+    /// length and vanish. Returns `false` (and changes nothing) when the
+    /// directions do not alternate.
+    fn vertex_event(
+        &mut self,
+        group: &[events::Event],
+        p0: Coord<f64>,
+    ) -> Result<bool, MethodError> {
+        let t0 = self.now;
+        let mut inv: Vec<VertexId> = Vec::new();
+        let mut cuts: Vec<(VertexId, LineId)> = Vec::new();
+        let mut next_candidates = Vec::new();
+        for e in group {
+            match e.kind {
+                EventKind::Edge { x, y } => inv.extend([x, y]),
+                EventKind::Split { v, candidate } => {
+                    let mut i = candidate as usize;
+                    let mut hit = false;
+                    while let Some(&c) = self.candidates[v.0 as usize].get(i) {
+                        if i > candidate as usize && c.t > t0 + self.tol {
+                            break;
+                        }
+                        if let Some(x) = self.find_piece(v, c.line) {
+                            hit = true;
+                            let y = self.w.v(x).next;
+                            if self.at(x, p0) {
+                                inv.push(x);
+                            } else if self.at(y, p0) {
+                                inv.push(y);
+                            } else {
+                                cuts.push((x, c.line));
+                            }
+                        }
+                        i += 1;
+                    }
+                    if hit {
+                        inv.push(v);
+                    } else {
+                        next_candidates.push((v, i as u32));
+                    }
+                }
+            }
+        }
+        let mut k = 0;
+        while k < inv.len() {
+            let u = inv[k];
+            for n in [self.w.v(u).prev, self.w.v(u).next] {
+                if !inv.contains(&n) && self.at(n, p0) {
+                    inv.push(n);
+                }
+            }
+            k += 1;
+        }
+        inv.sort_unstable();
+        inv.dedup();
+        cuts.sort_unstable_by_key(|c| c.0);
+        cuts.dedup_by_key(|c| c.0);
+        let is_inv = |v: VertexId| inv.binary_search(&v).is_ok();
+        cuts.retain(|c| !is_inv(c.0) && !is_inv(self.w.v(c.0).next));
+        // (arriving line, leaving line, vertex before, vertex after)
+        let mut chains: Vec<(LineId, LineId, VertexId, VertexId)> = Vec::new();
+        for &u in &inv {
+            let pred = self.w.v(u).prev;
+            if is_inv(pred) {
+                continue;
+            }
+            let mut w = u;
+            while is_inv(self.w.v(w).next) {
+                w = self.w.v(w).next;
+            }
+            chains.push((self.w.v(u).left, self.w.v(w).right, pred, self.w.v(w).next));
+        }
+        for &(x, l) in &cuts {
+            chains.push((l, l, x, self.w.v(x).next));
+        }
+        let angle = |d: Coord<f64>| d.y.atan2(d.x);
+        // (angle, leaving, chain)
+        let mut rays: Vec<(f64, bool, usize)> = Vec::with_capacity(2 * chains.len());
+        for (i, &(a, b, _, _)) in chains.iter().enumerate() {
+            rays.push((angle(self.w.line(a).dir * -1.0), false, i));
+            rays.push((angle(self.w.line(b).dir), true, i));
+        }
+        let mut pairs = None;
+        for leaving_first in [true, false] {
+            rays.sort_by(|r, s| {
+                r.0.total_cmp(&s.0).then(if leaving_first {
+                    s.1.cmp(&r.1)
+                } else {
+                    r.1.cmp(&s.1)
+                })
+            });
+            let m = rays.len();
+            if (0..m).all(|i| rays[i].1 != rays[(i + 1) % m].1) {
+                pairs = Some(
+                    (0..m)
+                        .filter(|&i| !rays[i].1)
+                        .map(|i| (rays[i].2, rays[(i + m - 1) % m].2))
+                        .collect::<Vec<_>>(),
+                );
+                break;
+            }
+        }
+        let Some(pairs) = pairs else {
+            return Ok(false);
+        };
+        for (v, i) in next_candidates {
+            self.push_candidate(v, i);
+        }
+        for &u in &inv {
+            self.finish(u, p0);
+        }
+        for (i, j) in pairs {
+            let (a, _, pred, _) = chains[i];
+            let (_, b, _, succ) = chains[j];
+            if pred == succ && a != b {
+                // A triangle collapses to the event point.
+                self.finish(pred, p0);
+            } else if a == b {
+                self.w.link(pred, succ);
+                if pred == succ {
+                    // A single vertex left: settled (ended) from the work list.
+                    self.work.push(pred);
+                }
+                if let Some(te) = edge_collapse_time(&self.w, pred, succ, t0) {
+                    self.q.push(te, EventKind::Edge { x: pred, y: succ });
+                }
+            } else {
+                let m = self.new_vertex(p0, a, b)?;
+                self.w.link(pred, m);
+                self.w.link(m, succ);
+            }
+        }
+        Ok(true)
     }
 
     fn drain_work(&mut self) -> Result<(), MethodError> {
@@ -444,11 +667,15 @@ impl<'a> Propagation<'a> {
             let at_y = (py - p).x.hypot((py - p).y) <= tol;
             // Touching a zero-length piece, or a piece end that already
             // carries one of v's own lines, changes nothing: not a split.
-            let no_op = if at_y {
-                at_x || w.v(y).right == w.v(v).right
-            } else {
-                at_x && w.v(x).left == w.v(v).left
-            };
+            // A vertex made by an event touching a piece end at once: the
+            // event resolved that contact already.
+            let fresh = w.v(v).exact.is_none() && w.v(v).t0 >= t - tol;
+            let no_op = (fresh && (at_x || at_y))
+                || if at_y {
+                    at_x || w.v(y).right == w.v(v).right
+                } else {
+                    at_x && w.v(x).left == w.v(v).left
+                };
             if no_op {
                 return false;
             }

@@ -102,8 +102,10 @@ pub struct Vertex {
 }
 
 /// `1 + n1 · n2` below this makes two lines a fold (antiparallel): the
-/// vertex speed `sqrt(2 / (1 + n1·n2))` would exceed about 14 000.
-pub const FOLD_EPS: f64 = 1e-8;
+/// vertex speed `sqrt(2 / (1 + n1·n2))` would exceed about 1.4 million.
+/// Nearly antiparallel lines above it keep their (fast) vertex: zipping
+/// them up as a fold would end traces off their offset lines.
+pub const FOLD_EPS: f64 = 1e-12;
 
 /// `a · b`.
 pub fn dot(a: Coord<f64>, b: Coord<f64>) -> f64 {
