@@ -268,6 +268,11 @@ fn set(f: &mut Feature<'_>, name: &str, v: Option<FieldValue>) -> Result<(), IoE
     .map_err(|e| IoError::gdal(format!("setting field `{name}`"), e))
 }
 
+/// A 32-bit integer field value (counts, flags, part indices).
+fn small(v: i64) -> Option<FieldValue> {
+    i32::try_from(v).ok().map(FieldValue::IntegerValue)
+}
+
 fn int(v: i64) -> Option<FieldValue> {
     Some(FieldValue::Integer64Value(v))
 }
@@ -524,29 +529,13 @@ impl Writer {
                 }
                 set(&mut f, "src_fid", fid(r.src_fid))?;
                 if explode {
-                    set(
-                        &mut f,
-                        "part",
-                        r.part.map(|p| FieldValue::IntegerValue(p as i32)),
-                    )?;
+                    set(&mut f, "part", r.part.and_then(|p| small(p as i64)))?;
                 }
                 set(&mut f, "method", text(&r.method))?;
                 set_scores(&mut f, r.scores.as_ref())?;
-                set(
-                    &mut f,
-                    "components",
-                    Some(FieldValue::IntegerValue(r.components as i32)),
-                )?;
-                set(
-                    &mut f,
-                    "legs",
-                    Some(FieldValue::IntegerValue(r.legs as i32)),
-                )?;
-                set(
-                    &mut f,
-                    "repaired",
-                    Some(FieldValue::IntegerValue(r.repaired as i32)),
-                )?;
+                set(&mut f, "components", small(r.components as i64))?;
+                set(&mut f, "legs", small(r.legs as i64))?;
+                set(&mut f, "repaired", small(r.repaired as i64))?;
                 f.create(&l)
                     .map_err(|e| IoError::gdal("writing a skeleton", e))?;
             }
@@ -563,33 +552,13 @@ impl Writer {
                         .map_err(|e| IoError::gdal("setting a geometry", e))?;
                 }
                 set(&mut f, "src_fid", fid(r.src_fid))?;
-                set(
-                    &mut f,
-                    "part",
-                    r.part.map(|p| FieldValue::IntegerValue(p as i32)),
-                )?;
+                set(&mut f, "part", r.part.and_then(|p| small(p as i64)))?;
                 set(&mut f, "method", text(&r.method))?;
-                set(
-                    &mut f,
-                    "chosen",
-                    Some(FieldValue::IntegerValue(r.chosen as i32)),
-                )?;
+                set(&mut f, "chosen", small(r.chosen as i64))?;
                 set_scores(&mut f, r.scores.as_ref())?;
-                set(
-                    &mut f,
-                    "components",
-                    Some(FieldValue::IntegerValue(r.components as i32)),
-                )?;
-                set(
-                    &mut f,
-                    "legs_raw",
-                    Some(FieldValue::IntegerValue(r.legs_raw as i32)),
-                )?;
-                set(
-                    &mut f,
-                    "legs",
-                    Some(FieldValue::IntegerValue(r.legs as i32)),
-                )?;
+                set(&mut f, "components", small(r.components as i64))?;
+                set(&mut f, "legs_raw", small(r.legs_raw as i64))?;
+                set(&mut f, "legs", small(r.legs as i64))?;
                 set(&mut f, "error", r.error.as_deref().and_then(text))?;
                 f.create(&l)
                     .map_err(|e| IoError::gdal("writing a candidate", e))?;
