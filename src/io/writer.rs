@@ -533,8 +533,8 @@ impl Writer {
                 }
                 set(&mut f, "method", text(&r.method))?;
                 set_scores(&mut f, r.scores.as_ref())?;
-                set(&mut f, "components", small(r.components as i64))?;
-                set(&mut f, "legs", small(r.legs as i64))?;
+                set(&mut f, "components", small(r.components))?;
+                set(&mut f, "legs", small(r.legs))?;
                 set(&mut f, "repaired", small(r.repaired as i64))?;
                 f.create(&l)
                     .map_err(|e| IoError::gdal("writing a skeleton", e))?;
@@ -556,9 +556,9 @@ impl Writer {
                 set(&mut f, "method", text(&r.method))?;
                 set(&mut f, "chosen", small(r.chosen as i64))?;
                 set_scores(&mut f, r.scores.as_ref())?;
-                set(&mut f, "components", small(r.components as i64))?;
-                set(&mut f, "legs_raw", small(r.legs_raw as i64))?;
-                set(&mut f, "legs", small(r.legs as i64))?;
+                set(&mut f, "components", small(r.components))?;
+                set(&mut f, "legs_raw", small(r.legs_raw))?;
+                set(&mut f, "legs", small(r.legs))?;
                 set(&mut f, "error", r.error.as_deref().and_then(text))?;
                 f.create(&l)
                     .map_err(|e| IoError::gdal("writing a candidate", e))?;
