@@ -17,7 +17,7 @@
 use geo::{Geometry, MultiLineString};
 use skeletonise::geometry::PreparedPolygon;
 use skeletonise::graph::{extend::ExtendParams, prune::PruneParams};
-use skeletonise::io::{read_layer_polygons, InputSpec, LayerRef, Reader};
+use skeletonise::io::{read_layer_polygons, InputSpec, Reader};
 use skeletonise::methods::{MethodId, SkeletonParams};
 use skeletonise::process::{polygon_parts, process, ProcessParams, Processed};
 use skeletonise::score::{metrics, score_skeleton, Bar, ScoreParams, Scores};
@@ -46,13 +46,7 @@ fn read_skeletons(
 ) -> Result<Vec<MultiLineString<f64>>, Error> {
     let mut by_fid: HashMap<u64, MultiLineString<f64>> = HashMap::new();
     let mut in_order = Vec::new();
-    let mut r = Reader::open(&InputSpec {
-        source: source.into(),
-        layer: Some(LayerRef::Name(layer.into())),
-        where_: None,
-        bbox: None,
-        reproject: None,
-    })?;
+    let mut r = Reader::open(&InputSpec::layer(source, layer))?;
     let field = match fid_field {
         Some(name) => Some(
             r.info()

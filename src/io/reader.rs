@@ -53,6 +53,19 @@ pub struct InputSpec {
     pub reproject: Option<String>,
 }
 
+impl InputSpec {
+    /// A whole layer of a source by name: no filter, no reprojection.
+    pub fn layer(source: &str, layer: &str) -> Self {
+        Self {
+            source: source.into(),
+            layer: Some(LayerRef::Name(layer.into())),
+            where_: None,
+            bbox: None,
+            reproject: None,
+        }
+    }
+}
+
 /// An attribute value of a source feature, carried unchanged to the output.
 #[derive(Debug, Clone, PartialEq)]
 pub struct AttributeValue(pub(crate) Option<FieldValue>);
@@ -428,13 +441,7 @@ pub type FidGeometry = (Option<u64>, geo::Geometry<f64>);
 /// Reads every feature of one layer of a file as `(fid, geometry)`, skipping
 /// NULL geometries: for benchmarks, examples and tests.
 pub fn read_layer_polygons(source: &str, layer: &str) -> Result<Vec<FidGeometry>, IoError> {
-    let mut r = Reader::open(&InputSpec {
-        source: source.into(),
-        layer: Some(LayerRef::Name(layer.into())),
-        where_: None,
-        bbox: None,
-        reproject: None,
-    })?;
+    let mut r = Reader::open(&InputSpec::layer(source, layer))?;
     let mut out = Vec::new();
     r.read::<IoError>(1024, false, |batch| {
         out.extend(
