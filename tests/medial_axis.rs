@@ -1,6 +1,8 @@
 //! Method MA (medial axis transform): exact shapes, the analytic parabola,
 //! the invariants of SPEC §3, robustness cases and every training layer.
 
+mod common;
+use common::{LAYERS, TRAIN};
 use geo::{polygon, Coord, LineString, Polygon};
 use skeletonise::geometry::PreparedPolygon;
 use skeletonise::graph::{EdgeId, SkeletonGraph};
@@ -8,15 +10,6 @@ use skeletonise::methods::medial_axis::{
     medial_axis_transform, resolution, ArcTolerance, MedialAxis,
 };
 use skeletonise::methods::{MethodError, SkeletonMethod};
-
-const TRAIN: &str = "../shared/data/gshhg-train.gpkg";
-const LAYERS: [&str; 5] = [
-    "islands_hebrides",
-    "lakes_scotland",
-    "river_st_lawrence",
-    "river_danube",
-    "river_lena",
-];
 
 fn c(x: f64, y: f64) -> Coord<f64> {
     Coord { x, y }

@@ -1,6 +1,8 @@
 //! Pruning and leg extension (SPEC §4–§5): known answers on small shapes and
 //! the invariants on every training layer for every method that succeeds.
 
+mod common;
+use common::TRAIN;
 use geo::{Coord, LineString, Polygon};
 use skeletonise::geometry::PreparedPolygon;
 use skeletonise::graph::extend::{extend, ExtendMode, ExtendParams, ON_BOUNDARY};
@@ -8,8 +10,6 @@ use skeletonise::graph::prune::{insignificant_legs, prune, PruneMode, PruneParam
 use skeletonise::graph::{GraphBuilder, SkeletonGraph};
 use skeletonise::io::read_layer_polygons;
 use skeletonise::methods::{build, cdt::Cdt, MethodId, SkeletonMethod, SkeletonParams};
-
-const TRAIN: &str = "../shared/data/gshhg-train.gpkg";
 
 fn c(x: f64, y: f64) -> Coord<f64> {
     Coord { x, y }

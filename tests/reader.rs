@@ -1,8 +1,8 @@
 //! The reader on the real training data.
 
+mod common;
+use common::TRAIN;
 use skeletonise::io::{read_layer_polygons, InputSpec, IoError, LayerRef, Reader};
-
-const TRAIN: &str = "../shared/data/gshhg-train.gpkg";
 
 #[test]
 fn reads_every_training_layer_with_its_fields() {

@@ -2,6 +2,8 @@
 //! training layers scored for the CDT skeleton, the medial axis scoring Z ≈ 0
 //! on every training polygon, and StSk = MA on convex polygons.
 
+mod common;
+use common::{LAYERS, TRAIN};
 use geo::{AffineOps, AffineTransform, Coord, LineString, MultiLineString, Polygon};
 use proptest::prelude::*;
 use skeletonise::geometry::PreparedPolygon;
@@ -11,8 +13,6 @@ use skeletonise::methods::{build, cdt::Cdt, MethodId, SkeletonMethod, SkeletonPa
 use skeletonise::process::polygon_parts;
 use skeletonise::score::{bars, metrics, score_skeleton, Bar, Scores};
 use std::time::{Duration, Instant};
-
-const TRAIN: &str = "../shared/data/gshhg-train.gpkg";
 
 fn c(x: f64, y: f64) -> Coord<f64> {
     Coord { x, y }
@@ -281,14 +281,6 @@ fn training_layers_score_with_cdt() {
         );
     }
 }
-
-const LAYERS: [&str; 5] = [
-    "lakes_scotland",
-    "islands_hebrides",
-    "river_st_lawrence",
-    "river_danube",
-    "river_lena",
-];
 
 /// The paper: "If a spatial file of a skeleton created by the MA(T) method
 /// could contain parabolic sections, the skeleton itself would have a

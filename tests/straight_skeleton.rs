@@ -1,6 +1,7 @@
 //! Straight skeleton (StSk): known answers, validity invariants, property
 //! tests on random star-shaped polygons, and every training layer.
 
+mod common;
 use geo::{Coord, LineString, Polygon};
 use proptest::prelude::*;
 use skeletonise::geometry::PreparedPolygon;
@@ -347,8 +348,7 @@ fn every_training_layer() {
         "river_danube",
         "river_lena",
     ] {
-        let feats =
-            skeletonise::io::read_layer_polygons("../shared/data/gshhg-train.gpkg", layer).unwrap();
+        let feats = skeletonise::io::read_layer_polygons(common::TRAIN, layer).unwrap();
         let polys: Vec<Polygon<f64>> = feats
             .into_iter()
             .flat_map(|(_, g)| match g {
@@ -392,9 +392,7 @@ fn every_training_layer() {
 /// whose node times never exceed the radius.
 #[test]
 fn largest_lena_reach() {
-    let feats =
-        skeletonise::io::read_layer_polygons("../shared/data/gshhg-train.gpkg", "river_lena")
-            .unwrap();
+    let feats = skeletonise::io::read_layer_polygons(common::TRAIN, "river_lena").unwrap();
     let p = feats
         .into_iter()
         .flat_map(|(_, g)| match g {

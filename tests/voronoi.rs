@@ -1,5 +1,7 @@
 //! `VD` and `DVD` on the real training layers and on a long rectangle.
 
+mod common;
+use common::{LAYERS, TRAIN};
 use geo::{Coord, LineString, Polygon};
 use rayon::prelude::*;
 use skeletonise::geometry::{densify::Density, PreparedPolygon};
@@ -7,15 +9,6 @@ use skeletonise::graph::SkeletonGraph;
 use skeletonise::io::read_layer_polygons;
 use skeletonise::methods::{voronoi::Voronoi, MethodError, SkeletonMethod};
 use skeletonise::process::polygon_parts;
-
-const TRAIN: &str = "../shared/data/gshhg-train.gpkg";
-const LAYERS: [&str; 5] = [
-    "islands_hebrides",
-    "lakes_scotland",
-    "river_st_lawrence",
-    "river_danube",
-    "river_lena",
-];
 
 fn parts(layer: &str) -> Vec<PreparedPolygon> {
     read_layer_polygons(TRAIN, layer)

@@ -12,6 +12,15 @@ use std::process::{Command, Output};
 
 /// The training data shipped beside the project.
 pub const TRAIN: &str = "../shared/data/gshhg-train.gpkg";
+/// Every layer of the training data.
+pub const LAYERS: [&str; 5] = [
+    "islands_hebrides",
+    "lakes_scotland",
+    "river_st_lawrence",
+    "river_danube",
+    "river_lena",
+];
+
 /// The embedded demo data.
 pub const DEMO: &str = "examples/data/demo.gpkg";
 
