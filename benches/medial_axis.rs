@@ -10,7 +10,7 @@ use skeletonise::methods::medial_axis::{ArcTolerance, MedialAxis};
 use skeletonise::methods::SkeletonMethod;
 use std::time::Duration;
 
-const TRAIN: &str = "../shared/data/gshhg-train.gpkg";
+const TRAIN: &str = "tests/data/gshhg-train.gpkg";
 
 fn layer(name: &str) -> Vec<PreparedPolygon> {
     skeletonise::io::read_layer_polygons(TRAIN, name)

@@ -6,7 +6,7 @@ use skeletonise::methods::straight_skeleton::StraightSkeleton;
 use skeletonise::methods::SkeletonMethod;
 
 fn layer(name: &str) -> Vec<PreparedPolygon> {
-    skeletonise::io::read_layer_polygons("../shared/data/gshhg-train.gpkg", name)
+    skeletonise::io::read_layer_polygons("tests/data/gshhg-train.gpkg", name)
         .unwrap_or_default()
         .into_iter()
         .flat_map(|(_, g)| match g {

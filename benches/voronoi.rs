@@ -11,7 +11,7 @@ use skeletonise::process::polygon_parts;
 use std::hint::black_box;
 use std::time::Duration;
 
-const TRAIN: &str = "../shared/data/gshhg-train.gpkg";
+const TRAIN: &str = "tests/data/gshhg-train.gpkg";
 
 fn parts(layer: &str) -> Vec<PreparedPolygon> {
     read_layer_polygons(TRAIN, layer)

@@ -33,7 +33,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let source = args
         .get(1)
         .cloned()
-        .unwrap_or_else(|| "../shared/data/gshhg-train.gpkg".into());
+        .unwrap_or_else(|| "tests/data/gshhg-train.gpkg".into());
     let out_dir = args.get(2).cloned().unwrap_or_else(|| "docs/img".into());
     std::fs::create_dir_all(&out_dir)?;
     for (layer, name) in [

@@ -1,7 +1,7 @@
 //! Medial axis of every feature of one layer, in parallel; prints timings.
 //!
 //! ```text
-//! cargo run --release --example ma_layer -- ../shared/data/gshhg-train.gpkg river_lena [--serial]
+//! cargo run --release --example ma_layer -- tests/data/gshhg-train.gpkg river_lena [--serial]
 //! ```
 //!
 //! Reading is timed separately from the skeletonisation, so the numbers can

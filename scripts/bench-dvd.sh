@@ -11,7 +11,7 @@
 # target/bench-dvd/venv by this script; the crate itself never needs them.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-DATA=${1:-../shared/data/gshhg-train.gpkg}
+DATA=${1:-tests/data/gshhg-train.gpkg}
 LAYERS=${LAYERS:-"river_lena islands_hebrides"}
 WORK=target/bench-dvd
 mkdir -p "$WORK"

@@ -5,7 +5,7 @@
 #   scripts/bench-ma.sh [layer ...]        (default: river_lena river_st_lawrence islands_hebrides)
 #
 # Environment:
-#   DATA=../shared/data/gshhg-train.gpkg   input GeoPackage
+#   DATA=tests/data/gshhg-train.gpkg   input GeoPackage
 #   RUNS=3                                 runs of our MA per layer (the fastest is reported)
 #   PG_TIMEOUT=3600                        seconds allowed per PostGIS query
 #   PG_PORT=54329                          loopback port of the throw-away cluster
@@ -25,7 +25,7 @@
 set -euo pipefail
 
 cd "$(dirname "$0")/.."
-DATA=${DATA:-../shared/data/gshhg-train.gpkg}
+DATA=${DATA:-tests/data/gshhg-train.gpkg}
 RUNS=${RUNS:-3}
 PG_TIMEOUT=${PG_TIMEOUT:-3600}
 PG_PORT=${PG_PORT:-54329}

@@ -4,7 +4,7 @@
 # Needs: postgresql-15, postgresql-15-postgis-3 (with SFCGAL), gdal-bin, time.
 # Usage: scripts/bench-stsk.sh [gpkg] [layers...]   (run from the crate root, as root)
 set -euo pipefail
-GPKG=$(realpath "${1:-../shared/data/gshhg-train.gpkg}")
+GPKG=$(realpath "${1:-tests/data/gshhg-train.gpkg}")
 shift || true
 LAYERS=("$@")
 [ ${#LAYERS[@]} -eq 0 ] && LAYERS=(river_st_lawrence river_lena islands_hebrides)

@@ -7,7 +7,7 @@
 # env:   SKELETONISE_SRC=…gshhg-train.gpkg  OUT=target/compare-methods  LAYERS="…"  RESULTS=docs/results.md
 set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
-export SKELETONISE_SRC=$(realpath "${SKELETONISE_SRC:-$ROOT/../shared/data/gshhg-train.gpkg}")
+export SKELETONISE_SRC=$(realpath "${SKELETONISE_SRC:-$ROOT/tests/data/gshhg-train.gpkg}")
 OUT=${OUT:-$ROOT/target/compare-methods}
 LAYERS=${LAYERS:-"islands_hebrides lakes_scotland river_st_lawrence river_danube river_lena"}
 RESULTS=${RESULTS:-$ROOT/docs/results.md}

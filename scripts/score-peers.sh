@@ -9,7 +9,7 @@
 # env:   DATA=…gshhg-train.gpkg  OUT=target/score-peers  LAYERS="…"  RESULTS=docs/results.md
 set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
-DATA=${DATA:-$ROOT/../shared/data/gshhg-train.gpkg}
+DATA=${DATA:-$ROOT/tests/data/gshhg-train.gpkg}
 OUT=${OUT:-$ROOT/target/score-peers}
 LAYERS=${LAYERS:-"lakes_scotland islands_hebrides"}
 RESULTS=${RESULTS:-$ROOT/docs/results.md}

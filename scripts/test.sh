@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Sets up a fresh Debian/Ubuntu machine (with Rust) and runs every test: unit tests,
 # end-to-end tests through the real binary on real GeoPackage files, doc tests.
-# The training data is expected at ../shared/data (beside the repository).
+# The test data lives in tests/data (GSHHG, Wessel & Smith), so a fresh clone needs nothing beside it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/deps.sh

@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 /// The training data shipped beside the project.
-pub const TRAIN: &str = "../shared/data/gshhg-train.gpkg";
+pub const TRAIN: &str = "tests/data/gshhg-train.gpkg";
 /// Every layer of the training data.
 pub const LAYERS: [&str; 5] = [
     "islands_hebrides",
