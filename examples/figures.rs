@@ -1,6 +1,7 @@
 //! Writes the README pictures: one training river and one island, the raw
-//! skeleton of every method that succeeds beside the same skeleton after the
-//! default `prune` (significance) and `extend` (ray) steps.
+//! skeleton of every method that succeeds beside its final skeleton from the
+//! default pipeline (`prune`: significance, every method pruned to the
+//! medial axis's legs; `extend`: centred), as `skeletonise run` writes it.
 //!
 //! ```text
 //! cargo run --release --example figures [-- path/to/gshhg-train.gpkg [out_dir]]
@@ -13,12 +14,13 @@
 
 use geo::{Area, Coord, Geometry, LineString, Polygon};
 use skeletonise::geometry::PreparedPolygon;
-use skeletonise::graph::extend::{extend, ExtendParams};
-use skeletonise::graph::prune::{prune, PruneParams};
-use skeletonise::graph::SkeletonGraph;
+use skeletonise::graph::extend::ExtendParams;
+use skeletonise::graph::prune::PruneParams;
 use skeletonise::io::read_layer_polygons;
-use skeletonise::methods::{build, MethodId, SkeletonParams};
-use skeletonise::score::{bars, metrics};
+use skeletonise::methods::MethodId;
+use skeletonise::process::{process, ProcessParams, Processed};
+use skeletonise::score::select::SelectParams;
+use skeletonise::score::ScoreParams;
 use std::fmt::Write as _;
 
 /// Width of one panel in SVG units.
@@ -101,15 +103,32 @@ fn figure(polygon: &Polygon<f64>, layer: &str) -> Result<String, Box<dyn std::er
         .map(|r: &LineString<f64>| frame.path(&r.0, true))
         .collect();
 
-    let mut rows: Vec<(MethodId, SkeletonGraph, SkeletonGraph)> = Vec::new();
-    for m in MethodId::ALL {
-        match build(m, &SkeletonParams::default()).skeletonise(&p) {
-            Ok(raw) => {
-                let pruned = prune(&raw, &PruneParams::default());
-                let done = extend(&pruned, &p, &ExtendParams::default());
-                rows.push((m, raw, done));
-            }
-            Err(e) => eprintln!("{layer}: {m} skipped: {e}"),
+    // The default pipeline, and the same with neither prune nor extend.
+    let final_params = ProcessParams {
+        prune: Some(PruneParams::default()),
+        extend: Some(ExtendParams::default()),
+        score: Some(ScoreParams::default()),
+        select: Some(SelectParams::default()),
+        ..ProcessParams::default()
+    };
+    let raw_params = ProcessParams {
+        prune: None,
+        extend: None,
+        ..final_params.clone()
+    };
+    let geom = Geometry::Polygon(polygon.clone());
+    let run = |params: &ProcessParams| match process(Some(&geom), params) {
+        Processed::Done(o) => Ok(o),
+        other => Err(format!("{layer}: {other:?}")),
+    };
+    let (raw, done) = (run(&raw_params)?, run(&final_params)?);
+    type Row = (MethodId, Panel, Panel);
+    let mut rows: Vec<Row> = Vec::new();
+    for (r, d) in raw.candidates.iter().zip(&done.candidates) {
+        let dm = d.method;
+        match (&r.result, &d.result) {
+            (Ok(r), Ok(d)) => rows.push((dm, Panel::of(r), Panel::of(d))),
+            (Err(e), _) | (_, Err(e)) => eprintln!("{layer}: {} skipped: {e}", d.method),
         }
     }
 
@@ -127,8 +146,7 @@ fn figure(polygon: &Polygon<f64>, layer: &str) -> Result<String, Box<dyn std::er
             .enumerate()
         {
             let (x0, y0) = (GAP + k as f64 * (pw + GAP), GAP + i as f64 * row_h);
-            let legs = g.leg_count();
-            let z = metrics(&bars(&p, g)).distortion;
+            let (legs, z) = (g.legs, g.z);
             let _ = writeln!(
                 s,
                 r#"<text x="{x0:.1}" y="{:.1}">{layer} · {m} · {label} · {legs} leg{} · Z {z:.4}</text>"#,
@@ -144,11 +162,7 @@ fn figure(polygon: &Polygon<f64>, layer: &str) -> Result<String, Box<dyn std::er
                 s,
                 r##"<path d="{rings}" fill="#ddd" stroke="#999" stroke-width="0.5" fill-rule="evenodd"/>"##
             );
-            let lines: String = g
-                .branches()
-                .iter()
-                .map(|b| frame.path(&b.coords, false))
-                .collect();
+            let lines: String = g.lines.0.iter().map(|l| frame.path(&l.0, false)).collect();
             let _ = writeln!(
                 s,
                 r##"<path d="{lines}" fill="none" stroke="#d00" stroke-width="1" stroke-linejoin="round"/>"##
@@ -158,4 +172,21 @@ fn figure(polygon: &Polygon<f64>, layer: &str) -> Result<String, Box<dyn std::er
     }
     s.push_str("</svg>\n");
     Ok(s)
+}
+
+/// What one panel draws: a candidate's lines, legs and distortion.
+struct Panel {
+    lines: geo::MultiLineString<f64>,
+    legs: usize,
+    z: f64,
+}
+
+impl Panel {
+    fn of(c: &skeletonise::process::CandidateSkeleton) -> Self {
+        Self {
+            lines: c.geometry.clone(),
+            legs: c.legs,
+            z: c.scores.map_or(f64::NAN, |s| s.distortion),
+        }
+    }
 }

@@ -4,8 +4,8 @@
 //! thread count.
 
 use crate::geometry::PreparedPolygon;
-use crate::graph::extend::{extend, ExtendParams};
-use crate::graph::prune::{prune, PruneParams};
+use crate::graph::extend::{prune_and_extend, ExtendParams};
+use crate::graph::prune::PruneParams;
 use crate::methods::medial_axis::{medial_axis_transform, MatSegment};
 use crate::methods::{build, MethodId, SkeletonParams};
 use crate::score::select::{select, SelectParams};
@@ -198,45 +198,169 @@ pub fn process(geom: Option<&Geometry<f64>>, params: &ProcessParams) -> Processe
     if let Some(reason) = invalidity(&prepared) {
         return Processed::Rejected(reason);
     }
+    let multi = prepared.len() > 1;
+    let per_part: Vec<Vec<Result<PartSkeleton, String>>> = prepared
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            part_skeletons(p, params)
+                .into_iter()
+                .map(|r| r.map_err(|e| if multi { format!("part {i}: {e}") } else { e }))
+                .collect()
+        })
+        .collect();
     let candidates: Vec<Candidate> = params
         .skeleton
         .methods
         .par_iter()
-        .map(|&m| Candidate {
+        .enumerate()
+        .map(|(k, &m)| Candidate {
             method: m,
-            result: run_method(m, &prepared, params),
+            result: candidate(k, &prepared, &per_part, params),
         })
         .collect();
     let scores: Vec<Option<Scores>> = candidates
         .iter()
         .map(|c| match &c.result {
-            Ok(s) => Some(s.scores.unwrap_or_default()),
-            Err(_) => None,
+            Ok(s) if !s.geometry.0.is_empty() => Some(s.scores.unwrap_or_default()),
+            _ => None,
         })
         .collect();
     let chosen = match (&params.select, params.score.is_some()) {
         (Some(sel), true) => select(&scores, sel),
-        _ => scores.iter().position(Option::is_some),
-    };
+        _ => None,
+    }
+    .or_else(|| scores.iter().position(Option::is_some));
     match chosen {
         Some(chosen) => Processed::Done(FeatureOutcome {
             candidates,
             chosen,
             parts: prepared.len(),
         }),
-        None => Processed::Rejected(
-            candidates
-                .iter()
-                .filter_map(|c| {
-                    c.result
-                        .as_ref()
-                        .err()
-                        .map(|e| format!("{}: {e}", c.method))
-                })
-                .collect::<Vec<_>>()
-                .join("; "),
-        ),
+        None => Processed::Rejected(rejection(&candidates)),
     }
+}
+
+/// Why no candidate could be written.
+fn rejection(candidates: &[Candidate]) -> String {
+    let reasons: Vec<String> = candidates
+        .iter()
+        .map(|c| match &c.result {
+            Err(e) => format!("{}: {e}", c.method),
+            Ok(_) => format!("{}: empty skeleton", c.method),
+        })
+        .collect();
+    reasons.join("; ")
+}
+
+/// One method's finished skeleton of one polygon part.
+#[derive(Debug, Clone)]
+struct PartSkeleton {
+    graph: crate::graph::SkeletonGraph,
+    legs_raw: usize,
+}
+
+/// Every method's finished skeleton of one polygon part, in `methods`
+/// order: raw skeletons in parallel, then the reference pruned and extended,
+/// then the others pruned to its structure (or each on its own).
+fn part_skeletons(
+    p: &PreparedPolygon,
+    params: &ProcessParams,
+) -> Vec<Result<PartSkeleton, String>> {
+    use crate::graph::prune::{PruneMode, Structure as Sharing};
+    use crate::graph::structure::{conform, Structure};
+    let methods = &params.skeleton.methods;
+    let raws: Vec<Result<crate::graph::SkeletonGraph, String>> = methods
+        .par_iter()
+        .map(|&m| {
+            build(m, &params.skeleton)
+                .skeletonise(p)
+                .map_err(|e| e.to_string())
+        })
+        .collect();
+    let finish = |raw: &crate::graph::SkeletonGraph| {
+        prune_and_extend(raw, p, params.prune.as_ref(), params.extend.as_ref())
+    };
+    let shared = params
+        .prune
+        .filter(|pr| pr.mode != PruneMode::None && pr.structure == Sharing::Shared);
+    let reference = shared.and_then(|_| {
+        params.skeleton.reference_order().into_iter().find_map(|m| {
+            methods
+                .iter()
+                .position(|&x| x == m)
+                .filter(|&k| raws[k].is_ok())
+        })
+    });
+    let structure = reference.map(|k| {
+        let g = finish(raws[k].as_ref().expect("the reference succeeded"));
+        let trunk = params.prune.is_some_and(|pr| pr.mode == PruneMode::Trunk);
+        (k, Structure::of(&g, p, trunk), g)
+    });
+    raws.par_iter()
+        .enumerate()
+        .map(|(k, raw)| {
+            let raw = raw.as_ref().map_err(Clone::clone)?;
+            let g = match &structure {
+                Some((r, _, g)) if *r == k => g.clone(),
+                Some((_, s, _)) => conform(raw, s, p),
+                None => finish(raw),
+            };
+            Ok(PartSkeleton {
+                graph: g,
+                legs_raw: raw.leg_count(),
+            })
+        })
+        .collect()
+}
+
+/// Method `k`'s candidate over all polygon parts: scored, with bars and
+/// widths when asked for.
+fn candidate(
+    k: usize,
+    parts: &[PreparedPolygon],
+    per_part: &[Vec<Result<PartSkeleton, String>>],
+    params: &ProcessParams,
+) -> Result<CandidateSkeleton, String> {
+    let mut lines = Vec::new();
+    let mut all_bars = Vec::new();
+    let mut widths = Vec::new();
+    let (mut components, mut legs_raw, mut legs) = (0, 0, 0);
+    let mut part_offset = 0;
+    for (p, results) in parts.iter().zip(per_part) {
+        let part = results[k].as_ref().map_err(Clone::clone)?;
+        let g = &part.graph;
+        legs_raw += part.legs_raw;
+        legs += g.leg_count();
+        components += g.components();
+        if params.score.is_some() {
+            let mut b = bars(p, g);
+            for bar in &mut b {
+                if let Some(h) = &mut bar.hit {
+                    h.part += part_offset;
+                }
+            }
+            part_offset += g.branches().len();
+            all_bars.extend(b);
+        }
+        if params.keep_widths {
+            widths.extend(medial_axis_transform(g, Some(p.boundary())));
+        }
+        lines.extend(g.to_multilinestring().0);
+    }
+    let scores = params.score.map(|_| metrics(&all_bars));
+    if !params.keep_bars {
+        all_bars.clear();
+    }
+    Ok(CandidateSkeleton {
+        geometry: MultiLineString(lines),
+        scores,
+        components,
+        legs_raw,
+        legs,
+        bars: all_bars,
+        widths,
+    })
 }
 
 /// The reason a prepared polygon is invalid, if it is (self-intersection,
@@ -255,99 +379,6 @@ fn invalidity(parts: &[PreparedPolygon]) -> Option<String> {
         }
     }
     None
-}
-
-/// Most prune → extend rounds: the first does the work, later ones only
-/// remove legs that turned out short once extended (rarely more than one).
-const MAX_PRUNE_ROUNDS: usize = 4;
-
-/// Prunes, extends, and — for the leg-removing modes — prunes again what the
-/// extension revealed as insignificant (a leg kept for the reach of what was
-/// cut behind its leaf can end up short once extended along its own
-/// direction), until stable. The result has every leaf on ∂P (with `ray` or
-/// `nearest`) and no leg insignificant by the SPEC rule.
-pub fn prune_and_extend(
-    raw: crate::graph::SkeletonGraph,
-    polygon: &PreparedPolygon,
-    pr: Option<&PruneParams>,
-    ex: Option<&ExtendParams>,
-) -> crate::graph::SkeletonGraph {
-    use crate::graph::prune::PruneMode;
-    let mut g = raw;
-    if let Some(pr) = pr {
-        g = prune(&g, pr);
-    }
-    if let Some(ex) = ex {
-        g = extend(&g, polygon, ex);
-        if let Some(pr) =
-            pr.filter(|p| matches!(p.mode, PruneMode::Significance | PruneMode::Length))
-        {
-            for _ in 1..MAX_PRUNE_ROUNDS {
-                let again = prune(&g, pr);
-                if again.edges().len() == g.edges().len()
-                    && again.total_length() == g.total_length()
-                {
-                    break;
-                }
-                g = extend(&again, polygon, ex);
-            }
-        }
-    }
-    g
-}
-
-fn run_method(
-    m: MethodId,
-    parts: &[PreparedPolygon],
-    params: &ProcessParams,
-) -> Result<CandidateSkeleton, String> {
-    let method = build(m, &params.skeleton);
-    let mut lines = Vec::new();
-    let mut all_bars = Vec::new();
-    let mut widths = Vec::new();
-    let (mut components, mut legs_raw, mut legs) = (0, 0, 0);
-    let mut part_offset = 0;
-    for (i, p) in parts.iter().enumerate() {
-        let raw = method.skeletonise(p).map_err(|e| {
-            if parts.len() > 1 {
-                format!("part {i}: {e}")
-            } else {
-                e.to_string()
-            }
-        })?;
-        legs_raw += raw.leg_count();
-        let g = prune_and_extend(raw, p, params.prune.as_ref(), params.extend.as_ref());
-        legs += g.leg_count();
-        components += g.components();
-        if params.score.is_some() {
-            let mut b = bars(p, &g);
-            let n_parts = g.branches().len();
-            for bar in &mut b {
-                if let Some(h) = &mut bar.hit {
-                    h.part += part_offset;
-                }
-            }
-            part_offset += n_parts;
-            all_bars.extend(b);
-        }
-        if params.keep_widths {
-            widths.extend(medial_axis_transform(&g, Some(p.boundary())));
-        }
-        lines.extend(g.to_multilinestring().0);
-    }
-    let scores = params.score.map(|_| metrics(&all_bars));
-    if !params.keep_bars {
-        all_bars.clear();
-    }
-    Ok(CandidateSkeleton {
-        geometry: MultiLineString(lines),
-        scores,
-        components,
-        legs_raw,
-        legs,
-        bars: all_bars,
-        widths,
-    })
 }
 
 #[cfg(test)]

@@ -5,8 +5,9 @@ mod common;
 use common::TRAIN;
 use geo::{Coord, LineString, Polygon};
 use skeletonise::geometry::PreparedPolygon;
-use skeletonise::graph::extend::{extend, ExtendMode, ExtendParams, ON_BOUNDARY};
-use skeletonise::graph::prune::{insignificant_legs, prune, PruneMode, PruneParams};
+use skeletonise::graph::extend::{extend, prune_and_extend, ExtendMode, ExtendParams, ON_BOUNDARY};
+use skeletonise::graph::planar::crossings;
+use skeletonise::graph::prune::{prune, PruneMode, PruneParams};
 use skeletonise::graph::{GraphBuilder, SkeletonGraph};
 use skeletonise::io::read_layer_polygons;
 use skeletonise::methods::{build, cdt::Cdt, MethodId, SkeletonMethod, SkeletonParams};
@@ -56,9 +57,9 @@ fn assert_leaves_on_boundary(g: &SkeletonGraph, p: &PreparedPolygon, what: &str)
 /// The default `prune` and `extend` steps as the pipeline runs them: the
 /// pruned graph, and the final one (pruned, extended, re-pruned until stable).
 fn default_steps(g: &SkeletonGraph, p: &PreparedPolygon) -> (SkeletonGraph, SkeletonGraph) {
-    let pruned = prune(g, &PruneParams::default());
-    let extended = skeletonise::process::prune_and_extend(
-        g.clone(),
+    let pruned = prune(g, &PruneParams::default(), p.boundary());
+    let extended = prune_and_extend(
+        g,
         p,
         Some(&PruneParams::default()),
         Some(&ExtendParams::default()),
@@ -191,7 +192,7 @@ fn trunk_on_a_polygon_with_holes_is_one_path_from_end_to_end() {
         mode: PruneMode::Trunk,
         ..Default::default()
     };
-    let t = prune(&raw, &trunk);
+    let t = prune(&raw, &trunk, p.boundary());
     assert!(is_simple_path(&t));
     let e = extend(&t, &p, &ExtendParams::default());
     assert!(is_simple_path(&e));
@@ -252,19 +253,24 @@ fn check_layer(layer: &str, m: MethodId) -> Option<(usize, usize, usize, usize)>
             let (pruned, extended) = default_steps(&raw, &p);
             let what = format!("{layer} fid {fid:?} {m}");
             assert_leaves_on_boundary(&extended, &p, &what);
-            let bad = insignificant_legs(&extended, &PruneParams::default());
-            assert!(bad.is_empty(), "{what}: insignificant legs {bad:?}");
+            assert_eq!(crossings(&extended), 0, "{what}: crossing pieces");
             assert_eq!(pruned.components(), raw.components(), "{what}");
             // `trunk`: one leaf-to-leaf line per component.
             let trunk = PruneParams {
                 mode: PruneMode::Trunk,
                 ..Default::default()
             };
-            let t = extend(&prune(&raw, &trunk), &p, &ExtendParams::default());
+            let t = prune_and_extend(&raw, &p, Some(&trunk), Some(&ExtendParams::default()));
+            assert_leaves_on_boundary(&t, &p, &what);
+            if matches!(m, MethodId::Vd | MethodId::Dvd) {
+                // Their skeleton may fall apart at necks; an end extended
+                // from one piece may meet another piece (noded there).
+                assert!(t.components() <= raw.components(), "{what} trunk");
+                continue;
+            }
             assert_eq!(t.components(), raw.components(), "{what} trunk");
             assert!(t.degrees().iter().all(|&d| d <= 2), "{what} trunk");
             assert_eq!(t.leg_count(), t.components(), "{what} trunk");
-            assert_leaves_on_boundary(&t, &p, &what);
             before += raw.leg_count();
             after += extended.leg_count();
         }

@@ -313,6 +313,46 @@ impl Boundary {
         best
     }
 
+    /// Nearest boundary point to `q` within the closed sector swept
+    /// counter-clockwise from direction `from` to direction `to` (an angle
+    /// below 180°): `(point, distance)`. The open segment from `q` to that
+    /// point crosses no boundary segment (a crossing would be a nearer
+    /// point in the sector).
+    pub fn nearest_in_sector(
+        &self,
+        q: Coord<f64>,
+        from: Coord<f64>,
+        to: Coord<f64>,
+    ) -> Option<(Coord<f64>, f64)> {
+        // Inside the sector: left of `from` and right of `to`.
+        let n1 = Coord {
+            x: -from.y,
+            y: from.x,
+        };
+        let n2 = Coord { x: to.y, y: -to.x };
+        let mut best: Option<(Coord<f64>, f64)> = None;
+        for (item, d2) in self.tree.nearest_neighbor_iter_with_distance_2(&pt(q)) {
+            if let Some((_, bd)) = best {
+                if d2.sqrt() > bd {
+                    break;
+                }
+            }
+            let s = &self.segments[item.data as usize];
+            let Some((a, b)) = clip_to_half_plane(s.a, s.b, q, n1) else {
+                continue;
+            };
+            let Some((a, b)) = clip_to_half_plane(a, b, q, n2) else {
+                continue;
+            };
+            let c = closest_on_segment(a, b, q).0;
+            let d = (c - q).x.hypot((c - q).y);
+            if best.is_none_or(|(_, bd)| d < bd) {
+                best = Some((c, d));
+            }
+        }
+        best
+    }
+
     /// First boundary point on the ray `origin + t · dir` with
     /// `min_t < t ≤ max_t`.
     pub fn first_hit(
@@ -350,6 +390,14 @@ impl Boundary {
             let s = &self.segments[item.data as usize];
             properly_cross(p, q, s.a, s.b)
         })
+    }
+
+    /// True when the segment from `p` to the boundary point `q` meets ∂P only
+    /// at `q`: [`Boundary::crosses`] on the segment stopped a millionth of
+    /// its length short of `q`, because a point computed on a boundary
+    /// segment lies on it only up to rounding and would "cross" it.
+    pub fn reaches(&self, p: Coord<f64>, q: Coord<f64>) -> bool {
+        !self.crosses(p, q + (p - q) * 1e-6)
     }
 
     /// Point-in-polygon by crossing parity along the ray towards +x
@@ -399,6 +447,24 @@ impl Boundary {
     }
 }
 
+/// Segment `ab` clipped to the half-plane `(x − q) · n ≥ 0`, or `None` when
+/// it lies wholly outside it.
+fn clip_to_half_plane(
+    a: Coord<f64>,
+    b: Coord<f64>,
+    q: Coord<f64>,
+    n: Coord<f64>,
+) -> Option<(Coord<f64>, Coord<f64>)> {
+    let fa = (a - q).x * n.x + (a - q).y * n.y;
+    let fb = (b - q).x * n.x + (b - q).y * n.y;
+    match (fa >= 0.0, fb >= 0.0) {
+        (true, true) => Some((a, b)),
+        (false, false) => None,
+        (true, false) => Some((a, a + (b - a) * (fa / (fa - fb)))),
+        (false, true) => Some((a + (b - a) * (fa / (fa - fb)), b)),
+    }
+}
+
 /// Closest point to `q` of segment `ab` clipped to the half-plane
 /// `(x − q) · n ≥ 0`, or `None` when the segment lies wholly outside it.
 fn clip_closest_in_half_plane(
@@ -407,14 +473,7 @@ fn clip_closest_in_half_plane(
     q: Coord<f64>,
     n: Coord<f64>,
 ) -> Option<Coord<f64>> {
-    let fa = (a - q).x * n.x + (a - q).y * n.y;
-    let fb = (b - q).x * n.x + (b - q).y * n.y;
-    let (a2, b2) = match (fa >= 0.0, fb >= 0.0) {
-        (true, true) => (a, b),
-        (false, false) => return None,
-        (true, false) => (a, a + (b - a) * (fa / (fa - fb))),
-        (false, true) => (a + (b - a) * (fa / (fa - fb)), b),
-    };
+    let (a2, b2) = clip_to_half_plane(a, b, q, n)?;
     Some(closest_on_segment(a2, b2, q).0)
 }
 
@@ -463,6 +522,23 @@ mod tests {
             )
             .unwrap();
         assert_eq!(h.t, 1.0);
+    }
+
+    #[test]
+    fn sector_nearest() {
+        let b = square_with_hole();
+        let q = Coord { x: 2.0, y: 2.0 };
+        let (e, n) = (Coord { x: 1.0, y: 0.0 }, Coord { x: 0.0, y: 1.0 });
+        // Towards the south-west corner only: from (−1, −1)/√2 through
+        // south to (1, −1)/√2 the nearest point is straight below.
+        let s = std::f64::consts::FRAC_1_SQRT_2;
+        let (c, d) = b
+            .nearest_in_sector(q, Coord { x: -s, y: -s }, Coord { x: s, y: -s })
+            .unwrap();
+        assert_eq!((c, d), (Coord { x: 2.0, y: 0.0 }, 2.0));
+        // North-east quadrant: the hole's corner (4, 4).
+        let (c, _) = b.nearest_in_sector(q, e, n).unwrap();
+        assert_eq!(c, Coord { x: 4.0, y: 4.0 });
     }
 
     #[test]

@@ -1,11 +1,21 @@
-//! Extension of legs to the boundary (SPEC §5).
+//! Extension of legs to the boundary (SPEC §5, refined by the issue on the
+//! default output's quality).
 //!
 //! After pruning, a leaf ℓ with r_ℓ > tolerance stops short of ∂P (most
 //! methods end legs inside P, and pruning a leg turns its junction into a
-//! leaf). `extend` joins every such leaf to ∂P with one new straight segment
-//! ending in a new node of radius 0, so that afterwards every leaf lies on ∂P.
+//! leaf). The extension joins every such leaf to ∂P, so that afterwards every
+//! leaf lies on ∂P.
 //!
-//! * `ray` (default): with L the leg's polyline from ℓ and
+//! * `centred` (default): along the method's own removed legs, or between
+//!   them where they fork symmetrically — see [`crate::graph::ends`]. It
+//!   needs what pruning removed, so it runs in [`prune_and_extend`]; on an
+//!   already pruned graph ([`extend`]) only its straight rays from leaves
+//!   inside P and its cut-end rule at leaves on ∂P apply.
+//!
+//! The straight modes join every leaf inside P with one new straight segment
+//! ending in a new node of radius 0:
+//!
+//! * `ray`: with L the leg's polyline from ℓ and
 //!   `q = L(min(2 r_ℓ, length(L)))` (the point at that arc length from ℓ),
 //!   cast the ray `ℓ + t · (ℓ − q) / |ℓ − q|`, t > 0, and add the segment from
 //!   ℓ to its first hit on ∂P: the leg continues in the direction it had over
@@ -33,6 +43,8 @@
 //! assert_eq!(g.total_length(), 10.0); // from (0, 2) to (10, 2)
 //! ```
 
+use super::prune::legs::point_at;
+use super::prune::{prune, prune_mask, PruneParams};
 use super::{polyline_length, SkeletonGraph};
 use crate::geometry::{Boundary, PreparedPolygon};
 use geo::Coord;
@@ -43,8 +55,12 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "lowercase")]
 pub enum ExtendMode {
-    /// Continue the leg's direction to the first boundary hit.
+    /// Continue along the method's own removed legs (or between them at a
+    /// symmetric fork) to ∂P.
     #[default]
+    #[serde(alias = "centered")]
+    Centred,
+    /// Continue the leg's direction to the first boundary hit.
     Ray,
     /// Join the leaf to the nearest boundary point.
     Nearest,
@@ -63,7 +79,7 @@ pub struct ExtendParams {
 impl Default for ExtendParams {
     fn default() -> Self {
         Self {
-            mode: ExtendMode::Ray,
+            mode: ExtendMode::Centred,
         }
     }
 }
@@ -77,8 +93,14 @@ pub fn extend(
     polygon: &PreparedPolygon,
     params: &ExtendParams,
 ) -> SkeletonGraph {
-    if params.mode == ExtendMode::None {
-        return graph.clone();
+    match params.mode {
+        ExtendMode::None => return graph.clone(),
+        ExtendMode::Centred => {
+            let m = graph.merged();
+            let keep = vec![true; m.edges().len()];
+            return super::ends::centred(&m, keep, polygon);
+        }
+        ExtendMode::Ray | ExtendMode::Nearest => {}
     }
     let boundary = polygon.boundary();
     let tol = ON_BOUNDARY * polygon.extent();
@@ -118,18 +140,69 @@ pub fn extend(
     out
 }
 
-/// The point at arc length `s` along `line` (its end when `s` ≥ its length).
-fn point_at(line: &[Coord<f64>], s: f64) -> Coord<f64> {
-    let mut left = s;
-    for w in line.windows(2) {
-        let d = w[1] - w[0];
-        let l = d.x.hypot(d.y);
-        if l >= left && l > 0.0 {
-            return w[0] + d * (left / l);
+/// Most prune → extend rounds for the straight modes: the first does the
+/// work, later ones only remove legs that turned out short once extended
+/// (rarely more than one).
+const MAX_PRUNE_ROUNDS: usize = 4;
+
+/// Prunes and extends one method's raw skeleton on its own.
+///
+/// With `centred` the extension follows what pruning removed. With the
+/// straight modes and a leg-removing prune mode, pruning runs again on what
+/// the extension revealed as insignificant (a leg kept for the reach of what
+/// was cut behind its leaf can end up short once extended along its own
+/// direction), until stable. With `ray`, `nearest` or `centred` every leaf
+/// of the result lies on ∂P; where an added segment crosses a line of the
+/// skeleton, both get a node there ([`super::planar`]).
+pub fn prune_and_extend(
+    raw: &SkeletonGraph,
+    polygon: &PreparedPolygon,
+    pr: Option<&PruneParams>,
+    ex: Option<&ExtendParams>,
+) -> SkeletonGraph {
+    let boundary = polygon.boundary();
+    let mode = ex.map_or(ExtendMode::None, |e| e.mode);
+    let g = if mode == ExtendMode::Centred {
+        let m = raw.merged();
+        let keep = match pr {
+            Some(p) => prune_mask(&m, p, boundary),
+            None => vec![true; m.edges().len()],
+        };
+        super::ends::centred(&m, keep, polygon)
+    } else {
+        prune_and_extend_straight(raw, polygon, pr, ex)
+    };
+    // Added segments may cross a line of the skeleton: node them.
+    super::planar::node_crossings(&g, boundary).0
+}
+
+/// [`prune_and_extend`] for the straight modes (and none).
+fn prune_and_extend_straight(
+    raw: &SkeletonGraph,
+    polygon: &PreparedPolygon,
+    pr: Option<&PruneParams>,
+    ex: Option<&ExtendParams>,
+) -> SkeletonGraph {
+    let boundary = polygon.boundary();
+    let mut g = match pr {
+        Some(p) => prune(raw, p, boundary),
+        None => raw.clone(),
+    };
+    if let Some(ex) = ex.filter(|e| e.mode != ExtendMode::None) {
+        g = extend(&g, polygon, ex);
+        if let Some(pr) = pr.filter(|p| p.removes_legs()) {
+            for _ in 1..MAX_PRUNE_ROUNDS {
+                let again = prune(&g, pr, boundary);
+                if again.edges().len() == g.edges().len()
+                    && again.total_length() == g.total_length()
+                {
+                    break;
+                }
+                g = extend(&again, polygon, ex);
+            }
         }
-        left -= l;
     }
-    *line.last().expect("a leg has at least two points")
+    g
 }
 
 /// The `ray` target for the leaf `leg[0]` at distance `r` from ∂P, or `None`
@@ -148,7 +221,7 @@ fn ray_target(boundary: &Boundary, leg: &[Coord<f64>], r: f64, tol: f64) -> Opti
     let max_t = 2.0 * (span.x.hypot(span.y) + r);
     let hit = boundary.first_hit(p, dir, 0.0, max_t)?;
     let mid = (p + hit.point) * 0.5;
-    if boundary.crosses(p, hit.point) || !boundary.contains_with_tolerance(mid, tol) {
+    if !boundary.reaches(p, hit.point) || !boundary.contains_with_tolerance(mid, tol) {
         return None;
     }
     Some(hit.point)
@@ -176,6 +249,7 @@ mod tests {
 
     #[test]
     fn point_at_walks_the_polyline() {
+        use super::point_at;
         let l = [c(0., 0.), c(1., 0.), c(1., 2.)];
         assert_eq!(point_at(&l, 0.5), c(0.5, 0.));
         assert_eq!(point_at(&l, 2.0), c(1., 1.));
@@ -191,7 +265,13 @@ mod tests {
         let mut b = GraphBuilder::new();
         b.polyline(&[c(10., 3.), c(10., 10.), c(18., 10.)]);
         let g = b.finish(p.boundary());
-        let ray = extend(&g, &p, &ExtendParams::default());
+        let ray = extend(
+            &g,
+            &p,
+            &ExtendParams {
+                mode: ExtendMode::Ray,
+            },
+        );
         let mut l = leaves(&ray);
         l.sort_by(|a, b| a.x.total_cmp(&b.x));
         // Leaf (10, 3), r = 3: the direction comes from (10, 9), so south;
@@ -228,7 +308,13 @@ mod tests {
         let mut b = GraphBuilder::new();
         b.segment(c(5., 25.), c(6., 25.));
         let g = b.finish(p.boundary());
-        let e = extend(&g, &p, &ExtendParams::default());
+        let e = extend(
+            &g,
+            &p,
+            &ExtendParams {
+                mode: ExtendMode::Ray,
+            },
+        );
         let mut l = leaves(&e);
         l.sort_by(|a, b| a.x.total_cmp(&b.x));
         assert_eq!(l, vec![c(0., 25.), c(10., 25.)]);

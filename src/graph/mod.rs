@@ -9,8 +9,13 @@
 //! edge's polyline runs from `nodes[a].pos` through `interior` to
 //! `nodes[b].pos`. Graphs are values: pruning and extension build new graphs.
 
+pub mod bridge;
+pub mod cut;
+pub mod ends;
 pub mod extend;
+pub mod planar;
 pub mod prune;
+pub mod structure;
 
 use crate::geometry::Boundary;
 use geo::{Coord, LineString, MultiLineString};
@@ -319,6 +324,31 @@ impl SkeletonGraph {
         for n in &mut self.nodes {
             n.radius = boundary.distance(n.pos);
         }
+    }
+
+    /// The polyline from node `n` along its first edge to the first node of
+    /// degree ≠ 2 (for a leaf: its whole branch, starting at the leaf);
+    /// `adj` is [`SkeletonGraph::adjacency`].
+    pub fn line_from(&self, n: NodeId, adj: &[Vec<EdgeId>]) -> Vec<Coord<f64>> {
+        let deg = |m: NodeId| adj[m.0 as usize].len();
+        let mut coords = vec![self.node(n).pos];
+        let Some(&first) = adj[n.0 as usize].first() else {
+            return coords;
+        };
+        let (mut at, mut via) = (n, first);
+        for _ in 0..self.edges.len() {
+            let c = self.oriented_coords(via, at);
+            coords.extend_from_slice(&c[1..]);
+            at = self.opposite(via, at);
+            if deg(at) != 2 || at == n {
+                break;
+            }
+            let Some(&next) = adj[at.0 as usize].iter().find(|&&e| e != via) else {
+                break;
+            };
+            via = next;
+        }
+        coords
     }
 
     /// Number of legs (branches with a leaf at one end).

@@ -171,6 +171,35 @@ pub struct SkeletonParams {
     /// How closely MA's polylines follow its parabolic arcs.
     #[serde(default)]
     pub arc_tolerance: medial_axis::ArcTolerance,
+    /// The method whose pruned and extended skeleton sets the legs every
+    /// method is pruned to (with `prune.structure: shared`); when it is not
+    /// among `methods` or fails on a polygon, the first that succeeds in the
+    /// order MA, StSk, DVD, CDT, VD.
+    #[serde(default = "default_reference")]
+    pub reference: MethodId,
+}
+
+fn default_reference() -> MethodId {
+    MethodId::Ma
+}
+
+impl SkeletonParams {
+    /// The order in which methods are tried as the reference structure.
+    pub fn reference_order(&self) -> Vec<MethodId> {
+        let mut order = vec![self.reference];
+        order.extend(
+            [
+                MethodId::Ma,
+                MethodId::StSk,
+                MethodId::Dvd,
+                MethodId::Cdt,
+                MethodId::Vd,
+            ]
+            .into_iter()
+            .filter(|m| *m != self.reference),
+        );
+        order
+    }
 }
 
 impl Default for SkeletonParams {
@@ -180,6 +209,7 @@ impl Default for SkeletonParams {
             densify: DensifyParams::default(),
             max_points: default_max_points(),
             arc_tolerance: medial_axis::ArcTolerance::default(),
+            reference: default_reference(),
         }
     }
 }

@@ -130,6 +130,7 @@ mod tests {
             let p = SelectParams {
                 by,
                 min_coverage: 0.0,
+                ..SelectParams::default()
             };
             assert_eq!(select(&[Some(empty), Some(poor)], &p), Some(1), "{by:?}");
         }

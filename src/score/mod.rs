@@ -62,6 +62,7 @@
 //! ```
 
 mod bars;
+pub mod defects;
 mod metrics;
 pub mod select;
 

@@ -1,4 +1,25 @@
-//! Method selection (SPEC §7).
+//! Method selection (SPEC §7, refined by the issue on the default output's
+//! quality).
+//!
+//! Among the candidates with hits (a skeleton without hits has nothing to
+//! measure, an empty one is never a candidate):
+//!
+//! 1. **Eligible**: coverage ≥ min(`min_coverage`, C_max − `coverage_slack`),
+//!    where C_max is the best coverage of any candidate. When some reach
+//!    `min_coverage` these are the eligible ones; when none does, every
+//!    candidate within `coverage_slack` of the best coverage is — a few
+//!    points of coverage (usually from spurs into bays) never outweigh a
+//!    several-fold worse distortion.
+//! 2. **Best**: the smallest `by` among the eligible ones, where values
+//!    within `tie` of the smallest count as equal (`by: distortion` only:
+//!    the medial axis approximates its parabolic arcs within
+//!    `arc_tolerance`, so where StSk or DVD coincide with it their exact
+//!    segments score ~10⁻¹² against MA's ~10⁻⁹–10⁻⁴, a difference no map
+//!    shows); among equals the method listed first in `methods` wins.
+//!
+//! With `prune.structure: shared` (the default) every candidate has the same
+//! legs reaching ∂P at the same places, so coverage differs little and the
+//! metric decides.
 
 use super::Scores;
 use schemars::JsonSchema;
@@ -35,6 +56,14 @@ fn default_min_coverage() -> f64 {
     0.9
 }
 
+fn default_coverage_slack() -> f64 {
+    0.25
+}
+
+fn default_tie() -> f64 {
+    1e-4
+}
+
 /// Options of the `select` step.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
@@ -42,9 +71,17 @@ pub struct SelectParams {
     /// Metric to minimise.
     #[serde(default)]
     pub by: SelectBy,
-    /// Candidates below this coverage are considered only if none reaches it.
+    /// Candidates reaching this coverage are eligible.
     #[serde(default = "default_min_coverage")]
     pub min_coverage: f64,
+    /// When none reaches `min_coverage`, those within this much of the best
+    /// coverage are eligible.
+    #[serde(default = "default_coverage_slack")]
+    pub coverage_slack: f64,
+    /// Distortions closer than this to the smallest count as equal (the
+    /// earlier method wins).
+    #[serde(default = "default_tie")]
+    pub tie: f64,
 }
 
 impl Default for SelectParams {
@@ -52,38 +89,40 @@ impl Default for SelectParams {
         Self {
             by: SelectBy::default(),
             min_coverage: default_min_coverage(),
+            coverage_slack: default_coverage_slack(),
+            tie: default_tie(),
         }
     }
 }
 
 /// Index of the chosen candidate among `candidates` (in `methods` order;
-/// `None` entries are methods that failed). Ties go to the earlier one.
+/// `None` entries are methods that failed or gave an empty skeleton), per
+/// the rule in the module documentation. Candidates without hits are chosen
+/// only when no candidate has one (then the first of them).
 pub fn select(candidates: &[Option<Scores>], params: &SelectParams) -> Option<usize> {
-    let ok = |s: &Scores| s.coverage >= params.min_coverage;
-    let mut best: Option<(usize, f64)> = None;
-    for (i, s) in candidates.iter().enumerate() {
-        let Some(s) = s else { continue };
-        if !ok(s) {
-            continue;
-        }
-        let v = params.by.value(s);
-        let v = if v.is_nan() { f64::INFINITY } else { v };
-        if best.is_none_or(|(_, bv)| v < bv) {
-            best = Some((i, v));
-        }
+    let scored: Vec<(usize, &Scores, f64)> = candidates
+        .iter()
+        .enumerate()
+        .filter_map(|(i, s)| {
+            let s = s.as_ref()?;
+            let v = params.by.value(s);
+            (s.hits > 0 && !v.is_nan()).then_some((i, s, v))
+        })
+        .collect();
+    if scored.is_empty() {
+        return candidates.iter().position(Option::is_some);
     }
-    if let Some((i, _)) = best {
-        return Some(i);
-    }
-    // None reaches min_coverage: the highest coverage wins.
-    let mut best: Option<(usize, f64)> = None;
-    for (i, s) in candidates.iter().enumerate() {
-        let Some(s) = s else { continue };
-        if best.is_none_or(|(_, bc)| s.coverage > bc) {
-            best = Some((i, s.coverage));
-        }
-    }
-    best.map(|(i, _)| i)
+    let c_max = scored.iter().map(|c| c.1.coverage).fold(0.0, f64::max);
+    let floor = params.min_coverage.min(c_max - params.coverage_slack);
+    let eligible: Vec<&(usize, &Scores, f64)> =
+        scored.iter().filter(|c| c.1.coverage >= floor).collect();
+    let best = eligible.iter().map(|c| c.2).fold(f64::INFINITY, f64::min);
+    let tie = if params.by == SelectBy::Distortion {
+        params.tie
+    } else {
+        0.0
+    };
+    eligible.iter().find(|c| c.2 <= best + tie).map(|c| c.0)
 }
 
 #[cfg(test)]
@@ -92,6 +131,8 @@ mod tests {
 
     fn s(coverage: f64, distortion: f64) -> Option<Scores> {
         Some(Scores {
+            bars: 100,
+            hits: (coverage * 100.0) as usize,
             coverage,
             distortion,
             ..Scores::default()
@@ -108,5 +149,39 @@ mod tests {
         assert_eq!(select(&[s(0.95, 0.1), s(0.99, 0.1)], &p), Some(0));
         assert_eq!(select(&[None, s(0.3, 0.1), s(0.6, 0.5)], &p), Some(2));
         assert_eq!(select(&[None, None], &p), None);
+    }
+
+    #[test]
+    fn a_few_points_of_coverage_never_outweigh_a_worse_distortion() {
+        let p = SelectParams::default();
+        // Nobody reaches 0.9: MA at 0.80 with Z 0.001 against a spur-laden
+        // CDT at 0.86 with Z 0.05 — MA is within the slack and wins.
+        assert_eq!(select(&[s(0.80, 0.001), s(0.86, 0.05)], &p), Some(0));
+        // Far below the best coverage (0.5 against 0.86): not eligible.
+        assert_eq!(select(&[s(0.50, 0.001), s(0.86, 0.05)], &p), Some(1));
+        // Above min_coverage: the metric alone decides.
+        assert_eq!(select(&[s(0.91, 0.002), s(0.99, 0.05)], &p), Some(0));
+    }
+
+    #[test]
+    fn distortions_within_the_tie_go_to_the_earlier_method() {
+        let p = SelectParams::default();
+        // MA's polyline arcs (Z 5e-5) against StSk's exact segments (1e-12).
+        assert_eq!(select(&[s(0.95, 5e-5), s(0.95, 1e-12)], &p), Some(0));
+        assert_eq!(select(&[s(0.95, 5e-4), s(0.95, 1e-12)], &p), Some(1));
+        let exact = SelectParams { tie: 0.0, ..p };
+        assert_eq!(select(&[s(0.95, 5e-5), s(0.95, 1e-12)], &exact), Some(1));
+    }
+
+    #[test]
+    fn a_skeleton_without_hits_only_wins_alone() {
+        let p = SelectParams::default();
+        let none = Some(Scores {
+            bars: 4,
+            distortion: f64::NAN,
+            ..Scores::default()
+        });
+        assert_eq!(select(&[none, s(0.2, 0.3)], &p), Some(1));
+        assert_eq!(select(&[None, none], &p), Some(1));
     }
 }

@@ -1,0 +1,151 @@
+//! Planarity of a finished skeleton: pieces never cross without a node.
+//!
+//! Every method's raw skeleton is planar, but the segments added afterwards
+//! (end segments, bridges across necks, straight rays) can cross a line of
+//! the skeleton. [`crossings`] finds every proper crossing of two segments
+//! (an R-tree over the segments' boxes, O(n log n) on real data), and
+//! [`node_crossings`] splits both edges there, so the written skeleton is a
+//! planar graph: two lines meet only at a node.
+
+use super::{Edge, SkeletonGraph};
+use crate::geometry::boundary::{orient, properly_cross};
+use crate::geometry::Boundary;
+use geo::Coord;
+use rstar::{primitives::GeomWithData, primitives::Rectangle, RTree, AABB};
+
+/// One segment of an edge's polyline: edge index, segment index, ends.
+#[derive(Debug, Clone, Copy)]
+struct Seg {
+    edge: usize,
+    index: usize,
+    a: Coord<f64>,
+    b: Coord<f64>,
+}
+
+fn segments(g: &SkeletonGraph) -> Vec<Seg> {
+    let mut out = Vec::new();
+    for i in 0..g.edges().len() {
+        let c = g.edge_coords(super::EdgeId(i as u32));
+        for (k, w) in c.windows(2).enumerate() {
+            if w[0] != w[1] {
+                out.push(Seg {
+                    edge: i,
+                    index: k,
+                    a: w[0],
+                    b: w[1],
+                });
+            }
+        }
+    }
+    out
+}
+
+/// The crossing point of two properly crossing segments.
+fn intersection(p: Coord<f64>, q: Coord<f64>, a: Coord<f64>, b: Coord<f64>) -> Coord<f64> {
+    let oa = orient(p, q, a);
+    let ob = orient(p, q, b);
+    let t = oa / (oa - ob);
+    a + (b - a) * t
+}
+
+/// Every proper crossing of two segments of `g`: (segment i, segment j,
+/// point), i < j, as indices into the segments in edge order.
+fn find(segs: &[Seg]) -> Vec<(usize, usize, Coord<f64>)> {
+    let tree: RTree<GeomWithData<Rectangle<[f64; 2]>, u32>> = RTree::bulk_load(
+        segs.iter()
+            .enumerate()
+            .map(|(i, s)| {
+                GeomWithData::new(
+                    Rectangle::from_corners([s.a.x, s.a.y], [s.b.x, s.b.y]),
+                    i as u32,
+                )
+            })
+            .collect(),
+    );
+    let mut out = Vec::new();
+    for (i, s) in segs.iter().enumerate() {
+        let env = AABB::from_corners(
+            [s.a.x.min(s.b.x), s.a.y.min(s.b.y)],
+            [s.a.x.max(s.b.x), s.a.y.max(s.b.y)],
+        );
+        for item in tree.locate_in_envelope_intersecting(&env) {
+            let j = item.data as usize;
+            if j <= i {
+                continue;
+            }
+            let t = &segs[j];
+            if properly_cross(s.a, s.b, t.a, t.b) {
+                out.push((i, j, intersection(s.a, s.b, t.a, t.b)));
+            }
+        }
+    }
+    out.sort_by(|x, y| x.0.cmp(&y.0).then(x.1.cmp(&y.1)));
+    out
+}
+
+/// Number of proper crossings between segments of `g` (0 for a planar
+/// skeleton).
+pub fn crossings(g: &SkeletonGraph) -> usize {
+    find(&segments(g)).len()
+}
+
+/// `g` with a node at every proper crossing (both edges split there; the new
+/// node's radius is its distance to ∂P). Returns the graph and the number of
+/// crossings noded.
+pub fn node_crossings(g: &SkeletonGraph, boundary: &Boundary) -> (SkeletonGraph, usize) {
+    let segs = segments(g);
+    let found = find(&segs);
+    if found.is_empty() {
+        return (g.clone(), 0);
+    }
+    // Crossing points per (edge, segment), with their parameter along it.
+    let mut cuts: std::collections::BTreeMap<(usize, usize), Vec<(f64, usize)>> =
+        Default::default();
+    let mut out = SkeletonGraph::new();
+    for n in g.nodes() {
+        out.add_node(n.pos, n.radius, n.time);
+    }
+    let mut cut_nodes = Vec::with_capacity(found.len());
+    for &(i, j, p) in &found {
+        let id = out.add_node(p, boundary.distance(p), None);
+        cut_nodes.push(id);
+        for s in [&segs[i], &segs[j]] {
+            let d = s.b - s.a;
+            let t = ((p - s.a).x * d.x + (p - s.a).y * d.y) / (d.x * d.x + d.y * d.y);
+            cuts.entry((s.edge, s.index))
+                .or_default()
+                .push((t, cut_nodes.len() - 1));
+        }
+    }
+    for (ei, e) in g.edges().iter().enumerate() {
+        let coords = g.edge_coords(super::EdgeId(ei as u32));
+        let mut from = e.a;
+        let mut interior: Vec<Coord<f64>> = Vec::new();
+        // Walk the polyline segment by segment; the k-th segment runs from
+        // coords[k] to coords[k + 1] (degenerate ones were skipped above but
+        // keep their index here).
+        for (k, &c) in coords.iter().enumerate().take(coords.len() - 1) {
+            if k > 0 {
+                interior.push(c);
+            }
+            if let Some(list) = cuts.get_mut(&(ei, k)) {
+                list.sort_by(|a, b| a.0.total_cmp(&b.0));
+                for &(_, c) in list.iter() {
+                    let to = cut_nodes[c];
+                    out.add_edge(from, to, std::mem::take(&mut interior));
+                    from = to;
+                }
+            }
+        }
+        out.add_edge(from, e.b, interior);
+    }
+    (drop_empty(out), found.len())
+}
+
+/// Removes zero-length edges (a crossing computed exactly at a segment's
+/// end would leave one).
+fn drop_empty(g: SkeletonGraph) -> SkeletonGraph {
+    g.filter_edges(|_, e: &Edge| {
+        !(e.interior.is_empty() && e.a != e.b && g.node(e.a).pos == g.node(e.b).pos)
+    })
+}

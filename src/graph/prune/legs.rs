@@ -1,0 +1,433 @@
+//! `significance` and `length` pruning: least significant leg first.
+//!
+//! A priority queue with lazy invalidation makes this O(n log n) in the
+//! number of branches; ties are broken by the leaf's coordinates, then by
+//! branch order. When removing a leg leaves its junction j with two
+//! branches, one of which is itself a leg insignificant at j while the other
+//! is not, that sibling leg goes too (j becomes a leaf): a leg is judged at
+//! the junction where it met the rest of the skeleton, so losing a sibling
+//! does not rescue it. This is what turns the medial axis of a rectangle (a
+//! centre segment and four corner legs) into its centre segment. A junction
+//! that becomes a leaf this way keeps the *reach* of what was cut behind it
+//! (the larger extent of the two legs), and a leg's length is always counted
+//! with the reach of its leaf (`length(leg) + reach(ℓ)`, reach = r_ℓ for an
+//! original leaf, 0 on ∂P): without it a long arm whose junctions are closer
+//! than two radii apart would be eroded junction by junction down to a
+//! stub. When both remaining branches are insignificant legs they are
+//! merged instead, so a component is never reduced below a simple path (two
+//! leaves); such a component, in which every leg was insignificant (a
+//! compact island), keeps its main axis — the path between the two leaves
+//! farthest apart — rather than the two legs the removal order happened to
+//! leave. A component that
+//! already is a path keeps both ends, and legs of a component with cycles
+//! (a polygon with holes) are removed down to the cycles.
+
+use super::{LegMeasure, PruneParams};
+use crate::geometry::Boundary;
+use crate::graph::cut::cut_ends;
+use crate::graph::{EdgeId, NodeId, SkeletonGraph};
+use geo::Coord;
+use std::cmp::{Ordering, Reverse};
+use std::collections::BinaryHeap;
+
+/// The point at arc length `s` along `line` (its end when `s` ≥ its length).
+pub fn point_at(line: &[Coord<f64>], s: f64) -> Coord<f64> {
+    let mut left = s;
+    for w in line.windows(2) {
+        let d = w[1] - w[0];
+        let l = d.x.hypot(d.y);
+        if l >= left && l > 0.0 {
+            return w[0] + d * (left / l);
+        }
+        left -= l;
+    }
+    *line.last().expect("a polyline has at least one point")
+}
+
+/// A branch of the working graph: an original edge of the merged graph, or
+/// two pieces joined at a former degree-2 node (a binary tree, so joining is
+/// O(1) however long the chain).
+#[derive(Debug, Clone, Copy)]
+struct Piece {
+    u: u32,
+    v: u32,
+    len: f64,
+    kind: Kind,
+}
+
+#[derive(Debug, Clone, Copy)]
+enum Kind {
+    Orig(u32),
+    /// Pieces `a` (from `u`) and `b` (to `v`) joined at node `at`.
+    Join {
+        a: u32,
+        b: u32,
+        at: u32,
+    },
+}
+
+/// Mutable multigraph over pieces. Invariant: `adj[n]` lists the alive pieces
+/// incident to n (a loop twice), and an alive piece's originals are kept.
+struct Work<'a> {
+    graph: &'a SkeletonGraph,
+    boundary: &'a Boundary,
+    pieces: Vec<Piece>,
+    alive: Vec<bool>,
+    adj: Vec<Vec<u32>>,
+    keep: Vec<bool>,
+    /// How far the skeleton (with its discs) reached beyond each leaf before
+    /// pruning: r_ℓ for an original leaf, the extent of the legs removed
+    /// behind a junction that became a leaf.
+    reach: Vec<f64>,
+}
+
+/// Heap entry; ordered by (key, leaf x, leaf y, piece id).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Entry {
+    key: f64,
+    leaf: (f64, f64),
+    piece: u32,
+}
+
+impl Eq for Entry {}
+
+impl PartialOrd for Entry {
+    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+        Some(self.cmp(o))
+    }
+}
+
+impl Ord for Entry {
+    fn cmp(&self, o: &Self) -> Ordering {
+        self.key
+            .total_cmp(&o.key)
+            .then(self.leaf.0.total_cmp(&o.leaf.0))
+            .then(self.leaf.1.total_cmp(&o.leaf.1))
+            .then(self.piece.cmp(&o.piece))
+    }
+}
+
+impl<'a> Work<'a> {
+    fn new(graph: &'a SkeletonGraph, boundary: &'a Boundary) -> Self {
+        let mut w = Work {
+            graph,
+            boundary,
+            pieces: Vec::with_capacity(graph.edges().len() * 2),
+            alive: Vec::new(),
+            adj: vec![Vec::new(); graph.nodes().len()],
+            keep: vec![true; graph.edges().len()],
+            reach: graph.nodes().iter().map(|n| n.radius.max(0.0)).collect(),
+        };
+        for (i, e) in graph.edges().iter().enumerate() {
+            let len = graph.edge_length(EdgeId(i as u32));
+            w.push_piece(e.a.0, e.b.0, len, Kind::Orig(i as u32));
+        }
+        w
+    }
+
+    fn push_piece(&mut self, u: u32, v: u32, len: f64, kind: Kind) -> u32 {
+        let id = self.pieces.len() as u32;
+        self.pieces.push(Piece { u, v, len, kind });
+        self.alive.push(true);
+        self.adj[u as usize].push(id);
+        self.adj[v as usize].push(id);
+        id
+    }
+
+    fn deg(&self, n: u32) -> usize {
+        self.adj[n as usize].len()
+    }
+
+    fn other(&self, p: u32, n: u32) -> u32 {
+        let pc = &self.pieces[p as usize];
+        if pc.u == n {
+            pc.v
+        } else {
+            pc.u
+        }
+    }
+
+    /// `(leaf, junction)` when piece `p` is a leg at a junction of degree ≥ 3.
+    fn leg(&self, p: u32) -> Option<(u32, u32)> {
+        let pc = &self.pieces[p as usize];
+        if pc.u == pc.v {
+            return None;
+        }
+        match (self.deg(pc.u), self.deg(pc.v)) {
+            (1, d) if d >= 3 => Some((pc.u, pc.v)),
+            (d, 1) if d >= 3 => Some((pc.v, pc.u)),
+            _ => None,
+        }
+    }
+
+    /// Removes piece `p` and drops its originals from the result.
+    fn remove(&mut self, p: u32) {
+        self.alive[p as usize] = false;
+        let Piece { u, v, .. } = self.pieces[p as usize];
+        self.adj[u as usize].retain(|&q| q != p);
+        self.adj[v as usize].retain(|&q| q != p);
+        let mut stack = vec![p];
+        while let Some(q) = stack.pop() {
+            match self.pieces[q as usize].kind {
+                Kind::Orig(e) => self.keep[e as usize] = false,
+                Kind::Join { a, b, .. } => stack.extend([a, b]),
+            }
+        }
+    }
+
+    /// Joins the two distinct pieces at degree-2 node `j` into one.
+    fn join(&mut self, j: u32) -> Option<u32> {
+        let (p1, p2) = (self.adj[j as usize][0], self.adj[j as usize][1]);
+        if p1 == p2 {
+            return None; // a loop: j anchors a pure cycle
+        }
+        let (u, v) = (self.other(p1, j), self.other(p2, j));
+        let len = self.pieces[p1 as usize].len + self.pieces[p2 as usize].len;
+        let id = self.pieces.len() as u32;
+        self.pieces.push(Piece {
+            u,
+            v,
+            len,
+            kind: Kind::Join {
+                a: p1,
+                b: p2,
+                at: j,
+            },
+        });
+        self.alive.push(true);
+        self.alive[p1 as usize] = false;
+        self.alive[p2 as usize] = false;
+        self.adj[j as usize].clear();
+        for (n, old) in [(u, p1), (v, p2)] {
+            let slot = self.adj[n as usize]
+                .iter_mut()
+                .find(|q| **q == old)
+                .expect("adjacency lists every alive piece");
+            *slot = id;
+        }
+        Some(id)
+    }
+
+    /// Extent of leg `p` seen from its junction: its length plus the reach
+    /// of its leaf.
+    fn extent(&self, p: u32, leaf: u32) -> f64 {
+        self.pieces[p as usize].len + self.reach[leaf as usize]
+    }
+
+    /// Piece `p` is a leg whose leaf is not `j` and which is insignificant
+    /// when judged at `j` (radius r_j).
+    fn insignificant_at(&self, p: u32, j: u32, params: &PruneParams) -> bool {
+        let o = self.other(p, j);
+        o != j && self.deg(o) == 1 && params.is_insignificant(&self.measure(p, o, j))
+    }
+
+    /// The leg `p` from junction `j` to leaf `leaf` as the rules see it. The
+    /// mouth radius (a boundary query) is only measured when the radius rule
+    /// alone would remove the leg.
+    fn measure(&self, p: u32, leaf: u32, j: u32) -> LegMeasure {
+        let rj = self.radius(j);
+        let mut leg = LegMeasure {
+            extent: self.extent(p, leaf),
+            r_junction: rj,
+            r_mouth: f64::INFINITY,
+        };
+        if params_may_need_mouth(&leg) {
+            let len = self.pieces[p as usize].len;
+            leg.r_mouth = if len > rj {
+                self.boundary.distance(self.point_at(p, j, rj))
+            } else {
+                self.radius(leaf).max(self.reach[leaf as usize])
+            };
+        }
+        leg
+    }
+
+    /// The point at arc length `s` along piece `p` walked from its end `from`.
+    fn point_at(&self, p: u32, from: u32, s: f64) -> Coord<f64> {
+        let (mut p, mut from, mut s) = (p, from, s);
+        loop {
+            let pc = self.pieces[p as usize];
+            match pc.kind {
+                Kind::Orig(e) => {
+                    let coords = self.graph.oriented_coords(EdgeId(e), NodeId(from));
+                    return point_at(&coords, s);
+                }
+                Kind::Join { a, b, at } => {
+                    // `a` runs from `u` to `at`, `b` from `at` to `v`.
+                    let (first, second) = if from == pc.u { (a, b) } else { (b, a) };
+                    let l1 = self.pieces[first as usize].len;
+                    if s <= l1 {
+                        p = first;
+                    } else {
+                        p = second;
+                        from = at;
+                        s -= l1;
+                    }
+                }
+            }
+        }
+    }
+
+    fn radius(&self, n: u32) -> f64 {
+        self.graph.nodes()[n as usize].radius
+    }
+
+    fn entry(&self, p: u32, params: &PruneParams) -> Option<Entry> {
+        let (leaf, j) = self.leg(p)?;
+        let leg = self.measure(p, leaf, j);
+        if !params.is_insignificant(&leg) {
+            return None;
+        }
+        let pos = self.graph.nodes()[leaf as usize].pos;
+        Some(Entry {
+            key: params.key(&leg),
+            leaf: (pos.x, pos.y),
+            piece: p,
+        })
+    }
+}
+
+/// The kept edges of `m` (a merged graph) after `significance` or `length`
+/// pruning (see the module documentation).
+pub fn mask(m: &SkeletonGraph, params: &PruneParams, boundary: &Boundary) -> Vec<bool> {
+    let mut w = Work::new(m, boundary);
+    // A cut end is an end of the skeleton whatever its legs measure: its
+    // corner legs go now (the extension ends the line on the cut), and its
+    // junction reaches on without limit, so the leg to it is never cut.
+    let tol = crate::graph::ends::END_ON_BOUNDARY * boundary.extent();
+    if params.mode == super::PruneMode::Significance {
+        for cut in cut_ends(m, boundary, tol) {
+            for leg in cut.legs {
+                if w.alive[leg.0 as usize] {
+                    w.remove(leg.0);
+                }
+            }
+            w.reach[cut.junction.0 as usize] = f64::INFINITY;
+        }
+    }
+    let mut collapsed: Vec<u32> = Vec::new();
+    let mut heap: BinaryHeap<Reverse<Entry>> = (0..w.pieces.len() as u32)
+        .filter_map(|p| w.entry(p, params).map(Reverse))
+        .collect();
+    while let Some(Reverse(e)) = heap.pop() {
+        // Lazy invalidation: a piece that was joined or removed is dead, and
+        // an alive piece keeps its leaf, length and junction radius.
+        if !w.alive[e.piece as usize] {
+            continue;
+        }
+        let Some((leaf, j)) = w.leg(e.piece) else {
+            continue;
+        };
+        let removed_extent = w.extent(e.piece, leaf);
+        w.remove(e.piece);
+        if w.deg(j) != 2 {
+            continue;
+        }
+        let (a, b) = (w.adj[j as usize][0], w.adj[j as usize][1]);
+        let (ia, ib) = (
+            w.insignificant_at(a, j, params),
+            w.insignificant_at(b, j, params),
+        );
+        let next = if ia != ib {
+            // The sibling leg insignificant at j goes too; j becomes a leaf
+            // of the other branch, which may now be an insignificant leg.
+            let (gone, stays) = if ia { (a, b) } else { (b, a) };
+            let gone_leaf = w.other(gone, j);
+            // j keeps the reach of what was cut behind it, so that a long
+            // arm is not eroded junction by junction.
+            w.reach[j as usize] = removed_extent.max(w.extent(gone, gone_leaf));
+            w.remove(gone);
+            Some(stays)
+        } else {
+            if ia && ib {
+                collapsed.push(j);
+            }
+            w.join(j)
+        };
+        if let Some(entry) = next.and_then(|p| w.entry(p, params)) {
+            heap.push(Reverse(entry));
+        }
+    }
+    let mut keep = w.keep;
+    if !collapsed.is_empty() {
+        // Everything in these components was insignificant: which two legs
+        // were left over is an accident of the removal order, so the
+        // component keeps its main axis instead.
+        let labels = m.component_labels();
+        let flagged: std::collections::BTreeSet<usize> =
+            collapsed.iter().map(|&j| labels[j as usize]).collect();
+        for c in flagged {
+            main_axis(m, &labels, c, &mut keep);
+        }
+    }
+    keep
+}
+
+/// Most leaves for which the farthest pair is searched exhaustively; a
+/// component with more falls back to its longest path.
+const MAX_AXIS_LEAVES: usize = 2000;
+
+/// Keeps, in component `c` of `m`, only its main axis: the path between
+/// the two leaves farthest apart (straight-line distance, the polygon's
+/// length), so a compact island gets a line through its middle from end to
+/// end rather than a curve between two corners on one side.
+fn main_axis(m: &SkeletonGraph, labels: &[usize], c: usize, keep: &mut [bool]) {
+    let deg = m.degrees();
+    let leaves: Vec<NodeId> = (0..m.nodes().len())
+        .filter(|&n| labels[n] == c && deg[n] == 1)
+        .map(|n| NodeId(n as u32))
+        .collect();
+    let in_c: Vec<bool> = m
+        .edges()
+        .iter()
+        .map(|e| labels[e.a.0 as usize] == c)
+        .collect();
+    let pair = if leaves.len() > MAX_AXIS_LEAVES {
+        None
+    } else {
+        let mut best: Option<(f64, NodeId, NodeId)> = None;
+        for (i, &a) in leaves.iter().enumerate() {
+            for &b in &leaves[i + 1..] {
+                let d = m.node(a).pos - m.node(b).pos;
+                let d2 = d.x * d.x + d.y * d.y;
+                if best.is_none_or(|(bd, _, _)| d2 > bd) {
+                    best = Some((d2, a, b));
+                }
+            }
+        }
+        best.map(|(_, a, b)| (a, b))
+    };
+    let path = pair.and_then(|(a, b)| super::trunk::shortest_path(m, &in_c, a, b));
+    match path {
+        Some(path) => {
+            for (i, k) in keep.iter_mut().enumerate() {
+                if in_c[i] {
+                    *k = false;
+                }
+            }
+            for e in path {
+                keep[e.0 as usize] = true;
+            }
+        }
+        None => {
+            let trunk = super::trunk::mask(m);
+            for (i, k) in keep.iter_mut().enumerate() {
+                if in_c[i] {
+                    *k = trunk[i];
+                }
+            }
+        }
+    }
+}
+
+/// True unless the radius rule alone already keeps the leg (then its mouth
+/// is never needed); conservative: any mode and ratio may ask.
+fn params_may_need_mouth(leg: &LegMeasure) -> bool {
+    leg.extent > leg.r_junction
+}
+
+/// Distance to ∂P where the leg `coords` (starting at its junction of radius
+/// `r_j`) leaves the junction's disc; at its far end when it is shorter.
+pub fn mouth_radius(coords: &[Coord<f64>], r_j: f64, boundary: &Boundary) -> f64 {
+    boundary.distance(point_at(coords, r_j))
+}

@@ -1,0 +1,192 @@
+//! `trunk` pruning: the longest leaf-to-leaf path of each component, one
+//! centreline per part.
+//!
+//! The two end leaves are found by repeated farthest-leaf sweeps (Dijkstra
+//! over branch lengths): exact on trees (the tree diameter), a heuristic for
+//! components with cycles, where the result is the shortest path between the
+//! leaf pair found, so a river with islands stays one connected line from end
+//! to end. A component with one leaf keeps its cycles without the leg; a
+//! component without leaves (a ring) is kept.
+
+use crate::graph::{EdgeId, NodeId, SkeletonGraph};
+use std::cmp::{Ordering, Reverse};
+use std::collections::BinaryHeap;
+
+/// Shortest-path distances from one source, reusing buffers across calls so
+/// that many components cost O(total size), not O(components × size).
+struct Sweep {
+    dist: Vec<f64>,
+    pred: Vec<Option<EdgeId>>,
+    touched: Vec<u32>,
+}
+
+impl Sweep {
+    fn new(n: usize) -> Self {
+        Self {
+            dist: vec![f64::INFINITY; n],
+            pred: vec![None; n],
+            touched: Vec::new(),
+        }
+    }
+
+    /// Dijkstra from `s`; returns the farthest leaf (ties: smaller node id).
+    fn run(
+        &mut self,
+        g: &SkeletonGraph,
+        adj: &[Vec<EdgeId>],
+        len: &[f64],
+        deg: &[usize],
+        s: NodeId,
+    ) -> (NodeId, f64) {
+        for &t in &self.touched {
+            self.dist[t as usize] = f64::INFINITY;
+            self.pred[t as usize] = None;
+        }
+        self.touched.clear();
+        let mut heap = BinaryHeap::new();
+        self.dist[s.0 as usize] = 0.0;
+        self.touched.push(s.0);
+        heap.push(Reverse((OrdF(0.0), s.0)));
+        let mut best = (s, 0.0);
+        while let Some(Reverse((OrdF(d), n))) = heap.pop() {
+            if d > self.dist[n as usize] {
+                continue;
+            }
+            if deg[n as usize] == 1 && (d > best.1 || (d == best.1 && n < best.0 .0 && d > 0.0)) {
+                best = (NodeId(n), d);
+            }
+            for &e in &adj[n as usize] {
+                let o = g.opposite(e, NodeId(n));
+                let nd = d + len[e.0 as usize];
+                if nd < self.dist[o.0 as usize] {
+                    if self.dist[o.0 as usize].is_infinite() {
+                        self.touched.push(o.0);
+                    }
+                    self.dist[o.0 as usize] = nd;
+                    self.pred[o.0 as usize] = Some(e);
+                    heap.push(Reverse((OrdF(nd), o.0)));
+                }
+            }
+        }
+        best
+    }
+}
+
+/// Total order on distances (never NaN: lengths are finite sums).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct OrdF(f64);
+impl Eq for OrdF {}
+impl PartialOrd for OrdF {
+    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+        Some(self.cmp(o))
+    }
+}
+impl Ord for OrdF {
+    fn cmp(&self, o: &Self) -> Ordering {
+        self.0.total_cmp(&o.0)
+    }
+}
+
+/// Farthest-leaf sweeps beyond the classic two; each can only lengthen the
+/// path, and on trees the second sweep is already exact.
+const MAX_SWEEPS: usize = 4;
+
+/// The kept edges of `m` (a merged graph): the trunk of every component.
+pub fn mask(m: &SkeletonGraph) -> Vec<bool> {
+    let adj = m.adjacency();
+    let deg = m.degrees();
+    let len: Vec<f64> = (0..m.edges().len())
+        .map(|i| m.edge_length(EdgeId(i as u32)))
+        .collect();
+    let labels = m.component_labels();
+    let mut leaves_of: Vec<Vec<NodeId>> = vec![Vec::new(); m.nodes().len()];
+    for (n, &d) in deg.iter().enumerate() {
+        if d == 1 {
+            leaves_of[labels[n]].push(NodeId(n as u32));
+        }
+    }
+    let mut keep = vec![false; m.edges().len()];
+    let mut sweep = Sweep::new(m.nodes().len());
+    let mut done = vec![false; m.nodes().len()];
+    for e in m.edges() {
+        let c = labels[e.a.0 as usize];
+        if done[c] {
+            continue;
+        }
+        done[c] = true;
+        let leaves = &leaves_of[c];
+        match leaves.len() {
+            0 => {
+                // A ring: keep the whole component.
+                for (k, f) in m.edges().iter().enumerate() {
+                    if labels[f.a.0 as usize] == c {
+                        keep[k] = true;
+                    }
+                }
+            }
+            1 => {
+                // Cycles and one leg: keep the cycles.
+                let leg = adj[leaves[0].0 as usize][0];
+                for (k, f) in m.edges().iter().enumerate() {
+                    if labels[f.a.0 as usize] == c && EdgeId(k as u32) != leg {
+                        keep[k] = true;
+                    }
+                }
+            }
+            _ => {
+                let (mut a, _) = sweep.run(m, &adj, &len, &deg, leaves[0]);
+                let (mut b, mut d) = sweep.run(m, &adj, &len, &deg, a);
+                for _ in 2..MAX_SWEEPS {
+                    let (c2, d2) = sweep.run(m, &adj, &len, &deg, b);
+                    if d2 <= d {
+                        // Restore the predecessors of the sweep from a.
+                        sweep.run(m, &adj, &len, &deg, a);
+                        break;
+                    }
+                    (a, b, d) = (b, c2, d2);
+                }
+                // Walk back from b to a along the predecessors of the sweep from a.
+                let mut n = b;
+                while n != a {
+                    let e = sweep.pred[n.0 as usize].expect("b is reachable from a");
+                    keep[e.0 as usize] = true;
+                    n = m.opposite(e, n);
+                }
+            }
+        }
+    }
+    keep
+}
+
+/// The edges of a shortest path from `from` to `to` in `g` over the edges for
+/// which `usable` is true (lengths = edge lengths), or `None` when `to` is
+/// not reachable.
+pub(crate) fn shortest_path(
+    g: &SkeletonGraph,
+    usable: &[bool],
+    from: NodeId,
+    to: NodeId,
+) -> Option<Vec<EdgeId>> {
+    let adj: Vec<Vec<EdgeId>> = g
+        .adjacency()
+        .into_iter()
+        .map(|es| es.into_iter().filter(|e| usable[e.0 as usize]).collect())
+        .collect();
+    let len: Vec<f64> = (0..g.edges().len())
+        .map(|i| g.edge_length(EdgeId(i as u32)))
+        .collect();
+    let deg: Vec<usize> = adj.iter().map(Vec::len).collect();
+    let mut sweep = Sweep::new(g.nodes().len());
+    sweep.run(g, &adj, &len, &deg, from);
+    if from != to && sweep.pred[to.0 as usize].is_none() {
+        return None;
+    }
+    let mut path = Vec::new();
+    let mut n = to;
+    while n != from {
+        let e = sweep.pred[n.0 as usize]?;
+        path.push(e);
+        n = g.opposite(e, n);
+    }
+    Some(path)
+}

@@ -1,0 +1,345 @@
+//! Like-for-like structure: every method of a feature pruned to the legs of
+//! one reference skeleton.
+//!
+//! The paper compared its methods "with the structure of the skeleton …
+//! as the basis for comparison (the number of legs and places of contact
+//! point with the outer boundary edge of an object)". Pruned on its own, each
+//! method keeps a different number of legs reaching ∂P at different places,
+//! so its coverage differs and the highest coverage wins although it comes
+//! from spurs. Here one reference skeleton — by default the medial axis,
+//! whose radii are exact disc radii, so its pruning measures what it claims,
+//! and whose legs end on ∂P — is pruned and extended; its line ends are the
+//! **contacts** ([`Structure::of`]). Every other method is then
+//! [`conform`]ed to them:
+//!
+//! 1. **Fragments joined** ([`crate::graph::bridge`]): VD and DVD fall apart
+//!    at narrow necks; pieces are joined across gaps of a few local radii.
+//! 2. **Terminals.** For a contact c on ∂P, the method's node v whose
+//!    inscribed disc comes closest to c: the smallest `|v − c| − r_v` (≥ 0,
+//!    and 0 exactly when the disc at v touches ∂P at c), among nodes that see
+//!    c without crossing ∂P, searched within 2ρ of c and farther only when
+//!    none is found (ρ: the reference's local radius at that end). At a
+//!    tapering tip that is the method's own leaf on the tip vertex; at a cut
+//!    end it is the node whose disc touches the end side's midpoint. For a
+//!    contact inside P (no extension) it is the nearest node.
+//! 3. **Peel.** Leaves that are not terminals are removed until none is
+//!    left: what stays is the method's own skeleton between its terminals,
+//!    with its cycles (holes). With `trunk`, the two terminals of a
+//!    component are joined by the method's shortest path between them.
+//! 4. **Ends.** Each terminal not yet at its contact is joined to it with a
+//!    straight segment (inside v's disc when the disc touches c); where such
+//!    a segment or a bridge crosses a line, both get a node there.
+//!
+//! So every method has the reference's legs, reaching ∂P at the same
+//! places, and the metrics decide between like structures.
+
+use super::bridge::bridge;
+use super::ends::{assemble, END_ON_BOUNDARY};
+use super::prune::legs::point_at;
+use super::prune::trunk::shortest_path;
+use super::{NodeId, SkeletonGraph, UnionFind};
+use crate::geometry::PreparedPolygon;
+use geo::Coord;
+use rstar::{primitives::GeomWithData, RTree};
+
+/// Where a reference line ends.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Contact {
+    /// The end point.
+    pub point: Coord<f64>,
+    /// Local radius of the reference at that end: the distance to ∂P one
+    /// local width back along the line (see [`end_radius`]).
+    pub radius: f64,
+    /// The end lies on ∂P.
+    pub on_boundary: bool,
+    /// Connected component of the reference that the end belongs to.
+    pub component: usize,
+    /// The reference line from the end back to its first junction (or its
+    /// other end): where to look for a terminal when no node sees the end.
+    pub approach: Vec<Coord<f64>>,
+}
+
+/// The structure every method of one polygon is pruned to.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Structure {
+    /// The reference's line ends, in node order.
+    pub contacts: Vec<Contact>,
+    /// One line per component (`trunk` pruning): terminals are joined by a
+    /// shortest path instead of keeping everything between them.
+    pub trunk: bool,
+}
+
+impl Structure {
+    /// The structure of a finished reference skeleton: its leaves.
+    pub fn of(reference: &SkeletonGraph, polygon: &PreparedPolygon, trunk: bool) -> Self {
+        let tol = END_ON_BOUNDARY * polygon.extent();
+        let deg = reference.degrees();
+        let labels = reference.component_labels();
+        let adj = reference.adjacency();
+        let contacts = (0..reference.nodes().len())
+            .filter(|&n| deg[n] == 1)
+            .map(|n| {
+                let node = reference.node(NodeId(n as u32));
+                let approach = reference.line_from(NodeId(n as u32), &adj);
+                Contact {
+                    point: node.pos,
+                    radius: end_radius(&approach, polygon),
+                    on_boundary: polygon.boundary().distance(node.pos) <= tol,
+                    component: labels[n],
+                    approach,
+                }
+            })
+            .collect();
+        Self { contacts, trunk }
+    }
+}
+
+/// The local radius of a line at its end: walking back from the end
+/// (`coords[0]`), the distance to ∂P at the first point whose arc length
+/// from the end reaches twice that distance (one local width back), or at
+/// the far end of `coords` when none does.
+pub fn end_radius(coords: &[Coord<f64>], polygon: &PreparedPolygon) -> f64 {
+    end_width_point(coords, polygon).1
+}
+
+/// Arc length from the end and distance to ∂P of the point one local width
+/// back along `coords` (see [`end_radius`]).
+pub fn end_width_point(coords: &[Coord<f64>], polygon: &PreparedPolygon) -> (f64, f64) {
+    let b = polygon.boundary();
+    let total = super::polyline_length(coords);
+    // Arc length s grows with slope 1 and the radius at most with slope 1,
+    // so s − 2 r(s) changes sign once on a medial line; sample it finely
+    // enough and bisect the first sign change.
+    let steps = 64;
+    let f = |s: f64| s - 2.0 * b.distance(point_at(coords, s));
+    let mut lo = 0.0;
+    for i in 1..=steps {
+        let s = total * i as f64 / steps as f64;
+        if f(s) >= 0.0 {
+            let mut hi = s;
+            for _ in 0..30 {
+                let mid = 0.5 * (lo + hi);
+                if f(mid) >= 0.0 {
+                    hi = mid;
+                } else {
+                    lo = mid;
+                }
+            }
+            return (hi, b.distance(point_at(coords, hi)));
+        }
+        lo = s;
+    }
+    (total, b.distance(point_at(coords, total)))
+}
+
+/// Prunes `raw` (one method's raw skeleton of `polygon`) to `structure`
+/// (see the module documentation).
+pub fn conform(
+    raw: &SkeletonGraph,
+    structure: &Structure,
+    polygon: &PreparedPolygon,
+) -> SkeletonGraph {
+    let g = bridge(raw, polygon);
+    if g.is_empty() {
+        return g;
+    }
+    let tol = END_ON_BOUNDARY * polygon.extent();
+    let tree: NodeTree = RTree::bulk_load(
+        g.nodes()
+            .iter()
+            .enumerate()
+            .map(|(i, n)| GeomWithData::new([n.pos.x, n.pos.y], i as u32))
+            .collect(),
+    );
+    let served: Vec<Option<(NodeId, bool)>> = structure
+        .contacts
+        .iter()
+        .map(|c| terminal(&g, &tree, c, polygon, tol))
+        .collect();
+    let terminals: Vec<Option<NodeId>> = served.iter().map(|t| t.map(|t| t.0)).collect();
+    let mut is_terminal = vec![false; g.nodes().len()];
+    for t in terminals.iter().flatten() {
+        is_terminal[t.0 as usize] = true;
+    }
+    let mut keep = peel(&g, &is_terminal);
+    if structure.trunk {
+        keep = trunk_paths(&g, keep, structure, &terminals);
+    }
+    let segments: Vec<(NodeId, Coord<f64>)> = structure
+        .contacts
+        .iter()
+        .zip(&served)
+        .filter_map(|(c, t)| {
+            let (t, sees) = (*t)?;
+            if !sees {
+                return None;
+            }
+            let p = g.node(t).pos;
+            let d = (p - c.point).x.hypot((p - c.point).y);
+            (c.on_boundary && d > tol).then_some((t, c.point))
+        })
+        .collect();
+    let out = assemble(&g, &keep, &segments);
+    super::planar::node_crossings(&out, polygon.boundary()).0
+}
+
+/// The node of `g` that serves contact `c` (see the module documentation),
+/// and whether it sees `c`. When no node sees `c` (the reference runs into
+/// a channel too narrow for this method's skeleton), the node that sees the
+/// reference line farthest along its approach to `c` serves it.
+fn terminal(
+    g: &SkeletonGraph,
+    tree: &NodeTree,
+    c: &Contact,
+    polygon: &PreparedPolygon,
+    tol: f64,
+) -> Option<(NodeId, bool)> {
+    let b = polygon.boundary();
+    let limit = 4.0 * polygon.extent();
+    let score = |d: f64, r: f64| if c.on_boundary { d - r } else { d };
+    if let Some(n) = best_seeing(
+        g,
+        tree,
+        c.point,
+        (2.0 * c.radius).max(1e3 * tol),
+        limit,
+        tol,
+        &score,
+        b,
+    ) {
+        return Some((n, true));
+    }
+    // Points back along the reference line, at doubling arc lengths.
+    let total = super::polyline_length(&c.approach);
+    let mut s = (c.radius).max(1e3 * tol);
+    while s < total {
+        let p = point_at(&c.approach, s);
+        let r = b.distance(p);
+        let near = |d: f64, _: f64| d;
+        if let Some(n) = best_seeing(
+            g,
+            tree,
+            p,
+            2.0 * r.max(tol),
+            2.0 * r.max(tol),
+            tol,
+            &near,
+            b,
+        ) {
+            return Some((n, false));
+        }
+        s *= 2.0;
+    }
+    None
+}
+
+type NodeTree = RTree<GeomWithData<[f64; 2], u32>>;
+
+/// The node with the smallest `score(distance, radius)` among those that see
+/// `q` (the segment to it stays in P), searched within `start` of `q` and
+/// four times farther each round up to `limit`.
+#[allow(clippy::too_many_arguments)]
+fn best_seeing(
+    g: &SkeletonGraph,
+    tree: &NodeTree,
+    q: Coord<f64>,
+    start: f64,
+    limit: f64,
+    tol: f64,
+    score: &dyn Fn(f64, f64) -> f64,
+    b: &crate::geometry::Boundary,
+) -> Option<NodeId> {
+    let mut reach = start;
+    loop {
+        let mut best: Option<(f64, f64, u32)> = None;
+        for item in tree.locate_within_distance([q.x, q.y], reach * reach) {
+            let n = item.data;
+            let node = g.node(NodeId(n));
+            let d = (node.pos - q).x.hypot((node.pos - q).y);
+            let key = (score(d, node.radius), d, n);
+            if best.is_some_and(|bk| bk.partial_cmp(&key).is_some_and(|o| o.is_le())) {
+                continue;
+            }
+            if d > tol && !b.reaches(node.pos, q) {
+                continue;
+            }
+            best = Some(key);
+        }
+        if let Some((_, _, n)) = best {
+            return Some(NodeId(n));
+        }
+        if reach >= limit {
+            return None;
+        }
+        reach = (reach * 4.0).min(limit);
+    }
+}
+
+/// Kept edges after removing, repeatedly, every leaf that is not a terminal.
+fn peel(g: &SkeletonGraph, is_terminal: &[bool]) -> Vec<bool> {
+    let adj = g.adjacency();
+    let mut keep = vec![true; g.edges().len()];
+    let mut deg: Vec<usize> = adj.iter().map(Vec::len).collect();
+    // Loops count twice in `adj` and never make a leaf.
+    let mut stack: Vec<usize> = (0..deg.len())
+        .filter(|&n| deg[n] == 1 && !is_terminal[n])
+        .collect();
+    while let Some(n) = stack.pop() {
+        if deg[n] != 1 || is_terminal[n] {
+            continue;
+        }
+        let Some(&e) = adj[n].iter().find(|e| keep[e.0 as usize]) else {
+            continue;
+        };
+        keep[e.0 as usize] = false;
+        deg[n] -= 1;
+        let o = g.opposite(e, NodeId(n as u32)).0 as usize;
+        deg[o] -= 1;
+        if deg[o] == 1 && !is_terminal[o] {
+            stack.push(o);
+        }
+    }
+    keep
+}
+
+/// With `trunk`: in every kept component that holds the two terminals of one
+/// reference component, only the shortest path between them.
+fn trunk_paths(
+    g: &SkeletonGraph,
+    keep: Vec<bool>,
+    structure: &Structure,
+    terminals: &[Option<NodeId>],
+) -> Vec<bool> {
+    let mut uf = UnionFind::new(g.nodes().len());
+    for (i, e) in g.edges().iter().enumerate() {
+        if keep[i] {
+            uf.union(e.a.0 as usize, e.b.0 as usize);
+        }
+    }
+    let mut by_component: std::collections::BTreeMap<usize, Vec<NodeId>> = Default::default();
+    for (c, t) in structure.contacts.iter().zip(terminals) {
+        if let Some(t) = t {
+            by_component.entry(c.component).or_default().push(*t);
+        }
+    }
+    let mut out = keep.clone();
+    for ts in by_component.values() {
+        let [a, b] = ts[..] else { continue };
+        let comp = uf.find(a.0 as usize);
+        if a == b || uf.find(b.0 as usize) != comp {
+            continue;
+        }
+        let Some(path) = shortest_path(g, &keep, a, b) else {
+            continue;
+        };
+        for (i, e) in g.edges().iter().enumerate() {
+            if keep[i] && uf.find(e.a.0 as usize) == comp {
+                out[i] = false;
+            }
+        }
+        for e in path {
+            out[e.0 as usize] = true;
+        }
+    }
+    out
+}
