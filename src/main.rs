@@ -297,11 +297,15 @@ fn main() -> ExitCode {
             println!(
                 "\nSteps (in this order; only `skeleton` is required):\n  \
                  prepare   make_valid (bool, default true), min_area (CRS units², default 0)\n  \
-                 skeleton  methods (list, default [MA, StSk, DVD, CDT, VD]), densify ({{factor: k}} default 4 | {{spacing: d}}), max_points (default 2000000), arc_tolerance ({{relative: f}} default 0.001 | {{absolute: d}})\n  \
-                 prune     mode (significance | length | trunk | none), ratio (default 1.0), min_length (default 0)\n  \
-                 extend    mode (ray | nearest | none)\n  \
+                 skeleton  methods (list, default [MA, StSk, DVD, CDT, VD]), densify ({{factor: k}} default 4 | {{spacing: d}}), max_points (default 2000000), arc_tolerance ({{relative: f}} default 0.001 | {{absolute: d}}), reference (method whose pruned skeleton sets every method's legs, default MA)\n  \
+                 prune     mode (significance | length | trunk | none), ratio (default 1.0), arm_ratio (default 1.0), min_length (default 0), structure (shared | independent, default shared)\n  \
+                 extend    mode (centred | ray | nearest | none, default centred)\n  \
                  score     (no options)\n  \
-                 select    by (distortion | deviation | deviation_parts | distortion_sum), min_coverage (default 0.9)\n\n\
+                 select    by (distortion | deviation | deviation_parts | distortion_sum), min_coverage (default 0.9), coverage_slack (default 0.25), tie (default 0.0001)\n\n\
+                 Selection: among candidates with hits, those with coverage >= min(min_coverage, best coverage - coverage_slack)\n  \
+                 are eligible; the smallest `by` wins, distortions within `tie` of it count as equal and go to the method\n  \
+                 listed first. With structure: shared every method has the reference's legs reaching the boundary at the\n  \
+                 same places, so the metric, not a few points of coverage, decides.\n\n\
                  `skeletonise schema` prints the full JSON Schema."
             );
             ExitCode::SUCCESS

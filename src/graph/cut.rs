@@ -11,8 +11,10 @@
 //!
 //! * a junction j of degree 3 with exactly two legs that end on ∂P at c₁,
 //!   c₂ (leaves at boundary vertices),
-//! * the chord |c₁c₂| spans at least [`MIN_SPAN`] of the local width 2 r_j
-//!   (the end is as wide as the shape), and
+//! * the chord |c₁c₂| spans at least [`MIN_SPAN`] of the local width 2 r_j,
+//!   and of the width where the line ending there joins the rest of the
+//!   skeleton (the end is as wide as the shape, not a flat-topped bump of a
+//!   wider river's bank),
 //! * ∂P between c₁ and c₂ (the shorter way round the ring) is straight:
 //!   every vertex within [`MAX_BOW`] × |c₁c₂| of the chord, and
 //! * the line arriving at j is at least [`MIN_LINE`] radii long (else j is
@@ -96,7 +98,13 @@ pub fn cut_ends(m: &SkeletonGraph, boundary: &Boundary, tol: f64) -> Vec<CutEnd>
         let Some(&line) = edges.iter().find(|&&e| e != e1 && e != e2) else {
             continue;
         };
-        let c = course_line(m, &adj, &deg, jn, line, tol, 2.0 * rj);
+        let (c, r_far) = course_line(m, &adj, &deg, jn, line, tol, 2.0 * rj);
+        // The cut spans the line it ends, not only a bump's own width: a
+        // flat-topped bump of a bank ends in a short straight edge too, but
+        // its line joins a much wider one.
+        if span < MIN_SPAN * 2.0 * r_far {
+            continue;
+        }
         // A line shorter than a quarter radius makes j one node of a
         // cluster (a square's centre split by rounding): no single line
         // arrives there, so there is no cut to end on.
@@ -134,7 +142,9 @@ pub fn cut_ends(m: &SkeletonGraph, boundary: &Boundary, tol: f64) -> Vec<CutEnd>
 }
 
 /// The line arriving at `j` along `first`, from `j` outwards, continued
-/// through nodes whose other branches are all legs into ∂P, up to `length`.
+/// through nodes whose other branches are all legs into ∂P, up to `length`;
+/// and the radius of the node where it stops (the junction where it joins
+/// the rest of the skeleton, or the node `length` along it).
 fn course_line(
     m: &SkeletonGraph,
     adj: &[Vec<EdgeId>],
@@ -143,7 +153,7 @@ fn course_line(
     first: EdgeId,
     tol: f64,
     length: f64,
-) -> Vec<Coord<f64>> {
+) -> (Vec<Coord<f64>>, f64) {
     let mut coords = vec![m.node(j).pos];
     let (mut at, mut via) = (j, first);
     let mut total = 0.0;
@@ -167,7 +177,7 @@ fn course_line(
         let [next] = onward[..] else { break };
         via = next;
     }
-    coords
+    (coords, m.node(at).radius)
 }
 
 /// Where each ring's segments start in [`Boundary::segments`].
