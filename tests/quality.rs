@@ -78,10 +78,6 @@ fn near(a: Coord<f64>, b: Coord<f64>, tol: f64) -> bool {
     (a - b).x.hypot((a - b).y) <= tol
 }
 
-fn chosen_lines(o: &FeatureOutcome) -> &MultiLineString<f64> {
-    &o.chosen().1.geometry
-}
-
 fn candidate_lines(o: &FeatureOutcome, m: MethodId) -> &MultiLineString<f64> {
     let c = o
         .candidates

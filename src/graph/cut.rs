@@ -32,7 +32,7 @@
 //! extension ends the line with a straight segment from j square to the
 //! cut, where j's disc touches it (the middle of a rectangle's end side).
 
-use super::prune::legs::point_at;
+use super::line::point_at;
 use super::{EdgeId, NodeId, SkeletonGraph};
 use crate::geometry::boundary::closest_on_segment;
 use crate::geometry::Boundary;

@@ -55,16 +55,12 @@
 //! falls back to following the skeleton, then to the nearest point of ∂P.
 
 use super::cut::{cut_ends, CutEnd};
-use super::prune::legs::point_at;
+use super::line::{end_turn, point_at, HOOK_DEG};
 use super::{EdgeId, NodeId, SkeletonGraph};
 use crate::geometry::{Boundary, PreparedPolygon};
-use crate::score::defects::{end_turn, HOOK_DEG};
 use geo::Coord;
 
-/// Relative tolerance (× polygon extent) within which a node lies on ∂P;
-/// above the coarsest coordinate resolution of any method (MA's grid,
-/// ≤ 1.5 × 10⁻⁸ × extent).
-pub const END_ON_BOUNDARY: f64 = 1e-7;
+pub use super::line::ON_BOUNDARY_END as END_ON_BOUNDARY;
 
 /// Largest angle between the line's course and a removed leg that the line
 /// follows.

@@ -43,7 +43,7 @@
 //! assert_eq!(g.total_length(), 10.0); // from (0, 2) to (10, 2)
 //! ```
 
-use super::prune::legs::point_at;
+use super::line::point_at;
 use super::prune::{prune, prune_mask, PruneParams};
 use super::{polyline_length, SkeletonGraph};
 use crate::geometry::{Boundary, PreparedPolygon};

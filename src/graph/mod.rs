@@ -13,6 +13,7 @@ pub mod bridge;
 pub mod cut;
 pub mod ends;
 pub mod extend;
+pub mod line;
 pub mod planar;
 pub mod prune;
 pub mod structure;

@@ -34,8 +34,8 @@
 //! places, and the metrics decide between like structures.
 
 use super::bridge::bridge;
-use super::ends::{assemble, END_ON_BOUNDARY};
-use super::prune::legs::point_at;
+use super::ends::assemble;
+use super::line::{end_radius, point_at, ON_BOUNDARY_END as END_ON_BOUNDARY};
 use super::prune::trunk::shortest_path;
 use super::{NodeId, SkeletonGraph, UnionFind};
 use crate::geometry::PreparedPolygon;
@@ -92,44 +92,6 @@ impl Structure {
             .collect();
         Self { contacts, trunk }
     }
-}
-
-/// The local radius of a line at its end: walking back from the end
-/// (`coords[0]`), the distance to ∂P at the first point whose arc length
-/// from the end reaches twice that distance (one local width back), or at
-/// the far end of `coords` when none does.
-pub fn end_radius(coords: &[Coord<f64>], polygon: &PreparedPolygon) -> f64 {
-    end_width_point(coords, polygon).1
-}
-
-/// Arc length from the end and distance to ∂P of the point one local width
-/// back along `coords` (see [`end_radius`]).
-pub fn end_width_point(coords: &[Coord<f64>], polygon: &PreparedPolygon) -> (f64, f64) {
-    let b = polygon.boundary();
-    let total = super::polyline_length(coords);
-    // Arc length s grows with slope 1 and the radius at most with slope 1,
-    // so s − 2 r(s) changes sign once on a medial line; sample it finely
-    // enough and bisect the first sign change.
-    let steps = 64;
-    let f = |s: f64| s - 2.0 * b.distance(point_at(coords, s));
-    let mut lo = 0.0;
-    for i in 1..=steps {
-        let s = total * i as f64 / steps as f64;
-        if f(s) >= 0.0 {
-            let mut hi = s;
-            for _ in 0..30 {
-                let mid = 0.5 * (lo + hi);
-                if f(mid) >= 0.0 {
-                    hi = mid;
-                } else {
-                    lo = mid;
-                }
-            }
-            return (hi, b.distance(point_at(coords, hi)));
-        }
-        lo = s;
-    }
-    (total, b.distance(point_at(coords, total)))
 }
 
 /// Prunes `raw` (one method's raw skeleton of `polygon`) to `structure`

@@ -5,7 +5,7 @@
 //!   running on into the polygon's end. Walking back from the end e, w is
 //!   the arc length of the first point whose distance to ∂P is half the
 //!   arc length walked (one local width back,
-//!   [`crate::graph::structure::end_width_point`]); the end's turn is the
+//!   [`crate::graph::line::end_width_point`]); the end's turn is the
 //!   angle between the line's course entering that stretch (from 1.5 w to
 //!   w back) and its last segment. A turn above [`HOOK_DEG`] is a hook.
 //! * **Crossing**: two segments of the skeleton that cross without a node
@@ -14,27 +14,13 @@
 //!   more than [`SHARP_DEG`], per kilometre of line: the saw-tooth of CDT and
 //!   VD lines (a cartographic line turns gently).
 
-use crate::geometry::PreparedPolygon;
-use crate::graph::prune::legs::point_at;
-use crate::graph::structure::end_width_point;
-use crate::graph::{polyline_length, GraphBuilder, NodeId, SkeletonGraph};
+use crate::graph::line::angle_deg;
+pub use crate::graph::line::{end_turn, end_turns, HOOK_DEG};
+use crate::graph::{GraphBuilder, SkeletonGraph};
 use geo::{Coord, MultiLineString};
-
-/// A line end that turns by more than this (degrees) within its last local
-/// width is a hook.
-pub const HOOK_DEG: f64 = 60.0;
 
 /// A vertex where the line turns by more than this (degrees) is a sharp turn.
 pub const SHARP_DEG: f64 = 45.0;
-
-fn angle_deg(a: Coord<f64>, b: Coord<f64>) -> Option<f64> {
-    let (la, lb) = (a.x.hypot(a.y), b.x.hypot(b.y));
-    if la == 0.0 || lb == 0.0 {
-        return None;
-    }
-    let c = ((a.x * b.x + a.y * b.y) / (la * lb)).clamp(-1.0, 1.0);
-    Some(c.acos().to_degrees())
-}
 
 /// The graph of skeleton lines made by any tool (end points shared bit for
 /// bit become nodes).
@@ -44,40 +30,6 @@ pub fn graph_of(lines: &MultiLineString<f64>) -> SkeletonGraph {
         b.polyline(&l.0);
     }
     b.finish_raw()
-}
-
-/// The turn (degrees) of every line end of `g`, a skeleton of `polygon`, in
-/// node order (see the module documentation).
-pub fn end_turns(g: &SkeletonGraph, polygon: &PreparedPolygon) -> Vec<f64> {
-    let adj = g.adjacency();
-    let mut out = Vec::new();
-    for n in 0..g.nodes().len() {
-        if adj[n].len() != 1 {
-            continue;
-        }
-        let coords = g.line_from(NodeId(n as u32), &adj);
-        if let Some(t) = end_turn(&coords, polygon) {
-            out.push(t);
-        }
-    }
-    out
-}
-
-/// The turn of the line `coords` at its first point (see the module docs).
-pub fn end_turn(coords: &[Coord<f64>], polygon: &PreparedPolygon) -> Option<f64> {
-    let total = polyline_length(coords);
-    if total <= 0.0 {
-        return None;
-    }
-    let (w, _) = end_width_point(coords, polygon);
-    let e = coords[0];
-    let last = coords.iter().copied().find(|&c| c != e)?;
-    let before = point_at(coords, w.min(total));
-    let start = point_at(coords, (1.5 * w).min(total));
-    if before == start {
-        return Some(0.0);
-    }
-    angle_deg(before - start, e - last)
 }
 
 /// Vertices where the lines of `g` turn by more than [`SHARP_DEG`], and the
@@ -110,6 +62,8 @@ mod tests {
     fn c(x: f64, y: f64) -> Coord<f64> {
         Coord { x, y }
     }
+
+    use crate::geometry::PreparedPolygon;
 
     #[test]
     fn a_straight_end_does_not_turn_and_a_sideways_stub_is_a_hook() {

@@ -25,24 +25,11 @@
 use super::{LegMeasure, PruneParams};
 use crate::geometry::Boundary;
 use crate::graph::cut::cut_ends;
+use crate::graph::line::{point_at, ON_BOUNDARY_END};
 use crate::graph::{EdgeId, NodeId, SkeletonGraph};
 use geo::Coord;
 use std::cmp::{Ordering, Reverse};
 use std::collections::BinaryHeap;
-
-/// The point at arc length `s` along `line` (its end when `s` ≥ its length).
-pub fn point_at(line: &[Coord<f64>], s: f64) -> Coord<f64> {
-    let mut left = s;
-    for w in line.windows(2) {
-        let d = w[1] - w[0];
-        let l = d.x.hypot(d.y);
-        if l >= left && l > 0.0 {
-            return w[0] + d * (left / l);
-        }
-        left -= l;
-    }
-    *line.last().expect("a polyline has at least one point")
-}
 
 /// A branch of the working graph: an original edge of the merged graph, or
 /// two pieces joined at a former degree-2 node (a binary tree, so joining is
@@ -294,7 +281,7 @@ pub fn mask(m: &SkeletonGraph, params: &PruneParams, boundary: &Boundary) -> Vec
     // A cut end is an end of the skeleton whatever its legs measure: its
     // corner legs go now (the extension ends the line on the cut), and its
     // junction reaches on without limit, so the leg to it is never cut.
-    let tol = crate::graph::ends::END_ON_BOUNDARY * boundary.extent();
+    let tol = ON_BOUNDARY_END * boundary.extent();
     if params.mode == super::PruneMode::Significance {
         for cut in cut_ends(m, boundary, tol) {
             for leg in cut.legs {
