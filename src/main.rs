@@ -291,7 +291,7 @@ fn main() -> ExitCode {
         }
         Command::Methods => {
             println!("Methods (skeleton step, `methods: [...]`):");
-            for m in MethodId::ALL {
+            for m in MethodId::builtin() {
                 println!("  {:<5} {}", m.as_str(), m.description());
             }
             println!(

@@ -7,7 +7,7 @@ use crate::geometry::PreparedPolygon;
 use crate::graph::extend::{prune_and_extend, ExtendParams};
 use crate::graph::prune::PruneParams;
 use crate::methods::medial_axis::{medial_axis_transform, MatSegment};
-use crate::methods::{build, MethodId, SkeletonParams};
+use crate::methods::{MethodId, Registry, SkeletonParams};
 use crate::score::select::{select, SelectParams};
 use crate::score::{bars, metrics, Bar, ScoreParams, Scores};
 use geo::{Area, Geometry, MultiLineString, Polygon};
@@ -24,6 +24,19 @@ pub struct PrepareParams {
     /// Polygon parts smaller than this (CRS units²) are skipped; a feature all
     /// of whose parts are skipped is counted as filtered.
     pub min_area: f64,
+}
+
+impl PrepareParams {
+    /// Checks the options: `(key, message)` of the first that is wrong.
+    pub fn validate(&self) -> Result<(), (String, String)> {
+        if self.min_area.is_nan() || self.min_area < 0.0 {
+            return Err((
+                "min_area".into(),
+                "min_area must be ≥ 0 (CRS units²)".into(),
+            ));
+        }
+        Ok(())
+    }
 }
 
 impl Default for PrepareParams {
@@ -54,6 +67,8 @@ pub struct ProcessParams {
     pub keep_bars: bool,
     /// Keep the local widths of the skeleton (for the `widths` layer).
     pub keep_widths: bool,
+    /// The methods `skeleton.methods` may name.
+    pub registry: Registry,
 }
 
 /// One method's result for one feature.
@@ -273,7 +288,9 @@ fn part_skeletons(
     let raws: Vec<Result<crate::graph::SkeletonGraph, String>> = methods
         .par_iter()
         .map(|&m| {
-            build(m, &params.skeleton)
+            params
+                .registry
+                .build(m, &params.skeleton)?
                 .skeletonise(p)
                 .map_err(|e| e.to_string())
         })
@@ -409,7 +426,7 @@ mod tests {
     fn rectangle_gets_a_cdt_skeleton() {
         let p = ProcessParams {
             skeleton: SkeletonParams {
-                methods: vec![MethodId::Cdt],
+                methods: vec![MethodId::CDT],
                 ..Default::default()
             },
             ..Default::default()
@@ -423,7 +440,7 @@ mod tests {
         let Processed::Done(o) = r else {
             panic!("{r:?}")
         };
-        assert_eq!(o.chosen().0, &MethodId::Cdt);
+        assert_eq!(o.chosen().0, &MethodId::CDT);
         assert!(!o.chosen().1.geometry.0.is_empty());
     }
 

@@ -91,15 +91,15 @@ fn candidate_lines(o: &FeatureOutcome, m: MethodId) -> &MultiLineString<f64> {
 fn rectangle_pruned_medial_axis_ends_on_the_short_sides_midpoints() {
     let rect = digitised(&[(0., 0.), (100., 0.), (100., 20.), (0., 20.)], 5.0);
     let o = run(&rect, &defaults());
-    assert_eq!(o.chosen().0, &MethodId::Ma);
-    let e = ends(candidate_lines(&o, MethodId::Ma));
+    assert_eq!(o.chosen().0, &MethodId::MA);
+    let e = ends(candidate_lines(&o, MethodId::MA));
     assert_eq!(e.len(), 2, "{e:?}");
     assert!(
         near(e[0], c(0., 10.), 1e-6) && near(e[1], c(100., 10.), 1e-6),
         "{e:?}"
     );
     // The same cut ends for every method (like-for-like structure).
-    for m in MethodId::ALL {
+    for m in MethodId::builtin() {
         let e = ends(candidate_lines(&o, m));
         assert_eq!(e.len(), 2, "{m}: {e:?}");
         assert!(
@@ -131,12 +131,12 @@ fn tapering_tip() -> Polygon<f64> {
 fn a_tapering_tip_is_reached_along_the_medial_axis_own_leg() {
     let p = tapering_tip();
     let o = run(&p, &defaults());
-    let lines = candidate_lines(&o, MethodId::Ma);
+    let lines = candidate_lines(&o, MethodId::MA);
     let e = ends(lines);
     assert!(e.iter().any(|&x| near(x, c(560., 30.), 1e-6)), "{e:?}");
     // Every point of the end near the tip lies on the raw medial axis.
     let pp = PreparedPolygon::new(&p).unwrap();
-    let raw = build(MethodId::Ma, &SkeletonParams::default())
+    let raw = build(MethodId::MA, &SkeletonParams::default())
         .skeletonise(&pp)
         .unwrap();
     let raw_lines = raw.to_multilinestring();
@@ -184,7 +184,7 @@ fn lake_with_bay() -> Polygon<f64> {
 fn a_long_bay_of_a_broad_lake_keeps_its_arm() {
     let p = lake_with_bay();
     let o = run(&p, &defaults());
-    let e = ends(candidate_lines(&o, MethodId::Ma));
+    let e = ends(candidate_lines(&o, MethodId::MA));
     // One end in the bay's tip.
     assert!(
         e.iter().any(|&q| near(q, c(500., 1100.), 1e-6)),
@@ -197,7 +197,7 @@ fn a_long_bay_of_a_broad_lake_keeps_its_arm() {
         arm_ratio: 0.0,
         ..PruneParams::default()
     });
-    let e = ends(candidate_lines(&run(&p, &off), MethodId::Ma));
+    let e = ends(candidate_lines(&run(&p, &off), MethodId::MA));
     assert!(e.iter().all(|q| q.y < 1000.0), "{e:?}");
 }
 
@@ -220,7 +220,7 @@ fn a_bump_of_the_bank_is_no_arm() {
         (0., 100.),
     ]);
     let o = run(&p, &defaults());
-    let e = ends(candidate_lines(&o, MethodId::Ma));
+    let e = ends(candidate_lines(&o, MethodId::MA));
     assert_eq!(e.len(), 2, "{e:?}");
     assert!(
         near(e[0], c(0., 50.), 1e-6) && near(e[1], c(1000., 50.), 1e-6),
@@ -248,7 +248,7 @@ fn t_shape() -> Polygon<f64> {
 #[test]
 fn every_method_has_the_same_contacts_on_a_t_shape() {
     let o = run(&t_shape(), &defaults());
-    let reference = ends(candidate_lines(&o, MethodId::Ma));
+    let reference = ends(candidate_lines(&o, MethodId::MA));
     // The three arms end on their end sides' midpoints.
     assert_eq!(reference.len(), 3, "{reference:?}");
     for (got, want) in reference
@@ -257,7 +257,7 @@ fn every_method_has_the_same_contacts_on_a_t_shape() {
     {
         assert!(near(*got, want, 1e-6), "{reference:?}");
     }
-    for m in MethodId::ALL {
+    for m in MethodId::builtin() {
         let e = ends(candidate_lines(&o, m));
         assert_eq!(e.len(), reference.len(), "{m}: {e:?}");
         for (a, b) in e.iter().zip(&reference) {
@@ -314,7 +314,7 @@ fn layer_defects(layer: &str, params: &ProcessParams) -> (usize, usize, usize, u
                 not_one_line += usize::from(!one_line);
             }
             let crossing = usize::from(crossings(&all) > 0);
-            let not_ma = usize::from(*method != MethodId::Ma);
+            let not_ma = usize::from(*method != MethodId::MA);
             (hooks, n_ends, crossing, not_one_line, not_ma)
         })
         .reduce(

@@ -298,15 +298,17 @@ fn training_layers_score_with_cdt() {
 fn raw_medial_axis_scores_zero_distortion_on_every_training_polygon() {
     use skeletonise::methods::medial_axis::ArcTolerance;
     assert_eq!(
-        SkeletonParams::default().arc_tolerance,
+        SkeletonParams::default().medial_axis.arc_tolerance,
         ArcTolerance::Relative(0.001)
     );
     for (f, z_max) in [(0.001, 0.001), (0.01, f64::INFINITY)] {
         let params = SkeletonParams {
-            arc_tolerance: ArcTolerance::Relative(f),
+            medial_axis: skeletonise::methods::medial_axis::MedialAxisOptions {
+                arc_tolerance: ArcTolerance::Relative(f),
+            },
             ..SkeletonParams::default()
         };
-        let ma = build(MethodId::Ma, &params);
+        let ma = build(MethodId::MA, &params);
         let bar_bound = f / (1.0 - f) * (1.0 + 1e-6);
         let (mut worst, mut worst_bar, mut n, mut over) = ((0.0f64, String::new()), 0.0f64, 0, 0);
         for layer in LAYERS {
@@ -432,8 +434,8 @@ fn straight_skeleton_equals_medial_axis_on_a_rotated_square() {
 }
 
 fn assert_stsk_equals_ma(name: &str, pts: &[(f64, f64)]) {
-    let ma = build(MethodId::Ma, &SkeletonParams::default());
-    let stsk = build(MethodId::StSk, &SkeletonParams::default());
+    let ma = build(MethodId::MA, &SkeletonParams::default());
+    let stsk = build(MethodId::STSK, &SkeletonParams::default());
     {
         let p = prepared(pts);
         let (g_ma, g_st) = (ma.skeletonise(&p).unwrap(), stsk.skeletonise(&p).unwrap());

@@ -71,6 +71,17 @@ impl Step {
         }
     }
 
+    /// Checks the step's options: `(key within the step, message)`.
+    pub fn validate(&self) -> Result<(), (String, String)> {
+        match self {
+            Step::Prepare(p) => p.validate(),
+            Step::Skeleton(p) => p.validate(),
+            Step::Prune(p) => p.validate(),
+            Step::Extend(_) | Step::Score(_) => Ok(()),
+            Step::Select(p) => p.validate(),
+        }
+    }
+
     /// Steps in the only order they may appear in.
     pub const ORDER: [&'static str; 6] =
         ["prepare", "skeleton", "prune", "extend", "score", "select"];
@@ -191,6 +202,7 @@ pub fn load_str(text: &str, origin: &str, overrides: &[String]) -> Result<Pipeli
         })?;
     }
     substitute_env(&mut value, "").map_err(|(k, m)| err(locs.value(&k), &k, m))?;
+    unknown_skeleton_keys(&value).map_err(|(k, m)| err(locs.key(&k), &k, m))?;
     // Enums are written as single-key maps (`prune: {...}`, `densify: {factor: 4}`).
     let mut track = serde_path_to_error::Track::new();
     let de = serde_path_to_error::Deserializer::new(value, &mut track);
@@ -214,6 +226,38 @@ pub fn load_str(text: &str, origin: &str, overrides: &[String]) -> Result<Pipeli
         origin: origin.to_string(),
         overrides: overrides.to_vec(),
     })
+}
+
+/// The `skeleton` step takes its own keys and every registered method's
+/// options flat (so that serde cannot reject unknown ones itself): a key
+/// that none of them owns is an error.
+fn unknown_skeleton_keys(root: &Value) -> Result<(), (String, String)> {
+    let Some(steps) = root.get("steps").and_then(Value::as_sequence) else {
+        return Ok(());
+    };
+    let mut allowed = vec!["methods", "reference"];
+    for e in crate::methods::BUILTIN {
+        allowed.extend(e.options.iter().copied());
+    }
+    for (i, step) in steps.iter().enumerate() {
+        let Some(opts) = step.get("skeleton").and_then(Value::as_mapping) else {
+            continue;
+        };
+        for k in opts.keys() {
+            let k = k.as_str().unwrap_or_default();
+            if !allowed.contains(&k) {
+                let list: Vec<String> = allowed.iter().map(|a| format!("`{a}`")).collect();
+                return Err((
+                    format!("steps[{i}].skeleton.{k}"),
+                    format!(
+                        "unknown field `{k}`, expected one of {}; `skeletonise schema` lists every key",
+                        list.join(", ")
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 fn path_string(p: &serde_path_to_error::Path) -> String {
@@ -279,7 +323,7 @@ fn validate(f: &PipelineFile, _locs: &Locations) -> Result<(), (String, String)>
         last = Some((rank, s.name()));
     }
     let pos = |name: &str| f.steps.iter().position(|s| s.name() == name);
-    let Some(sk) = pos("skeleton") else {
+    let Some(_) = pos("skeleton") else {
         return Err((
             "steps".into(),
             "the `skeleton` step is required, e.g. `- skeleton: { methods: [MA, CDT] }`".into(),
@@ -291,62 +335,9 @@ fn validate(f: &PipelineFile, _locs: &Locations) -> Result<(), (String, String)>
             "`select` needs the `score` step before it: add `- score: {}`".into(),
         ));
     }
-    for s in &f.steps {
-        let at = |k: &str| format!("steps[{}].{}.{k}", pos(s.name()).unwrap_or(0), s.name());
-        match s {
-            Step::Skeleton(p) => {
-                if p.methods.is_empty() {
-                    return Err((
-                        at("methods"),
-                        "list at least one method: VD, DVD, CDT, StSk, MA".into(),
-                    ));
-                }
-                let mut seen = std::collections::HashSet::new();
-                if let Some(d) = p.methods.iter().find(|m| !seen.insert(**m)) {
-                    return Err((at("methods"), format!("method {d} is listed twice")));
-                }
-                match p.densify {
-                    crate::methods::DensifyParams::Factor(0) => {
-                        return Err((
-                            at("densify.factor"),
-                            "factor must be at least 1 (the paper uses 2 and 4)".into(),
-                        ))
-                    }
-                    crate::methods::DensifyParams::Spacing(d) if !(d > 0.0 && d.is_finite()) => {
-                        return Err((
-                            at("densify.spacing"),
-                            "spacing must be a positive number of CRS units".into(),
-                        ))
-                    }
-                    _ => {}
-                }
-                p.arc_tolerance
-                    .validate()
-                    .map_err(|m| (at("arc_tolerance"), m))?;
-                let _ = sk;
-            }
-            Step::Prune(p) => {
-                if !(p.ratio >= 0.0 && p.ratio.is_finite()) {
-                    return Err((at("ratio"), "ratio must be a finite number ≥ 0".into()));
-                }
-                if p.min_length.is_nan() || p.min_length < 0.0 {
-                    return Err((
-                        at("min_length"),
-                        "min_length must be ≥ 0 (CRS units)".into(),
-                    ));
-                }
-            }
-            Step::Select(p) if !(0.0..=1.0).contains(&p.min_coverage) => {
-                return Err((
-                    at("min_coverage"),
-                    "min_coverage is a fraction between 0 and 1".into(),
-                ));
-            }
-            Step::Prepare(p) if p.min_area.is_nan() || p.min_area < 0.0 => {
-                return Err((at("min_area"), "min_area must be ≥ 0 (CRS units²)".into()));
-            }
-            _ => {}
-        }
+    for (i, s) in f.steps.iter().enumerate() {
+        s.validate()
+            .map_err(|(k, m)| (format!("steps[{i}].{}.{k}", s.name()), m))?;
     }
     if f.output.path.trim().is_empty() {
         return Err((

@@ -38,7 +38,7 @@ pub struct Cdt;
 
 fn fail(reason: impl Into<String>) -> MethodError {
     MethodError::Failed {
-        method: MethodId::Cdt,
+        method: MethodId::CDT,
         reason: reason.into(),
     }
 }
@@ -155,7 +155,7 @@ fn centroid(c: &[Coord<f64>; 3]) -> Coord<f64> {
 
 impl SkeletonMethod for Cdt {
     fn id(&self) -> MethodId {
-        MethodId::Cdt
+        MethodId::CDT
     }
 
     fn skeletonise(&self, polygon: &PreparedPolygon) -> Result<SkeletonGraph, MethodError> {

@@ -7,8 +7,9 @@
 //! | `StSk` | [`straight_skeleton`] |
 //! | `MA` | [`medial_axis`] |
 //!
-//! Adding a method is one new module plus one arm in [`MethodId`] and
-//! [`build`]. Every method returns a [`SkeletonGraph`] whose node radii are
+//! Adding a method is one new module plus one [`MethodEntry`] (in
+//! [`BUILTIN`], or added to a [`Registry`] with [`Registry::with`]): its
+//! parsing, help, schema and construction come from the entry. Every method returns a [`SkeletonGraph`] whose node radii are
 //! distances to ∂P, whose points lie in P and whose edges do not cross ∂P.
 
 pub mod cdt;
@@ -22,74 +23,89 @@ use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-/// The method identifiers used in pipeline files and the `method` attribute.
-#[derive(
-    Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize, JsonSchema,
-)]
-pub enum MethodId {
-    /// Voronoi diagram of the boundary vertices.
-    #[serde(rename = "VD")]
-    Vd,
-    /// Voronoi diagram of the densified boundary.
-    #[serde(rename = "DVD")]
-    Dvd,
-    /// Constrained Delaunay triangulation (De Lucia & Black rules).
-    #[serde(rename = "CDT")]
-    Cdt,
-    /// Straight skeleton.
-    #[serde(rename = "StSk")]
-    StSk,
-    /// Medial axis (transform).
-    #[serde(rename = "MA")]
-    Ma,
-}
+/// A method's identifier, as written in pipeline files and the `method`
+/// attribute. The built-in ones are constants; a method added to a
+/// [`Registry`] brings its own (`MethodId::new("Centroid")`).
+#[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct MethodId(&'static str);
 
 impl MethodId {
-    /// Every method, in the order the paper presents them.
-    pub const ALL: [MethodId; 5] = [
-        MethodId::Vd,
-        MethodId::Dvd,
-        MethodId::Cdt,
-        MethodId::StSk,
-        MethodId::Ma,
-    ];
+    /// Voronoi diagram of the boundary vertices.
+    pub const VD: MethodId = MethodId("VD");
+    /// Voronoi diagram of the densified boundary.
+    pub const DVD: MethodId = MethodId("DVD");
+    /// Constrained Delaunay triangulation (De Lucia & Black rules).
+    pub const CDT: MethodId = MethodId("CDT");
+    /// Straight skeleton.
+    pub const STSK: MethodId = MethodId("StSk");
+    /// Medial axis (transform).
+    pub const MA: MethodId = MethodId("MA");
+
+    /// The identifier of a method outside the built-in ones.
+    pub const fn new(id: &'static str) -> Self {
+        MethodId(id)
+    }
+
+    /// The built-in methods, in the order the paper presents them.
+    pub fn builtin() -> impl Iterator<Item = MethodId> {
+        BUILTIN.iter().map(|e| e.id)
+    }
 
     /// The identifier as written in pipeline files and output attributes.
     pub fn as_str(self) -> &'static str {
-        match self {
-            MethodId::Vd => "VD",
-            MethodId::Dvd => "DVD",
-            MethodId::Cdt => "CDT",
-            MethodId::StSk => "StSk",
-            MethodId::Ma => "MA",
-        }
+        self.0
     }
 
-    /// One-line description for `skeletonise methods`.
+    /// One-line description (of a built-in method; empty otherwise).
     pub fn description(self) -> &'static str {
-        match self {
-            MethodId::Vd => "Voronoi diagram of the boundary vertices; finite edges inside P that do not cross the boundary",
-            MethodId::Dvd => "Voronoi diagram after densifying every boundary edge (densify: {factor: k} or {spacing: d})",
-            MethodId::Cdt => "constrained Delaunay triangulation, skeleton per triangle by De Lucia & Black's rules (paper Fig. 3)",
-            MethodId::StSk => "straight skeleton: trace of the wavefront vertices as the edges move inward at unit speed",
-            MethodId::Ma => "medial axis: Voronoi diagram of the boundary segments inside P, without edges from reflex vertices",
-        }
+        Registry::builtin().get(self).map_or("", |e| e.description)
+    }
+}
+
+impl std::fmt::Debug for MethodId {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.0)
     }
 }
 
 impl std::fmt::Display for MethodId {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.as_str())
+        f.write_str(self.0)
     }
 }
 
 impl std::str::FromStr for MethodId {
     type Err = String;
+    /// A built-in method by its identifier (case-insensitive).
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        MethodId::ALL
-            .into_iter()
-            .find(|m| m.as_str().eq_ignore_ascii_case(s))
-            .ok_or_else(|| format!("unknown method `{s}`; expected one of VD, DVD, CDT, StSk, MA"))
+        Registry::builtin().parse(s)
+    }
+}
+
+impl Serialize for MethodId {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.0)
+    }
+}
+
+impl<'de> Deserialize<'de> for MethodId {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let s = String::deserialize(d)?;
+        s.parse().map_err(serde::de::Error::custom)
+    }
+}
+
+impl JsonSchema for MethodId {
+    fn schema_name() -> std::borrow::Cow<'static, str> {
+        "MethodId".into()
+    }
+    fn json_schema(_: &mut schemars::SchemaGenerator) -> schemars::Schema {
+        let ids: Vec<&str> = BUILTIN.iter().map(|e| e.id.as_str()).collect();
+        schemars::json_schema!({
+            "description": "A skeleton method (`skeletonise methods` describes them).",
+            "type": "string",
+            "enum": ids,
+        })
     }
 }
 
@@ -115,72 +131,41 @@ pub enum MethodError {
     },
 }
 
-/// Densification of the boundary for DVD.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields, rename_all = "lowercase")]
-pub enum DensifyParams {
-    /// `k − 1` equally spaced pseudo-nodes on each boundary edge (paper: 2 and 4).
-    Factor(u32),
-    /// No piece longer than this many CRS units.
-    Spacing(f64),
-}
-
-impl Default for DensifyParams {
-    fn default() -> Self {
-        DensifyParams::Factor(4)
-    }
-}
-
-impl From<DensifyParams> for crate::geometry::densify::Density {
-    fn from(d: DensifyParams) -> Self {
-        match d {
-            DensifyParams::Factor(k) => Self::Factor(k),
-            DensifyParams::Spacing(s) => Self::Spacing(s),
-        }
-    }
-}
-
 /// The paper's recommendation first: ties in selection go to the earlier method.
 fn default_methods() -> Vec<MethodId> {
     vec![
-        MethodId::Ma,
-        MethodId::StSk,
-        MethodId::Dvd,
-        MethodId::Cdt,
-        MethodId::Vd,
+        MethodId::MA,
+        MethodId::STSK,
+        MethodId::DVD,
+        MethodId::CDT,
+        MethodId::VD,
     ]
 }
 
-fn default_max_points() -> usize {
-    2_000_000
+fn default_reference() -> MethodId {
+    MethodId::MA
 }
 
-/// Options of the `skeleton` step.
+/// Options of the `skeleton` step: which methods run, the reference for the
+/// shared structure, and each method's own options (written flat in the
+/// step, e.g. `densify:` for DVD, `arc_tolerance:` for MA).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
 pub struct SkeletonParams {
     /// Methods to run on every polygon; ties in selection go to the earlier one.
     #[serde(default = "default_methods")]
     pub methods: Vec<MethodId>,
-    /// Boundary densification for DVD.
-    #[serde(default)]
-    pub densify: DensifyParams,
-    /// Most points a densified polygon may have (DVD); more is an error for that feature.
-    #[serde(default = "default_max_points")]
-    pub max_points: usize,
-    /// How closely MA's polylines follow its parabolic arcs.
-    #[serde(default)]
-    pub arc_tolerance: medial_axis::ArcTolerance,
     /// The method whose pruned and extended skeleton sets the legs every
     /// method is pruned to (with `prune.structure: shared`); when it is not
     /// among `methods` or fails on a polygon, the first that succeeds in the
     /// order MA, StSk, DVD, CDT, VD.
     #[serde(default = "default_reference")]
     pub reference: MethodId,
-}
-
-fn default_reference() -> MethodId {
-    MethodId::Ma
+    /// DVD's options.
+    #[serde(flatten)]
+    pub voronoi: voronoi::VoronoiOptions,
+    /// MA's options.
+    #[serde(flatten)]
+    pub medial_axis: medial_axis::MedialAxisOptions,
 }
 
 impl SkeletonParams {
@@ -188,17 +173,27 @@ impl SkeletonParams {
     pub fn reference_order(&self) -> Vec<MethodId> {
         let mut order = vec![self.reference];
         order.extend(
-            [
-                MethodId::Ma,
-                MethodId::StSk,
-                MethodId::Dvd,
-                MethodId::Cdt,
-                MethodId::Vd,
-            ]
-            .into_iter()
-            .filter(|m| *m != self.reference),
+            default_methods()
+                .into_iter()
+                .filter(|m| *m != self.reference),
         );
         order
+    }
+
+    /// Checks the options: `(key, message)` of the first that is wrong.
+    pub fn validate(&self) -> Result<(), (String, String)> {
+        if self.methods.is_empty() {
+            return Err((
+                "methods".into(),
+                "list at least one method: VD, DVD, CDT, StSk, MA".into(),
+            ));
+        }
+        let mut seen = std::collections::HashSet::new();
+        if let Some(d) = self.methods.iter().find(|m| !seen.insert(**m)) {
+            return Err(("methods".into(), format!("method {d} is listed twice")));
+        }
+        self.voronoi.validate()?;
+        self.medial_axis.validate()
     }
 }
 
@@ -206,10 +201,9 @@ impl Default for SkeletonParams {
     fn default() -> Self {
         Self {
             methods: default_methods(),
-            densify: DensifyParams::default(),
-            max_points: default_max_points(),
-            arc_tolerance: medial_axis::ArcTolerance::default(),
             reference: default_reference(),
+            voronoi: voronoi::VoronoiOptions::default(),
+            medial_axis: medial_axis::MedialAxisOptions::default(),
         }
     }
 }
@@ -225,16 +219,164 @@ pub trait SkeletonMethod: Send + Sync {
     fn skeletonise(&self, polygon: &PreparedPolygon) -> Result<SkeletonGraph, MethodError>;
 }
 
-/// The method registry: an instance of method `id` configured by `params`.
+/// One method as the registry knows it: its identifier, name, description
+/// and constructor. Parsing, help, the JSON Schema's list and construction
+/// all come from these entries.
+#[derive(Clone, Copy)]
+pub struct MethodEntry {
+    /// Identifier in pipeline files and the `method` attribute.
+    pub id: MethodId,
+    /// Full name.
+    pub name: &'static str,
+    /// One-line description for `skeletonise methods`.
+    pub description: &'static str,
+    /// Keys of the `skeleton` step that configure this method.
+    pub options: &'static [&'static str],
+    /// An instance configured by the step's options.
+    pub build: fn(&SkeletonParams) -> Box<dyn SkeletonMethod>,
+}
+
+impl std::fmt::Debug for MethodEntry {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("MethodEntry").field("id", &self.id).finish()
+    }
+}
+
+/// The built-in methods, in the order the paper presents them.
+pub const BUILTIN: &[MethodEntry] = &[
+    MethodEntry {
+        id: MethodId::VD,
+        name: "Voronoi diagram",
+        description: "Voronoi diagram of the boundary vertices; finite edges inside P that do not cross the boundary",
+        options: &[],
+        build: |_| Box::new(voronoi::Voronoi::plain()),
+    },
+    MethodEntry {
+        id: MethodId::DVD,
+        name: "densified Voronoi diagram",
+        description: "Voronoi diagram after densifying every boundary edge (densify: {factor: k} or {spacing: d})",
+        options: &["densify", "max_points"],
+        build: |p| Box::new(voronoi::Voronoi::densified(p.voronoi.densify.into(), p.voronoi.max_points)),
+    },
+    MethodEntry {
+        id: MethodId::CDT,
+        name: "constrained Delaunay triangulation",
+        description: "constrained Delaunay triangulation, skeleton per triangle by De Lucia & Black's rules (paper Fig. 3)",
+        options: &[],
+        build: |_| Box::new(cdt::Cdt),
+    },
+    MethodEntry {
+        id: MethodId::STSK,
+        name: "straight skeleton",
+        description: "straight skeleton: trace of the wavefront vertices as the edges move inward at unit speed",
+        options: &[],
+        build: |_| Box::new(straight_skeleton::StraightSkeleton),
+    },
+    MethodEntry {
+        id: MethodId::MA,
+        name: "medial axis",
+        description: "medial axis: Voronoi diagram of the boundary segments inside P, without edges from reflex vertices",
+        options: &["arc_tolerance"],
+        build: |p| Box::new(medial_axis::MedialAxis::new(p.medial_axis.arc_tolerance)),
+    },
+];
+
+/// The methods a run can use: the built-in ones, plus any added with
+/// [`Registry::with`].
+#[derive(Debug, Clone)]
+pub struct Registry {
+    entries: Vec<MethodEntry>,
+}
+
+impl PartialEq for Registry {
+    fn eq(&self, o: &Self) -> bool {
+        self.entries
+            .iter()
+            .map(|e| e.id)
+            .eq(o.entries.iter().map(|e| e.id))
+    }
+}
+
+impl Default for Registry {
+    fn default() -> Self {
+        Self::builtin()
+    }
+}
+
+impl Registry {
+    /// The built-in methods.
+    pub fn builtin() -> Self {
+        Self {
+            entries: BUILTIN.to_vec(),
+        }
+    }
+
+    /// This registry with one more method (replacing one with the same id).
+    pub fn with(mut self, entry: MethodEntry) -> Self {
+        self.entries.retain(|e| e.id != entry.id);
+        self.entries.push(entry);
+        self
+    }
+
+    /// Every entry, in registration order.
+    pub fn entries(&self) -> &[MethodEntry] {
+        &self.entries
+    }
+
+    /// The entry of method `id`.
+    pub fn get(&self, id: MethodId) -> Option<&MethodEntry> {
+        self.entries.iter().find(|e| e.id == id)
+    }
+
+    /// The method named `s` (case-insensitive).
+    pub fn parse(&self, s: &str) -> Result<MethodId, String> {
+        self.entries
+            .iter()
+            .find(|e| e.id.as_str().eq_ignore_ascii_case(s))
+            .map(|e| e.id)
+            .ok_or_else(|| {
+                let ids: Vec<&str> = self.entries.iter().map(|e| e.id.as_str()).collect();
+                format!("unknown method `{s}`; expected one of {}", ids.join(", "))
+            })
+    }
+
+    /// An instance of method `id` configured by `params`.
+    pub fn build(
+        &self,
+        id: MethodId,
+        params: &SkeletonParams,
+    ) -> Result<Box<dyn SkeletonMethod>, String> {
+        self.get(id)
+            .map(|e| (e.build)(params))
+            .ok_or_else(|| format!("method {id} is not registered"))
+    }
+}
+
+/// An instance of the built-in method `id` configured by `params`.
+///
+/// # Panics
+/// When `id` is not a built-in method (use a [`Registry`] for others).
 pub fn build(id: MethodId, params: &SkeletonParams) -> Box<dyn SkeletonMethod> {
-    match id {
-        MethodId::Cdt => Box::new(cdt::Cdt),
-        MethodId::Vd => Box::new(voronoi::Voronoi::plain()),
-        MethodId::Dvd => Box::new(voronoi::Voronoi::densified(
-            params.densify.into(),
-            params.max_points,
-        )),
-        MethodId::StSk => Box::new(straight_skeleton::StraightSkeleton),
-        MethodId::Ma => Box::new(medial_axis::MedialAxis::new(params.arc_tolerance)),
+    Registry::builtin()
+        .build(id, params)
+        .expect("a built-in method")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_entry_builds_the_method_it_names() {
+        for e in BUILTIN {
+            assert_eq!((e.build)(&SkeletonParams::default()).id(), e.id);
+        }
+    }
+
+    #[test]
+    fn ids_parse_case_insensitively_and_unknown_ones_list_the_known() {
+        assert_eq!("stsk".parse::<MethodId>(), Ok(MethodId::STSK));
+        let e = "XYZ".parse::<MethodId>().unwrap_err();
+        assert!(e.contains("VD, DVD, CDT, StSk, MA"), "{e}");
     }
 }

@@ -60,11 +60,82 @@ use crate::geometry::{boundary::orient, densify, densify::Density, PreparedPolyg
 use crate::graph::UnionFind;
 use crate::graph::{GraphBuilder, SkeletonGraph};
 use geo::{Coord, LineString};
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
 use spade::{DelaunayTriangulation, InsertionError, Point2, Triangulation};
 
 /// Relative tolerance (× the polygon's extent) for "on ∂P" and for merging
 /// coincident Voronoi vertices (SPEC §3: points within 1e-9 × extent of P).
 pub const RELATIVE_TOLERANCE: f64 = 1e-9;
+
+/// Densification of the boundary for DVD.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, rename_all = "lowercase")]
+pub enum DensifyParams {
+    /// `k − 1` equally spaced pseudo-nodes on each boundary edge (paper: 2 and 4).
+    Factor(u32),
+    /// No piece longer than this many CRS units.
+    Spacing(f64),
+}
+
+impl Default for DensifyParams {
+    fn default() -> Self {
+        DensifyParams::Factor(4)
+    }
+}
+
+impl From<DensifyParams> for Density {
+    fn from(d: DensifyParams) -> Self {
+        match d {
+            DensifyParams::Factor(k) => Self::Factor(k),
+            DensifyParams::Spacing(s) => Self::Spacing(s),
+        }
+    }
+}
+
+fn default_max_points() -> usize {
+    2_000_000
+}
+
+/// DVD's options in the `skeleton` step.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct VoronoiOptions {
+    /// Boundary densification for DVD.
+    #[serde(default)]
+    pub densify: DensifyParams,
+    /// Most points a densified polygon may have (DVD); more is an error for that feature.
+    #[serde(default = "default_max_points")]
+    pub max_points: usize,
+}
+
+impl Default for VoronoiOptions {
+    fn default() -> Self {
+        Self {
+            densify: DensifyParams::default(),
+            max_points: default_max_points(),
+        }
+    }
+}
+
+impl VoronoiOptions {
+    /// Checks the options: `(key, message)` of the first that is wrong.
+    pub fn validate(&self) -> Result<(), (String, String)> {
+        match self.densify {
+            DensifyParams::Factor(0) => Err((
+                "densify.factor".into(),
+                "factor must be at least 1 (the paper uses 2 and 4)".into(),
+            )),
+            DensifyParams::Spacing(d) if !(d > 0.0 && d.is_finite()) => Err((
+                "densify.spacing".into(),
+                "spacing must be a positive number of CRS units".into(),
+            )),
+            _ if self.max_points == 0 => {
+                Err(("max_points".into(), "max_points must be at least 1".into()))
+            }
+            _ => Ok(()),
+        }
+    }
+}
 
 /// Voronoi skeleton of the (optionally densified) boundary vertices.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -145,9 +216,9 @@ fn densified_count<'a>(
 impl SkeletonMethod for Voronoi {
     fn id(&self) -> MethodId {
         if self.density.is_some() {
-            MethodId::Dvd
+            MethodId::DVD
         } else {
-            MethodId::Vd
+            MethodId::VD
         }
     }
 

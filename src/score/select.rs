@@ -95,6 +95,29 @@ impl Default for SelectParams {
     }
 }
 
+impl SelectParams {
+    /// Checks the options: `(key, message)` of the first that is wrong.
+    pub fn validate(&self) -> Result<(), (String, String)> {
+        let fraction = |v: f64| (0.0..=1.0).contains(&v);
+        if !fraction(self.min_coverage) {
+            return Err((
+                "min_coverage".into(),
+                "min_coverage is a fraction between 0 and 1".into(),
+            ));
+        }
+        if !fraction(self.coverage_slack) {
+            return Err((
+                "coverage_slack".into(),
+                "coverage_slack is a fraction between 0 and 1".into(),
+            ));
+        }
+        if !(self.tie >= 0.0 && self.tie <= 1.0) {
+            return Err(("tie".into(), "tie is a distortion between 0 and 1".into()));
+        }
+        Ok(())
+    }
+}
+
 /// Index of the chosen candidate among `candidates` (in `methods` order;
 /// `None` entries are methods that failed or gave an empty skeleton), per
 /// the rule in the module documentation. Candidates without hits are chosen

@@ -172,6 +172,26 @@ impl PruneParams {
         }
     }
 
+    /// Checks the options: `(key, message)` of the first that is wrong.
+    pub fn validate(&self) -> Result<(), (String, String)> {
+        if !(self.ratio >= 0.0 && self.ratio.is_finite()) {
+            return Err(("ratio".into(), "ratio must be a finite number ≥ 0".into()));
+        }
+        if !(self.arm_ratio >= 0.0 && self.arm_ratio.is_finite()) {
+            return Err((
+                "arm_ratio".into(),
+                "arm_ratio must be a finite number ≥ 0 (0 turns the arm rule off)".into(),
+            ));
+        }
+        if self.min_length.is_nan() || self.min_length < 0.0 {
+            return Err((
+                "min_length".into(),
+                "min_length must be ≥ 0 (CRS units)".into(),
+            ));
+        }
+        Ok(())
+    }
+
     /// True for the modes that remove legs one by one.
     pub fn removes_legs(&self) -> bool {
         matches!(self.mode, PruneMode::Significance | PruneMode::Length)

@@ -114,6 +114,23 @@ impl ArcTolerance {
     }
 }
 
+/// MA's options in the `skeleton` step.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize, JsonSchema)]
+pub struct MedialAxisOptions {
+    /// How closely MA's polylines follow its parabolic arcs.
+    #[serde(default)]
+    pub arc_tolerance: ArcTolerance,
+}
+
+impl MedialAxisOptions {
+    /// Checks the options: `(key, message)` of the first that is wrong.
+    pub fn validate(&self) -> Result<(), (String, String)> {
+        self.arc_tolerance
+            .validate()
+            .map_err(|m| ("arc_tolerance".into(), m))
+    }
+}
+
 /// Finest arc tolerance, in grid units: below the grid spacing the input
 /// itself is not known, and this keeps the number of pieces bounded.
 const TOLERANCE_FLOOR: f64 = 1e-3;
@@ -147,14 +164,14 @@ pub fn resolution(polygon: &PreparedPolygon) -> f64 {
 
 fn fail(reason: impl Into<String>) -> MethodError {
     MethodError::Failed {
-        method: MethodId::Ma,
+        method: MethodId::MA,
         reason: reason.into(),
     }
 }
 
 impl SkeletonMethod for MedialAxis {
     fn id(&self) -> MethodId {
-        MethodId::Ma
+        MethodId::MA
     }
 
     fn skeletonise(&self, polygon: &PreparedPolygon) -> Result<SkeletonGraph, MethodError> {

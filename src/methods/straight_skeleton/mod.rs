@@ -124,7 +124,7 @@ struct Arc {
 
 fn fail(reason: impl Into<String>) -> MethodError {
     MethodError::Failed {
-        method: MethodId::StSk,
+        method: MethodId::STSK,
         reason: reason.into(),
     }
 }
@@ -863,7 +863,7 @@ pub fn straight_skeleton_with_stats(
 
 impl SkeletonMethod for StraightSkeleton {
     fn id(&self) -> MethodId {
-        MethodId::StSk
+        MethodId::STSK
     }
 
     fn skeletonise(&self, polygon: &PreparedPolygon) -> Result<SkeletonGraph, MethodError> {
