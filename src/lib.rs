@@ -13,10 +13,12 @@
 
 pub mod config;
 pub mod external;
+pub mod feature;
 pub mod geometry;
 pub mod graph;
 pub mod io;
 pub mod methods;
+pub mod output;
 pub mod pipeline;
 pub mod process;
 pub mod score;

@@ -2,19 +2,20 @@
 //! input order, so the output is identical for any thread count.
 //!
 //! GDAL is used only on the calling thread (reader and writer); workers run
-//! [`crate::process::process`] on owned data.
+//! [`crate::process::feature_rows`] on owned data. `run` and `score` are the
+//! same [`Job`]: they differ only in where the skeletons come from.
 
-use crate::config::{OnError, Pipeline};
-use crate::io::reader::{InputFeature, Reader};
-use crate::io::writer::{
-    check_output, BarRow, CandidateRow, RejectedRow, RunRecord, ScoreColumns, SkeletonRow,
-    WidthRow, Writer,
-};
+use crate::config::{InputSpec, OnError, OutputSpec, Pipeline};
+use crate::feature::Feature;
+use crate::io::reader::Reader;
+use crate::io::writer::{check_output, Writer};
 use crate::io::IoError;
-use crate::process::{process, ProcessParams, Processed};
-use crate::score::Scores;
+use crate::output::{Rows, RunRecord};
+use crate::process::{feature_rows, FeatureRows, ProcessParams, RowOptions, Skeletons, Status};
+use geo::MultiLineString;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
+use std::collections::HashMap;
 use std::time::Instant;
 use thiserror::Error;
 
@@ -78,148 +79,132 @@ pub fn validate(p: &Pipeline) -> Result<crate::io::SourceInfo, RunError> {
     Ok(reader.info().clone())
 }
 
-/// The score columns of an output row.
-pub fn columns(s: &Scores) -> ScoreColumns {
-    ScoreColumns {
-        bars: s.bars as i64,
-        hits: s.hits as i64,
-        coverage: s.coverage,
-        deviation: s.deviation,
-        deviation_parts: s.deviation_parts,
-        distortion_sum: s.distortion_sum,
-        distortion: s.distortion,
-    }
+/// Skeletons made by another tool, for `skeletonise score`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Given {
+    /// The tool's name, written to the `method` attribute.
+    pub label: String,
+    /// Its lines by polygon FID.
+    pub lines: HashMap<u64, MultiLineString<f64>>,
 }
 
-/// Rows produced for one input feature.
-#[derive(Default)]
-struct Rows {
-    skeletons: Vec<SkeletonRow>,
-    candidates: Vec<CandidateRow>,
-    bars: Vec<BarRow>,
-    widths: Vec<WidthRow>,
-    rejected: Vec<RejectedRow>,
-    filtered: bool,
+/// What a run reads, computes and writes: a pipeline file, or `score`'s
+/// arguments.
+#[derive(Debug, Clone)]
+pub struct Job<'a> {
+    /// Name for logs and `skeletonise_runs`.
+    pub name: String,
+    /// What to record as the pipeline in `skeletonise_runs`.
+    pub provenance: String,
+    /// The polygons.
+    pub input: &'a InputSpec,
+    /// The output GeoPackage.
+    pub output: &'a OutputSpec,
+    /// The per-feature steps.
+    pub params: ProcessParams,
+    /// What to do with features that cannot be processed.
+    pub on_error: OnError,
+    /// The skeletons when another tool made them.
+    pub given: Option<&'a Given>,
 }
 
-fn feature_rows(f: &InputFeature, params: &ProcessParams, p: &Pipeline) -> Rows {
-    let mut rows = Rows::default();
-    if let Some(e) = &f.geometry_error {
-        rows.rejected.push(RejectedRow {
-            src_fid: f.fid,
-            reason: e.clone(),
-            wkb: f.source_wkb.clone(),
-        });
-        return rows;
-    }
-    // With `explode`, every polygon part is its own unit of work and row.
-    let units: Vec<(Option<usize>, Option<geo::Geometry<f64>>)> =
-        match (&f.geometry, p.file.output.explode) {
-            (Some(geo::Geometry::MultiPolygon(mp)), true) if !mp.0.is_empty() => {
-                mp.0.iter()
-                    .enumerate()
-                    .map(|(i, poly)| (Some(i), Some(geo::Geometry::Polygon(poly.clone()))))
-                    .collect()
-            }
-            (g, true) => vec![(Some(0), g.clone())],
-            (g, false) => vec![(None, g.clone())],
-        };
-    let mut any_written = false;
-    for (part, geom) in units {
-        match process(geom.as_ref(), params) {
-            Processed::Done(o) => {
-                let (method, chosen) = o.chosen();
-                rows.skeletons.push(SkeletonRow {
-                    src_fid: f.fid,
-                    part,
-                    attributes: f.attributes.clone(),
-                    geometry: chosen.geometry.clone(),
-                    method: method.to_string(),
-                    scores: chosen.scores.as_ref().map(columns),
-                    components: chosen.components as i64,
-                    legs: chosen.legs as i64,
-                    repaired: f.repaired,
-                });
-                any_written = true;
-                rows.widths.extend(chosen.widths.iter().map(|w| WidthRow {
-                    src_fid: f.fid,
-                    method: method.to_string(),
-                    geometry: w.line,
-                    width_start: w.width_start(),
-                    width_end: w.width_end(),
-                }));
-                for (i, c) in o.candidates.iter().enumerate() {
-                    if p.file.output.candidates {
-                        rows.candidates.push(CandidateRow {
-                            src_fid: f.fid,
-                            part,
-                            method: c.method.to_string(),
-                            geometry: c.result.as_ref().ok().map(|s| s.geometry.clone()),
-                            scores: c
-                                .result
-                                .as_ref()
-                                .ok()
-                                .and_then(|s| s.scores.as_ref())
-                                .map(columns),
-                            chosen: i == o.chosen,
-                            components: c.result.as_ref().map(|s| s.components as i64).unwrap_or(0),
-                            legs_raw: c.result.as_ref().map(|s| s.legs_raw as i64).unwrap_or(0),
-                            legs: c.result.as_ref().map(|s| s.legs as i64).unwrap_or(0),
-                            error: c.result.as_ref().err().cloned(),
-                        });
-                    }
-                    if p.file.output.bars {
-                        if let Ok(s) = &c.result {
-                            for b in &s.bars {
-                                let end = b.hit.map(|h| h.point).unwrap_or(b.origin);
-                                rows.bars.push(BarRow {
-                                    src_fid: f.fid,
-                                    method: c.method.to_string(),
-                                    geometry: geo::LineString(vec![b.origin, end]),
-                                    d_left: b.hit.map(|h| h.d_left),
-                                    d_right: b.hit.map(|h| h.d_right),
-                                    delta_d: b.hit.map(|h| h.delta_d()),
-                                    z: b.hit.map(|h| h.z()),
-                                    part: b.hit.map(|h| h.part as i64),
-                                });
-                            }
-                        }
-                    }
-                }
-            }
-            Processed::Filtered => {}
-            Processed::Rejected(reason) => {
-                let reason = match part {
-                    Some(i) if p.file.output.explode => format!("part {i}: {reason}"),
-                    _ => reason,
-                };
-                rows.rejected.push(RejectedRow {
-                    src_fid: f.fid,
-                    reason,
-                    wkb: f.source_wkb.clone(),
-                });
-            }
+impl<'a> Job<'a> {
+    /// The job of a pipeline file.
+    pub fn of(p: &'a Pipeline) -> Self {
+        Self {
+            name: p.file.name.clone().unwrap_or_default(),
+            provenance: p.provenance_text(),
+            input: &p.file.input,
+            output: &p.file.output,
+            params: p.process_params(),
+            on_error: p.file.on_error,
+            given: None,
         }
     }
-    rows.filtered = !any_written && rows.rejected.is_empty();
-    rows
+
+    fn skeletons(&self, f: &Feature) -> Skeletons<'_> {
+        match self.given {
+            None => Skeletons::Computed,
+            Some(g) => Skeletons::Given {
+                label: &g.label,
+                lines: f.fid.and_then(|fid| g.lines.get(&fid)),
+            },
+        }
+    }
 }
 
 /// Runs the pipeline end to end.
 pub fn run(p: &Pipeline, opts: &RunOptions) -> Result<RunSummary, RunError> {
+    run_job(&Job::of(p), opts)
+}
+
+/// Counts of a run so far.
+#[derive(Debug, Default)]
+struct Counts {
+    read: u64,
+    written: u64,
+    rejected: u64,
+    filtered: u64,
+    rows: u64,
+    methods: std::collections::BTreeMap<String, u64>,
+}
+
+impl Counts {
+    /// Counts one feature; under `on_error: fail` a rejection is the error.
+    fn add(&mut self, f: &Feature, r: &FeatureRows, on_error: OnError) -> Result<(), RunError> {
+        if let (OnError::Fail, Some(rej)) = (on_error, r.rows.rejected.first()) {
+            return Err(RunError::Rejected {
+                fid: f.fid.map_or_else(|| "(no fid)".into(), |x| x.to_string()),
+                reason: rej.reason.clone(),
+            });
+        }
+        for rej in &r.rows.rejected {
+            tracing::warn!(fid = f.fid, reason = %rej.reason, "feature rejected");
+        }
+        match &r.status {
+            Status::Rejected => self.rejected += 1,
+            Status::Filtered => self.filtered += 1,
+            Status::Written(methods) => {
+                self.written += 1;
+                for m in methods {
+                    *self.methods.entry(m.clone()).or_default() += 1;
+                }
+            }
+        }
+        self.rows += r.rows.skeletons.len() as u64;
+        Ok(())
+    }
+}
+
+fn progress_bar(show: bool, len: u64) -> ProgressBar {
+    if !show {
+        return ProgressBar::hidden();
+    }
+    let b = ProgressBar::new(len);
+    b.set_style(
+        ProgressStyle::with_template(
+            "{spinner} {bar:40} {pos}/{len} features {elapsed_precise} (eta {eta})",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    b
+}
+
+/// Runs a job: read in batches → process each batch's features in parallel
+/// → write in input order.
+pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError> {
     let started = chrono::Utc::now();
     let clock = Instant::now();
-    let mut reader = Reader::open(&p.file.input)?;
+    let mut reader = Reader::open(job.input)?;
     let info = reader.info().clone();
-    let mut writer = Writer::create(&p.file.output, &info)?;
+    let mut writer = Writer::create(job.output, &info)?;
     let threads = opts.threads.unwrap_or_else(rayon::current_num_threads);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
         .map_err(|_| RunError::Threads(threads))?;
-    let params = p.process_params();
     tracing::info!(
-        pipeline = p.file.name.as_deref().unwrap_or(&p.origin),
+        pipeline = %job.name,
         source = %info.source,
         layer = %info.layer,
         crs = %info.crs_name,
@@ -228,70 +213,24 @@ pub fn run(p: &Pipeline, opts: &RunOptions) -> Result<RunSummary, RunError> {
         threads,
         "run started"
     );
-    let bar = if opts.progress {
-        let b = ProgressBar::new(info.selected);
-        b.set_style(
-            ProgressStyle::with_template(
-                "{spinner} {bar:40} {pos}/{len} features {elapsed_precise} (eta {eta})",
-            )
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-        );
-        b
-    } else {
-        ProgressBar::hidden()
-    };
-    let (mut read, mut written, mut rejected, mut filtered, mut rows_written) =
-        (0u64, 0u64, 0u64, 0u64, 0u64);
-    let mut methods: std::collections::BTreeMap<String, u64> = Default::default();
+    let bar = progress_bar(opts.progress, info.selected);
+    let row_opts = RowOptions::from(job.output);
+    let mut counts = Counts::default();
     let batch = opts.batch_size.unwrap_or(256).max(1);
-    let result = reader.read::<RunError>(batch, params.prepare.make_valid, |features| {
-        let rows: Vec<Rows> = pool.install(|| {
+    let result = reader.read::<RunError>(batch, job.params.prepare.make_valid, |features| {
+        let done: Vec<FeatureRows> = pool.install(|| {
             features
                 .par_iter()
-                .map(|f| feature_rows(f, &params, p))
+                .map(|f| feature_rows(f, job.skeletons(f), &job.params, row_opts))
                 .collect()
         });
-        read += features.len() as u64;
-        let mut sk = Vec::new();
-        let mut ca = Vec::new();
-        let mut ba = Vec::new();
-        let mut rj = Vec::new();
-        let mut wi = Vec::new();
-        for (f, r) in features.iter().zip(rows) {
-            if p.file.on_error == OnError::Fail {
-                if let Some(rej) = r.rejected.first() {
-                    return Err(RunError::Rejected {
-                        fid: f
-                            .fid
-                            .map(|x| x.to_string())
-                            .unwrap_or_else(|| "(no fid)".into()),
-                        reason: rej.reason.clone(),
-                    });
-                }
-            }
-            for rej in &r.rejected {
-                tracing::warn!(fid = f.fid, reason = %rej.reason, "feature rejected");
-            }
-            // Each feature counts once: rejected if any part was rejected,
-            // else written if it has a row, else filtered (min_area).
-            if !r.rejected.is_empty() {
-                rejected += 1;
-            } else if r.filtered {
-                filtered += 1;
-            } else {
-                written += 1;
-            }
-            rows_written += r.skeletons.len() as u64;
-            for s in &r.skeletons {
-                *methods.entry(s.method.clone()).or_default() += 1;
-            }
-            sk.extend(r.skeletons);
-            ca.extend(r.candidates);
-            ba.extend(r.bars);
-            rj.extend(r.rejected);
-            wi.extend(r.widths);
+        counts.read += features.len() as u64;
+        let mut rows = Rows::default();
+        for (f, r) in features.iter().zip(done) {
+            counts.add(f, &r, job.on_error)?;
+            rows.append(r.rows);
         }
-        writer.write_batch(&sk, &ca, &ba, &wi, &rj)?;
+        writer.write_batch(&rows)?;
         bar.inc(features.len() as u64);
         Ok(())
     });
@@ -300,31 +239,31 @@ pub fn run(p: &Pipeline, opts: &RunOptions) -> Result<RunSummary, RunError> {
         writer.abort();
         return Err(e);
     }
-    filtered += info.total.saturating_sub(info.selected);
+    counts.filtered += info.total.saturating_sub(info.selected);
     let elapsed_s = clock.elapsed().as_secs_f64();
     let record = RunRecord {
-        name: p.file.name.clone().unwrap_or_default(),
+        name: job.name.clone(),
         started_utc: started.to_rfc3339(),
         finished_utc: chrono::Utc::now().to_rfc3339(),
         tool_version: env!("CARGO_PKG_VERSION").to_string(),
-        pipeline: p.provenance_text(),
+        pipeline: job.provenance.clone(),
         input: format!("{} (layer {})", info.source, info.layer),
-        read,
-        written,
-        rejected,
-        filtered,
+        read: counts.read,
+        written: counts.written,
+        rejected: counts.rejected,
+        filtered: counts.filtered,
         elapsed_s,
-        threads: threads as i64,
+        threads,
     };
     let out = writer.finish(&record)?;
     Ok(RunSummary {
-        read,
-        written,
-        rows: rows_written,
-        rejected,
-        filtered,
+        read: counts.read,
+        written: counts.written,
+        rows: counts.rows,
+        rejected: counts.rejected,
+        filtered: counts.filtered,
         elapsed_s,
         output: out.display().to_string(),
-        methods: methods.into_iter().collect(),
+        methods: counts.methods.into_iter().collect(),
     })
 }

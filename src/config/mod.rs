@@ -14,11 +14,12 @@
 //! ```
 
 pub mod locate;
+mod sections;
+
+pub use sections::{InputSpec, LayerRef, OutputSpec};
 
 use crate::graph::extend::ExtendParams;
 use crate::graph::prune::PruneParams;
-use crate::io::writer::OutputSpec;
-use crate::io::InputSpec;
 use crate::methods::SkeletonParams;
 use crate::process::{PrepareParams, ProcessParams};
 use crate::score::select::SelectParams;

@@ -5,10 +5,7 @@
 pub mod reader;
 pub mod writer;
 
-pub use reader::{
-    read_layer_polygons, AttributeValue, FieldInfo, InputFeature, InputSpec, LayerRef, Reader,
-    SourceInfo,
-};
+pub use reader::{read_layer_polygons, FieldInfo, InputSpec, LayerRef, Reader, SourceInfo};
 
 use thiserror::Error;
 

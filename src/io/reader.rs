@@ -1,5 +1,5 @@
 //! Reader: any OGR data source (file, folder, `PG:` connection, `/vsizip/…`)
-//! → owned [`InputFeature`]s with `geo` geometries.
+//! → owned [`Feature`]s with `geo` geometries.
 //!
 //! Z and M are dropped, curves linearised, geometries reprojected when asked
 //! and, with `make_valid`, repaired by GDAL's MakeValid (keeping only the
@@ -11,77 +11,9 @@ use gdal::cpl::CslStringList;
 use gdal::spatial_ref::{AxisMappingStrategy, CoordTransform, SpatialRef};
 use gdal::vector::{FieldValue, Geometry, LayerAccess};
 use gdal::{Dataset, DatasetOptions, GdalOpenFlags};
-use schemars::JsonSchema;
-use serde::{Deserialize, Serialize};
 
-/// A layer chosen by name or by index.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(untagged)]
-pub enum LayerRef {
-    /// Zero-based layer index.
-    Index(usize),
-    /// Layer name.
-    Name(String),
-}
-
-impl std::fmt::Display for LayerRef {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            LayerRef::Index(i) => write!(f, "#{i}"),
-            LayerRef::Name(n) => write!(f, "`{n}`"),
-        }
-    }
-}
-
-/// The `input` section of a pipeline file.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct InputSpec {
-    /// Any OGR data source string: file, folder, `PG:…`, `/vsizip/…`.
-    pub source: String,
-    /// Layer name or zero-based index; default the first layer.
-    #[serde(default)]
-    pub layer: Option<LayerRef>,
-    /// OGR SQL attribute filter.
-    #[serde(default, rename = "where")]
-    pub where_: Option<String>,
-    /// Spatial filter `[xmin, ymin, xmax, ymax]` in the source CRS.
-    #[serde(default)]
-    pub bbox: Option<[f64; 4]>,
-    /// Target CRS (e.g. `EPSG:3035`); required when the source CRS is geographic.
-    #[serde(default)]
-    pub reproject: Option<String>,
-}
-
-impl InputSpec {
-    /// A whole layer of a source by name: no filter, no reprojection.
-    pub fn layer(source: &str, layer: &str) -> Self {
-        Self {
-            source: source.into(),
-            layer: Some(LayerRef::Name(layer.into())),
-            where_: None,
-            bbox: None,
-            reproject: None,
-        }
-    }
-}
-
-/// An attribute value of a source feature, carried unchanged to the output.
-#[derive(Debug, Clone, PartialEq)]
-pub struct AttributeValue(pub(crate) Option<FieldValue>);
-
-impl AttributeValue {
-    /// The value as text (for logs and tests); `None` for NULL.
-    pub fn as_text(&self) -> Option<String> {
-        self.0.as_ref().map(|v| match v {
-            FieldValue::IntegerValue(i) => i.to_string(),
-            FieldValue::Integer64Value(i) => i.to_string(),
-            FieldValue::RealValue(r) => r.to_string(),
-            FieldValue::StringValue(s) => s.clone(),
-            other => format!("{other:?}"),
-        })
-    }
-}
+pub use crate::config::{InputSpec, LayerRef};
+use crate::feature::{Feature, Value};
 
 /// A source field definition.
 #[derive(Debug, Clone, PartialEq)]
@@ -113,23 +45,6 @@ pub struct SourceInfo {
     pub total: u64,
     /// Features that pass `where` and `bbox`.
     pub selected: u64,
-}
-
-/// One source feature, owned.
-#[derive(Debug, Clone, PartialEq)]
-pub struct InputFeature {
-    /// The source FID.
-    pub fid: Option<u64>,
-    /// Attribute values in [`SourceInfo::fields`] order.
-    pub attributes: Vec<AttributeValue>,
-    /// The geometry (2D, linear, reprojected); `None` when NULL or unreadable.
-    pub geometry: Option<geo::Geometry<f64>>,
-    /// Why the geometry could not be read, when it could not.
-    pub geometry_error: Option<String>,
-    /// The source geometry as WKB (2D), kept for the `rejected` layer.
-    pub source_wkb: Option<Vec<u8>>,
-    /// Set when MakeValid changed the geometry.
-    pub repaired: bool,
 }
 
 /// An open input layer.
@@ -285,7 +200,7 @@ impl Reader {
         &mut self,
         batch: usize,
         make_valid: bool,
-        mut on_batch: impl FnMut(Vec<InputFeature>) -> Result<(), E>,
+        mut on_batch: impl FnMut(Vec<Feature>) -> Result<(), E>,
     ) -> Result<(), E> {
         let mut layer = self
             .dataset
@@ -303,9 +218,9 @@ impl Reader {
         let mut buf = Vec::with_capacity(batch);
         for f in layer.features() {
             let attributes = (0..n_fields)
-                .map(|i| AttributeValue(f.field(i).ok().flatten()))
+                .map(|i| value(f.field(i).ok().flatten()))
                 .collect();
-            let mut feat = InputFeature {
+            let mut feat = Feature {
                 fid: f.fid(),
                 attributes,
                 geometry: None,
@@ -337,6 +252,23 @@ impl Reader {
             on_batch(buf)?;
         }
         Ok(())
+    }
+}
+
+/// A field value as the per-feature path carries it.
+fn value(v: Option<FieldValue>) -> Value {
+    match v {
+        None => Value::Null,
+        Some(FieldValue::IntegerValue(i)) => Value::Integer(i),
+        Some(FieldValue::Integer64Value(i)) => Value::Integer64(i),
+        Some(FieldValue::RealValue(r)) => Value::Real(r),
+        Some(FieldValue::StringValue(s)) => Value::Text(s),
+        Some(FieldValue::DateValue(d)) => Value::Date(d),
+        Some(FieldValue::DateTimeValue(d)) => Value::DateTime(d),
+        Some(FieldValue::IntegerListValue(l)) => Value::IntegerList(l),
+        Some(FieldValue::Integer64ListValue(l)) => Value::Integer64List(l),
+        Some(FieldValue::RealListValue(l)) => Value::RealList(l),
+        Some(FieldValue::StringListValue(l)) => Value::TextList(l),
     }
 }
 

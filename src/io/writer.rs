@@ -1,215 +1,29 @@
 //! Writer: the output GeoPackage (SPEC §9).
 //!
 //! Layers: `skeletons` (name configurable; one row per feature, or per part
-//! with `explode`), optional `candidates` and `bars`, `rejected`, and the
-//! attribute table `skeletonise_runs`. Everything is written to a temporary
+//! with `explode`), optional `candidates`, `bars` and `widths`, `rejected`,
+//! and the attribute table `skeletonise_runs` — each created and filled from
+//! its description in [`crate::output`]. Everything is written to a temporary
 //! file beside the output, in one transaction per batch, and renamed over the
 //! output only when the run succeeds: a killed run never leaves a half-written
 //! output.
 
-use super::reader::{AttributeValue, FieldInfo, SourceInfo};
+use super::reader::{FieldInfo, SourceInfo};
 use super::IoError;
+use crate::feature::Value;
+use crate::output::{
+    Cell, Column, ColumnType, GeometryKind, LayerDef, Rows, RunRecord, Shape, When, BARS,
+    CANDIDATES, REJECTED, RUNS, SKELETONS, WIDTHS,
+};
 use gdal::spatial_ref::SpatialRef;
 use gdal::vector::{
     Feature, FieldDefn, FieldValue, Geometry, LayerAccess, LayerOptions, OGRFieldType,
     OGRwkbGeometryType, ToGdal,
 };
 use gdal::{Dataset, DriverManager};
-use schemars::JsonSchema;
-use serde::{Deserialize, Serialize};
+
+pub use crate::config::OutputSpec;
 use std::path::{Path, PathBuf};
-
-fn default_layer() -> String {
-    "skeletons".into()
-}
-
-/// The `output` section of a pipeline file.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct OutputSpec {
-    /// Path of the GeoPackage to write.
-    pub path: String,
-    /// Name of the skeleton layer.
-    #[serde(default = "default_layer")]
-    pub layer: String,
-    /// Replace an existing output file.
-    #[serde(default)]
-    pub overwrite: bool,
-    /// Also write every method's skeleton and scores (layer `candidates`).
-    #[serde(default)]
-    pub candidates: bool,
-    /// Also write the scoring bars (layer `bars`).
-    #[serde(default)]
-    pub bars: bool,
-    /// One row per polygon part instead of per feature.
-    #[serde(default)]
-    pub explode: bool,
-    /// Also write the chosen skeleton segment by segment with the local width
-    /// of the polygon (2 × disc radius) at both ends (layer `widths`): the
-    /// medial axis transform, for deciding what is narrow enough to collapse.
-    #[serde(default)]
-    pub widths: bool,
-}
-
-/// The metric columns of `skeletons` and `candidates`.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct ScoreColumns {
-    /// N.
-    pub bars: i64,
-    /// n.
-    pub hits: i64,
-    /// n / N.
-    pub coverage: f64,
-    /// s.
-    pub deviation: f64,
-    /// S.
-    pub deviation_parts: f64,
-    /// SZ.
-    pub distortion_sum: f64,
-    /// Z.
-    pub distortion: f64,
-}
-
-/// One row of the `skeletons` layer.
-#[derive(Debug, Clone, PartialEq)]
-pub struct SkeletonRow {
-    /// Source FID.
-    pub src_fid: Option<u64>,
-    /// Polygon part index (with `explode`).
-    pub part: Option<usize>,
-    /// Source attributes.
-    pub attributes: Vec<AttributeValue>,
-    /// The skeleton.
-    pub geometry: geo::MultiLineString<f64>,
-    /// Chosen method id.
-    pub method: String,
-    /// Scores of the chosen method, when scored.
-    pub scores: Option<ScoreColumns>,
-    /// Connected components of the skeleton.
-    pub components: i64,
-    /// Legs after pruning and extension.
-    pub legs: i64,
-    /// MakeValid changed the input.
-    pub repaired: bool,
-}
-
-/// One row of the `candidates` layer.
-#[derive(Debug, Clone, PartialEq)]
-pub struct CandidateRow {
-    /// Source FID.
-    pub src_fid: Option<u64>,
-    /// Polygon part index (with `explode`).
-    pub part: Option<usize>,
-    /// Method id.
-    pub method: String,
-    /// The skeleton, or `None` when the method failed.
-    pub geometry: Option<geo::MultiLineString<f64>>,
-    /// Scores, when scored.
-    pub scores: Option<ScoreColumns>,
-    /// Whether this candidate was chosen.
-    pub chosen: bool,
-    /// Components, raw legs, final legs.
-    pub components: i64,
-    /// Legs before pruning.
-    pub legs_raw: i64,
-    /// Legs after pruning and extension.
-    pub legs: i64,
-    /// Why the method failed.
-    pub error: Option<String>,
-}
-
-/// One row of the `bars` layer.
-#[derive(Debug, Clone, PartialEq)]
-pub struct BarRow {
-    /// Source FID.
-    pub src_fid: Option<u64>,
-    /// Method id.
-    pub method: String,
-    /// From origin to hit (or to the origin alone for a miss).
-    pub geometry: geo::LineString<f64>,
-    /// d_L, d_P, Δd, z — `None` for a miss.
-    pub d_left: Option<f64>,
-    /// d_P.
-    pub d_right: Option<f64>,
-    /// Δd.
-    pub delta_d: Option<f64>,
-    /// z.
-    pub z: Option<f64>,
-    /// Part index.
-    pub part: Option<i64>,
-}
-
-/// One row of the `widths` layer.
-#[derive(Debug, Clone, PartialEq)]
-pub struct WidthRow {
-    /// Source FID.
-    pub src_fid: Option<u64>,
-    /// Method id.
-    pub method: String,
-    /// The segment.
-    pub geometry: geo::Line<f64>,
-    /// Width (2 r) at the start.
-    pub width_start: f64,
-    /// Width (2 r) at the end.
-    pub width_end: f64,
-}
-
-/// One row of the `rejected` layer.
-#[derive(Debug, Clone, PartialEq)]
-pub struct RejectedRow {
-    /// Source FID.
-    pub src_fid: Option<u64>,
-    /// Why the feature was not processed.
-    pub reason: String,
-    /// The input geometry as WKB, when there was one.
-    pub wkb: Option<Vec<u8>>,
-}
-
-/// The `skeletonise_runs` row.
-#[derive(Debug, Clone, PartialEq)]
-pub struct RunRecord {
-    /// Pipeline name.
-    pub name: String,
-    /// Start, UTC, RFC 3339.
-    pub started_utc: String,
-    /// End, UTC, RFC 3339.
-    pub finished_utc: String,
-    /// Tool version.
-    pub tool_version: String,
-    /// The pipeline text (with overrides).
-    pub pipeline: String,
-    /// Input source and layer.
-    pub input: String,
-    /// Features read.
-    pub read: u64,
-    /// Rows written to the skeleton layer.
-    pub written: u64,
-    /// Features rejected.
-    pub rejected: u64,
-    /// Features filtered by where/bbox/min_area.
-    pub filtered: u64,
-    /// Wall time.
-    pub elapsed_s: f64,
-    /// Worker threads.
-    pub threads: i64,
-}
-
-/// Field names the tool adds to the skeleton layer.
-pub const SKELETON_FIELDS: [&str; 13] = [
-    "src_fid",
-    "part",
-    "method",
-    "bars",
-    "hits",
-    "coverage",
-    "deviation",
-    "deviation_parts",
-    "distortion_sum",
-    "distortion",
-    "components",
-    "legs",
-    "repaired",
-];
 
 /// An open output GeoPackage (a temporary file until [`Writer::finish`]).
 pub struct Writer {
@@ -257,66 +71,68 @@ fn field(layer: &gdal::vector::Layer<'_>, name: &str, ty: u32) -> Result<(), IoE
         .map_err(|e| IoError::gdal(format!("creating field `{name}`"), e))
 }
 
-fn set(f: &mut Feature<'_>, name: &str, v: Option<FieldValue>) -> Result<(), IoError> {
-    let idx = f
-        .field_index(name)
-        .map_err(|e| IoError::gdal(format!("field `{name}`"), e))?;
+fn ogr_type(t: ColumnType) -> u32 {
+    match t {
+        ColumnType::Int32 => OGRFieldType::OFTInteger,
+        ColumnType::Int64 => OGRFieldType::OFTInteger64,
+        ColumnType::Real => OGRFieldType::OFTReal,
+        ColumnType::Text => OGRFieldType::OFTString,
+    }
+}
+
+fn ogr_geometry(g: GeometryKind) -> u32 {
+    match g {
+        GeometryKind::MultiLineString => OGRwkbGeometryType::wkbMultiLineString,
+        GeometryKind::LineString => OGRwkbGeometryType::wkbLineString,
+        GeometryKind::Unknown => OGRwkbGeometryType::wkbUnknown,
+        GeometryKind::None => OGRwkbGeometryType::wkbNone,
+    }
+}
+
+/// A tool column's value as GDAL writes it (`None` for NULL).
+fn cell_value(c: Cell, ty: ColumnType) -> Option<FieldValue> {
+    match (c, ty) {
+        (Cell::Null, _) => None,
+        (Cell::Int(v), ColumnType::Int32) => i32::try_from(v).ok().map(FieldValue::IntegerValue),
+        (Cell::Int(v), _) => Some(FieldValue::Integer64Value(v)),
+        (Cell::Real(v), _) => v.is_finite().then_some(FieldValue::RealValue(v)),
+        (Cell::Text(s), _) => Some(FieldValue::StringValue(s)),
+    }
+}
+
+/// A source attribute as GDAL writes it.
+fn attribute_value(v: &Value) -> Option<FieldValue> {
+    Some(match v {
+        Value::Null => return None,
+        Value::Integer(i) => FieldValue::IntegerValue(*i),
+        Value::Integer64(i) => FieldValue::Integer64Value(*i),
+        Value::Real(r) => FieldValue::RealValue(*r),
+        Value::Text(s) => FieldValue::StringValue(s.clone()),
+        Value::Date(d) => FieldValue::DateValue(*d),
+        Value::DateTime(d) => FieldValue::DateTimeValue(*d),
+        Value::IntegerList(l) => FieldValue::IntegerListValue(l.clone()),
+        Value::Integer64List(l) => FieldValue::Integer64ListValue(l.clone()),
+        Value::RealList(l) => FieldValue::RealListValue(l.clone()),
+        Value::TextList(l) => FieldValue::StringListValue(l.clone()),
+    })
+}
+
+fn set_field(f: &mut Feature<'_>, idx: usize, v: Option<FieldValue>) -> Result<(), IoError> {
     match v {
         Some(v) => f.set_field(idx, &v),
         None => f.set_field_null(idx),
     }
-    .map_err(|e| IoError::gdal(format!("setting field `{name}`"), e))
+    .map_err(|e| IoError::gdal(format!("setting field {idx}"), e))
 }
 
-/// A 32-bit integer field value (counts, flags, part indices).
-fn small(v: i64) -> Option<FieldValue> {
-    i32::try_from(v).ok().map(FieldValue::IntegerValue)
-}
-
-fn int(v: i64) -> Option<FieldValue> {
-    Some(FieldValue::Integer64Value(v))
-}
-
-fn real(v: f64) -> Option<FieldValue> {
-    v.is_finite().then_some(FieldValue::RealValue(v))
-}
-
-fn text(v: &str) -> Option<FieldValue> {
-    Some(FieldValue::StringValue(v.to_string()))
-}
-
-fn fid(v: Option<u64>) -> Option<FieldValue> {
-    v.map(|x| FieldValue::Integer64Value(x as i64))
-}
-
-fn add_score_fields(layer: &gdal::vector::Layer<'_>) -> Result<(), IoError> {
-    field(layer, "bars", OGRFieldType::OFTInteger64)?;
-    field(layer, "hits", OGRFieldType::OFTInteger64)?;
-    for n in [
-        "coverage",
-        "deviation",
-        "deviation_parts",
-        "distortion_sum",
-        "distortion",
-    ] {
-        field(layer, n, OGRFieldType::OFTReal)?;
+fn shape_to_gdal(s: Shape<'_>) -> Result<Geometry, IoError> {
+    match s {
+        Shape::Lines(l) => to_gdal(l),
+        Shape::Line(l) => to_gdal(&l),
+        Shape::Wkb(w) => {
+            Geometry::from_wkb(w).map_err(|e| IoError::gdal("reading a WKB geometry", e))
+        }
     }
-    Ok(())
-}
-
-fn set_scores(f: &mut Feature<'_>, s: Option<&ScoreColumns>) -> Result<(), IoError> {
-    let s = s.copied();
-    set(f, "bars", s.map(|s| FieldValue::Integer64Value(s.bars)))?;
-    set(f, "hits", s.map(|s| FieldValue::Integer64Value(s.hits)))?;
-    set(f, "coverage", s.and_then(|s| real(s.coverage)))?;
-    set(f, "deviation", s.and_then(|s| real(s.deviation)))?;
-    set(
-        f,
-        "deviation_parts",
-        s.and_then(|s| real(s.deviation_parts)),
-    )?;
-    set(f, "distortion_sum", s.and_then(|s| real(s.distortion_sum)))?;
-    set(f, "distortion", s.and_then(|s| real(s.distortion)))
 }
 
 fn to_gdal<G: ToGdal>(g: &G) -> Result<Geometry, IoError> {
@@ -353,8 +169,8 @@ impl Writer {
             .fields
             .iter()
             .map(|f| {
-                let clash = SKELETON_FIELDS
-                    .iter()
+                let clash = SKELETONS
+                    .column_names()
                     .any(|n| n.eq_ignore_ascii_case(&f.name));
                 (
                     if clash {
@@ -374,117 +190,19 @@ impl Writer {
             source_fields,
         };
         let r = (|| -> Result<(), IoError> {
-            fn opts<'a>(name: &'a str, srs: Option<&'a SpatialRef>, ty: u32) -> LayerOptions<'a> {
-                LayerOptions {
-                    name,
-                    srs,
-                    ty,
-                    options: None,
-                }
-            }
             let srs = srs.as_ref();
-            {
-                let l = ds
-                    .create_layer(opts(
-                        &spec.layer,
-                        srs,
-                        OGRwkbGeometryType::wkbMultiLineString,
-                    ))
-                    .map_err(|e| IoError::gdal(format!("creating layer `{}`", spec.layer), e))?;
-                for (name, f) in &w.source_fields {
-                    let d = FieldDefn::new(name, f.kind)
-                        .map_err(|e| IoError::gdal("copying a field", e))?;
-                    d.set_width(f.width);
-                    d.set_precision(f.precision);
-                    d.add_to_layer(&l)
-                        .map_err(|e| IoError::gdal(format!("copying field `{name}`"), e))?;
-                }
-                field(&l, "src_fid", OGRFieldType::OFTInteger64)?;
-                if spec.explode {
-                    field(&l, "part", OGRFieldType::OFTInteger)?;
-                }
-                field(&l, "method", OGRFieldType::OFTString)?;
-                add_score_fields(&l)?;
-                field(&l, "components", OGRFieldType::OFTInteger)?;
-                field(&l, "legs", OGRFieldType::OFTInteger)?;
-                field(&l, "repaired", OGRFieldType::OFTInteger)?;
-            }
+            w.create_layer(&mut ds, &SKELETONS, &spec.layer, srs)?;
             if spec.candidates {
-                let l = ds
-                    .create_layer(opts(
-                        "candidates",
-                        srs,
-                        OGRwkbGeometryType::wkbMultiLineString,
-                    ))
-                    .map_err(|e| IoError::gdal("creating layer `candidates`", e))?;
-                field(&l, "src_fid", OGRFieldType::OFTInteger64)?;
-                field(&l, "part", OGRFieldType::OFTInteger)?;
-                field(&l, "method", OGRFieldType::OFTString)?;
-                field(&l, "chosen", OGRFieldType::OFTInteger)?;
-                add_score_fields(&l)?;
-                field(&l, "components", OGRFieldType::OFTInteger)?;
-                field(&l, "legs_raw", OGRFieldType::OFTInteger)?;
-                field(&l, "legs", OGRFieldType::OFTInteger)?;
-                field(&l, "error", OGRFieldType::OFTString)?;
+                w.create_layer(&mut ds, &CANDIDATES, CANDIDATES.name, srs)?;
             }
             if spec.bars {
-                let l = ds
-                    .create_layer(opts("bars", srs, OGRwkbGeometryType::wkbLineString))
-                    .map_err(|e| IoError::gdal("creating layer `bars`", e))?;
-                field(&l, "src_fid", OGRFieldType::OFTInteger64)?;
-                field(&l, "method", OGRFieldType::OFTString)?;
-                for n in ["d_left", "d_right", "delta_d", "z"] {
-                    field(&l, n, OGRFieldType::OFTReal)?;
-                }
-                field(&l, "part", OGRFieldType::OFTInteger64)?;
+                w.create_layer(&mut ds, &BARS, BARS.name, srs)?;
             }
             if spec.widths {
-                let l = ds
-                    .create_layer(opts("widths", srs, OGRwkbGeometryType::wkbLineString))
-                    .map_err(|e| IoError::gdal("creating layer `widths`", e))?;
-                field(&l, "src_fid", OGRFieldType::OFTInteger64)?;
-                field(&l, "method", OGRFieldType::OFTString)?;
-                for n in ["width_start", "width_end", "width"] {
-                    field(&l, n, OGRFieldType::OFTReal)?;
-                }
+                w.create_layer(&mut ds, &WIDTHS, WIDTHS.name, srs)?;
             }
-            {
-                let l = ds
-                    .create_layer(opts("rejected", srs, OGRwkbGeometryType::wkbUnknown))
-                    .map_err(|e| IoError::gdal("creating layer `rejected`", e))?;
-                field(&l, "src_fid", OGRFieldType::OFTInteger64)?;
-                field(&l, "reason", OGRFieldType::OFTString)?;
-            }
-            {
-                let l = ds
-                    .create_layer(LayerOptions {
-                        name: "skeletonise_runs",
-                        srs: None,
-                        ty: OGRwkbGeometryType::wkbNone,
-                        options: None,
-                    })
-                    .map_err(|e| IoError::gdal("creating table `skeletonise_runs`", e))?;
-                for n in [
-                    "name",
-                    "started_utc",
-                    "finished_utc",
-                    "tool_version",
-                    "pipeline",
-                    "input",
-                ] {
-                    field(&l, n, OGRFieldType::OFTString)?;
-                }
-                for n in [
-                    "features_read",
-                    "features_written",
-                    "features_rejected",
-                    "features_filtered",
-                    "threads",
-                ] {
-                    field(&l, n, OGRFieldType::OFTInteger64)?;
-                }
-                field(&l, "elapsed_s", OGRFieldType::OFTReal)?;
-            }
+            w.create_layer(&mut ds, &REJECTED, REJECTED.name, srs)?;
+            w.create_layer(&mut ds, &RUNS, RUNS.name, None)?;
             Ok(())
         })();
         w.ds = Some(ds);
@@ -495,163 +213,112 @@ impl Writer {
         Ok(w)
     }
 
-    fn ds(&mut self) -> &mut Dataset {
-        self.ds.as_mut().expect("open until finish/abort")
+    /// Creates the layer `name` described by `def`.
+    fn create_layer<R>(
+        &self,
+        ds: &mut Dataset,
+        def: &LayerDef<R>,
+        name: &str,
+        srs: Option<&SpatialRef>,
+    ) -> Result<(), IoError> {
+        let l = ds
+            .create_layer(LayerOptions {
+                name,
+                srs,
+                ty: ogr_geometry(def.geometry),
+                options: None,
+            })
+            .map_err(|e| IoError::gdal(format!("creating layer `{name}`"), e))?;
+        if def.attributes.is_some() {
+            for (fname, f) in &self.source_fields {
+                let d = FieldDefn::new(fname, f.kind)
+                    .map_err(|e| IoError::gdal("copying a field", e))?;
+                d.set_width(f.width);
+                d.set_precision(f.precision);
+                d.add_to_layer(&l)
+                    .map_err(|e| IoError::gdal(format!("copying field `{fname}`"), e))?;
+            }
+        }
+        for c in self.columns(def) {
+            field(&l, c.name, ogr_type(c.ty))?;
+        }
+        Ok(())
+    }
+
+    /// The columns of `def` this output has.
+    fn columns<'d, R>(&self, def: &'d LayerDef<R>) -> impl Iterator<Item = &'d Column<R>> {
+        let explode = self.spec.explode;
+        def.columns
+            .iter()
+            .filter(move |c| c.when == When::Always || explode)
+    }
+
+    /// Writes `rows` to the layer `name` described by `def`.
+    fn write_rows<R>(
+        &self,
+        ds: &Dataset,
+        def: &LayerDef<R>,
+        name: &str,
+        rows: &[R],
+    ) -> Result<(), IoError> {
+        if rows.is_empty() {
+            return Ok(());
+        }
+        let l = ds
+            .layer_by_name(name)
+            .map_err(|e| IoError::gdal(format!("opening layer `{name}`"), e))?;
+        let n_source = if def.attributes.is_some() {
+            self.source_fields.len()
+        } else {
+            0
+        };
+        let columns: Vec<&Column<R>> = self.columns(def).collect();
+        for r in rows {
+            let mut f =
+                Feature::new(l.defn()).map_err(|e| IoError::gdal("creating a feature", e))?;
+            if let Some(s) = (def.shape)(r) {
+                f.set_geometry(shape_to_gdal(s)?)
+                    .map_err(|e| IoError::gdal("setting a geometry", e))?;
+            }
+            if let Some(attrs) = def.attributes {
+                for (i, v) in attrs(r).iter().enumerate().take(n_source) {
+                    set_field(&mut f, i, attribute_value(v))?;
+                }
+            }
+            for (k, c) in columns.iter().enumerate() {
+                set_field(&mut f, n_source + k, cell_value((c.get)(r), c.ty))?;
+            }
+            f.create(&l)
+                .map_err(|e| IoError::gdal(format!("writing a row of `{name}`"), e))?;
+        }
+        Ok(())
     }
 
     /// Writes one batch of rows in one transaction.
-    pub fn write_batch(
-        &mut self,
-        skeletons: &[SkeletonRow],
-        candidates: &[CandidateRow],
-        bars: &[BarRow],
-        widths: &[WidthRow],
-        rejected: &[RejectedRow],
-    ) -> Result<(), IoError> {
-        let layer_name = self.spec.layer.clone();
-        let explode = self.spec.explode;
-        let source_fields = self.source_fields.clone();
-        let txn = self
-            .ds()
-            .start_transaction()
-            .map_err(|e| IoError::gdal("starting a transaction", e))?;
-        {
-            let l = txn
-                .layer_by_name(&layer_name)
-                .map_err(|e| IoError::gdal("opening the skeleton layer", e))?;
-            for r in skeletons {
-                let mut f =
-                    Feature::new(l.defn()).map_err(|e| IoError::gdal("creating a feature", e))?;
-                f.set_geometry(to_gdal(&r.geometry)?)
-                    .map_err(|e| IoError::gdal("setting a geometry", e))?;
-                for ((name, _), v) in source_fields.iter().zip(&r.attributes) {
-                    set(&mut f, name, v.0.clone())?;
-                }
-                set(&mut f, "src_fid", fid(r.src_fid))?;
-                if explode {
-                    set(&mut f, "part", r.part.and_then(|p| small(p as i64)))?;
-                }
-                set(&mut f, "method", text(&r.method))?;
-                set_scores(&mut f, r.scores.as_ref())?;
-                set(&mut f, "components", small(r.components))?;
-                set(&mut f, "legs", small(r.legs))?;
-                set(&mut f, "repaired", small(r.repaired as i64))?;
-                f.create(&l)
-                    .map_err(|e| IoError::gdal("writing a skeleton", e))?;
-            }
-        }
-        if !candidates.is_empty() {
-            let l = txn
-                .layer_by_name("candidates")
-                .map_err(|e| IoError::gdal("opening `candidates`", e))?;
-            for r in candidates {
-                let mut f =
-                    Feature::new(l.defn()).map_err(|e| IoError::gdal("creating a feature", e))?;
-                if let Some(g) = &r.geometry {
-                    f.set_geometry(to_gdal(g)?)
-                        .map_err(|e| IoError::gdal("setting a geometry", e))?;
-                }
-                set(&mut f, "src_fid", fid(r.src_fid))?;
-                set(&mut f, "part", r.part.and_then(|p| small(p as i64)))?;
-                set(&mut f, "method", text(&r.method))?;
-                set(&mut f, "chosen", small(r.chosen as i64))?;
-                set_scores(&mut f, r.scores.as_ref())?;
-                set(&mut f, "components", small(r.components))?;
-                set(&mut f, "legs_raw", small(r.legs_raw))?;
-                set(&mut f, "legs", small(r.legs))?;
-                set(&mut f, "error", r.error.as_deref().and_then(text))?;
-                f.create(&l)
-                    .map_err(|e| IoError::gdal("writing a candidate", e))?;
-            }
-        }
-        if !bars.is_empty() {
-            let l = txn
-                .layer_by_name("bars")
-                .map_err(|e| IoError::gdal("opening `bars`", e))?;
-            for r in bars {
-                let mut f =
-                    Feature::new(l.defn()).map_err(|e| IoError::gdal("creating a feature", e))?;
-                f.set_geometry(to_gdal(&r.geometry)?)
-                    .map_err(|e| IoError::gdal("setting a geometry", e))?;
-                set(&mut f, "src_fid", fid(r.src_fid))?;
-                set(&mut f, "method", text(&r.method))?;
-                set(&mut f, "d_left", r.d_left.and_then(real))?;
-                set(&mut f, "d_right", r.d_right.and_then(real))?;
-                set(&mut f, "delta_d", r.delta_d.and_then(real))?;
-                set(&mut f, "z", r.z.and_then(real))?;
-                set(&mut f, "part", r.part.and_then(int))?;
-                f.create(&l)
-                    .map_err(|e| IoError::gdal("writing a bar", e))?;
-            }
-        }
-        if !widths.is_empty() {
-            let l = txn
-                .layer_by_name("widths")
-                .map_err(|e| IoError::gdal("opening `widths`", e))?;
-            for r in widths {
-                let mut f =
-                    Feature::new(l.defn()).map_err(|e| IoError::gdal("creating a feature", e))?;
-                f.set_geometry(to_gdal(&geo::LineString(vec![
-                    r.geometry.start,
-                    r.geometry.end,
-                ]))?)
-                .map_err(|e| IoError::gdal("setting a geometry", e))?;
-                set(&mut f, "src_fid", fid(r.src_fid))?;
-                set(&mut f, "method", text(&r.method))?;
-                set(&mut f, "width_start", real(r.width_start))?;
-                set(&mut f, "width_end", real(r.width_end))?;
-                set(&mut f, "width", real((r.width_start + r.width_end) / 2.0))?;
-                f.create(&l)
-                    .map_err(|e| IoError::gdal("writing a width", e))?;
-            }
-        }
-        if !rejected.is_empty() {
-            let l = txn
-                .layer_by_name("rejected")
-                .map_err(|e| IoError::gdal("opening `rejected`", e))?;
-            for r in rejected {
-                let mut f =
-                    Feature::new(l.defn()).map_err(|e| IoError::gdal("creating a feature", e))?;
-                if let Some(g) = r.wkb.as_deref().and_then(|w| Geometry::from_wkb(w).ok()) {
-                    f.set_geometry(g)
-                        .map_err(|e| IoError::gdal("setting a geometry", e))?;
-                }
-                set(&mut f, "src_fid", fid(r.src_fid))?;
-                set(&mut f, "reason", text(&r.reason))?;
-                f.create(&l)
-                    .map_err(|e| IoError::gdal("writing a rejected feature", e))?;
-            }
-        }
-        txn.commit()
-            .map_err(|e| IoError::gdal("committing a batch", e))
+    pub fn write_batch(&mut self, rows: &Rows) -> Result<(), IoError> {
+        let mut ds = self.ds.take().expect("open until finish/abort");
+        let r = (|| {
+            let txn = ds
+                .start_transaction()
+                .map_err(|e| IoError::gdal("starting a transaction", e))?;
+            self.write_rows(&txn, &SKELETONS, &self.spec.layer, &rows.skeletons)?;
+            self.write_rows(&txn, &CANDIDATES, CANDIDATES.name, &rows.candidates)?;
+            self.write_rows(&txn, &BARS, BARS.name, &rows.bars)?;
+            self.write_rows(&txn, &WIDTHS, WIDTHS.name, &rows.widths)?;
+            self.write_rows(&txn, &REJECTED, REJECTED.name, &rows.rejected)?;
+            txn.commit()
+                .map_err(|e| IoError::gdal("committing a batch", e))
+        })();
+        self.ds = Some(ds);
+        r
     }
 
     /// Writes the run record, closes the file and renames it over the output.
     pub fn finish(mut self, run: &RunRecord) -> Result<PathBuf, IoError> {
-        {
-            let ds = self.ds();
-            let l = ds
-                .layer_by_name("skeletonise_runs")
-                .map_err(|e| IoError::gdal("opening `skeletonise_runs`", e))?;
-            let mut f =
-                Feature::new(l.defn()).map_err(|e| IoError::gdal("creating a feature", e))?;
-            set(&mut f, "name", text(&run.name))?;
-            set(&mut f, "started_utc", text(&run.started_utc))?;
-            set(&mut f, "finished_utc", text(&run.finished_utc))?;
-            set(&mut f, "tool_version", text(&run.tool_version))?;
-            set(&mut f, "pipeline", text(&run.pipeline))?;
-            set(&mut f, "input", text(&run.input))?;
-            set(&mut f, "features_read", int(run.read as i64))?;
-            set(&mut f, "features_written", int(run.written as i64))?;
-            set(&mut f, "features_rejected", int(run.rejected as i64))?;
-            set(&mut f, "features_filtered", int(run.filtered as i64))?;
-            set(&mut f, "threads", int(run.threads))?;
-            set(&mut f, "elapsed_s", real(run.elapsed_s))?;
-            f.create(&l)
-                .map_err(|e| IoError::gdal("writing the run record", e))?;
-        }
+        let ds = self.ds.take().expect("open until finish/abort");
+        self.write_rows(&ds, &RUNS, RUNS.name, std::slice::from_ref(run))?;
         // Closing flushes the file before it is renamed into place.
-        drop(self.ds.take());
+        drop(ds);
         if self.path.exists() && !self.spec.overwrite {
             let _ = std::fs::remove_file(&self.tmp);
             return Err(IoError::OutputExists {

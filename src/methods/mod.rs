@@ -40,6 +40,9 @@ impl MethodId {
     pub const STSK: MethodId = MethodId("StSk");
     /// Medial axis (transform).
     pub const MA: MethodId = MethodId("MA");
+    /// A skeleton made by another tool and scored with `skeletonise score`
+    /// (its rows carry the tool's label instead).
+    pub const EXTERNAL: MethodId = MethodId("external");
 
     /// The identifier of a method outside the built-in ones.
     pub const fn new(id: &'static str) -> Self {

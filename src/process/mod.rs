@@ -3,15 +3,19 @@
 //! features can be processed in parallel with identical results for any
 //! thread count.
 
+mod candidates;
+pub mod rows;
+
+pub use rows::{feature_rows, FeatureRows, RowOptions, Skeletons, Status};
+
 use crate::geometry::PreparedPolygon;
-use crate::graph::extend::{prune_and_extend, ExtendParams};
+use crate::graph::extend::ExtendParams;
 use crate::graph::prune::PruneParams;
-use crate::methods::medial_axis::{medial_axis_transform, MatSegment};
+use crate::methods::medial_axis::MatSegment;
 use crate::methods::{MethodId, Registry, SkeletonParams};
 use crate::score::select::{select, SelectParams};
-use crate::score::{bars, metrics, Bar, ScoreParams, Scores};
+use crate::score::{Bar, ScoreParams, Scores};
 use geo::{Area, Geometry, MultiLineString, Polygon};
-use rayon::prelude::*;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
@@ -191,49 +195,78 @@ fn kind(g: &Geometry<f64>) -> &'static str {
 
 /// Processes one feature's geometry through every step.
 pub fn process(geom: Option<&Geometry<f64>>, params: &ProcessParams) -> Processed {
-    let parts = match polygon_parts(geom) {
+    let prepared = match prepare(geom, &params.prepare) {
         Ok(p) => p,
-        Err(e) => return Processed::Rejected(e),
+        Err(other) => return other,
     };
+    let candidates = candidates::computed(&prepared, params);
+    choose(candidates, prepared.len(), params)
+}
+
+/// Scores skeleton lines made by another tool (`label`) for one feature's
+/// geometry: the same steps as [`process`] from `score` on, with the lines
+/// in place of the methods' skeletons.
+pub fn process_given(
+    geom: Option<&Geometry<f64>>,
+    lines: &MultiLineString<f64>,
+    label: &str,
+    params: &ProcessParams,
+) -> Processed {
+    let prepared = match prepare(geom, &params.prepare) {
+        Ok(p) => p,
+        Err(other) => return other,
+    };
+    if lines.0.iter().all(|l| l.0.len() < 2) {
+        return Processed::Rejected(format!("{label}: no skeleton lines joined to this polygon"));
+    }
+    let candidate = Candidate {
+        method: MethodId::EXTERNAL,
+        result: Ok(candidates::given(&prepared, lines, params)),
+    };
+    choose(vec![candidate], prepared.len(), params)
+}
+
+/// The polygon parts of a feature's geometry, normalised and checked, or
+/// what becomes of the feature instead (rejected, or filtered by
+/// `min_area`).
+pub fn prepare(
+    geom: Option<&Geometry<f64>>,
+    params: &PrepareParams,
+) -> Result<Vec<PreparedPolygon>, Processed> {
+    let parts = polygon_parts(geom).map_err(Processed::Rejected)?;
     let parts: Vec<Polygon<f64>> = parts
         .into_iter()
-        .filter(|p| params.prepare.min_area <= 0.0 || p.unsigned_area() >= params.prepare.min_area)
+        .filter(|p| params.min_area <= 0.0 || p.unsigned_area() >= params.min_area)
         .collect();
     if parts.is_empty() {
-        return Processed::Filtered;
+        return Err(Processed::Filtered);
     }
     let mut prepared = Vec::with_capacity(parts.len());
     for (i, p) in parts.iter().enumerate() {
         match PreparedPolygon::new(p) {
             Ok(pp) => prepared.push(pp),
-            Err(e) if parts.len() > 1 => return Processed::Rejected(format!("part {i}: {e}")),
-            Err(e) => return Processed::Rejected(e.to_string()),
+            Err(e) => return Err(Processed::Rejected(part_reason(i, parts.len(), &e))),
         }
     }
     if let Some(reason) = invalidity(&prepared) {
-        return Processed::Rejected(reason);
+        return Err(Processed::Rejected(reason));
     }
-    let multi = prepared.len() > 1;
-    let per_part: Vec<Vec<Result<PartSkeleton, String>>> = prepared
-        .iter()
-        .enumerate()
-        .map(|(i, p)| {
-            part_skeletons(p, params)
-                .into_iter()
-                .map(|r| r.map_err(|e| if multi { format!("part {i}: {e}") } else { e }))
-                .collect()
-        })
-        .collect();
-    let candidates: Vec<Candidate> = params
-        .skeleton
-        .methods
-        .par_iter()
-        .enumerate()
-        .map(|(k, &m)| Candidate {
-            method: m,
-            result: candidate(k, &prepared, &per_part, params),
-        })
-        .collect();
+    Ok(prepared)
+}
+
+/// A reason for polygon part `i` of `n`: prefixed with the part when there
+/// is more than one.
+pub(crate) fn part_reason(i: usize, n: usize, reason: &dyn std::fmt::Display) -> String {
+    if n > 1 {
+        format!("part {i}: {reason}")
+    } else {
+        reason.to_string()
+    }
+}
+
+/// The outcome for a feature's candidates: the chosen one by `select` (or
+/// the first with a skeleton), or the rejection when none has one.
+fn choose(candidates: Vec<Candidate>, parts: usize, params: &ProcessParams) -> Processed {
     let scores: Vec<Option<Scores>> = candidates
         .iter()
         .map(|c| match &c.result {
@@ -250,7 +283,7 @@ pub fn process(geom: Option<&Geometry<f64>>, params: &ProcessParams) -> Processe
         Some(chosen) => Processed::Done(FeatureOutcome {
             candidates,
             chosen,
-            parts: prepared.len(),
+            parts,
         }),
         None => Processed::Rejected(rejection(&candidates)),
     }
@@ -268,134 +301,20 @@ fn rejection(candidates: &[Candidate]) -> String {
     reasons.join("; ")
 }
 
-/// One method's finished skeleton of one polygon part.
-#[derive(Debug, Clone)]
-struct PartSkeleton {
-    graph: crate::graph::SkeletonGraph,
-    legs_raw: usize,
-}
-
-/// Every method's finished skeleton of one polygon part, in `methods`
-/// order: raw skeletons in parallel, then the reference pruned and extended,
-/// then the others pruned to its structure (or each on its own).
-fn part_skeletons(
-    p: &PreparedPolygon,
-    params: &ProcessParams,
-) -> Vec<Result<PartSkeleton, String>> {
-    use crate::graph::prune::{PruneMode, Structure as Sharing};
-    use crate::graph::structure::{conform, Structure};
-    let methods = &params.skeleton.methods;
-    let raws: Vec<Result<crate::graph::SkeletonGraph, String>> = methods
-        .par_iter()
-        .map(|&m| {
-            params
-                .registry
-                .build(m, &params.skeleton)?
-                .skeletonise(p)
-                .map_err(|e| e.to_string())
-        })
-        .collect();
-    let finish = |raw: &crate::graph::SkeletonGraph| {
-        prune_and_extend(raw, p, params.prune.as_ref(), params.extend.as_ref())
-    };
-    let shared = params
-        .prune
-        .filter(|pr| pr.mode != PruneMode::None && pr.structure == Sharing::Shared);
-    let reference = shared.and_then(|_| {
-        params.skeleton.reference_order().into_iter().find_map(|m| {
-            methods
-                .iter()
-                .position(|&x| x == m)
-                .filter(|&k| raws[k].is_ok())
-        })
-    });
-    let structure = reference.map(|k| {
-        let g = finish(raws[k].as_ref().expect("the reference succeeded"));
-        let trunk = params.prune.is_some_and(|pr| pr.mode == PruneMode::Trunk);
-        (k, Structure::of(&g, p, trunk), g)
-    });
-    raws.par_iter()
-        .enumerate()
-        .map(|(k, raw)| {
-            let raw = raw.as_ref().map_err(Clone::clone)?;
-            let g = match &structure {
-                Some((r, _, g)) if *r == k => g.clone(),
-                Some((_, s, _)) => conform(raw, s, p),
-                None => finish(raw),
-            };
-            Ok(PartSkeleton {
-                graph: g,
-                legs_raw: raw.leg_count(),
-            })
-        })
-        .collect()
-}
-
-/// Method `k`'s candidate over all polygon parts: scored, with bars and
-/// widths when asked for.
-fn candidate(
-    k: usize,
-    parts: &[PreparedPolygon],
-    per_part: &[Vec<Result<PartSkeleton, String>>],
-    params: &ProcessParams,
-) -> Result<CandidateSkeleton, String> {
-    let mut lines = Vec::new();
-    let mut all_bars = Vec::new();
-    let mut widths = Vec::new();
-    let (mut components, mut legs_raw, mut legs) = (0, 0, 0);
-    let mut part_offset = 0;
-    for (p, results) in parts.iter().zip(per_part) {
-        let part = results[k].as_ref().map_err(Clone::clone)?;
-        let g = &part.graph;
-        legs_raw += part.legs_raw;
-        legs += g.leg_count();
-        components += g.components();
-        if params.score.is_some() {
-            let mut b = bars(p, g);
-            for bar in &mut b {
-                if let Some(h) = &mut bar.hit {
-                    h.part += part_offset;
-                }
-            }
-            part_offset += g.branches().len();
-            all_bars.extend(b);
-        }
-        if params.keep_widths {
-            widths.extend(medial_axis_transform(g, Some(p.boundary())));
-        }
-        lines.extend(g.to_multilinestring().0);
-    }
-    let scores = params.score.map(|_| metrics(&all_bars));
-    if !params.keep_bars {
-        all_bars.clear();
-    }
-    Ok(CandidateSkeleton {
-        geometry: MultiLineString(lines),
-        scores,
-        components,
-        legs_raw,
-        legs,
-        bars: all_bars,
-        widths,
-    })
-}
-
 /// The reason a prepared polygon is invalid, if it is (self-intersection,
 /// crossing or touching rings, holes outside the shell).
 fn invalidity(parts: &[PreparedPolygon]) -> Option<String> {
-    for (i, p) in parts.iter().enumerate() {
-        if let Some(err) = crate::geometry::validity::problem(p) {
-            let prefix = if parts.len() > 1 {
-                format!("part {i}: ")
-            } else {
-                String::new()
-            };
-            return Some(format!(
-                "{prefix}invalid polygon: {err}; enable `prepare: {{ make_valid: true }}` to repair it"
-            ));
-        }
-    }
-    None
+    parts.iter().enumerate().find_map(|(i, p)| {
+        crate::geometry::validity::problem(p).map(|err| {
+            part_reason(
+                i,
+                parts.len(),
+                &format!(
+                    "invalid polygon: {err}; enable `prepare: {{ make_valid: true }}` to repair it"
+                ),
+            )
+        })
+    })
 }
 
 #[cfg(test)]

@@ -1,0 +1,88 @@
+//! The `input` and `output` sections of a pipeline file.
+
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+/// A layer chosen by name or by index.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(untagged)]
+pub enum LayerRef {
+    /// Zero-based layer index.
+    Index(usize),
+    /// Layer name.
+    Name(String),
+}
+
+impl std::fmt::Display for LayerRef {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            LayerRef::Index(i) => write!(f, "#{i}"),
+            LayerRef::Name(n) => write!(f, "`{n}`"),
+        }
+    }
+}
+
+/// The `input` section of a pipeline file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct InputSpec {
+    /// Any OGR data source string: file, folder, `PG:…`, `/vsizip/…`.
+    pub source: String,
+    /// Layer name or zero-based index; default the first layer.
+    #[serde(default)]
+    pub layer: Option<LayerRef>,
+    /// OGR SQL attribute filter.
+    #[serde(default, rename = "where")]
+    pub where_: Option<String>,
+    /// Spatial filter `[xmin, ymin, xmax, ymax]` in the source CRS.
+    #[serde(default)]
+    pub bbox: Option<[f64; 4]>,
+    /// Target CRS (e.g. `EPSG:3035`); required when the source CRS is geographic.
+    #[serde(default)]
+    pub reproject: Option<String>,
+}
+
+impl InputSpec {
+    /// A whole layer of a source by name: no filter, no reprojection.
+    pub fn layer(source: &str, layer: &str) -> Self {
+        Self {
+            source: source.into(),
+            layer: Some(LayerRef::Name(layer.into())),
+            where_: None,
+            bbox: None,
+            reproject: None,
+        }
+    }
+}
+
+fn default_layer() -> String {
+    "skeletons".into()
+}
+
+/// The `output` section of a pipeline file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSpec {
+    /// Path of the GeoPackage to write.
+    pub path: String,
+    /// Name of the skeleton layer.
+    #[serde(default = "default_layer")]
+    pub layer: String,
+    /// Replace an existing output file.
+    #[serde(default)]
+    pub overwrite: bool,
+    /// Also write every method's skeleton and scores (layer `candidates`).
+    #[serde(default)]
+    pub candidates: bool,
+    /// Also write the scoring bars (layer `bars`).
+    #[serde(default)]
+    pub bars: bool,
+    /// One row per polygon part instead of per feature.
+    #[serde(default)]
+    pub explode: bool,
+    /// Also write the chosen skeleton segment by segment with the local width
+    /// of the polygon (2 × disc radius) at both ends (layer `widths`): the
+    /// medial axis transform, for deciding what is narrow enough to collapse.
+    #[serde(default)]
+    pub widths: bool,
+}

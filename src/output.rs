@@ -1,0 +1,681 @@
+//! The output GeoPackage's layers (SPEC §9), described as data: each layer
+//! is one [`LayerDef`] — its name, geometry type and columns, each column
+//! with its type and how its value is taken from a row. The writer
+//! ([`crate::io::writer`]) creates and fills any layer from its description,
+//! so adding a column is one entry in one table below.
+//!
+//! Rows are plain data made by the per-feature work ([`crate::process`]);
+//! nothing here touches GDAL.
+
+use crate::feature::Value;
+use crate::score::Scores;
+
+/// The type of a column.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ColumnType {
+    /// 32-bit integer.
+    Int32,
+    /// 64-bit integer.
+    Int64,
+    /// Floating point.
+    Real,
+    /// Text.
+    Text,
+}
+
+/// A value written to a column.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Cell {
+    /// NULL.
+    Null,
+    /// An integer (written as the column's integer type).
+    Int(i64),
+    /// A number; non-finite values are written as NULL.
+    Real(f64),
+    /// Text.
+    Text(String),
+}
+
+/// The geometry type of a layer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GeometryKind {
+    /// MULTILINESTRING.
+    MultiLineString,
+    /// LINESTRING.
+    LineString,
+    /// Any geometry (the `rejected` layer keeps the input's).
+    Unknown,
+    /// An attribute table.
+    None,
+}
+
+/// A row's geometry, borrowed or made for writing.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Shape<'a> {
+    /// Lines.
+    Lines(&'a geo::MultiLineString<f64>),
+    /// One line.
+    Line(geo::LineString<f64>),
+    /// A geometry as WKB.
+    Wkb(&'a [u8]),
+}
+
+/// When a column is part of its layer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum When {
+    /// Always.
+    Always,
+    /// Only with `output.explode`.
+    Explode,
+}
+
+/// One column of a layer.
+pub struct Column<R> {
+    /// Column name.
+    pub name: &'static str,
+    /// Column type.
+    pub ty: ColumnType,
+    /// The column's value in a row.
+    pub get: fn(&R) -> Cell,
+    /// When the column is written.
+    pub when: When,
+}
+
+impl<R> Clone for Column<R> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<R> Copy for Column<R> {}
+
+/// One output layer.
+pub struct LayerDef<R: 'static> {
+    /// Layer name (the skeleton layer's is configurable: `output.layer`).
+    pub name: &'static str,
+    /// Geometry type.
+    pub geometry: GeometryKind,
+    /// The row's geometry.
+    pub shape: for<'a> fn(&'a R) -> Option<Shape<'a>>,
+    /// The source feature's attributes, written first under the source's
+    /// field names (the skeleton layer).
+    pub attributes: Option<fn(&R) -> &[Value]>,
+    /// The tool's columns.
+    pub columns: &'static [Column<R>],
+}
+
+impl<R> LayerDef<R> {
+    /// The names of the tool's columns.
+    pub fn column_names(&self) -> impl Iterator<Item = &'static str> + '_ {
+        self.columns.iter().map(|c| c.name)
+    }
+}
+
+fn int(v: impl TryInto<i64>) -> Cell {
+    v.try_into().map_or(Cell::Null, Cell::Int)
+}
+
+fn text(s: &str) -> Cell {
+    Cell::Text(s.to_string())
+}
+
+fn fid(v: Option<u64>) -> Cell {
+    v.map_or(Cell::Null, int)
+}
+
+fn real(v: Option<f64>) -> Cell {
+    v.map_or(Cell::Null, Cell::Real)
+}
+
+/// A row with the paper's scores.
+pub trait Scored {
+    /// The scores, when the pipeline scores.
+    fn scores(&self) -> Option<&Scores>;
+}
+
+fn s_bars<R: Scored>(r: &R) -> Cell {
+    r.scores().map_or(Cell::Null, |s| int(s.bars))
+}
+fn s_hits<R: Scored>(r: &R) -> Cell {
+    r.scores().map_or(Cell::Null, |s| int(s.hits))
+}
+fn s_coverage<R: Scored>(r: &R) -> Cell {
+    real(r.scores().map(|s| s.coverage))
+}
+fn s_deviation<R: Scored>(r: &R) -> Cell {
+    real(r.scores().map(|s| s.deviation))
+}
+fn s_deviation_parts<R: Scored>(r: &R) -> Cell {
+    real(r.scores().map(|s| s.deviation_parts))
+}
+fn s_distortion_sum<R: Scored>(r: &R) -> Cell {
+    real(r.scores().map(|s| s.distortion_sum))
+}
+fn s_distortion<R: Scored>(r: &R) -> Cell {
+    real(r.scores().map(|s| s.distortion))
+}
+
+/// The score columns of a [`Scored`] row type, in SPEC order.
+macro_rules! score_columns {
+    ($r:ty) => {
+        [
+            Column {
+                name: "bars",
+                ty: ColumnType::Int64,
+                get: s_bars::<$r>,
+                when: When::Always,
+            },
+            Column {
+                name: "hits",
+                ty: ColumnType::Int64,
+                get: s_hits::<$r>,
+                when: When::Always,
+            },
+            Column {
+                name: "coverage",
+                ty: ColumnType::Real,
+                get: s_coverage::<$r>,
+                when: When::Always,
+            },
+            Column {
+                name: "deviation",
+                ty: ColumnType::Real,
+                get: s_deviation::<$r>,
+                when: When::Always,
+            },
+            Column {
+                name: "deviation_parts",
+                ty: ColumnType::Real,
+                get: s_deviation_parts::<$r>,
+                when: When::Always,
+            },
+            Column {
+                name: "distortion_sum",
+                ty: ColumnType::Real,
+                get: s_distortion_sum::<$r>,
+                when: When::Always,
+            },
+            Column {
+                name: "distortion",
+                ty: ColumnType::Real,
+                get: s_distortion::<$r>,
+                when: When::Always,
+            },
+        ]
+    };
+}
+
+/// Concatenates column arrays into one static slice.
+macro_rules! columns {
+    ($r:ty; $($part:expr),+ $(,)?) => {{
+        const PARTS: &[&[Column<$r>]] = &[$(&$part),+];
+        const N: usize = {
+            let (mut n, mut p) = (0, 0);
+            while p < PARTS.len() {
+                n += PARTS[p].len();
+                p += 1;
+            }
+            n
+        };
+        const ALL: [Column<$r>; N] = {
+            let mut out = [PARTS[0][0]; N];
+            let (mut i, mut p) = (0, 0);
+            while p < PARTS.len() {
+                let mut k = 0;
+                while k < PARTS[p].len() {
+                    out[i] = PARTS[p][k];
+                    i += 1;
+                    k += 1;
+                }
+                p += 1;
+            }
+            out
+        };
+        &ALL
+    }};
+}
+
+/// One row of the skeleton layer.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SkeletonRow {
+    /// Source FID.
+    pub src_fid: Option<u64>,
+    /// Index of the polygon part (with `explode`).
+    pub polygon_part: Option<usize>,
+    /// Source attributes.
+    pub attributes: Vec<Value>,
+    /// The skeleton.
+    pub geometry: geo::MultiLineString<f64>,
+    /// The chosen method.
+    pub method: String,
+    /// Its scores, when scored.
+    pub scores: Option<Scores>,
+    /// Connected components of the skeleton.
+    pub components: usize,
+    /// Legs of the skeleton.
+    pub legs: usize,
+    /// MakeValid changed the input.
+    pub repaired: bool,
+}
+
+impl Scored for SkeletonRow {
+    fn scores(&self) -> Option<&Scores> {
+        self.scores.as_ref()
+    }
+}
+
+/// The skeleton layer (named by `output.layer`, default `skeletons`).
+pub const SKELETONS: LayerDef<SkeletonRow> = LayerDef {
+    name: "skeletons",
+    geometry: GeometryKind::MultiLineString,
+    shape: |r| Some(Shape::Lines(&r.geometry)),
+    attributes: Some(|r| &r.attributes),
+    columns: columns!(SkeletonRow;
+        [
+            Column { name: "src_fid", ty: ColumnType::Int64, get: |r: &SkeletonRow| fid(r.src_fid), when: When::Always },
+            Column { name: "polygon_part", ty: ColumnType::Int32, get: |r: &SkeletonRow| r.polygon_part.map_or(Cell::Null, int), when: When::Explode },
+            Column { name: "method", ty: ColumnType::Text, get: |r: &SkeletonRow| text(&r.method), when: When::Always },
+        ],
+        score_columns!(SkeletonRow),
+        [
+            Column { name: "components", ty: ColumnType::Int32, get: |r: &SkeletonRow| int(r.components), when: When::Always },
+            Column { name: "legs", ty: ColumnType::Int32, get: |r: &SkeletonRow| int(r.legs), when: When::Always },
+            Column { name: "repaired", ty: ColumnType::Int32, get: |r: &SkeletonRow| int(i64::from(r.repaired)), when: When::Always },
+        ],
+    ),
+};
+
+/// One row of the `candidates` layer: one method's result for one feature.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CandidateRow {
+    /// Source FID.
+    pub src_fid: Option<u64>,
+    /// Index of the polygon part (with `explode`).
+    pub polygon_part: Option<usize>,
+    /// The method.
+    pub method: String,
+    /// The skeleton, or `None` when the method failed.
+    pub geometry: Option<geo::MultiLineString<f64>>,
+    /// Scores, when scored.
+    pub scores: Option<Scores>,
+    /// Whether this candidate was chosen.
+    pub chosen: bool,
+    /// Connected components.
+    pub components: usize,
+    /// Legs before pruning.
+    pub legs_raw: usize,
+    /// Legs after pruning and extension.
+    pub legs: usize,
+    /// Why the method failed.
+    pub error: Option<String>,
+}
+
+impl Scored for CandidateRow {
+    fn scores(&self) -> Option<&Scores> {
+        self.scores.as_ref()
+    }
+}
+
+/// The `candidates` layer.
+pub const CANDIDATES: LayerDef<CandidateRow> = LayerDef {
+    name: "candidates",
+    geometry: GeometryKind::MultiLineString,
+    shape: |r| r.geometry.as_ref().map(Shape::Lines),
+    attributes: None,
+    columns: columns!(CandidateRow;
+        [
+            Column { name: "src_fid", ty: ColumnType::Int64, get: |r: &CandidateRow| fid(r.src_fid), when: When::Always },
+            Column { name: "polygon_part", ty: ColumnType::Int32, get: |r: &CandidateRow| r.polygon_part.map_or(Cell::Null, int), when: When::Always },
+            Column { name: "method", ty: ColumnType::Text, get: |r: &CandidateRow| text(&r.method), when: When::Always },
+            Column { name: "chosen", ty: ColumnType::Int32, get: |r: &CandidateRow| int(i64::from(r.chosen)), when: When::Always },
+        ],
+        score_columns!(CandidateRow),
+        [
+            Column { name: "components", ty: ColumnType::Int32, get: |r: &CandidateRow| int(r.components), when: When::Always },
+            Column { name: "legs_raw", ty: ColumnType::Int32, get: |r: &CandidateRow| int(r.legs_raw), when: When::Always },
+            Column { name: "legs", ty: ColumnType::Int32, get: |r: &CandidateRow| int(r.legs), when: When::Always },
+            Column { name: "error", ty: ColumnType::Text, get: |r: &CandidateRow| r.error.as_deref().map_or(Cell::Null, text), when: When::Always },
+        ],
+    ),
+};
+
+/// One row of the `bars` layer.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BarRow {
+    /// Source FID.
+    pub src_fid: Option<u64>,
+    /// The method.
+    pub method: String,
+    /// From the bar's origin to its hit (the origin alone for a miss).
+    pub geometry: geo::LineString<f64>,
+    /// d_L; `None` for a miss.
+    pub d_left: Option<f64>,
+    /// d_P.
+    pub d_right: Option<f64>,
+    /// Δd.
+    pub delta_d: Option<f64>,
+    /// z.
+    pub z: Option<f64>,
+    /// The skeleton branch (the paper's part) that was hit.
+    pub branch: Option<usize>,
+}
+
+/// The `bars` layer.
+pub const BARS: LayerDef<BarRow> = LayerDef {
+    name: "bars",
+    geometry: GeometryKind::LineString,
+    shape: |r| Some(Shape::Line(r.geometry.clone())),
+    attributes: None,
+    columns: &[
+        Column {
+            name: "src_fid",
+            ty: ColumnType::Int64,
+            get: |r| fid(r.src_fid),
+            when: When::Always,
+        },
+        Column {
+            name: "method",
+            ty: ColumnType::Text,
+            get: |r| text(&r.method),
+            when: When::Always,
+        },
+        Column {
+            name: "d_left",
+            ty: ColumnType::Real,
+            get: |r| real(r.d_left),
+            when: When::Always,
+        },
+        Column {
+            name: "d_right",
+            ty: ColumnType::Real,
+            get: |r| real(r.d_right),
+            when: When::Always,
+        },
+        Column {
+            name: "delta_d",
+            ty: ColumnType::Real,
+            get: |r| real(r.delta_d),
+            when: When::Always,
+        },
+        Column {
+            name: "z",
+            ty: ColumnType::Real,
+            get: |r| real(r.z),
+            when: When::Always,
+        },
+        Column {
+            name: "branch",
+            ty: ColumnType::Int64,
+            get: |r| r.branch.map_or(Cell::Null, int),
+            when: When::Always,
+        },
+    ],
+};
+
+/// One row of the `widths` layer: a skeleton segment with the polygon's
+/// local width at both ends.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WidthRow {
+    /// Source FID.
+    pub src_fid: Option<u64>,
+    /// The method.
+    pub method: String,
+    /// The segment.
+    pub geometry: geo::Line<f64>,
+    /// Width (2 r) at the start.
+    pub width_start: f64,
+    /// Width (2 r) at the end.
+    pub width_end: f64,
+}
+
+/// The `widths` layer.
+pub const WIDTHS: LayerDef<WidthRow> = LayerDef {
+    name: "widths",
+    geometry: GeometryKind::LineString,
+    shape: |r| {
+        Some(Shape::Line(geo::LineString(vec![
+            r.geometry.start,
+            r.geometry.end,
+        ])))
+    },
+    attributes: None,
+    columns: &[
+        Column {
+            name: "src_fid",
+            ty: ColumnType::Int64,
+            get: |r| fid(r.src_fid),
+            when: When::Always,
+        },
+        Column {
+            name: "method",
+            ty: ColumnType::Text,
+            get: |r| text(&r.method),
+            when: When::Always,
+        },
+        Column {
+            name: "width_start",
+            ty: ColumnType::Real,
+            get: |r| Cell::Real(r.width_start),
+            when: When::Always,
+        },
+        Column {
+            name: "width_end",
+            ty: ColumnType::Real,
+            get: |r| Cell::Real(r.width_end),
+            when: When::Always,
+        },
+        Column {
+            name: "width",
+            ty: ColumnType::Real,
+            get: |r| Cell::Real((r.width_start + r.width_end) / 2.0),
+            when: When::Always,
+        },
+    ],
+};
+
+/// One row of the `rejected` layer.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RejectedRow {
+    /// Source FID.
+    pub src_fid: Option<u64>,
+    /// Why the feature was not processed.
+    pub reason: String,
+    /// The input geometry as WKB, when there was one.
+    pub wkb: Option<Vec<u8>>,
+}
+
+/// The `rejected` layer.
+pub const REJECTED: LayerDef<RejectedRow> = LayerDef {
+    name: "rejected",
+    geometry: GeometryKind::Unknown,
+    shape: |r| r.wkb.as_deref().map(Shape::Wkb),
+    attributes: None,
+    columns: &[
+        Column {
+            name: "src_fid",
+            ty: ColumnType::Int64,
+            get: |r| fid(r.src_fid),
+            when: When::Always,
+        },
+        Column {
+            name: "reason",
+            ty: ColumnType::Text,
+            get: |r| text(&r.reason),
+            when: When::Always,
+        },
+    ],
+};
+
+/// The `skeletonise_runs` row: provenance of one run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunRecord {
+    /// Pipeline name.
+    pub name: String,
+    /// Start, UTC, RFC 3339.
+    pub started_utc: String,
+    /// End, UTC, RFC 3339.
+    pub finished_utc: String,
+    /// Tool version.
+    pub tool_version: String,
+    /// The pipeline text (with overrides).
+    pub pipeline: String,
+    /// Input source and layer.
+    pub input: String,
+    /// Features read.
+    pub read: u64,
+    /// Features written.
+    pub written: u64,
+    /// Features rejected.
+    pub rejected: u64,
+    /// Features filtered by where/bbox/min_area.
+    pub filtered: u64,
+    /// Wall time.
+    pub elapsed_s: f64,
+    /// Worker threads.
+    pub threads: usize,
+}
+
+/// The `skeletonise_runs` attribute table.
+pub const RUNS: LayerDef<RunRecord> = LayerDef {
+    name: "skeletonise_runs",
+    geometry: GeometryKind::None,
+    shape: |_| None,
+    attributes: None,
+    columns: &[
+        Column {
+            name: "name",
+            ty: ColumnType::Text,
+            get: |r| text(&r.name),
+            when: When::Always,
+        },
+        Column {
+            name: "started_utc",
+            ty: ColumnType::Text,
+            get: |r| text(&r.started_utc),
+            when: When::Always,
+        },
+        Column {
+            name: "finished_utc",
+            ty: ColumnType::Text,
+            get: |r| text(&r.finished_utc),
+            when: When::Always,
+        },
+        Column {
+            name: "tool_version",
+            ty: ColumnType::Text,
+            get: |r| text(&r.tool_version),
+            when: When::Always,
+        },
+        Column {
+            name: "pipeline",
+            ty: ColumnType::Text,
+            get: |r| text(&r.pipeline),
+            when: When::Always,
+        },
+        Column {
+            name: "input",
+            ty: ColumnType::Text,
+            get: |r| text(&r.input),
+            when: When::Always,
+        },
+        Column {
+            name: "features_read",
+            ty: ColumnType::Int64,
+            get: |r| int(r.read),
+            when: When::Always,
+        },
+        Column {
+            name: "features_written",
+            ty: ColumnType::Int64,
+            get: |r| int(r.written),
+            when: When::Always,
+        },
+        Column {
+            name: "features_rejected",
+            ty: ColumnType::Int64,
+            get: |r| int(r.rejected),
+            when: When::Always,
+        },
+        Column {
+            name: "features_filtered",
+            ty: ColumnType::Int64,
+            get: |r| int(r.filtered),
+            when: When::Always,
+        },
+        Column {
+            name: "threads",
+            ty: ColumnType::Int64,
+            get: |r| int(r.threads),
+            when: When::Always,
+        },
+        Column {
+            name: "elapsed_s",
+            ty: ColumnType::Real,
+            get: |r| Cell::Real(r.elapsed_s),
+            when: When::Always,
+        },
+    ],
+};
+
+/// The rows one feature produces, layer by layer.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Rows {
+    /// Skeleton layer rows.
+    pub skeletons: Vec<SkeletonRow>,
+    /// `candidates` rows.
+    pub candidates: Vec<CandidateRow>,
+    /// `bars` rows.
+    pub bars: Vec<BarRow>,
+    /// `widths` rows.
+    pub widths: Vec<WidthRow>,
+    /// `rejected` rows.
+    pub rejected: Vec<RejectedRow>,
+}
+
+impl Rows {
+    /// Appends `other`'s rows.
+    pub fn append(&mut self, mut other: Rows) {
+        self.skeletons.append(&mut other.skeletons);
+        self.candidates.append(&mut other.candidates);
+        self.bars.append(&mut other.bars);
+        self.widths.append(&mut other.widths);
+        self.rejected.append(&mut other.rejected);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_skeleton_layer_lists_its_columns_in_spec_order() {
+        let names: Vec<&str> = SKELETONS.column_names().collect();
+        assert_eq!(
+            names,
+            [
+                "src_fid",
+                "polygon_part",
+                "method",
+                "bars",
+                "hits",
+                "coverage",
+                "deviation",
+                "deviation_parts",
+                "distortion_sum",
+                "distortion",
+                "components",
+                "legs",
+                "repaired"
+            ]
+        );
+        let cands: Vec<&str> = CANDIDATES.column_names().collect();
+        assert_eq!(cands.len(), 15);
+    }
+
+    #[test]
+    fn cells_map_absent_and_out_of_range_values_to_null() {
+        assert_eq!(fid(None), Cell::Null);
+        assert_eq!(int(u64::MAX), Cell::Null);
+        assert_eq!(real(None), Cell::Null);
+    }
+}

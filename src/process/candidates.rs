@@ -1,0 +1,182 @@
+//! Every method's candidate skeleton of one feature, or a given skeleton's:
+//! skeletons part by part, the reference's structure, pruning, extension,
+//! scores, bars and widths.
+
+use super::{part_reason, CandidateSkeleton, ProcessParams};
+use crate::geometry::PreparedPolygon;
+use crate::graph::extend::prune_and_extend;
+use crate::graph::SkeletonGraph;
+use crate::methods::medial_axis::medial_axis_transform;
+use crate::score::defects::graph_of;
+use crate::score::{bars, metrics};
+use geo::MultiLineString;
+use rayon::prelude::*;
+
+/// Every method's candidate for the polygon parts `prepared`, in `methods`
+/// order.
+pub(super) fn computed(
+    prepared: &[PreparedPolygon],
+    params: &ProcessParams,
+) -> Vec<super::Candidate> {
+    let n = prepared.len();
+    let per_part: Vec<Vec<Result<PartSkeleton, String>>> = prepared
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            part_skeletons(p, params)
+                .into_iter()
+                .map(|r| r.map_err(|e| part_reason(i, n, &e)))
+                .collect()
+        })
+        .collect();
+    params
+        .skeleton
+        .methods
+        .par_iter()
+        .enumerate()
+        .map(|(k, &m)| {
+            let parts: Result<Vec<PartSkeleton>, String> =
+                per_part.iter().map(|r| r[k].clone()).collect();
+            super::Candidate {
+                method: m,
+                result: parts.map(|parts| finish(prepared, &parts, params)),
+            }
+        })
+        .collect()
+}
+
+/// A given skeleton (lines made by another tool) as a candidate: the same
+/// lines scored against every polygon part.
+pub(super) fn given(
+    prepared: &[PreparedPolygon],
+    lines: &MultiLineString<f64>,
+    params: &ProcessParams,
+) -> CandidateSkeleton {
+    let graph = graph_of(lines);
+    let legs = graph.leg_count();
+    let parts: Vec<PartSkeleton> = prepared
+        .iter()
+        .map(|_| PartSkeleton {
+            graph: graph.clone(),
+            legs_raw: legs,
+        })
+        .collect();
+    let mut c = finish(prepared, &parts, params);
+    // The lines once, not once per polygon part.
+    c.geometry = lines.clone();
+    c.components = graph.components();
+    c.legs = legs;
+    c.legs_raw = legs;
+    c
+}
+
+/// One method's finished skeleton of one polygon part.
+#[derive(Debug, Clone)]
+pub(super) struct PartSkeleton {
+    graph: crate::graph::SkeletonGraph,
+    legs_raw: usize,
+}
+
+/// Every method's finished skeleton of one polygon part, in `methods`
+/// order: raw skeletons in parallel, then the reference pruned and extended,
+/// then the others pruned to its structure (or each on its own).
+pub(super) fn part_skeletons(
+    p: &PreparedPolygon,
+    params: &ProcessParams,
+) -> Vec<Result<PartSkeleton, String>> {
+    use crate::graph::prune::{PruneMode, Structure as Sharing};
+    use crate::graph::structure::{conform, Structure};
+    let methods = &params.skeleton.methods;
+    let raws: Vec<Result<crate::graph::SkeletonGraph, String>> = methods
+        .par_iter()
+        .map(|&m| {
+            params
+                .registry
+                .build(m, &params.skeleton)?
+                .skeletonise(p)
+                .map_err(|e| e.to_string())
+        })
+        .collect();
+    let finish = |raw: &crate::graph::SkeletonGraph| {
+        prune_and_extend(raw, p, params.prune.as_ref(), params.extend.as_ref())
+    };
+    let shared = params
+        .prune
+        .filter(|pr| pr.mode != PruneMode::None && pr.structure == Sharing::Shared);
+    let reference = shared.and_then(|_| {
+        params.skeleton.reference_order().into_iter().find_map(|m| {
+            methods
+                .iter()
+                .position(|&x| x == m)
+                .filter(|&k| raws[k].is_ok())
+        })
+    });
+    let structure = reference.map(|k| {
+        let g = finish(raws[k].as_ref().expect("the reference succeeded"));
+        let trunk = params.prune.is_some_and(|pr| pr.mode == PruneMode::Trunk);
+        (k, Structure::of(&g, p, trunk), g)
+    });
+    raws.par_iter()
+        .enumerate()
+        .map(|(k, raw)| {
+            let raw = raw.as_ref().map_err(Clone::clone)?;
+            let g = match &structure {
+                Some((r, _, g)) if *r == k => g.clone(),
+                Some((_, s, _)) => conform(raw, s, p),
+                None => finish(raw),
+            };
+            Ok(PartSkeleton {
+                graph: g,
+                legs_raw: raw.leg_count(),
+            })
+        })
+        .collect()
+}
+
+/// One candidate from its finished skeleton of every polygon part: scored
+/// (branches numbered across the parts), with bars and widths when asked
+/// for.
+fn finish(
+    prepared: &[PreparedPolygon],
+    parts: &[PartSkeleton],
+    params: &ProcessParams,
+) -> CandidateSkeleton {
+    let mut lines = Vec::new();
+    let mut all_bars = Vec::new();
+    let mut widths = Vec::new();
+    let (mut components, mut legs_raw, mut legs) = (0, 0, 0);
+    let mut branch_offset = 0;
+    for (p, part) in prepared.iter().zip(parts) {
+        let g: &SkeletonGraph = &part.graph;
+        legs_raw += part.legs_raw;
+        legs += g.leg_count();
+        components += g.components();
+        if params.score.is_some() {
+            let mut b = bars(p, g);
+            for bar in &mut b {
+                if let Some(h) = &mut bar.hit {
+                    h.part += branch_offset;
+                }
+            }
+            branch_offset += g.branches().len();
+            all_bars.extend(b);
+        }
+        if params.keep_widths {
+            widths.extend(medial_axis_transform(g, Some(p.boundary())));
+        }
+        lines.extend(g.to_multilinestring().0);
+    }
+    let scores = params.score.map(|_| metrics(&all_bars));
+    if !params.keep_bars {
+        all_bars.clear();
+    }
+    CandidateSkeleton {
+        geometry: MultiLineString(lines),
+        scores,
+        components,
+        legs_raw,
+        legs,
+        bars: all_bars,
+        widths,
+    }
+}

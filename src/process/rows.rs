@@ -1,0 +1,213 @@
+//! From one input feature to its output rows: the one per-feature path of
+//! every command. `run` computes the skeletons with the pipeline's methods;
+//! `score` takes them from another tool's lines ([`Skeletons`]); both go
+//! through the same steps from `score` on and give the same rows.
+
+use super::{process, process_given, FeatureOutcome, ProcessParams, Processed};
+use crate::feature::Feature;
+use crate::output::{BarRow, CandidateRow, RejectedRow, Rows, SkeletonRow, WidthRow};
+use geo::{Geometry, MultiLineString};
+
+/// Where a feature's skeletons come from.
+#[derive(Debug, Clone, Copy)]
+pub enum Skeletons<'a> {
+    /// Computed by the pipeline's methods.
+    Computed,
+    /// Made by another tool (`label` goes to the `method` attribute); `None`
+    /// when no line was joined to the feature.
+    Given {
+        /// The other tool's name.
+        label: &'a str,
+        /// Its lines for this feature.
+        lines: Option<&'a MultiLineString<f64>>,
+    },
+}
+
+/// Which optional rows to make (the `output` section's switches).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct RowOptions {
+    /// One row per polygon part.
+    pub explode: bool,
+    /// Every method's row in `candidates`.
+    pub candidates: bool,
+    /// Every bar in `bars`.
+    pub bars: bool,
+    /// The chosen skeleton's local widths in `widths`.
+    pub widths: bool,
+}
+
+impl From<&crate::config::OutputSpec> for RowOptions {
+    fn from(o: &crate::config::OutputSpec) -> Self {
+        Self {
+            explode: o.explode,
+            candidates: o.candidates,
+            bars: o.bars,
+            widths: o.widths,
+        }
+    }
+}
+
+/// How a feature counts in the run's summary.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Status {
+    /// Written, with the method chosen for each row.
+    Written(Vec<String>),
+    /// Listed in `rejected` (any polygon part rejected).
+    Rejected,
+    /// Skipped by `min_area`.
+    Filtered,
+}
+
+/// A feature's rows and how it counts.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FeatureRows {
+    /// The rows, layer by layer.
+    pub rows: Rows,
+    /// How the feature counts.
+    pub status: Status,
+}
+
+/// The output rows of one feature (see the module documentation).
+pub fn feature_rows(
+    f: &Feature,
+    skeletons: Skeletons<'_>,
+    params: &ProcessParams,
+    opts: RowOptions,
+) -> FeatureRows {
+    let mut rows = Rows::default();
+    if let Some(e) = &f.geometry_error {
+        rows.rejected.push(rejected(f, e.clone()));
+        return FeatureRows {
+            rows,
+            status: Status::Rejected,
+        };
+    }
+    let mut methods = Vec::new();
+    for (part, geom) in units(f.geometry.as_ref(), opts.explode) {
+        let processed = match skeletons {
+            Skeletons::Computed => process(geom.as_ref(), params),
+            Skeletons::Given { label, lines } => match lines {
+                Some(l) => process_given(geom.as_ref(), l, label, params),
+                None => Processed::Rejected(format!(
+                    "{label}: no skeleton lines joined to this polygon; check the join key or the skeletons' location"
+                )),
+            },
+        };
+        let label = match skeletons {
+            Skeletons::Computed => None,
+            Skeletons::Given { label, .. } => Some(label),
+        };
+        match processed {
+            Processed::Done(o) => {
+                methods.push(outcome_rows(f, part, &o, label, opts, &mut rows));
+            }
+            Processed::Filtered => {}
+            Processed::Rejected(reason) => {
+                let reason = match part {
+                    Some(i) if opts.explode => format!("part {i}: {reason}"),
+                    _ => reason,
+                };
+                rows.rejected.push(rejected(f, reason));
+            }
+        }
+    }
+    let status = if !rows.rejected.is_empty() {
+        Status::Rejected
+    } else if methods.is_empty() {
+        Status::Filtered
+    } else {
+        Status::Written(methods)
+    };
+    FeatureRows { rows, status }
+}
+
+/// The units of work of a feature: the whole geometry, or with `explode`
+/// each polygon part (numbered).
+fn units(
+    geom: Option<&Geometry<f64>>,
+    explode: bool,
+) -> Vec<(Option<usize>, Option<Geometry<f64>>)> {
+    match (geom, explode) {
+        (Some(Geometry::MultiPolygon(mp)), true) if !mp.0.is_empty() => {
+            mp.0.iter()
+                .enumerate()
+                .map(|(i, p)| (Some(i), Some(Geometry::Polygon(p.clone()))))
+                .collect()
+        }
+        (g, true) => vec![(Some(0), g.cloned())],
+        (g, false) => vec![(None, g.cloned())],
+    }
+}
+
+fn rejected(f: &Feature, reason: String) -> RejectedRow {
+    RejectedRow {
+        src_fid: f.fid,
+        reason,
+        wkb: f.source_wkb.clone(),
+    }
+}
+
+/// Appends the rows of one processed unit; returns the chosen method's name.
+fn outcome_rows(
+    f: &Feature,
+    part: Option<usize>,
+    o: &FeatureOutcome,
+    label: Option<&str>,
+    opts: RowOptions,
+    rows: &mut Rows,
+) -> String {
+    let name = |m: crate::methods::MethodId| label.map_or_else(|| m.to_string(), str::to_string);
+    let (method, chosen) = o.chosen();
+    let method = name(*method);
+    rows.skeletons.push(SkeletonRow {
+        src_fid: f.fid,
+        polygon_part: part,
+        attributes: f.attributes.clone(),
+        geometry: chosen.geometry.clone(),
+        method: method.clone(),
+        scores: chosen.scores,
+        components: chosen.components,
+        legs: chosen.legs,
+        repaired: f.repaired,
+    });
+    if opts.widths {
+        rows.widths.extend(chosen.widths.iter().map(|w| WidthRow {
+            src_fid: f.fid,
+            method: method.clone(),
+            geometry: w.line,
+            width_start: w.width_start(),
+            width_end: w.width_end(),
+        }));
+    }
+    for (i, c) in o.candidates.iter().enumerate() {
+        let cname = name(c.method);
+        let ok = c.result.as_ref().ok();
+        if opts.candidates {
+            rows.candidates.push(CandidateRow {
+                src_fid: f.fid,
+                polygon_part: part,
+                method: cname.clone(),
+                geometry: ok.map(|s| s.geometry.clone()),
+                scores: ok.and_then(|s| s.scores),
+                chosen: i == o.chosen,
+                components: ok.map_or(0, |s| s.components),
+                legs_raw: ok.map_or(0, |s| s.legs_raw),
+                legs: ok.map_or(0, |s| s.legs),
+                error: c.result.as_ref().err().cloned(),
+            });
+        }
+        if let (true, Some(s)) = (opts.bars, ok) {
+            rows.bars.extend(s.bars.iter().map(|b| BarRow {
+                src_fid: f.fid,
+                method: cname.clone(),
+                geometry: geo::LineString(vec![b.origin, b.hit.map_or(b.origin, |h| h.point)]),
+                d_left: b.hit.map(|h| h.d_left),
+                d_right: b.hit.map(|h| h.d_right),
+                delta_d: b.hit.map(|h| h.delta_d()),
+                z: b.hit.map(|h| h.z()),
+                branch: b.hit.map(|h| h.part),
+            }));
+        }
+    }
+    method
+}
