@@ -4,7 +4,6 @@
 
 use clap::{Parser, Subcommand, ValueEnum};
 use skeletonise::config;
-use skeletonise::methods::MethodId;
 use skeletonise::pipeline::{self, RunError, RunOptions};
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -96,45 +95,84 @@ enum Command {
         file: PipelineArgs,
     },
     /// Score skeletons made by any tool with the paper's metrics.
-    Score {
-        /// Polygon source (any OGR data source).
-        #[arg(long, value_name = "SRC")]
-        polygons: String,
-        /// Polygon layer (default: the first).
-        #[arg(long, value_name = "LAYER")]
-        polygons_layer: Option<String>,
-        /// Skeleton source (lines; any OGR data source).
-        #[arg(long, value_name = "SRC")]
-        skeletons: String,
-        /// Skeleton layer (default: the first).
-        #[arg(long, value_name = "LAYER")]
-        skeletons_layer: Option<String>,
-        /// Join by key: the skeleton field holding the polygon's key (FID, or `--polygon-key`); without it, join by location.
-        #[arg(long, value_name = "FIELD")]
-        skeleton_key: Option<String>,
-        /// Polygon field matched by `--skeleton-key` (default: the polygon FID).
-        #[arg(long, value_name = "FIELD", requires = "skeleton_key")]
-        polygon_key: Option<String>,
-        /// Label for the `method` attribute (e.g. the tool's name).
-        #[arg(long, default_value = "external")]
-        label: String,
-        /// Output GeoPackage.
-        #[arg(short = 'o', long = "output", value_name = "OUT.gpkg")]
-        output: PathBuf,
-        /// Replace an existing output.
-        #[arg(long)]
-        overwrite: bool,
-        /// Also write the bars layer.
-        #[arg(long)]
-        bars: bool,
-        /// Target CRS for both sources (required when they are geographic).
-        #[arg(long, value_name = "CRS")]
-        reproject: Option<String>,
-    },
+    Score(ScoreArgs),
     /// List the methods and steps with their options.
     Methods,
     /// Print the JSON Schema of the pipeline file.
     Schema,
+}
+
+/// The arguments of `skeletonise score`.
+#[derive(clap::Args)]
+struct ScoreArgs {
+    /// Polygon source (any OGR data source).
+    #[arg(long, value_name = "SRC")]
+    polygons: String,
+    /// Polygon layer (default: the first).
+    #[arg(long, value_name = "LAYER")]
+    polygons_layer: Option<String>,
+    /// Skeleton source (lines; any OGR data source).
+    #[arg(long, value_name = "SRC")]
+    skeletons: String,
+    /// Skeleton layer (default: the first).
+    #[arg(long, value_name = "LAYER")]
+    skeletons_layer: Option<String>,
+    /// Join by key: the skeleton field holding the polygon's key (FID, or `--polygon-key`); without it, join by location.
+    #[arg(long, value_name = "FIELD")]
+    skeleton_key: Option<String>,
+    /// Polygon field matched by `--skeleton-key` (default: the polygon FID).
+    #[arg(long, value_name = "FIELD", requires = "skeleton_key")]
+    polygon_key: Option<String>,
+    /// Label for the `method` attribute (e.g. the tool's name).
+    #[arg(long, default_value = "external")]
+    label: String,
+    /// Output GeoPackage.
+    #[arg(short = 'o', long = "output", value_name = "OUT.gpkg")]
+    output: PathBuf,
+    /// Replace an existing output.
+    #[arg(long)]
+    overwrite: bool,
+    /// Also write the bars layer.
+    #[arg(long)]
+    bars: bool,
+    /// Target CRS for both sources (required when they are geographic).
+    #[arg(long, value_name = "CRS")]
+    reproject: Option<String>,
+}
+
+impl ScoreArgs {
+    fn job(&self) -> skeletonise::external::ScoreJob {
+        use skeletonise::config::{InputSpec, LayerRef, OutputSpec};
+        use skeletonise::external::{Join, ScoreJob};
+        let spec = |source: &String, layer: &Option<String>| InputSpec {
+            source: source.clone(),
+            layer: layer.clone().map(LayerRef::Name),
+            where_: None,
+            bbox: None,
+            reproject: self.reproject.clone(),
+        };
+        ScoreJob {
+            polygons: spec(&self.polygons, &self.polygons_layer),
+            skeletons: spec(&self.skeletons, &self.skeletons_layer),
+            join: match &self.skeleton_key {
+                Some(k) => Join::Key {
+                    polygon_field: self.polygon_key.clone(),
+                    skeleton_field: k.clone(),
+                },
+                None => Join::Location,
+            },
+            label: self.label.clone(),
+            output: OutputSpec {
+                path: self.output.display().to_string(),
+                layer: "skeletons".into(),
+                overwrite: self.overwrite,
+                candidates: false,
+                bars: self.bars,
+                explode: false,
+                widths: false,
+            },
+        }
+    }
 }
 
 fn init_logging(cli: &Cli) {
@@ -173,140 +211,13 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     init_logging(&cli);
     match &cli.command {
-        Command::Run { file, threads } => {
-            let p = match file.load() {
-                Ok(p) => p,
-                Err(c) => return c,
-            };
-            let opts = RunOptions {
-                threads: *threads,
-                progress: !cli.quiet
-                    && std::io::stderr().is_terminal()
-                    && matches!(cli.log_format, LogFormat::Text),
-                batch_size: None,
-            };
-            match pipeline::run(&p, &opts) {
-                Ok(s) => {
-                    let methods = s
-                        .methods
-                        .iter()
-                        .map(|(m, n)| format!("{m}={n}"))
-                        .collect::<Vec<_>>()
-                        .join(",");
-                    tracing::info!(
-                        read = s.read,
-                        written = s.written,
-                        rejected = s.rejected,
-                        filtered = s.filtered,
-                        rows = s.rows,
-                        seconds = format!("{:.2}", s.elapsed_s),
-                        methods = %methods,
-                        output = %s.output,
-                        "done: {} read, {} written, {} rejected, {} filtered in {:.2} s → {}",
-                        s.read, s.written, s.rejected, s.filtered, s.elapsed_s, s.output
-                    );
-                    ExitCode::SUCCESS
-                }
-                Err(e) => run_error(e),
-            }
-        }
-        Command::Validate { file } => {
-            let p = match file.load() {
-                Ok(p) => p,
-                Err(c) => return c,
-            };
-            match pipeline::validate(&p) {
-                Ok(info) => {
-                    let fields = info
-                        .fields
-                        .iter()
-                        .map(|f| f.name.as_str())
-                        .collect::<Vec<_>>()
-                        .join(", ");
-                    println!(
-                        "{}: valid. input `{}` layer `{}`: {} features ({} after filters), CRS {}, fields: {}; output {}",
-                        p.origin, info.source, info.layer, info.total, info.selected, info.crs_name, fields, p.file.output.path
-                    );
-                    ExitCode::SUCCESS
-                }
-                Err(e) => run_error(e),
-            }
-        }
-        Command::Score {
-            polygons,
-            polygons_layer,
-            skeletons,
-            skeletons_layer,
-            skeleton_key,
-            polygon_key,
-            label,
-            output,
-            overwrite,
-            bars,
-            reproject,
-        } => {
-            let spec = |source: &String, layer: &Option<String>| skeletonise::io::InputSpec {
-                source: source.clone(),
-                layer: layer.clone().map(skeletonise::io::LayerRef::Name),
-                where_: None,
-                bbox: None,
-                reproject: reproject.clone(),
-            };
-            let job = skeletonise::external::ScoreJob {
-                polygons: spec(polygons, polygons_layer),
-                skeletons: spec(skeletons, skeletons_layer),
-                join: match skeleton_key {
-                    Some(k) => skeletonise::external::Join::Key {
-                        polygon_field: polygon_key.clone(),
-                        skeleton_field: k.clone(),
-                    },
-                    None => skeletonise::external::Join::Location,
-                },
-                label: label.clone(),
-                output: skeletonise::io::writer::OutputSpec {
-                    path: output.display().to_string(),
-                    layer: "skeletons".into(),
-                    overwrite: *overwrite,
-                    candidates: false,
-                    bars: *bars,
-                    explode: false,
-                    widths: false,
-                },
-            };
-            match skeletonise::external::score_external(&job, *bars) {
-                Ok(s) => {
-                    tracing::info!(
-                        read = s.read,
-                        written = s.written,
-                        rejected = s.rejected,
-                        seconds = format!("{:.2}", s.elapsed_s),
-                        output = %s.output,
-                        "scored: {} polygons, {} with a skeleton, {} without → {}",
-                        s.read, s.written, s.rejected, s.output
-                    );
-                    ExitCode::SUCCESS
-                }
-                Err(e) => run_error(e),
-            }
-        }
+        Command::Run { file, threads } => cmd_run(&cli, file, *threads),
+        Command::Validate { file } => cmd_validate(file),
+        Command::Score(args) => cmd_score(args),
         Command::Methods => {
-            println!("Methods (skeleton step, `methods: [...]`):");
-            for m in MethodId::builtin() {
-                println!("  {:<5} {}", m.as_str(), m.description());
-            }
-            println!(
-                "\nSteps (in this order; only `skeleton` is required):\n  \
-                 prepare   make_valid (bool, default true), min_area (CRS units², default 0)\n  \
-                 skeleton  methods (list, default [MA, StSk, DVD, CDT, VD]), densify ({{factor: k}} default 4 | {{spacing: d}}), max_points (default 2000000), arc_tolerance ({{relative: f}} default 0.001 | {{absolute: d}}), reference (method whose pruned skeleton sets every method's legs, default MA)\n  \
-                 prune     mode (significance | length | trunk | none), ratio (default 1.0), arm_ratio (default 1.0), min_length (default 0), structure (shared | independent, default shared)\n  \
-                 extend    mode (centred | ray | nearest | none, default centred)\n  \
-                 score     (no options)\n  \
-                 select    by (distortion | deviation | deviation_parts | distortion_sum), min_coverage (default 0.9), coverage_slack (default 0.25), tie (default 0.0001)\n\n\
-                 Selection: among candidates with hits, those with coverage >= min(min_coverage, best coverage - coverage_slack)\n  \
-                 are eligible; the smallest `by` wins, distortions within `tie` of it count as equal and go to the method\n  \
-                 listed first. With structure: shared every method has the reference's legs reaching the boundary at the\n  \
-                 same places, so the metric, not a few points of coverage, decides.\n\n\
-                 `skeletonise schema` prints the full JSON Schema."
+            print!(
+                "{}",
+                config::describe(&skeletonise::methods::Registry::builtin())
             );
             ExitCode::SUCCESS
         }
@@ -317,5 +228,83 @@ fn main() -> ExitCode {
             );
             ExitCode::SUCCESS
         }
+    }
+}
+
+/// Logs the summary line of a finished run.
+fn log_summary(s: &pipeline::RunSummary) {
+    let methods = s
+        .methods
+        .iter()
+        .map(|(m, n)| format!("{m}={n}"))
+        .collect::<Vec<_>>()
+        .join(",");
+    tracing::info!(
+        read = s.read,
+        written = s.written,
+        rejected = s.rejected,
+        filtered = s.filtered,
+        rows = s.rows,
+        seconds = format!("{:.2}", s.elapsed_s),
+        methods = %methods,
+        output = %s.output,
+        "done: {} read, {} written, {} rejected, {} filtered in {:.2} s → {}",
+        s.read, s.written, s.rejected, s.filtered, s.elapsed_s, s.output
+    );
+}
+
+fn cmd_run(cli: &Cli, file: &PipelineArgs, threads: Option<usize>) -> ExitCode {
+    let p = match file.load() {
+        Ok(p) => p,
+        Err(c) => return c,
+    };
+    let opts = RunOptions {
+        threads,
+        progress: !cli.quiet
+            && std::io::stderr().is_terminal()
+            && matches!(cli.log_format, LogFormat::Text),
+        batch_size: None,
+    };
+    match pipeline::run(&p, &opts) {
+        Ok(s) => {
+            log_summary(&s);
+            ExitCode::SUCCESS
+        }
+        Err(e) => run_error(e),
+    }
+}
+
+fn cmd_validate(file: &PipelineArgs) -> ExitCode {
+    let p = match file.load() {
+        Ok(p) => p,
+        Err(c) => return c,
+    };
+    match pipeline::validate(&p) {
+        Ok(info) => {
+            let fields: Vec<&str> = info.fields.iter().map(|f| f.name.as_str()).collect();
+            println!(
+                "{}: valid. input `{}` layer `{}`: {} features ({} after filters), CRS {}, fields: {}; output {}",
+                p.origin,
+                info.source,
+                info.layer,
+                info.total,
+                info.selected,
+                info.crs_name,
+                fields.join(", "),
+                p.file.output.path
+            );
+            ExitCode::SUCCESS
+        }
+        Err(e) => run_error(e),
+    }
+}
+
+fn cmd_score(args: &ScoreArgs) -> ExitCode {
+    match skeletonise::external::score_external(&args.job(), args.bars) {
+        Ok(s) => {
+            log_summary(&s);
+            ExitCode::SUCCESS
+        }
+        Err(e) => run_error(e),
     }
 }

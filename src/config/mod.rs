@@ -49,13 +49,13 @@ pub enum Step {
     Prepare(PrepareParams),
     /// The skeleton methods to run.
     Skeleton(SkeletonParams),
-    /// Removal of insignificant legs.
+    /// Removal of insignificant legs: a leg goes when it protrudes less than `ratio` radii beyond the disc at its junction and is no arm (it protrudes less than `arm_ratio` times its own width at the mouth); cut ends stay; with `structure: shared` every method gets the reference method's legs.
     Prune(PruneParams),
-    /// Extension of legs to the boundary.
+    /// Extension of legs to the boundary: `centred` continues along the method's own removed legs, or ends between them where they fork on both sides of the line.
     Extend(ExtendParams),
     /// The paper's metrics.
     Score(ScoreParams),
-    /// Choice of the best method per feature.
+    /// Choice of the best method per feature: among the candidates with hits, those with coverage ≥ min(`min_coverage`, best coverage − `coverage_slack`) are eligible; the smallest `by` wins, distortions within `tie` of it counting as equal (the method listed first wins).
     Select(SelectParams),
 }
 
@@ -392,32 +392,7 @@ fn apply_override(root: &mut Value, o: &str) -> Result<(), String> {
                 } else {
                     // A step addressed by name.
                     let k = Value::String(seg.to_string());
-                    let found = seq
-                        .iter()
-                        .position(|v| v.as_mapping().is_some_and(|m| m.contains_key(&k)));
-                    let idx = match found {
-                        Some(idx) => idx,
-                        None => {
-                            let rank =
-                                Step::ORDER.iter().position(|n| *n == seg).ok_or_else(|| {
-                                    format!("no step `{seg}`; steps are {}", Step::ORDER.join(", "))
-                                })?;
-                            let at = seq
-                                .iter()
-                                .position(|v| {
-                                    v.as_mapping()
-                                        .and_then(|m| m.keys().next())
-                                        .and_then(Value::as_str)
-                                        .and_then(|n| Step::ORDER.iter().position(|o| *o == n))
-                                        .is_some_and(|r| r > rank)
-                                })
-                                .unwrap_or(seq.len());
-                            let mut m = serde_yaml_ng::Mapping::new();
-                            m.insert(k.clone(), Value::Mapping(Default::default()));
-                            seq.insert(at, Value::Mapping(m));
-                            at
-                        }
-                    };
+                    let idx = step_index(seq, seg)?;
                     let m = seq[idx].as_mapping_mut().expect("a step is a mapping");
                     if last {
                         m.insert(k, new);
@@ -440,6 +415,36 @@ fn apply_override(root: &mut Value, o: &str) -> Result<(), String> {
         i += 1;
     }
     Ok(())
+}
+
+/// The index of step `name` in the `steps` list, inserting an empty step in
+/// its place in the step order when it is absent.
+fn step_index(seq: &mut Vec<Value>, name: &str) -> Result<usize, String> {
+    let k = Value::String(name.to_string());
+    if let Some(idx) = seq
+        .iter()
+        .position(|v| v.as_mapping().is_some_and(|m| m.contains_key(&k)))
+    {
+        return Ok(idx);
+    }
+    let rank = Step::ORDER
+        .iter()
+        .position(|n| *n == name)
+        .ok_or_else(|| format!("no step `{name}`; steps are {}", Step::ORDER.join(", ")))?;
+    let at = seq
+        .iter()
+        .position(|v| {
+            v.as_mapping()
+                .and_then(|m| m.keys().next())
+                .and_then(Value::as_str)
+                .and_then(|n| Step::ORDER.iter().position(|o| *o == n))
+                .is_some_and(|r| r > rank)
+        })
+        .unwrap_or(seq.len());
+    let mut m = serde_yaml_ng::Mapping::new();
+    m.insert(k, Value::Mapping(Default::default()));
+    seq.insert(at, Value::Mapping(m));
+    Ok(at)
 }
 
 /// Replaces `${NAME}` and `${NAME:-default}` in every string.
@@ -496,6 +501,92 @@ fn expand(s: &str) -> Result<String, String> {
 /// The JSON Schema of the pipeline file.
 pub fn json_schema() -> serde_json::Value {
     serde_json::to_value(schemars::schema_for!(PipelineFile)).unwrap_or_default()
+}
+
+/// `skeletonise methods`: the registered methods, then every step with its
+/// options — their values and defaults taken from the same JSON Schema that
+/// `skeletonise schema` prints (so from the types and their serde defaults).
+pub fn describe(registry: &crate::methods::Registry) -> String {
+    use std::fmt::Write as _;
+    let schema = json_schema();
+    let defs = &schema["$defs"];
+    let mut out = String::from("Methods (skeleton step, `methods: [...]`):\n");
+    for e in registry.entries() {
+        let _ = writeln!(out, "  {:<5} {} — {}", e.id.as_str(), e.name, e.description);
+    }
+    out.push_str("\nSteps (in this order; only `skeleton` is required):\n");
+    for step in defs["Step"]["oneOf"].as_array().into_iter().flatten() {
+        let Some((name, body)) = step["properties"].as_object().and_then(|p| p.iter().next())
+        else {
+            continue;
+        };
+        let params = resolve(defs, body);
+        let _ = writeln!(out, "  {name:<9} {}", first_line(&step["description"]));
+        for (key, prop) in params["properties"].as_object().into_iter().flatten() {
+            let _ = writeln!(
+                out,
+                "    {key:<16} {}{}",
+                values(defs, prop),
+                default_of(prop)
+            );
+            let _ = writeln!(out, "    {:<16} {}", "", first_line(&prop["description"]));
+        }
+    }
+    out.push_str("\n`skeletonise schema` prints the full JSON Schema; README.md explains pruning,\nextension and selection.\n");
+    out
+}
+
+fn resolve<'a>(defs: &'a serde_json::Value, v: &'a serde_json::Value) -> &'a serde_json::Value {
+    match v["$ref"].as_str().and_then(|r| r.strip_prefix("#/$defs/")) {
+        Some(name) => &defs[name],
+        None => v,
+    }
+}
+
+fn first_line(v: &serde_json::Value) -> String {
+    v.as_str()
+        .unwrap_or_default()
+        .split("\n\n")
+        .next()
+        .unwrap_or_default()
+        .replace('\n', " ")
+}
+
+/// The values an option takes: its enumeration, or its type.
+fn values(defs: &serde_json::Value, prop: &serde_json::Value) -> String {
+    let t = resolve(defs, prop);
+    let items = &t["items"];
+    if let Some(list) = t["oneOf"].as_array() {
+        let names: Vec<String> = list
+            .iter()
+            .map(|o| match (&o["const"], o["properties"].as_object()) {
+                (serde_json::Value::String(c), _) => c.clone(),
+                (_, Some(p)) => p
+                    .keys()
+                    .map(|k| format!("{{{k}: …}}"))
+                    .collect::<Vec<_>>()
+                    .join(" | "),
+                _ => "…".into(),
+            })
+            .collect();
+        return names.join(" | ");
+    }
+    if let Some(e) = resolve(defs, items)["enum"].as_array() {
+        let names: Vec<&str> = e.iter().filter_map(|x| x.as_str()).collect();
+        return format!("list of {}", names.join(", "));
+    }
+    if let Some(e) = t["enum"].as_array() {
+        let names: Vec<&str> = e.iter().filter_map(|x| x.as_str()).collect();
+        return names.join(" | ");
+    }
+    t["type"].as_str().unwrap_or("value").to_string()
+}
+
+fn default_of(prop: &serde_json::Value) -> String {
+    match &prop["default"] {
+        serde_json::Value::Null => String::new(),
+        d => format!(" (default {d})"),
+    }
 }
 
 #[cfg(test)]
@@ -562,6 +653,21 @@ mod tests {
         let e = load_str(&OK.replace("in.gpkg", "${SKELETONISE_NOPE}"), "p.yaml", &[]).unwrap_err();
         assert_eq!(e.key, "input.source");
         assert_eq!(e.position, Some((2, 11)));
+    }
+
+    #[test]
+    fn description_lists_methods_steps_and_defaults() {
+        let d = describe(&crate::methods::Registry::builtin());
+        for needle in [
+            "MA    medial axis",
+            "prune ",
+            "arm_ratio        number (default 1.0)",
+            "mode             centred | ray | nearest | none (default \"centred\")",
+            "coverage_slack   number (default 0.25)",
+            "methods          list of VD, DVD, CDT, StSk, MA (default [\"MA\",\"StSk\",\"DVD\",\"CDT\",\"VD\"])",
+        ] {
+            assert!(d.contains(needle), "`{needle}` missing from:\n{d}");
+        }
     }
 
     #[test]

@@ -56,6 +56,49 @@ pub struct Reader {
     target: Option<SpatialRef>,
 }
 
+/// `AUTH:CODE` of a CRS, else its name.
+fn crs_name(s: &SpatialRef) -> String {
+    match (s.auth_name(), s.auth_code().ok()) {
+        (Some(a), Some(c)) => format!("{a}:{c}"),
+        _ => s.name().unwrap_or_else(|| "(unnamed)".into()),
+    }
+}
+
+/// The CRS to reproject to, checked: projected, and a source CRS to start
+/// from; without `reproject`, the source CRS must not be geographic.
+fn target_srs(
+    spec: &InputSpec,
+    source_srs: Option<&SpatialRef>,
+    layer_name: &str,
+) -> Result<Option<SpatialRef>, IoError> {
+    let Some(t) = &spec.reproject else {
+        if let Some(s) = source_srs.filter(|s| s.is_geographic()) {
+            return Err(IoError::Geographic {
+                layer: layer_name.to_string(),
+                crs: s.name().unwrap_or_else(|| "(unnamed)".into()),
+            });
+        }
+        return Ok(None);
+    };
+    let bad = |reason: String| IoError::BadReproject {
+        target: t.clone(),
+        reason,
+    };
+    let srs = SpatialRef::from_definition(t).map_err(|e| bad(e.to_string()))?;
+    if srs.is_geographic() {
+        return Err(bad(
+            "it is a geographic CRS; choose a projected one (metres), e.g. a UTM zone or EPSG:3035"
+                .into(),
+        ));
+    }
+    if source_srs.is_none() {
+        return Err(bad(format!(
+            "layer `{layer_name}` has no CRS to reproject from; assign one to the source first"
+        )));
+    }
+    Ok(Some(traditional(srs)))
+}
+
 fn traditional(mut s: SpatialRef) -> SpatialRef {
     s.set_axis_mapping_strategy(AxisMappingStrategy::TraditionalGisOrder);
     s
@@ -75,33 +118,14 @@ impl Reader {
             source_name: spec.source.clone(),
             reason: e.to_string(),
         })?;
-        let names: Vec<String> = dataset.layers().map(|l| l.name()).collect();
-        let no_layer = |layer: String| IoError::NoLayer {
-            source_name: spec.source.clone(),
-            layer,
-            available: if names.is_empty() {
-                "(none)".into()
-            } else {
-                names.join(", ")
-            },
-        };
-        let layer_index = match &spec.layer {
-            None if names.is_empty() => return Err(no_layer("#0".into())),
-            None => 0,
-            Some(LayerRef::Index(i)) if *i < names.len() => *i,
-            Some(LayerRef::Name(n)) => names
-                .iter()
-                .position(|x| x == n)
-                .ok_or_else(|| no_layer(format!("`{n}`")))?,
-            Some(other) => return Err(no_layer(other.to_string())),
-        };
+        let layer_index = Self::layer_index(&dataset, spec)?;
         let mut layer = dataset
             .layer(layer_index)
             .map_err(|e| IoError::gdal("opening the layer", e))?;
         let layer_name = layer.name();
         let total = layer.feature_count();
-        let defn = layer.defn();
-        let fields = defn
+        let fields = layer
+            .defn()
             .fields()
             .map(|f| FieldInfo {
                 name: f.name(),
@@ -111,49 +135,10 @@ impl Reader {
             })
             .collect();
         let source_srs = layer.spatial_ref();
-        let target = match &spec.reproject {
-            Some(t) => {
-                let srs = SpatialRef::from_definition(t).map_err(|e| IoError::BadReproject {
-                    target: t.clone(),
-                    reason: e.to_string(),
-                })?;
-                if srs.is_geographic() {
-                    return Err(IoError::BadReproject {
-                        target: t.clone(),
-                        reason: "it is a geographic CRS; choose a projected one (metres), e.g. a UTM zone or EPSG:3035".into(),
-                    });
-                }
-                if source_srs.is_none() {
-                    return Err(IoError::BadReproject {
-                        target: t.clone(),
-                        reason: format!("layer `{layer_name}` has no CRS to reproject from; assign one to the source first"),
-                    });
-                }
-                Some(traditional(srs))
-            }
-            None => {
-                if let Some(s) = &source_srs {
-                    if s.is_geographic() {
-                        return Err(IoError::Geographic {
-                            layer: layer_name,
-                            crs: s.name().unwrap_or_else(|| "(unnamed)".into()),
-                        });
-                    }
-                }
-                None
-            }
-        };
+        let target = target_srs(spec, source_srs.as_ref(), &layer_name)?;
         let out_srs = target.as_ref().or(source_srs.as_ref());
         let srs_wkt = out_srs.and_then(|s| s.to_wkt().ok());
-        let crs_name = out_srs
-            .map(|s| {
-                let code = s.auth_code().ok();
-                match (s.auth_name(), code) {
-                    (Some(a), Some(c)) => format!("{a}:{c}"),
-                    _ => s.name().unwrap_or_else(|| "(unnamed)".into()),
-                }
-            })
-            .unwrap_or_else(|| "(no CRS)".into());
+        let crs_name = out_srs.map_or_else(|| "(no CRS)".into(), crs_name);
         Self::apply_filters(&mut layer, spec)?;
         let selected = layer.feature_count();
         let info = SourceInfo {
@@ -172,6 +157,30 @@ impl Reader {
             info,
             target,
         })
+    }
+
+    /// The index of the layer `spec` asks for.
+    fn layer_index(dataset: &Dataset, spec: &InputSpec) -> Result<usize, IoError> {
+        let names: Vec<String> = dataset.layers().map(|l| l.name()).collect();
+        let no_layer = |layer: String| IoError::NoLayer {
+            source_name: spec.source.clone(),
+            layer,
+            available: if names.is_empty() {
+                "(none)".into()
+            } else {
+                names.join(", ")
+            },
+        };
+        match &spec.layer {
+            None if names.is_empty() => Err(no_layer("#0".into())),
+            None => Ok(0),
+            Some(LayerRef::Index(i)) if *i < names.len() => Ok(*i),
+            Some(LayerRef::Name(n)) => names
+                .iter()
+                .position(|x| x == n)
+                .ok_or_else(|| no_layer(format!("`{n}`"))),
+            Some(other) => Err(no_layer(other.to_string())),
+        }
     }
 
     fn apply_filters(layer: &mut gdal::vector::Layer<'_>, spec: &InputSpec) -> Result<(), IoError> {

@@ -89,7 +89,34 @@ pub fn inside_triangles(polygon: &PreparedPolygon) -> Result<Vec<InsideTriangle>
             p.0, p.1
         )));
     }
-    // Flood fill: depth = number of constraint edges crossed from the outer face.
+    let depth = crossing_depths(&cdt);
+    let mut out = Vec::new();
+    for face in cdt.inner_faces() {
+        if depth[face.fix().index()].unwrap_or(0).is_multiple_of(2) {
+            continue;
+        }
+        let edges = face.adjacent_edges();
+        let mut corners = [Coord { x: 0.0, y: 0.0 }; 3];
+        let mut on_boundary = [false; 3];
+        for (i, e) in edges.iter().enumerate() {
+            let p = e.from().position();
+            corners[i] = Coord {
+                x: p.x + origin.x,
+                y: p.y + origin.y,
+            };
+            on_boundary[i] = cdt.is_constraint_edge(e.as_undirected().fix());
+        }
+        out.push(InsideTriangle {
+            corners,
+            on_boundary,
+        });
+    }
+    Ok(out)
+}
+
+/// Flood fill from the outer face: per face, the number of constraint edges
+/// (boundary edges) crossed to reach it — odd inside P.
+fn crossing_depths(cdt: &ConstrainedDelaunayTriangulation<Point2<f64>>) -> Vec<Option<u32>> {
     let mut depth: Vec<Option<u32>> = vec![None; cdt.num_all_faces()];
     let outer = cdt.outer_face();
     depth[outer.fix().index()] = Some(0);
@@ -114,28 +141,7 @@ pub fn inside_triangles(polygon: &PreparedPolygon) -> Result<Vec<InsideTriangle>
             }
         }
     }
-    let mut out = Vec::new();
-    for face in cdt.inner_faces() {
-        if depth[face.fix().index()].unwrap_or(0).is_multiple_of(2) {
-            continue;
-        }
-        let edges = face.adjacent_edges();
-        let mut corners = [Coord { x: 0.0, y: 0.0 }; 3];
-        let mut on_boundary = [false; 3];
-        for (i, e) in edges.iter().enumerate() {
-            let p = e.from().position();
-            corners[i] = Coord {
-                x: p.x + origin.x,
-                y: p.y + origin.y,
-            };
-            on_boundary[i] = cdt.is_constraint_edge(e.as_undirected().fix());
-        }
-        out.push(InsideTriangle {
-            corners,
-            on_boundary,
-        });
-    }
-    Ok(out)
+    depth
 }
 
 fn mid(a: Coord<f64>, b: Coord<f64>) -> Coord<f64> {

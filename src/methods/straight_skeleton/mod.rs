@@ -411,6 +411,31 @@ impl<'a> Propagation<'a> {
         p0: Coord<f64>,
     ) -> Result<bool, MethodError> {
         let t0 = self.now;
+        let (inv, cuts, next_candidates) = self.involved(group, p0, t0);
+        let chains = self.chains(&inv, &cuts);
+        let Some(pairs) = self.pair_rays(&chains) else {
+            return Ok(false);
+        };
+        for (v, i) in next_candidates {
+            self.push_candidate(v, i);
+        }
+        for &u in &inv {
+            self.finish(u, p0);
+        }
+        self.relink(&pairs, &chains, p0, t0)?;
+        Ok(true)
+    }
+
+    /// The vertices a vertex event at `p0` involves (sorted), the wavefront
+    /// pieces split there (vertex before the cut, line), and the split
+    /// candidates to try later.
+    #[allow(clippy::type_complexity)]
+    fn involved(
+        &mut self,
+        group: &[events::Event],
+        p0: Coord<f64>,
+        t0: f64,
+    ) -> (Vec<VertexId>, Vec<(VertexId, LineId)>, Vec<(VertexId, u32)>) {
         let mut inv: Vec<VertexId> = Vec::new();
         let mut cuts: Vec<(VertexId, LineId)> = Vec::new();
         let mut next_candidates = Vec::new();
@@ -461,9 +486,20 @@ impl<'a> Propagation<'a> {
         cuts.dedup_by_key(|c| c.0);
         let is_inv = |v: VertexId| inv.binary_search(&v).is_ok();
         cuts.retain(|c| !is_inv(c.0) && !is_inv(self.w.v(c.0).next));
-        // (arriving line, leaving line, vertex before, vertex after)
-        let mut chains: Vec<(LineId, LineId, VertexId, VertexId)> = Vec::new();
-        for &u in &inv {
+        (inv, cuts, next_candidates)
+    }
+
+    /// The wavefront chains meeting at the event: (arriving line, leaving
+    /// line, vertex before, vertex after), one per run of involved vertices
+    /// and one per cut piece.
+    fn chains(
+        &self,
+        inv: &[VertexId],
+        cuts: &[(VertexId, LineId)],
+    ) -> Vec<(LineId, LineId, VertexId, VertexId)> {
+        let is_inv = |v: VertexId| inv.binary_search(&v).is_ok();
+        let mut chains = Vec::new();
+        for &u in inv {
             let pred = self.w.v(u).prev;
             if is_inv(pred) {
                 continue;
@@ -474,9 +510,18 @@ impl<'a> Propagation<'a> {
             }
             chains.push((self.w.v(u).left, self.w.v(w).right, pred, self.w.v(w).next));
         }
-        for &(x, l) in &cuts {
+        for &(x, l) in cuts {
             chains.push((l, l, x, self.w.v(x).next));
         }
+        chains
+    }
+
+    /// Pairs each chain's arriving ray with the chain whose leaving ray comes
+    /// next by angle around the event (`None` when they do not alternate).
+    fn pair_rays(
+        &self,
+        chains: &[(LineId, LineId, VertexId, VertexId)],
+    ) -> Option<Vec<(usize, usize)>> {
         let angle = |d: Coord<f64>| d.y.atan2(d.x);
         // (angle, leaving, chain)
         let mut rays: Vec<(f64, bool, usize)> = Vec::with_capacity(2 * chains.len());
@@ -484,7 +529,6 @@ impl<'a> Propagation<'a> {
             rays.push((angle(self.w.line(a).dir * -1.0), false, i));
             rays.push((angle(self.w.line(b).dir), true, i));
         }
-        let mut pairs = None;
         for leaving_first in [true, false] {
             rays.sort_by(|r, s| {
                 r.0.total_cmp(&s.0).then(if leaving_first {
@@ -495,25 +539,26 @@ impl<'a> Propagation<'a> {
             });
             let m = rays.len();
             if (0..m).all(|i| rays[i].1 != rays[(i + 1) % m].1) {
-                pairs = Some(
+                return Some(
                     (0..m)
                         .filter(|&i| !rays[i].1)
                         .map(|i| (rays[i].2, rays[(i + m - 1) % m].2))
-                        .collect::<Vec<_>>(),
+                        .collect(),
                 );
-                break;
             }
         }
-        let Some(pairs) = pairs else {
-            return Ok(false);
-        };
-        for (v, i) in next_candidates {
-            self.push_candidate(v, i);
-        }
-        for &u in &inv {
-            self.finish(u, p0);
-        }
-        for (i, j) in pairs {
+        None
+    }
+
+    /// Links the wavefront anew around the event at `p0`.
+    fn relink(
+        &mut self,
+        pairs: &[(usize, usize)],
+        chains: &[(LineId, LineId, VertexId, VertexId)],
+        p0: Coord<f64>,
+        t0: f64,
+    ) -> Result<(), MethodError> {
+        for &(i, j) in pairs {
             let (a, _, pred, _) = chains[i];
             let (_, b, _, succ) = chains[j];
             if pred == succ && a != b {
@@ -534,7 +579,7 @@ impl<'a> Propagation<'a> {
                 self.w.link(m, succ);
             }
         }
-        Ok(true)
+        Ok(())
     }
 
     fn drain_work(&mut self) -> Result<(), MethodError> {
