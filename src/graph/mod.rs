@@ -66,6 +66,30 @@ pub struct Branch {
     pub coords: Vec<Coord<f64>>,
 }
 
+/// A leg (SPEC §2): a branch with a leaf at one end — the one definition
+/// that pruning, counting and the `legs` column share. Pruning judges the
+/// legs that end at a junction.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Leg {
+    /// The branch, oriented from the leaf (`start`) to its other end (`end`).
+    pub branch: Branch,
+    /// The other end is a junction (degree ≥ 3), not the other leaf of a
+    /// simple path.
+    pub junction: bool,
+}
+
+impl Leg {
+    /// The leaf.
+    pub fn leaf(&self) -> NodeId {
+        self.branch.start
+    }
+
+    /// The node at the other end.
+    pub fn other(&self) -> NodeId {
+        self.branch.end
+    }
+}
+
 impl Branch {
     /// Length of the chain's polyline.
     pub fn length(&self) -> f64 {
@@ -352,15 +376,34 @@ impl SkeletonGraph {
         coords
     }
 
-    /// Number of legs (branches with a leaf at one end).
-    pub fn leg_count(&self) -> usize {
+    /// The legs (SPEC §2): branches with a leaf at one end, oriented from
+    /// the leaf. A simple path (leaf to leaf) is one leg.
+    pub fn legs(&self) -> Vec<Leg> {
         let deg = self.degrees();
         self.branches()
-            .iter()
-            .filter(|b| {
-                b.start != b.end && (deg[b.start.0 as usize] == 1 || deg[b.end.0 as usize] == 1)
+            .into_iter()
+            .filter(|b| b.start != b.end)
+            .filter_map(|mut b| {
+                if deg[b.start.0 as usize] != 1 {
+                    if deg[b.end.0 as usize] != 1 {
+                        return None;
+                    }
+                    std::mem::swap(&mut b.start, &mut b.end);
+                    b.edges.reverse();
+                    b.coords.reverse();
+                }
+                let junction = deg[b.end.0 as usize] >= 3;
+                Some(Leg {
+                    branch: b,
+                    junction,
+                })
             })
-            .count()
+            .collect()
+    }
+
+    /// Number of legs ([`SkeletonGraph::legs`]): the `legs` column.
+    pub fn leg_count(&self) -> usize {
+        self.legs().len()
     }
 }
 

@@ -153,3 +153,38 @@ pub fn wkts(ds: &Dataset, layer: &str) -> Vec<Option<String>> {
         .map(|f| f.geometry().and_then(|g| g.wkt().ok()))
         .collect()
 }
+
+/// A canonical text of every layer of an output GeoPackage except the run
+/// record (which holds times): per layer its name, field names and every
+/// row — geometry as WKB in hex, values as GDAL gives them — so that two
+/// runs compare equal exactly when their content is the same.
+pub fn canonical(path: &Path) -> String {
+    let ds = open(path);
+    let mut out = String::new();
+    let mut names: Vec<String> = ds.layers().map(|l| l.name()).collect();
+    names.sort();
+    for name in names.iter().filter(|n| *n != "skeletonise_runs") {
+        let mut l = ds.layer_by_name(name).unwrap();
+        let fields: Vec<String> = l.defn().fields().map(|f| f.name()).collect();
+        out.push_str(&format!("## {name}: {}\n", fields.join(",")));
+        for f in l.features() {
+            let g = f
+                .geometry()
+                .and_then(|g| g.wkb().ok())
+                .map(|w| w.iter().map(|b| format!("{b:02x}")).collect::<String>())
+                .unwrap_or_default();
+            let vals: Vec<String> = (0..fields.len())
+                .map(|i| format!("{:?}", f.field(i).ok().flatten()))
+                .collect();
+            out.push_str(&format!("{g}|{}\n", vals.join("|")));
+        }
+    }
+    out
+}
+
+/// FNV-1a, 64 bit: a stable fingerprint of a text.
+pub fn fingerprint(text: &str) -> u64 {
+    text.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+    })
+}

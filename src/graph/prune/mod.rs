@@ -1,9 +1,10 @@
 //! Pruning of insignificant legs (SPEC §4, refined by the issue on the
 //! default output's quality).
 //!
-//! A **leg** is a branch with a leaf ℓ at one end and a junction j (degree ≥ 3)
-//! at the other; r_j is the junction's radius (its distance to ∂P, set by
-//! every method). With `ratio` = ρ, `arm_ratio` = α and `min_length` = m, a
+//! A **leg** ([`crate::graph::Leg`], SPEC §2) is a branch with a leaf ℓ at
+//! one end; pruning judges the legs whose other end is a junction j (degree
+//! ≥ 3), r_j being the junction's radius (its distance to ∂P, set by every
+//! method). With `ratio` = ρ, `arm_ratio` = α and `min_length` = m, a
 //! leg of extent L (its length plus the reach of its leaf, see below) is
 //!
 //! ```text
@@ -237,34 +238,25 @@ pub fn insignificant_legs(
     params: &PruneParams,
     boundary: &Boundary,
 ) -> Vec<(NodeId, NodeId, f64)> {
-    let deg = graph.degrees();
-    let mut out = Vec::new();
-    for b in graph.branches() {
-        if b.start == b.end {
-            continue;
-        }
-        let (ds, de) = (deg[b.start.0 as usize], deg[b.end.0 as usize]);
-        for (leaf, j, dl, dj) in [(b.start, b.end, ds, de), (b.end, b.start, de, ds)] {
-            if dl == 1 && dj >= 3 {
-                let len = b.length();
-                let rj = graph.node(j).radius;
-                let coords: Vec<_> = if j == b.start {
-                    b.coords.clone()
-                } else {
-                    b.coords.iter().rev().copied().collect()
-                };
-                let leg = LegMeasure {
-                    extent: len,
-                    r_junction: rj,
-                    r_mouth: legs::mouth_radius(&coords, rj, boundary),
-                };
-                if params.is_insignificant(&leg) {
-                    out.push((leaf, j, len));
-                }
-            }
-        }
-    }
-    out
+    graph
+        .legs()
+        .into_iter()
+        .filter(|l| l.junction)
+        .filter_map(|l| {
+            let len = l.branch.length();
+            let rj = graph.node(l.other()).radius;
+            // The mouth is measured from the junction.
+            let from_junction: Vec<_> = l.branch.coords.iter().rev().copied().collect();
+            let leg = LegMeasure {
+                extent: len,
+                r_junction: rj,
+                r_mouth: legs::mouth_radius(&from_junction, rj, boundary),
+            };
+            params
+                .is_insignificant(&leg)
+                .then_some((l.leaf(), l.other(), len))
+        })
+        .collect()
 }
 
 #[cfg(test)]
