@@ -9,6 +9,7 @@
 
 use crate::feature::Value;
 use crate::score::Scores;
+use ColumnType::{Int32, Int64, Real, Text};
 
 /// The type of a column.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -79,6 +80,26 @@ pub struct Column<R> {
     pub get: fn(&R) -> Cell,
     /// When the column is written.
     pub when: When,
+}
+
+/// A column written always.
+pub const fn col<R>(name: &'static str, ty: ColumnType, get: fn(&R) -> Cell) -> Column<R> {
+    Column {
+        name,
+        ty,
+        get,
+        when: When::Always,
+    }
+}
+
+/// A column written only with `output.explode`.
+pub const fn col_explode<R>(name: &'static str, ty: ColumnType, get: fn(&R) -> Cell) -> Column<R> {
+    Column {
+        name,
+        ty,
+        get,
+        when: When::Explode,
+    }
 }
 
 impl<R> Clone for Column<R> {
@@ -159,48 +180,13 @@ fn s_distortion<R: Scored>(r: &R) -> Cell {
 macro_rules! score_columns {
     ($r:ty) => {
         [
-            Column {
-                name: "bars",
-                ty: ColumnType::Int64,
-                get: s_bars::<$r>,
-                when: When::Always,
-            },
-            Column {
-                name: "hits",
-                ty: ColumnType::Int64,
-                get: s_hits::<$r>,
-                when: When::Always,
-            },
-            Column {
-                name: "coverage",
-                ty: ColumnType::Real,
-                get: s_coverage::<$r>,
-                when: When::Always,
-            },
-            Column {
-                name: "deviation",
-                ty: ColumnType::Real,
-                get: s_deviation::<$r>,
-                when: When::Always,
-            },
-            Column {
-                name: "deviation_parts",
-                ty: ColumnType::Real,
-                get: s_deviation_parts::<$r>,
-                when: When::Always,
-            },
-            Column {
-                name: "distortion_sum",
-                ty: ColumnType::Real,
-                get: s_distortion_sum::<$r>,
-                when: When::Always,
-            },
-            Column {
-                name: "distortion",
-                ty: ColumnType::Real,
-                get: s_distortion::<$r>,
-                when: When::Always,
-            },
+            col("bars", Int64, s_bars::<$r>),
+            col("hits", Int64, s_hits::<$r>),
+            col("coverage", Real, s_coverage::<$r>),
+            col("deviation", Real, s_deviation::<$r>),
+            col("deviation_parts", Real, s_deviation_parts::<$r>),
+            col("distortion_sum", Real, s_distortion_sum::<$r>),
+            col("distortion", Real, s_distortion::<$r>),
         ]
     };
 }
@@ -272,15 +258,15 @@ pub const SKELETONS: LayerDef<SkeletonRow> = LayerDef {
     attributes: Some(|r| &r.attributes),
     columns: columns!(SkeletonRow;
         [
-            Column { name: "src_fid", ty: ColumnType::Int64, get: |r: &SkeletonRow| fid(r.src_fid), when: When::Always },
-            Column { name: "polygon_part", ty: ColumnType::Int32, get: |r: &SkeletonRow| r.polygon_part.map_or(Cell::Null, int), when: When::Explode },
-            Column { name: "method", ty: ColumnType::Text, get: |r: &SkeletonRow| text(&r.method), when: When::Always },
+            col("src_fid", Int64, |r: &SkeletonRow| fid(r.src_fid)),
+            col_explode("polygon_part", Int32, |r: &SkeletonRow| r.polygon_part.map_or(Cell::Null, int)),
+            col("method", Text, |r: &SkeletonRow| text(&r.method)),
         ],
         score_columns!(SkeletonRow),
         [
-            Column { name: "components", ty: ColumnType::Int32, get: |r: &SkeletonRow| int(r.components), when: When::Always },
-            Column { name: "legs", ty: ColumnType::Int32, get: |r: &SkeletonRow| int(r.legs), when: When::Always },
-            Column { name: "repaired", ty: ColumnType::Int32, get: |r: &SkeletonRow| int(i64::from(r.repaired)), when: When::Always },
+            col("components", Int32, |r: &SkeletonRow| int(r.components)),
+            col("legs", Int32, |r: &SkeletonRow| int(r.legs)),
+            col("repaired", Int32, |r: &SkeletonRow| int(i64::from(r.repaired))),
         ],
     ),
 };
@@ -324,17 +310,17 @@ pub const CANDIDATES: LayerDef<CandidateRow> = LayerDef {
     attributes: None,
     columns: columns!(CandidateRow;
         [
-            Column { name: "src_fid", ty: ColumnType::Int64, get: |r: &CandidateRow| fid(r.src_fid), when: When::Always },
-            Column { name: "polygon_part", ty: ColumnType::Int32, get: |r: &CandidateRow| r.polygon_part.map_or(Cell::Null, int), when: When::Always },
-            Column { name: "method", ty: ColumnType::Text, get: |r: &CandidateRow| text(&r.method), when: When::Always },
-            Column { name: "chosen", ty: ColumnType::Int32, get: |r: &CandidateRow| int(i64::from(r.chosen)), when: When::Always },
+            col("src_fid", Int64, |r: &CandidateRow| fid(r.src_fid)),
+            col("polygon_part", Int32, |r: &CandidateRow| r.polygon_part.map_or(Cell::Null, int)),
+            col("method", Text, |r: &CandidateRow| text(&r.method)),
+            col("chosen", Int32, |r: &CandidateRow| int(i64::from(r.chosen))),
         ],
         score_columns!(CandidateRow),
         [
-            Column { name: "components", ty: ColumnType::Int32, get: |r: &CandidateRow| int(r.components), when: When::Always },
-            Column { name: "legs_raw", ty: ColumnType::Int32, get: |r: &CandidateRow| int(r.legs_raw), when: When::Always },
-            Column { name: "legs", ty: ColumnType::Int32, get: |r: &CandidateRow| int(r.legs), when: When::Always },
-            Column { name: "error", ty: ColumnType::Text, get: |r: &CandidateRow| r.error.as_deref().map_or(Cell::Null, text), when: When::Always },
+            col("components", Int32, |r: &CandidateRow| int(r.components)),
+            col("legs_raw", Int32, |r: &CandidateRow| int(r.legs_raw)),
+            col("legs", Int32, |r: &CandidateRow| int(r.legs)),
+            col("error", Text, |r: &CandidateRow| r.error.as_deref().map_or(Cell::Null, text)),
         ],
     ),
 };
@@ -367,48 +353,13 @@ pub const BARS: LayerDef<BarRow> = LayerDef {
     shape: |r| Some(Shape::Line(r.geometry.clone())),
     attributes: None,
     columns: &[
-        Column {
-            name: "src_fid",
-            ty: ColumnType::Int64,
-            get: |r| fid(r.src_fid),
-            when: When::Always,
-        },
-        Column {
-            name: "method",
-            ty: ColumnType::Text,
-            get: |r| text(&r.method),
-            when: When::Always,
-        },
-        Column {
-            name: "d_left",
-            ty: ColumnType::Real,
-            get: |r| real(r.d_left),
-            when: When::Always,
-        },
-        Column {
-            name: "d_right",
-            ty: ColumnType::Real,
-            get: |r| real(r.d_right),
-            when: When::Always,
-        },
-        Column {
-            name: "delta_d",
-            ty: ColumnType::Real,
-            get: |r| real(r.delta_d),
-            when: When::Always,
-        },
-        Column {
-            name: "z",
-            ty: ColumnType::Real,
-            get: |r| real(r.z),
-            when: When::Always,
-        },
-        Column {
-            name: "branch",
-            ty: ColumnType::Int64,
-            get: |r| r.branch.map_or(Cell::Null, int),
-            when: When::Always,
-        },
+        col("src_fid", Int64, |r| fid(r.src_fid)),
+        col("method", Text, |r| text(&r.method)),
+        col("d_left", Real, |r| real(r.d_left)),
+        col("d_right", Real, |r| real(r.d_right)),
+        col("delta_d", Real, |r| real(r.delta_d)),
+        col("z", Real, |r| real(r.z)),
+        col("branch", Int64, |r| r.branch.map_or(Cell::Null, int)),
     ],
 };
 
@@ -440,36 +391,13 @@ pub const WIDTHS: LayerDef<WidthRow> = LayerDef {
     },
     attributes: None,
     columns: &[
-        Column {
-            name: "src_fid",
-            ty: ColumnType::Int64,
-            get: |r| fid(r.src_fid),
-            when: When::Always,
-        },
-        Column {
-            name: "method",
-            ty: ColumnType::Text,
-            get: |r| text(&r.method),
-            when: When::Always,
-        },
-        Column {
-            name: "width_start",
-            ty: ColumnType::Real,
-            get: |r| Cell::Real(r.width_start),
-            when: When::Always,
-        },
-        Column {
-            name: "width_end",
-            ty: ColumnType::Real,
-            get: |r| Cell::Real(r.width_end),
-            when: When::Always,
-        },
-        Column {
-            name: "width",
-            ty: ColumnType::Real,
-            get: |r| Cell::Real((r.width_start + r.width_end) / 2.0),
-            when: When::Always,
-        },
+        col("src_fid", Int64, |r| fid(r.src_fid)),
+        col("method", Text, |r| text(&r.method)),
+        col("width_start", Real, |r| Cell::Real(r.width_start)),
+        col("width_end", Real, |r| Cell::Real(r.width_end)),
+        col("width", Real, |r| {
+            Cell::Real((r.width_start + r.width_end) / 2.0)
+        }),
     ],
 };
 
@@ -491,18 +419,8 @@ pub const REJECTED: LayerDef<RejectedRow> = LayerDef {
     shape: |r| r.wkb.as_deref().map(Shape::Wkb),
     attributes: None,
     columns: &[
-        Column {
-            name: "src_fid",
-            ty: ColumnType::Int64,
-            get: |r| fid(r.src_fid),
-            when: When::Always,
-        },
-        Column {
-            name: "reason",
-            ty: ColumnType::Text,
-            get: |r| text(&r.reason),
-            when: When::Always,
-        },
+        col("src_fid", Int64, |r| fid(r.src_fid)),
+        col("reason", Text, |r| text(&r.reason)),
     ],
 };
 
@@ -542,78 +460,18 @@ pub const RUNS: LayerDef<RunRecord> = LayerDef {
     shape: |_| None,
     attributes: None,
     columns: &[
-        Column {
-            name: "name",
-            ty: ColumnType::Text,
-            get: |r| text(&r.name),
-            when: When::Always,
-        },
-        Column {
-            name: "started_utc",
-            ty: ColumnType::Text,
-            get: |r| text(&r.started_utc),
-            when: When::Always,
-        },
-        Column {
-            name: "finished_utc",
-            ty: ColumnType::Text,
-            get: |r| text(&r.finished_utc),
-            when: When::Always,
-        },
-        Column {
-            name: "tool_version",
-            ty: ColumnType::Text,
-            get: |r| text(&r.tool_version),
-            when: When::Always,
-        },
-        Column {
-            name: "pipeline",
-            ty: ColumnType::Text,
-            get: |r| text(&r.pipeline),
-            when: When::Always,
-        },
-        Column {
-            name: "input",
-            ty: ColumnType::Text,
-            get: |r| text(&r.input),
-            when: When::Always,
-        },
-        Column {
-            name: "features_read",
-            ty: ColumnType::Int64,
-            get: |r| int(r.read),
-            when: When::Always,
-        },
-        Column {
-            name: "features_written",
-            ty: ColumnType::Int64,
-            get: |r| int(r.written),
-            when: When::Always,
-        },
-        Column {
-            name: "features_rejected",
-            ty: ColumnType::Int64,
-            get: |r| int(r.rejected),
-            when: When::Always,
-        },
-        Column {
-            name: "features_filtered",
-            ty: ColumnType::Int64,
-            get: |r| int(r.filtered),
-            when: When::Always,
-        },
-        Column {
-            name: "threads",
-            ty: ColumnType::Int64,
-            get: |r| int(r.threads),
-            when: When::Always,
-        },
-        Column {
-            name: "elapsed_s",
-            ty: ColumnType::Real,
-            get: |r| Cell::Real(r.elapsed_s),
-            when: When::Always,
-        },
+        col("name", Text, |r| text(&r.name)),
+        col("started_utc", Text, |r| text(&r.started_utc)),
+        col("finished_utc", Text, |r| text(&r.finished_utc)),
+        col("tool_version", Text, |r| text(&r.tool_version)),
+        col("pipeline", Text, |r| text(&r.pipeline)),
+        col("input", Text, |r| text(&r.input)),
+        col("features_read", Int64, |r| int(r.read)),
+        col("features_written", Int64, |r| int(r.written)),
+        col("features_rejected", Int64, |r| int(r.rejected)),
+        col("features_filtered", Int64, |r| int(r.filtered)),
+        col("threads", Int64, |r| int(r.threads)),
+        col("elapsed_s", Real, |r| Cell::Real(r.elapsed_s)),
     ],
 };
 

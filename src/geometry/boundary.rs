@@ -295,22 +295,7 @@ impl Boundary {
         q: Coord<f64>,
         normal: Coord<f64>,
     ) -> Option<(Coord<f64>, f64)> {
-        let mut best: Option<(Coord<f64>, f64)> = None;
-        for (item, d2) in self.tree.nearest_neighbor_iter_with_distance_2(&pt(q)) {
-            if let Some((_, bd)) = best {
-                if d2.sqrt() > bd {
-                    break;
-                }
-            }
-            let s = &self.segments[item.data as usize];
-            if let Some(c) = clip_closest_in_half_plane(s.a, s.b, q, normal) {
-                let d = (c - q).x.hypot((c - q).y);
-                if best.is_none_or(|(_, bd)| d < bd) {
-                    best = Some((c, d));
-                }
-            }
-        }
-        best
+        self.nearest_clipped(q, |a, b| clip_to_half_plane(a, b, q, normal))
     }
 
     /// Nearest boundary point to `q` within the closed sector swept
@@ -330,18 +315,28 @@ impl Boundary {
             y: from.x,
         };
         let n2 = Coord { x: to.y, y: -to.x };
+        self.nearest_clipped(q, |a, b| {
+            let (a, b) = clip_to_half_plane(a, b, q, n1)?;
+            clip_to_half_plane(a, b, q, n2)
+        })
+    }
+
+    /// Nearest point to `q` of the boundary segments as `clip` cuts them
+    /// down (`None`: the whole segment is out). Visits segments in order of
+    /// distance and stops as soon as the next is farther than the best point
+    /// found.
+    fn nearest_clipped(
+        &self,
+        q: Coord<f64>,
+        clip: impl Fn(Coord<f64>, Coord<f64>) -> Option<(Coord<f64>, Coord<f64>)>,
+    ) -> Option<(Coord<f64>, f64)> {
         let mut best: Option<(Coord<f64>, f64)> = None;
         for (item, d2) in self.tree.nearest_neighbor_iter_with_distance_2(&pt(q)) {
-            if let Some((_, bd)) = best {
-                if d2.sqrt() > bd {
-                    break;
-                }
+            if best.is_some_and(|(_, bd)| d2.sqrt() > bd) {
+                break;
             }
             let s = &self.segments[item.data as usize];
-            let Some((a, b)) = clip_to_half_plane(s.a, s.b, q, n1) else {
-                continue;
-            };
-            let Some((a, b)) = clip_to_half_plane(a, b, q, n2) else {
+            let Some((a, b)) = clip(s.a, s.b) else {
                 continue;
             };
             let c = closest_on_segment(a, b, q).0;
@@ -463,18 +458,6 @@ fn clip_to_half_plane(
         (true, false) => Some((a, a + (b - a) * (fa / (fa - fb)))),
         (false, true) => Some((a + (b - a) * (fa / (fa - fb)), b)),
     }
-}
-
-/// Closest point to `q` of segment `ab` clipped to the half-plane
-/// `(x − q) · n ≥ 0`, or `None` when the segment lies wholly outside it.
-fn clip_closest_in_half_plane(
-    a: Coord<f64>,
-    b: Coord<f64>,
-    q: Coord<f64>,
-    n: Coord<f64>,
-) -> Option<Coord<f64>> {
-    let (a2, b2) = clip_to_half_plane(a, b, q, n)?;
-    Some(closest_on_segment(a2, b2, q).0)
 }
 
 #[cfg(test)]

@@ -587,11 +587,7 @@ impl<'a> Extender<'a> {
         let limit = 6.0 * self.radius(start);
         let (mut at, mut via, mut walked) = (start, rec.edges.first().copied(), 0.0);
         for _ in 0..self.m.edges().len() {
-            let Some(e) = self.adj[at.0 as usize]
-                .iter()
-                .copied()
-                .find(|&x| st.keep[x.0 as usize] && Some(x) != via)
-            else {
+            let Some(e) = self.next_kept(at, via, st) else {
                 break;
             };
             let c = self.m.oriented_coords(e, at);
@@ -606,6 +602,14 @@ impl<'a> Extender<'a> {
         fwd
     }
 
+    /// The kept edge at `at` other than `via`, walking along a kept line.
+    fn next_kept(&self, at: NodeId, via: Option<EdgeId>, st: &State) -> Option<EdgeId> {
+        self.adj[at.0 as usize]
+            .iter()
+            .copied()
+            .find(|&x| st.keep[x.0 as usize] && Some(x) != via)
+    }
+
     /// The start of `leaf`'s end zone: walking back along the kept line,
     /// the first node whose distance from the leaf along the line reaches
     /// [`ZONE`] times its radius (one local width), never past a kept
@@ -617,11 +621,7 @@ impl<'a> Extender<'a> {
         let (mut at, mut via) = (leaf, None);
         let mut s = 0.0;
         for _ in 0..self.m.edges().len() {
-            let Some(e) = self.adj[at.0 as usize]
-                .iter()
-                .copied()
-                .find(|&x| st.keep[x.0 as usize] && Some(x) != via)
-            else {
+            let Some(e) = self.next_kept(at, via, st) else {
                 break;
             };
             let o = self.m.opposite(e, at);

@@ -76,6 +76,12 @@ pub struct ExtendParams {
     pub mode: ExtendMode,
 }
 
+impl From<ExtendMode> for ExtendParams {
+    fn from(mode: ExtendMode) -> Self {
+        Self { mode }
+    }
+}
+
 impl Default for ExtendParams {
     fn default() -> Self {
         Self {
@@ -265,35 +271,17 @@ mod tests {
         let mut b = GraphBuilder::new();
         b.polyline(&[c(10., 3.), c(10., 10.), c(18., 10.)]);
         let g = b.finish(p.boundary());
-        let ray = extend(
-            &g,
-            &p,
-            &ExtendParams {
-                mode: ExtendMode::Ray,
-            },
-        );
+        let ray = extend(&g, &p, &ExtendMode::Ray.into());
         let mut l = leaves(&ray);
         l.sort_by(|a, b| a.x.total_cmp(&b.x));
         // Leaf (10, 3), r = 3: the direction comes from (10, 9), so south;
         // leaf (18, 10), r = 2: from (14, 10), so east.
         assert_eq!(l, vec![c(10., 0.), c(20., 10.)]);
-        let near = extend(
-            &g,
-            &p,
-            &ExtendParams {
-                mode: ExtendMode::Nearest,
-            },
-        );
+        let near = extend(&g, &p, &ExtendMode::Nearest.into());
         let mut l = leaves(&near);
         l.sort_by(|a, b| a.x.total_cmp(&b.x));
         assert_eq!(l, vec![c(10., 0.), c(20., 10.)]);
-        let none = extend(
-            &g,
-            &p,
-            &ExtendParams {
-                mode: ExtendMode::None,
-            },
-        );
+        let none = extend(&g, &p, &ExtendMode::None.into());
         assert_eq!(none, g);
     }
 
@@ -308,13 +296,7 @@ mod tests {
         let mut b = GraphBuilder::new();
         b.segment(c(5., 25.), c(6., 25.));
         let g = b.finish(p.boundary());
-        let e = extend(
-            &g,
-            &p,
-            &ExtendParams {
-                mode: ExtendMode::Ray,
-            },
-        );
+        let e = extend(&g, &p, &ExtendMode::Ray.into());
         let mut l = leaves(&e);
         l.sort_by(|a, b| a.x.total_cmp(&b.x));
         assert_eq!(l, vec![c(0., 25.), c(10., 25.)]);

@@ -276,6 +276,13 @@ mod tests {
         .clone()
     }
 
+    fn trunk_params() -> PruneParams {
+        PruneParams {
+            mode: PruneMode::Trunk,
+            ..Default::default()
+        }
+    }
+
     fn leg(extent: f64, r_junction: f64) -> LegMeasure {
         LegMeasure {
             extent,
@@ -399,14 +406,7 @@ mod tests {
         let p = prune(&g, &PruneParams::default(), &far());
         assert_eq!(p.leg_count(), 0);
         assert!((p.total_length() - 40.0).abs() < 1e-9);
-        let t = prune(
-            &g,
-            &PruneParams {
-                mode: PruneMode::Trunk,
-                ..Default::default()
-            },
-            &far(),
-        );
+        let t = prune(&g, &trunk_params(), &far());
         let deg = t.degrees();
         assert_eq!(deg.iter().filter(|&&d| d == 1).count(), 2);
         assert!(deg.iter().all(|&d| d <= 2));
@@ -416,14 +416,7 @@ mod tests {
     #[test]
     fn trunk_is_the_tree_diameter() {
         let g = star(1.0, &[(5., 0.), (-7., 0.), (0., 6.), (0., -1.5)]);
-        let t = prune(
-            &g,
-            &PruneParams {
-                mode: PruneMode::Trunk,
-                ..Default::default()
-            },
-            &far(),
-        );
+        let t = prune(&g, &trunk_params(), &far());
         assert_eq!(t.edges().len(), 1);
         assert!((t.total_length() - 13.0).abs() < 1e-12);
     }
