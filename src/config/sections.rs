@@ -86,3 +86,14 @@ pub struct OutputSpec {
     #[serde(default)]
     pub widths: bool,
 }
+
+impl From<&OutputSpec> for crate::process::RowOptions {
+    fn from(o: &OutputSpec) -> Self {
+        Self {
+            explode: o.explode,
+            candidates: o.candidates,
+            bars: o.bars,
+            widths: o.widths,
+        }
+    }
+}

@@ -36,17 +36,6 @@ pub struct RowOptions {
     pub widths: bool,
 }
 
-impl From<&crate::config::OutputSpec> for RowOptions {
-    fn from(o: &crate::config::OutputSpec) -> Self {
-        Self {
-            explode: o.explode,
-            candidates: o.candidates,
-            bars: o.bars,
-            widths: o.widths,
-        }
-    }
-}
-
 /// How a feature counts in the run's summary.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Status {
