@@ -14,12 +14,9 @@
 
 use geo::{Area, Coord, Geometry, LineString, Polygon};
 use skeletonise::geometry::PreparedPolygon;
-use skeletonise::graph::extend::ExtendParams;
-use skeletonise::graph::prune::PruneParams;
 use skeletonise::io::read_layer_polygons;
 use skeletonise::methods::MethodId;
 use skeletonise::process::{process, ProcessParams, Processed};
-use skeletonise::score::select::SelectParams;
 use skeletonise::score::ScoreParams;
 use std::fmt::Write as _;
 
@@ -104,13 +101,7 @@ fn figure(polygon: &Polygon<f64>, layer: &str) -> Result<String, Box<dyn std::er
         .collect();
 
     // The default pipeline, and the same with neither prune nor extend.
-    let final_params = ProcessParams {
-        prune: Some(PruneParams::default()),
-        extend: Some(ExtendParams::default()),
-        score: Some(ScoreParams::default()),
-        select: Some(SelectParams::default()),
-        ..ProcessParams::default()
-    };
+    let final_params = ProcessParams::all_steps();
     let raw_params = ProcessParams {
         prune: None,
         extend: None,

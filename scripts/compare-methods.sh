@@ -36,7 +36,7 @@ NOISE = 1e-4
 def rows(layer, variant):
     db = sqlite3.connect(os.path.join(out, f"{layer}-{variant}.gpkg"))
     r = db.execute(
-        "select src_fid, part, method, chosen, legs_raw, legs, coverage, deviation,"
+        "select src_fid, polygon_part, method, chosen, legs_raw, legs, coverage, deviation,"
         " deviation_parts, distortion, error from candidates"
     ).fetchall()
     db.close()

@@ -8,15 +8,12 @@ use geo::{Coord, Geometry, LineString, MultiLineString, Polygon};
 use rayon::prelude::*;
 use skeletonise::geometry::boundary::closest_on_segment;
 use skeletonise::geometry::PreparedPolygon;
-use skeletonise::graph::extend::ExtendParams;
 use skeletonise::graph::planar::crossings;
 use skeletonise::graph::prune::{PruneMode, PruneParams};
 use skeletonise::io::read_layer_polygons;
 use skeletonise::methods::{build, MethodId, SkeletonParams};
 use skeletonise::process::{polygon_parts, process, FeatureOutcome, ProcessParams, Processed};
 use skeletonise::score::defects::{end_turns, graph_of, HOOK_DEG};
-use skeletonise::score::select::SelectParams;
-use skeletonise::score::ScoreParams;
 
 fn c(x: f64, y: f64) -> Coord<f64> {
     Coord { x, y }
@@ -43,13 +40,7 @@ fn digitised(v: &[(f64, f64)], step: f64) -> Polygon<f64> {
 
 /// The default pipeline's steps (as `pipelines/demo.yaml` runs them).
 fn defaults() -> ProcessParams {
-    ProcessParams {
-        prune: Some(PruneParams::default()),
-        extend: Some(ExtendParams::default()),
-        score: Some(ScoreParams::default()),
-        select: Some(SelectParams::default()),
-        ..ProcessParams::default()
-    }
+    ProcessParams::all_steps()
 }
 
 fn run(p: &Polygon<f64>, params: &ProcessParams) -> FeatureOutcome {

@@ -75,6 +75,21 @@ pub struct ProcessParams {
     pub registry: Registry,
 }
 
+impl ProcessParams {
+    /// Every step with its defaults, as a pipeline file that lists
+    /// `prepare`, `skeleton`, `prune`, `extend`, `score` and `select` with
+    /// no options runs them.
+    pub fn all_steps() -> Self {
+        Self {
+            prune: Some(PruneParams::default()),
+            extend: Some(ExtendParams::default()),
+            score: Some(ScoreParams::default()),
+            select: Some(SelectParams::default()),
+            ..Self::default()
+        }
+    }
+}
+
 /// One method's result for one feature.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Candidate {
