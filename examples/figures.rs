@@ -17,7 +17,6 @@ use skeletonise::geometry::PreparedPolygon;
 use skeletonise::io::read_layer_polygons;
 use skeletonise::methods::MethodId;
 use skeletonise::process::{process, ProcessParams, Processed};
-use skeletonise::score::ScoreParams;
 use std::fmt::Write as _;
 
 /// Width of one panel in SVG units.
