@@ -1,6 +1,6 @@
 //! One source feature as the per-feature path sees it: owned data, no GDAL.
 //!
-//! The reader ([`crate::io::reader`]) makes these from any OGR source; the
+//! The reader (`io::reader`, with the `gdal` feature) makes these from any OGR source; the
 //! per-feature work ([`crate::process`]) turns each into its output rows
 //! ([`crate::output`]) without touching a file.
 

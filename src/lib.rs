@@ -7,18 +7,29 @@
 //! paper; a YAML pipeline from any OGR source to a GeoPackage.
 //!
 //! The per-feature path ([`process`]) is pure Rust on owned [`geo`] types;
-//! GDAL is touched only by [`io`].
+//! GDAL is touched only by `io`.
+//!
+//! Cargo features: `gdal` (the reader and writer `io`, the run driver
+//! `pipeline` and `external`'s join of another tool's lines) and `cli` (the
+//! `skeletonise` binary; implies `gdal`), both on by default. With
+//! `--no-default-features` the core — methods, pruning, extension, scoring,
+//! selection, the pipeline file model and the per-feature path — builds
+//! without GDAL, for bindings and distributed engines that bring their own
+//! I/O.
 
 #![warn(missing_docs)]
 
 pub mod config;
+#[cfg(feature = "gdal")]
 pub mod external;
 pub mod feature;
 pub mod geometry;
 pub mod graph;
+#[cfg(feature = "gdal")]
 pub mod io;
 pub mod methods;
 pub mod output;
+#[cfg(feature = "gdal")]
 pub mod pipeline;
 pub mod process;
 pub mod score;

@@ -1,7 +1,7 @@
 //! The output GeoPackage's layers (SPEC §9), described as data: each layer
 //! is one [`LayerDef`] — its name, geometry type and columns, each column
 //! with its type and how its value is taken from a row. The writer
-//! ([`crate::io::writer`]) creates and fills any layer from its description,
+//! (`io::writer`, with the `gdal` feature) creates and fills any layer from its description,
 //! so adding a column is one entry in one table below.
 //!
 //! Rows are plain data made by the per-feature work ([`crate::process`]);

@@ -58,7 +58,7 @@ pub enum RunError {
     #[error(transparent)]
     Io(#[from] IoError),
     /// A feature was rejected under `on_error: fail` (exit 65).
-    #[error("feature {fid} was rejected: {reason} (on_error: fail stops the run; no output was written; use `on_error: reject` to list such features in the `rejected` layer instead)")]
+    #[error("{}", crate::config::rejected_under_fail(.fid, .reason))]
     Rejected {
         /// Source FID.
         fid: String,

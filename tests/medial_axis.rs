@@ -1,7 +1,10 @@
 //! Method MA (medial axis transform): exact shapes, the analytic parabola,
 //! the invariants of SPEC §3, robustness cases and every training layer.
+// Without GDAL the training-layer tests are left out, and with them some imports.
+#![cfg_attr(not(feature = "gdal"), allow(unused_imports, dead_code))]
 
 mod common;
+#[cfg(feature = "gdal")]
 use common::{LAYERS, TRAIN};
 use geo::{polygon, Coord, LineString, Polygon};
 use skeletonise::geometry::PreparedPolygon;
@@ -540,6 +543,7 @@ fn arc_tolerance_serde() {
     assert_eq!(ArcTolerance::default(), ArcTolerance::Relative(0.001));
 }
 
+#[cfg(feature = "gdal")]
 #[test]
 fn every_training_layer_runs_with_no_rejected_feature() {
     for layer in LAYERS {

@@ -1,15 +1,20 @@
 //! The default output's quality (the issue on centred ends and like-for-like
 //! selection): known answers on constructed shapes, and the defect counts a
 //! cartographer sees on every training layer.
+// Without GDAL the training-layer tests are left out, and with them some imports.
+#![cfg_attr(not(feature = "gdal"), allow(unused_imports, dead_code))]
 
 mod common;
+#[cfg(feature = "gdal")]
 use common::{LAYERS, TRAIN};
 use geo::{Coord, Geometry, LineString, MultiLineString, Polygon};
+#[cfg(feature = "gdal")]
 use rayon::prelude::*;
 use skeletonise::geometry::boundary::closest_on_segment;
 use skeletonise::geometry::PreparedPolygon;
 use skeletonise::graph::planar::crossings;
 use skeletonise::graph::prune::{PruneMode, PruneParams};
+#[cfg(feature = "gdal")]
 use skeletonise::io::read_layer_polygons;
 use skeletonise::methods::{build, MethodId, SkeletonParams};
 use skeletonise::process::{polygon_parts, process, FeatureOutcome, ProcessParams, Processed};
@@ -269,6 +274,7 @@ fn independent_structure_prunes_every_method_on_its_own() {
     assert!(o.candidates.iter().all(|c| c.result.is_ok()));
 }
 
+#[cfg(feature = "gdal")]
 /// Counts on one training layer: hooked ends and ends of the chosen
 /// skeletons, skeletons with a crossing, and with `trunk`, polygon parts
 /// whose chosen skeleton is not one line and rivers not won by MA.
@@ -314,6 +320,7 @@ fn layer_defects(layer: &str, params: &ProcessParams) -> (usize, usize, usize, u
         )
 }
 
+#[cfg(feature = "gdal")]
 #[test]
 fn default_output_on_every_training_layer_has_no_hooks_or_crossings() {
     for layer in LAYERS {
@@ -327,6 +334,7 @@ fn default_output_on_every_training_layer_has_no_hooks_or_crossings() {
     }
 }
 
+#[cfg(feature = "gdal")]
 #[test]
 fn trunk_gives_one_line_per_polygon_part_and_ma_wins_every_river() {
     let mut params = defaults();

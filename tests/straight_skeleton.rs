@@ -1,5 +1,7 @@
 //! Straight skeleton (StSk): known answers, validity invariants, property
 //! tests on random star-shaped polygons, and every training layer.
+// Without GDAL the training-layer tests are left out, and with them some imports.
+#![cfg_attr(not(feature = "gdal"), allow(unused_imports, dead_code))]
 
 mod common;
 use geo::{Coord, LineString, Polygon};
@@ -337,6 +339,7 @@ proptest! {
     }
 }
 
+#[cfg(feature = "gdal")]
 #[test]
 fn every_training_layer() {
     use rayon::prelude::*;
@@ -390,6 +393,7 @@ fn every_training_layer() {
 /// banks whose fast reflex vertices split faces far from their own ray)
 /// yields a skeleton whose nodes lie in P, whose edges do not cross ∂P and
 /// whose node times never exceed the radius.
+#[cfg(feature = "gdal")]
 #[test]
 fn largest_lena_reach() {
     let feats = skeletonise::io::read_layer_polygons(common::TRAIN, "river_lena").unwrap();

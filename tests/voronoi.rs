@@ -1,15 +1,21 @@
 //! `VD` and `DVD` on the real training layers and on a long rectangle.
+// Without GDAL the training-layer tests are left out, and with them some imports.
+#![cfg_attr(not(feature = "gdal"), allow(unused_imports, dead_code))]
 
 mod common;
+#[cfg(feature = "gdal")]
 use common::{LAYERS, TRAIN};
 use geo::{Coord, LineString, Polygon};
+#[cfg(feature = "gdal")]
 use rayon::prelude::*;
 use skeletonise::geometry::{densify::Density, PreparedPolygon};
 use skeletonise::graph::SkeletonGraph;
+#[cfg(feature = "gdal")]
 use skeletonise::io::read_layer_polygons;
 use skeletonise::methods::{voronoi::Voronoi, MethodError, SkeletonMethod};
 use skeletonise::process::polygon_parts;
 
+#[cfg(feature = "gdal")]
 fn parts(layer: &str) -> Vec<PreparedPolygon> {
     read_layer_polygons(TRAIN, layer)
         .unwrap()
@@ -19,6 +25,7 @@ fn parts(layer: &str) -> Vec<PreparedPolygon> {
         .collect()
 }
 
+#[cfg(feature = "gdal")]
 fn run_with_threads(
     threads: usize,
     method: &Voronoi,
@@ -31,6 +38,7 @@ fn run_with_threads(
     pool.install(|| parts.par_iter().map(|p| method.skeletonise(p)).collect())
 }
 
+#[cfg(feature = "gdal")]
 /// SPEC §3 invariants of a raw skeleton, and radius = distance to ∂P.
 fn assert_valid(layer: &str, p: &PreparedPolygon, g: &SkeletonGraph) {
     let b = p.boundary();
@@ -55,6 +63,7 @@ fn assert_valid(layer: &str, p: &PreparedPolygon, g: &SkeletonGraph) {
     }
 }
 
+#[cfg(feature = "gdal")]
 #[test]
 fn real_layers_are_valid_and_independent_of_the_thread_count() {
     let methods = [
@@ -80,6 +89,7 @@ fn real_layers_are_valid_and_independent_of_the_thread_count() {
     }
 }
 
+#[cfg(feature = "gdal")]
 #[test]
 fn densified_skeleton_of_a_real_river_is_connected() {
     // The Danube reach is one polygon without holes: DVD at the paper's
@@ -146,6 +156,7 @@ fn dvd_converges_to_the_medial_axis() {
     assert!(mean[3] < 0.01 * 10.0, "still {} from the MA", mean[3]);
 }
 
+#[cfg(feature = "gdal")]
 #[test]
 fn a_spacing_that_would_create_millions_of_points_is_an_error() {
     let p = &parts("river_danube")[0];

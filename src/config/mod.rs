@@ -119,23 +119,103 @@ pub struct Pipeline {
     pub overrides: Vec<String>,
 }
 
+/// The per-feature parameters of `steps` (and of the `output` switches that
+/// ask for bars and widths).
+pub fn process_params(steps: &[Step], output: Option<&OutputSpec>) -> ProcessParams {
+    let mut p = ProcessParams::default();
+    for s in steps {
+        match s {
+            Step::Prepare(x) => p.prepare = *x,
+            Step::Skeleton(x) => p.skeleton = x.clone(),
+            Step::Prune(x) => p.prune = Some(*x),
+            Step::Extend(x) => p.extend = Some(*x),
+            Step::Score(x) => p.score = Some(*x),
+            Step::Select(x) => p.select = Some(*x),
+        }
+    }
+    if let Some(o) = output {
+        p.keep_bars = o.bars;
+        p.keep_widths = o.widths;
+    }
+    p
+}
+
+/// The error text of a feature rejected under `on_error: fail` (`fid` as
+/// text, `(no fid)` when it has none).
+pub fn rejected_under_fail(fid: &str, reason: &str) -> String {
+    format!("feature {fid} was rejected: {reason} (on_error: fail stops the run; no output was written; use `on_error: reject` to list such features in the `rejected` layer instead)")
+}
+
+/// A pipeline file read for its steps only, by callers that bring their own
+/// data (the Python binding): `input` and `output` may be left out, and
+/// only `output.explode` and `on_error` are used of what is beside the
+/// steps. Keys, types, step order and option ranges are checked by the same
+/// code, with the same messages, as for [`PipelineFile`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct StepsFile {
+    /// A name for logs.
+    #[serde(default)]
+    pub name: Option<String>,
+    /// Ignored (the caller brings the data).
+    #[serde(default)]
+    pub input: Option<InputSpec>,
+    /// Steps, in the order prepare → skeleton → prune → extend → score → select; only `skeleton` is required.
+    pub steps: Vec<Step>,
+    /// Only `explode` is used (the caller writes the data).
+    #[serde(default)]
+    pub output: Option<OutputSpec>,
+    /// `reject` (default) or `fail`.
+    #[serde(default)]
+    pub on_error: OnError,
+}
+
+/// A loaded, validated [`StepsFile`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Steps {
+    /// The file's content after overrides and substitution.
+    pub file: StepsFile,
+    /// The original text.
+    pub text: String,
+    /// Where it came from.
+    pub origin: String,
+}
+
+impl Steps {
+    /// The per-feature parameters of the steps.
+    pub fn process_params(&self) -> ProcessParams {
+        process_params(&self.file.steps, self.file.output.as_ref())
+    }
+}
+
+/// Loads, overrides, substitutes and validates the steps of a pipeline file
+/// whose `input` and `output` sections may be absent.
+pub fn load_steps(path: &std::path::Path, overrides: &[String]) -> Result<Steps, ConfigError> {
+    let origin = path.display().to_string();
+    let text = read_text(path, &origin)?;
+    load_steps_str(&text, &origin, overrides)
+}
+
+/// [`load_steps`] from text; `origin` names it in errors.
+pub fn load_steps_str(
+    text: &str,
+    origin: &str,
+    overrides: &[String],
+) -> Result<Steps, ConfigError> {
+    let file: StepsFile = parse(text, origin, overrides, |f: &StepsFile| {
+        validate_steps(&f.steps)
+    })?;
+    Ok(Steps {
+        file,
+        text: text.to_string(),
+        origin: origin.to_string(),
+    })
+}
+
 impl Pipeline {
     /// The per-feature parameters of the steps.
     pub fn process_params(&self) -> ProcessParams {
-        let mut p = ProcessParams::default();
-        for s in &self.file.steps {
-            match s {
-                Step::Prepare(x) => p.prepare = *x,
-                Step::Skeleton(x) => p.skeleton = x.clone(),
-                Step::Prune(x) => p.prune = Some(*x),
-                Step::Extend(x) => p.extend = Some(*x),
-                Step::Score(x) => p.score = Some(*x),
-                Step::Select(x) => p.select = Some(*x),
-            }
-        }
-        p.keep_bars = self.file.output.bars;
-        p.keep_widths = self.file.output.widths;
-        p
+        process_params(&self.file.steps, Some(&self.file.output))
     }
 
     /// The pipeline text with the overrides appended as comments, for provenance.
@@ -165,17 +245,38 @@ pub struct ConfigError {
 /// Loads, overrides, substitutes and validates a pipeline file.
 pub fn load(path: &std::path::Path, overrides: &[String]) -> Result<Pipeline, ConfigError> {
     let origin = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| ConfigError {
-        origin: origin.clone(),
+    let text = read_text(path, &origin)?;
+    load_str(&text, &origin, overrides)
+}
+
+fn read_text(path: &std::path::Path, origin: &str) -> Result<String, ConfigError> {
+    std::fs::read_to_string(path).map_err(|e| ConfigError {
+        origin: origin.to_string(),
         position: None,
         key: String::new(),
         message: format!("cannot read the pipeline file: {e}"),
-    })?;
-    load_str(&text, &origin, overrides)
+    })
 }
 
 /// [`load`] from text; `origin` names it in errors.
 pub fn load_str(text: &str, origin: &str, overrides: &[String]) -> Result<Pipeline, ConfigError> {
+    let file: PipelineFile = parse(text, origin, overrides, validate)?;
+    Ok(Pipeline {
+        file,
+        text: text.to_string(),
+        origin: origin.to_string(),
+        overrides: overrides.to_vec(),
+    })
+}
+
+/// Parses `text` as a `T` after overrides and substitution, then checks it
+/// with `check`; every error located in the text.
+fn parse<T: serde::de::DeserializeOwned>(
+    text: &str,
+    origin: &str,
+    overrides: &[String],
+    check: impl Fn(&T) -> Result<(), (String, String)>,
+) -> Result<T, ConfigError> {
     let err = |position, key: &str, message: String| ConfigError {
         origin: origin.to_string(),
         position,
@@ -207,9 +308,8 @@ pub fn load_str(text: &str, origin: &str, overrides: &[String]) -> Result<Pipeli
     // Enums are written as single-key maps (`prune: {...}`, `densify: {factor: 4}`).
     let mut track = serde_path_to_error::Track::new();
     let de = serde_path_to_error::Deserializer::new(value, &mut track);
-    let parsed: Result<PipelineFile, _> =
-        serde_yaml_ng::with::singleton_map_recursive::deserialize(de);
-    let file: PipelineFile = parsed.map_err(|e| {
+    let parsed: Result<T, _> = serde_yaml_ng::with::singleton_map_recursive::deserialize(de);
+    let file: T = parsed.map_err(|e| {
         let key = path_string(&track.path());
         let inner = e.to_string();
         // Point unknown keys at the key itself.
@@ -220,13 +320,8 @@ pub fn load_str(text: &str, origin: &str, overrides: &[String]) -> Result<Pipeli
         };
         err(pos, &key, hint(&inner))
     })?;
-    validate(&file, &locs).map_err(|(k, m)| err(locs.key(&k), &k, m))?;
-    Ok(Pipeline {
-        file,
-        text: text.to_string(),
-        origin: origin.to_string(),
-        overrides: overrides.to_vec(),
-    })
+    check(&file).map_err(|(k, m)| err(locs.key(&k), &k, m))?;
+    Ok(file)
 }
 
 /// The `skeleton` step takes its own keys and every registered method's
@@ -296,9 +391,22 @@ fn hint(msg: &str) -> String {
     }
 }
 
-fn validate(f: &PipelineFile, _locs: &Locations) -> Result<(), (String, String)> {
+fn validate(f: &PipelineFile) -> Result<(), (String, String)> {
+    validate_steps(&f.steps)?;
+    if f.output.path.trim().is_empty() {
+        return Err((
+            "output.path".into(),
+            "give the output GeoPackage path".into(),
+        ));
+    }
+    Ok(())
+}
+
+/// Step order, the required `skeleton`, `select` after `score`, and every
+/// step's option ranges: `(key path, message)` of the first that is wrong.
+fn validate_steps(steps: &[Step]) -> Result<(), (String, String)> {
     let mut last: Option<(usize, &str)> = None;
-    for (i, s) in f.steps.iter().enumerate() {
+    for (i, s) in steps.iter().enumerate() {
         let rank = Step::ORDER.iter().position(|n| *n == s.name()).unwrap_or(0);
         if let Some((r, name)) = last {
             if rank == r {
@@ -323,7 +431,7 @@ fn validate(f: &PipelineFile, _locs: &Locations) -> Result<(), (String, String)>
         }
         last = Some((rank, s.name()));
     }
-    let pos = |name: &str| f.steps.iter().position(|s| s.name() == name);
+    let pos = |name: &str| steps.iter().position(|s| s.name() == name);
     let Some(_) = pos("skeleton") else {
         return Err((
             "steps".into(),
@@ -336,15 +444,9 @@ fn validate(f: &PipelineFile, _locs: &Locations) -> Result<(), (String, String)>
             "`select` needs the `score` step before it: add `- score: {}`".into(),
         ));
     }
-    for (i, s) in f.steps.iter().enumerate() {
+    for (i, s) in steps.iter().enumerate() {
         s.validate()
             .map_err(|(k, m)| (format!("steps[{i}].{}.{k}", s.name()), m))?;
-    }
-    if f.output.path.trim().is_empty() {
-        return Err((
-            "output.path".into(),
-            "give the output GeoPackage path".into(),
-        ));
     }
     Ok(())
 }
@@ -668,6 +770,38 @@ mod tests {
         ] {
             assert!(d.contains(needle), "`{needle}` missing from:\n{d}");
         }
+    }
+
+    #[test]
+    fn steps_files_need_no_input_or_output_and_share_the_messages() {
+        let s = load_steps_str(
+            "steps:\n  - skeleton: {methods: [CDT]}\n  - prune: {ratio: 2}\n",
+            "s.yaml",
+            &["steps.extend.mode=ray".into()],
+        )
+        .unwrap();
+        let pp = s.process_params();
+        assert_eq!(pp.prune.unwrap().ratio, 2.0);
+        assert_eq!(
+            pp.extend.unwrap().mode,
+            crate::graph::extend::ExtendMode::Ray
+        );
+        let e = load_steps_str(
+            "steps:\n  - prepare: {}\n  - skeleton: {}\n  - prune: {ratoi: 1.5}\n",
+            "s.yaml",
+            &[],
+        )
+        .unwrap_err();
+        let full = load_str(&OK.replace("ratio: 1.5", "ratoi: 1.5"), "p.yaml", &[]).unwrap_err();
+        assert_eq!(
+            (e.key.as_str(), e.position),
+            ("steps[2].prune.ratoi", Some((4, 13)))
+        );
+        assert_eq!(e.message, full.message);
+        let e = load_steps_str("steps:\n  - prune: {}\n", "s.yaml", &[]).unwrap_err();
+        assert!(e.message.contains("`skeleton` step is required"), "{e}");
+        // A full pipeline file is a steps file too.
+        assert!(load_steps_str(OK, "p.yaml", &[]).is_ok());
     }
 
     #[test]
