@@ -1,0 +1,443 @@
+"""Collapse polygons to skeletons on GeoPandas and Dask-GeoPandas.
+
+The same per-feature path as the ``skeletonise`` command line (Rust, the GIL
+released, one thread per core): methods VD, DVD, CDT, StSk and MA, pruning,
+extension to the boundary, the deviation and distortion metrics of Szombara's
+*Comparison of methods used in cartography for the skeletonisation of areal
+objects*, and the choice of the best method per feature.
+
+- :func:`skeletonise` — a GeoSeries (or shapely array) in, a GeoDataFrame with
+  the columns of the ``skeletons`` layer out; options are the pipeline file's.
+- :func:`apply` — the steps of a pipeline file on a GeoDataFrame, keeping its
+  columns and index: the function to ``map_partitions`` on a Dask cluster.
+
+Every input row gives an output row: a feature that cannot be processed has a
+NULL skeleton and its reason in ``rejected``; one skipped by ``min_area`` has a
+NULL skeleton and no reason. Invalid polygons are repaired with shapely's
+``make_valid`` (GEOS MakeValid, as GDAL's in the command line) when the
+``prepare`` step's ``make_valid`` is on (the default), and get ``repaired = 1``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+from typing import Any, Mapping, Sequence, Union
+
+import numpy as np
+import pandas as pd
+import shapely
+
+from . import _core
+from ._core import PipelineError, RejectedError
+
+__all__ = [
+    "skeletonise",
+    "apply",
+    "describe",
+    "schema",
+    "columns",
+    "PipelineError",
+    "RejectedError",
+    "__version__",
+]
+
+__version__: str = _core.__version__
+
+StepOption = Union[bool, str, Mapping[str, Any], None]
+
+# The key a bare string stands for, per step: `prune="trunk"` is `prune={"mode": "trunk"}`.
+_SHORTHAND = {"prune": "mode", "extend": "mode", "select": "by"}
+
+
+def describe() -> str:
+    """The methods and every step's options with their defaults (``skeletonise methods``)."""
+    return _core.describe()
+
+
+def schema() -> dict:
+    """The JSON Schema of the pipeline file (``skeletonise schema``)."""
+    return json.loads(_core.schema())
+
+
+def columns(layer: str = "skeletons", *, explode: bool = False) -> list[tuple[str, str]]:
+    """The tool's columns of ``layer`` (``skeletons`` or ``candidates``) as ``(name, type)``.
+
+    They come from the same table the command line's GeoPackage writer uses;
+    the frames returned here add ``rejected`` (the reason, text) and the geometry.
+    """
+    return list(_core.columns(layer, explode)[0])
+
+
+def _step(name: str, value: StepOption) -> dict | None:
+    if value is None or value is False:
+        return None
+    if value is True:
+        return {}
+    if isinstance(value, str) and name in _SHORTHAND:
+        return {_SHORTHAND[name]: value}
+    if isinstance(value, Mapping):
+        return dict(value)
+    raise PipelineError(
+        f"skeletonise(): `{name}`: expected a mapping of the step's options, "
+        f"True (the step with its defaults) or False (no {name} step), not {value!r}"
+    )
+
+
+def _json_default(o: Any) -> Any:
+    if isinstance(o, np.generic):
+        return o.item()
+    if isinstance(o, (tuple, set, frozenset, np.ndarray)):
+        return list(o)
+    raise TypeError(f"{type(o).__name__} is not an option value")
+
+
+def _options_pipeline(
+    *,
+    make_valid: bool | None,
+    min_area: float | None,
+    skeleton: Mapping[str, Any],
+    steps: Mapping[str, StepOption],
+    on_error: str,
+) -> "_core.Pipeline":
+    prepare = {k: v for k, v in (("make_valid", make_valid), ("min_area", min_area)) if v is not None}
+    doc: dict[str, Any] = {"steps": [{"prepare": prepare}, {"skeleton": {k: v for k, v in skeleton.items() if v is not None}}]}
+    for name, value in steps.items():
+        body = _step(name, value)
+        if body is not None:
+            doc["steps"].append({name: body})
+    doc["on_error"] = on_error
+    try:
+        text = json.dumps(doc, default=_json_default)
+    except TypeError as e:
+        raise PipelineError(f"skeletonise(): {e}") from None
+    return _core.Pipeline.from_options(text, "skeletonise()")
+
+
+def _geometry_array(geometries: Any) -> tuple[np.ndarray, pd.Index | None, Any]:
+    """The geometries as a shapely array, with the index and CRS when they have them."""
+    import geopandas as gpd
+
+    if isinstance(geometries, gpd.GeoDataFrame):
+        geometries = geometries.geometry
+    if isinstance(geometries, gpd.GeoSeries):
+        return np.asarray(geometries.values, dtype=object), geometries.index, geometries.crs
+    if isinstance(geometries, pd.Series):
+        return np.asarray(geometries.values, dtype=object), geometries.index, None
+    arr = np.asarray(geometries, dtype=object)
+    if arr.ndim != 1:
+        raise ValueError("geometries must be one-dimensional: a GeoSeries, a shapely array or a list")
+    return arr, None, None
+
+
+def _prepare(arr: np.ndarray, make_valid: bool) -> tuple[np.ndarray, np.ndarray, float]:
+    """Repairs invalid polygons as the command line's reader does (GEOS MakeValid)."""
+    t0 = time.perf_counter()
+    repaired = np.zeros(len(arr), dtype=bool)
+    if make_valid and len(arr):
+        present = ~shapely.is_missing(arr)
+        bad = present & ~shapely.is_valid(arr)
+        if bad.any():
+            arr = arr.copy()
+            arr[bad] = shapely.make_valid(arr[bad])
+            repaired = bad
+    return arr, repaired, time.perf_counter() - t0
+
+
+_POLYGONAL = (int(shapely.GeometryType.POLYGON), int(shapely.GeometryType.MULTIPOLYGON))
+
+
+def _encode(arr: np.ndarray, exchange: str) -> Any:
+    """GeoArrow ragged arrays when every geometry is a polygon or multipolygon (or
+    missing), else WKB (which carries any geometry, so that points, lines and
+    collections are rejected with the command line's reason)."""
+    if exchange not in ("auto", "geoarrow", "wkb"):
+        raise ValueError(f"exchange must be `auto`, `geoarrow` or `wkb`, not `{exchange}`")
+    if exchange != "wkb" and len(arr):
+        types = shapely.get_type_id(arr)
+        missing = types < 0
+        if np.isin(types[~missing], _POLYGONAL).all():
+            if missing.any():
+                arr = arr.copy()
+                arr[missing] = shapely.Polygon()
+            kind, coords, offsets = shapely.to_ragged_array(arr, include_z=False)
+            return (
+                int(kind),
+                np.ascontiguousarray(coords, dtype=np.float64),
+                [np.ascontiguousarray(o, dtype=np.int64) for o in offsets],
+                missing if missing.any() else None,
+            )
+        if exchange == "geoarrow":
+            raise ValueError("exchange=`geoarrow` takes polygons and multipolygons only; use `auto` or `wkb`")
+    return shapely.to_wkb(arr, output_dimension=2, byte_order=1, include_srid=False).tolist()
+
+
+def _decode(geometry: tuple) -> np.ndarray:
+    if geometry[0] == "wkb":
+        return shapely.from_wkb(np.asarray(geometry[1], dtype=object))
+    _, coords, line_offsets, geom_offsets, null = geometry
+    if len(geom_offsets) <= 1:
+        return np.empty(0, dtype=object)
+    out = shapely.from_ragged_array(
+        shapely.GeometryType.MULTILINESTRING,
+        coords.reshape(-1, 2),
+        (line_offsets, geom_offsets),
+    )
+    out[null] = None
+    return out
+
+
+_DTYPES = {"int32": "Int32", "int64": "Int64", "real": "float64", "text": object}
+
+
+def _column(kind: str, values: Any) -> Any:
+    if kind in ("int32", "int64"):
+        v, null = values
+        return pd.array(pd.arrays.IntegerArray(v, null), dtype=_DTYPES[kind])
+    if kind == "real":
+        return values
+    return np.asarray(values, dtype=object)
+
+
+def _fids(index: pd.Index | None, n: int) -> np.ndarray:
+    """``src_fid``: the index when it is an integer index (as pyogrio's ``fid_as_index``
+    gives the source FIDs), else the 0-based position."""
+    if index is not None and pd.api.types.is_integer_dtype(index.dtype):
+        return np.asarray(index, dtype=np.int64)
+    return np.arange(n, dtype=np.int64)
+
+
+def _run(
+    pipeline: "_core.Pipeline",
+    arr: np.ndarray,
+    index: pd.Index | None,
+    crs: Any,
+    *,
+    candidates: bool,
+    explode: bool | None,
+    threads: int | None,
+    exchange: str,
+    output: str,
+    attributes: pd.DataFrame | None = None,
+    geometry_name: str = "geometry",
+):
+    import geopandas as gpd
+
+    t0 = time.perf_counter()
+    arr, repaired, t_valid = _prepare(arr, pipeline.make_valid)
+    payload = _encode(arr, exchange)
+    t1 = time.perf_counter()
+    done = _core.Pipeline.run(
+        pipeline,
+        payload,
+        fids=_fids(index, len(arr)),
+        repaired=repaired,
+        candidates=candidates,
+        explode=explode,
+        threads=threads,
+        output=output,
+    )
+    t2 = time.perf_counter()
+    rows = done["row"]
+    layer = "candidates" if candidates else "skeletons"
+    out_index = (index if index is not None else pd.RangeIndex(len(arr))).take(rows)
+    tool: dict[str, Any] = {name: _column(kind, values) for name, kind, values in done["columns"]}
+    tool["rejected"] = np.asarray(done["rejected"], dtype=object)
+    frame = pd.DataFrame(tool, index=out_index)
+    if attributes is not None and len(attributes.columns) and _core.columns(layer, False)[1]:
+        # Source fields first, renamed where they clash with the tool's (as the writer does).
+        clash = {n.lower() for n, _ in _core.columns("skeletons", True)[0]} | {"rejected"}
+        source = attributes.iloc[rows]
+        source.index = out_index
+        source = source.rename(columns=lambda c: f"src_{c}" if str(c).lower() in clash else c)
+        frame = pd.concat([source, frame], axis=1)
+    frame = gpd.GeoDataFrame(
+        frame,
+        geometry=gpd.GeoSeries(_decode(done["geometry"]), index=out_index, crs=crs),
+        crs=crs,
+    )
+    if geometry_name != "geometry":
+        frame = frame.rename_geometry(geometry_name)
+    t3 = time.perf_counter()
+    frame.attrs["skeletonise"] = {
+        "pipeline": pipeline.name,
+        "tool_version": __version__,
+        "counts": dict(done["counts"]),
+        "timings": {
+            "make_valid_s": t_valid,
+            "to_rust_s": t1 - t0 - t_valid,
+            **done["timings"],
+            "from_rust_s": t3 - t2,
+            "total_s": t3 - t0,
+        },
+        "exchange": "wkb" if isinstance(payload, list) else "geoarrow",
+    }
+    return frame
+
+
+def skeletonise(
+    geometries: Any,
+    *,
+    methods: Sequence[str] | None = None,
+    reference: str | None = None,
+    densify: Mapping[str, float] | None = None,
+    max_points: int | None = None,
+    arc_tolerance: Mapping[str, float] | None = None,
+    make_valid: bool | None = None,
+    min_area: float | None = None,
+    prune: StepOption = True,
+    extend: StepOption = True,
+    score: StepOption = True,
+    select: StepOption = True,
+    candidates: bool = False,
+    explode: bool = False,
+    on_error: str = "reject",
+    threads: int | None = None,
+    exchange: str = "auto",
+    output: str = "geoarrow",
+):
+    """Skeletonises every polygon of ``geometries``.
+
+    Parameters
+    ----------
+    geometries
+        A GeoSeries, a GeoDataFrame (its active geometry), a shapely array or a
+        list of shapely geometries, in a projected CRS (radii and scores are in
+        CRS units).
+    methods, reference, densify, max_points, arc_tolerance
+        The ``skeleton`` step's options, as in the pipeline file; ``None`` is
+        the file's default (``methods=["MA", "StSk", "DVD", "CDT", "VD"]``,
+        ``reference="MA"``, ``densify={"factor": 4}``, ``max_points=2_000_000``,
+        ``arc_tolerance={"relative": 0.001}``).
+    make_valid, min_area
+        The ``prepare`` step's options (defaults ``True`` and ``0``).
+    prune, extend, score, select
+        Each step's options as a mapping with the pipeline file's keys and
+        defaults (``prune={"mode": "trunk"}``, ``select={"by": "deviation"}``),
+        a string for the step's main key (``prune="trunk"``, ``extend="ray"``,
+        ``select="deviation"``), ``True`` for the step with its defaults (the
+        default for all four) or ``False`` to leave the step out.
+    candidates
+        Every method's row (the ``candidates`` layer: ``chosen``, ``legs_raw``,
+        ``error``) instead of the chosen one's.
+    explode
+        One row per polygon part (``polygon_part``), the index repeated.
+    on_error
+        ``reject`` (a row with the reason in ``rejected``) or ``fail`` (raise
+        :class:`RejectedError` at the first rejected feature).
+    threads
+        Worker threads: ``None`` one per core, ``1`` the calling thread only (on
+        a Dask worker, where Dask runs the partitions in parallel).
+    exchange, output
+        How geometries cross to Rust and back: ``auto`` (GeoArrow ragged arrays
+        for polygons, WKB otherwise), ``geoarrow`` or ``wkb``; ``output``
+        ``geoarrow`` or ``wkb``. For measurements; the results are the same.
+
+    Returns
+    -------
+    geopandas.GeoDataFrame
+        One row per input geometry (per polygon part with ``explode``; per
+        method with ``candidates``), with the input's index and CRS and the
+        columns of the command line's ``skeletons`` (or ``candidates``) layer,
+        then ``rejected`` and the skeleton (MULTILINESTRING) as geometry.
+        ``src_fid`` is the index where it is an integer index, else the
+        position. ``frame.attrs["skeletonise"]`` holds counts and timings.
+
+    Raises
+    ------
+    PipelineError
+        An invalid option, with the command line's message.
+    RejectedError
+        A rejected feature under ``on_error="fail"``.
+    """
+    pipeline = _options_pipeline(
+        make_valid=make_valid,
+        min_area=min_area,
+        skeleton={
+            "methods": methods,
+            "reference": reference,
+            "densify": densify,
+            "max_points": max_points,
+            "arc_tolerance": arc_tolerance,
+        },
+        steps={"prune": prune, "extend": extend, "score": score, "select": select},
+        on_error=on_error,
+    )
+    arr, index, crs = _geometry_array(geometries)
+    return _run(
+        pipeline,
+        arr,
+        index,
+        crs,
+        candidates=candidates,
+        explode=explode,
+        threads=threads,
+        exchange=exchange,
+        output=output,
+    )
+
+
+_PIPELINES: dict[tuple[str, float, tuple[str, ...]], "_core.Pipeline"] = {}
+
+
+def _load(pipeline: Union[str, os.PathLike, "_core.Pipeline"], overrides: Sequence[str]) -> "_core.Pipeline":
+    if isinstance(pipeline, _core.Pipeline):
+        return pipeline
+    path = os.fspath(pipeline)
+    key = (os.path.abspath(path), os.stat(path).st_mtime if os.path.exists(path) else 0.0, tuple(overrides))
+    if key not in _PIPELINES:
+        _PIPELINES[key] = _core.Pipeline.load(path, list(overrides))
+    return _PIPELINES[key]
+
+
+def load_pipeline(path: Union[str, os.PathLike], overrides: Sequence[str] = ()) -> "_core.Pipeline":
+    """Loads and validates a pipeline file once (to pass to :func:`apply` many times)."""
+    return _core.Pipeline.load(os.fspath(path), list(overrides))
+
+
+def apply(
+    gdf,
+    pipeline: Union[str, os.PathLike, "_core.Pipeline"],
+    *,
+    overrides: Sequence[str] = (),
+    candidates: bool = False,
+    threads: int | None = None,
+):
+    """Runs the steps of a pipeline file on a GeoDataFrame.
+
+    The file is validated as ``skeletonise validate`` does, with the same
+    messages; its ``input`` and ``output`` sections may be left out and are
+    not used, except ``output.explode`` (one row per polygon part) and
+    ``on_error``. ``overrides`` are ``--set`` style ``KEY=VALUE`` strings.
+
+    Returns a GeoDataFrame with the input's index, its columns (renamed
+    ``src_<name>`` where they clash with the tool's, as in the GeoPackage),
+    the columns of the ``skeletons`` layer, ``rejected`` and the skeleton in
+    place of the input's geometry (same column name, same CRS). With
+    ``candidates=True``, the ``candidates`` layer instead: every method's row
+    (without the input's columns, as in the GeoPackage).
+
+    For Dask-GeoPandas, ``ddf.map_partitions(skeletonise.apply, "file.yaml",
+    threads=1, meta=...)``: see ``examples/dask_islands.py``.
+    """
+    p = _load(pipeline, overrides)
+    geometry_name = gdf.geometry.name
+    arr = np.asarray(gdf.geometry.values, dtype=object)
+    attributes = gdf.drop(columns=[geometry_name])
+    return _run(
+        p,
+        arr,
+        gdf.index,
+        gdf.crs,
+        candidates=candidates,
+        explode=None,
+        threads=threads,
+        exchange="auto",
+        output="geoarrow",
+        attributes=attributes,
+        geometry_name=geometry_name,
+    )
+
+
+__all__.append("load_pipeline")

@@ -1,0 +1,71 @@
+"""Type stubs of the Rust extension ``skeletonise._core`` (built by maturin)."""
+
+from os import PathLike
+from typing import Any, Literal, Optional, Sequence, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+class PipelineError(ValueError):
+    """An invalid pipeline file or option; the text is the command line's (exit status 78 there)."""
+
+class RejectedError(RuntimeError):
+    """A feature was rejected under ``on_error: fail``; the text is the command line's (exit status 65 there)."""
+
+# (type id 3 polygon / 6 multipolygon, coords (n, 2) float64, offsets int64 per level, null mask or None)
+Ragged = tuple[int, npt.NDArray[np.float64], list[npt.NDArray[np.int64]], Optional[npt.NDArray[np.bool_]]]
+
+class Pipeline:
+    """The validated steps of a pipeline, from a file or from keyword options."""
+
+    @staticmethod
+    def load(path: Union[str, PathLike[str]], overrides: Sequence[str] = ...) -> Pipeline:
+        """Loads and validates a pipeline file (``input`` and ``output`` may be absent); raises PipelineError."""
+    @staticmethod
+    def from_options(text: str, origin: str) -> Pipeline:
+        """Validates a steps document made from keyword options (JSON text); raises PipelineError."""
+    @property
+    def make_valid(self) -> bool:
+        """Whether the ``prepare`` step repairs invalid polygons."""
+    @property
+    def explode(self) -> bool:
+        """One row per polygon part (``output.explode``)."""
+    @property
+    def on_error(self) -> Literal["reject", "fail"]:
+        """``reject`` or ``fail``."""
+    @property
+    def name(self) -> Optional[str]:
+        """The pipeline's name."""
+    @property
+    def text(self) -> str:
+        """The text the pipeline was read from."""
+    def run(
+        self,
+        geometry: Union[list[Optional[bytes]], Ragged],
+        *,
+        fids: Optional[npt.NDArray[np.int64]] = None,
+        repaired: Optional[npt.NDArray[np.bool_]] = None,
+        candidates: bool = False,
+        explode: Optional[bool] = None,
+        threads: Optional[int] = None,
+        output: Literal["geoarrow", "wkb"] = "geoarrow",
+    ) -> dict[str, Any]:
+        """Runs the steps with the GIL released.
+
+        Returns ``row`` (the input position of every output row), ``columns``
+        (``(name, type, values)``; integers as ``(values, null mask)``),
+        ``rejected`` (reasons), ``geometry`` (``("geoarrow", coords, line_offsets,
+        geom_offsets, null)`` or ``("wkb", list)``), ``counts`` and ``timings``.
+        Raises RejectedError under ``on_error: fail``.
+        """
+
+def columns(layer: str, explode: bool = False) -> tuple[list[tuple[str, str]], bool]:
+    """The columns of ``skeletons`` or ``candidates`` as ``(name, type)``, and whether the layer carries the source's attributes."""
+
+def describe() -> str:
+    """The methods and every step's options with their defaults."""
+
+def schema() -> str:
+    """The JSON Schema of the pipeline file, as JSON text."""

@@ -1,0 +1,227 @@
+//! `skeletonise._core`: the Rust side of the Python package.
+//!
+//! The Python side (`skeletonise/__init__.py`) turns a GeoSeries into WKB or
+//! GeoArrow-style ragged arrays (coordinates and offsets), repairs invalid
+//! polygons with shapely's `make_valid` when the `prepare` step asks for
+//! it, and assembles the GeoDataFrame. This side parses the geometries, runs
+//! the per-feature path of the core (`process::feature_rows`, the same as
+//! the command line's) on rayon's threads with the GIL released, and hands
+//! back the columns of the `skeletons` (or `candidates`) layer as the
+//! declarative tables of `skeletonise::output` describe them.
+
+mod run;
+mod table;
+mod wkb;
+
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use skeletonise::config::{self, ConfigError, OnError, Steps};
+use skeletonise::output::{ColumnType, LayerDef, When, CANDIDATES, SKELETONS};
+
+pyo3::create_exception!(
+    _core,
+    PipelineError,
+    PyValueError,
+    "An invalid pipeline file or option; the text is the command line's (exit status 78 there)."
+);
+pyo3::create_exception!(
+    _core,
+    RejectedError,
+    PyRuntimeError,
+    "A feature was rejected under `on_error: fail`; the text is the command line's (exit status 65 there)."
+);
+
+/// The validated steps of a pipeline, from a file or from keyword options.
+#[pyclass(frozen, module = "skeletonise._core")]
+pub struct Pipeline {
+    steps: Steps,
+}
+
+/// Rewrites a key path of the steps document made from keyword options to
+/// the keyword: `steps[2].prune.ratio` → `prune.ratio`; the options of
+/// `prepare` and `skeleton` are keywords of their own (`steps[1].skeleton.methods` → `methods`).
+fn keyword_key(key: &str) -> String {
+    let Some(rest) = key.strip_prefix("steps[") else {
+        return key.to_string();
+    };
+    let Some((_, path)) = rest.split_once("].") else {
+        return key.to_string();
+    };
+    for flat in ["prepare.", "skeleton."] {
+        if let Some(k) = path.strip_prefix(flat) {
+            return k.to_string();
+        }
+    }
+    path.to_string()
+}
+
+fn pipeline_error(e: ConfigError) -> PyErr {
+    PipelineError::new_err(e.to_string())
+}
+
+#[pymethods]
+impl Pipeline {
+    /// Loads and validates a pipeline file (`input` and `output` may be
+    /// absent); `overrides` are `--set` style `KEY=VALUE` strings.
+    #[staticmethod]
+    #[pyo3(signature = (path, overrides = Vec::new()))]
+    fn load(path: std::path::PathBuf, overrides: Vec<String>) -> PyResult<Self> {
+        config::load_steps(&path, &overrides)
+            .map(|steps| Self { steps })
+            .map_err(pipeline_error)
+    }
+
+    /// Validates a steps document made from keyword options (JSON text);
+    /// `origin` names the caller in errors.
+    #[staticmethod]
+    fn from_options(text: &str, origin: &str) -> PyResult<Self> {
+        config::load_steps_str(text, origin, &[])
+            .map(|steps| Self { steps })
+            .map_err(|e| {
+                pipeline_error(ConfigError {
+                    key: keyword_key(&e.key),
+                    position: None,
+                    ..e
+                })
+            })
+    }
+
+    /// Whether the `prepare` step repairs invalid polygons.
+    #[getter]
+    fn make_valid(&self) -> bool {
+        self.steps.process_params().prepare.make_valid
+    }
+
+    /// One row per polygon part (`output.explode`).
+    #[getter]
+    fn explode(&self) -> bool {
+        self.steps.file.output.as_ref().is_some_and(|o| o.explode)
+    }
+
+    /// `reject` or `fail`.
+    #[getter]
+    fn on_error(&self) -> &'static str {
+        match self.steps.file.on_error {
+            OnError::Reject => "reject",
+            OnError::Fail => "fail",
+        }
+    }
+
+    /// The pipeline's name, if it has one.
+    #[getter]
+    fn name(&self) -> Option<String> {
+        self.steps.file.name.clone()
+    }
+
+    /// The text the pipeline was read from.
+    #[getter]
+    fn text(&self) -> String {
+        self.steps.text.clone()
+    }
+
+    /// Runs the steps on geometries given as WKB (`geometry` a list of bytes
+    /// or None) or as ragged arrays (`geometry` a tuple `(type_id, coords,
+    /// offsets, null)`, the layout of `shapely.to_ragged_array`).
+    #[pyo3(signature = (geometry, *, fids = None, repaired = None, candidates = false, explode = None, threads = None, output = "geoarrow"))]
+    #[allow(clippy::too_many_arguments)]
+    fn run<'py>(
+        &self,
+        py: Python<'py>,
+        geometry: &Bound<'py, PyAny>,
+        fids: Option<numpy::PyReadonlyArray1<'py, i64>>,
+        repaired: Option<numpy::PyReadonlyArray1<'py, bool>>,
+        candidates: bool,
+        explode: Option<bool>,
+        threads: Option<usize>,
+        output: &str,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let params = self.steps.process_params();
+        let opts = run::Options {
+            explode: explode.unwrap_or_else(|| self.explode()),
+            candidates,
+            threads,
+            fail: self.steps.file.on_error == OnError::Fail,
+            geoarrow_out: match output {
+                "geoarrow" => true,
+                "wkb" => false,
+                other => {
+                    return Err(PyValueError::new_err(format!(
+                        "output must be `geoarrow` or `wkb`, not `{other}`"
+                    )))
+                }
+            },
+        };
+        run::run(py, geometry, fids, repaired, &params, &opts)
+    }
+}
+
+/// The columns of a layer (`skeletons` or `candidates`) as `(name, type)`
+/// pairs, type one of `int32`, `int64`, `real`, `text`, and whether the
+/// layer carries the source's attributes.
+#[pyfunction]
+#[pyo3(signature = (layer, explode = false))]
+fn columns(layer: &str, explode: bool) -> PyResult<(Vec<(&'static str, &'static str)>, bool)> {
+    fn of<R>(def: &LayerDef<R>, explode: bool) -> (Vec<(&'static str, &'static str)>, bool) {
+        let cols = def
+            .columns
+            .iter()
+            .filter(|c| c.when == When::Always || explode)
+            .map(|c| (c.name, type_name(c.ty)))
+            .collect();
+        (cols, def.attributes.is_some())
+    }
+    match layer {
+        "skeletons" => Ok(of(&SKELETONS, explode)),
+        "candidates" => Ok(of(&CANDIDATES, explode)),
+        other => Err(PyValueError::new_err(format!(
+            "no layer `{other}`; the layers are `skeletons` and `candidates`"
+        ))),
+    }
+}
+
+pub(crate) fn type_name(t: ColumnType) -> &'static str {
+    match t {
+        ColumnType::Int32 => "int32",
+        ColumnType::Int64 => "int64",
+        ColumnType::Real => "real",
+        ColumnType::Text => "text",
+    }
+}
+
+/// The methods and every step's options with their defaults (the text of
+/// `skeletonise methods`).
+#[pyfunction]
+fn describe() -> String {
+    config::describe(&skeletonise::methods::Registry::builtin())
+}
+
+/// The JSON Schema of the pipeline file, as JSON text.
+#[pyfunction]
+fn schema() -> String {
+    config::json_schema().to_string()
+}
+
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add("PipelineError", m.py().get_type::<PipelineError>())?;
+    m.add("RejectedError", m.py().get_type::<RejectedError>())?;
+    m.add_class::<Pipeline>()?;
+    m.add_function(wrap_pyfunction!(columns, m)?)?;
+    m.add_function(wrap_pyfunction!(describe, m)?)?;
+    m.add_function(wrap_pyfunction!(schema, m)?)?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::keyword_key;
+
+    #[test]
+    fn keys_of_keyword_options_name_the_keyword() {
+        assert_eq!(keyword_key("steps[2].prune.ratoi"), "prune.ratoi");
+        assert_eq!(keyword_key("steps[1].skeleton.methods[0]"), "methods[0]");
+        assert_eq!(keyword_key("steps[0].prepare.min_area"), "min_area");
+        assert_eq!(keyword_key("steps"), "steps");
+    }
+}

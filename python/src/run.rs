@@ -1,0 +1,474 @@
+//! One call of `Pipeline.run`: geometries in, the layer's columns out, all
+//! the work done with the GIL released.
+
+use crate::table::{self, ColumnData, Out, Values};
+use crate::{type_name, wkb, RejectedError};
+use geo::{Coord, Geometry, LineString, MultiPolygon, Polygon};
+use numpy::{PyArray1, PyReadonlyArray1, PyReadonlyArray2};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::{PyBytes, PyDict, PyList, PyTuple};
+use rayon::prelude::*;
+use skeletonise::feature::Feature;
+use skeletonise::output::{CANDIDATES, SKELETONS};
+use skeletonise::process::{
+    feature_rows, FeatureRows, ProcessParams, RowOptions, Skeletons, Status,
+};
+use std::time::Instant;
+
+/// How to run and what to return.
+pub struct Options {
+    /// One row per polygon part.
+    pub explode: bool,
+    /// The `candidates` layer (every method's row) instead of `skeletons`.
+    pub candidates: bool,
+    /// Worker threads: `None` rayon's global pool, 1 the calling thread.
+    pub threads: Option<usize>,
+    /// `on_error: fail`: the first rejected feature is an error.
+    pub fail: bool,
+    /// Return geometries as GeoArrow buffers (else WKB).
+    pub geoarrow_out: bool,
+}
+
+/// The geometries as handed over.
+enum Input<'a> {
+    /// WKB per feature (`None` for NULL).
+    Wkb(Vec<Option<&'a [u8]>>),
+    /// `shapely.to_ragged_array` of polygons (3) or multipolygons (6).
+    Ragged {
+        multi: bool,
+        coords: &'a [f64],
+        offsets: Vec<&'a [i64]>,
+        null: Option<&'a [bool]>,
+    },
+}
+
+impl Input<'_> {
+    fn len(&self) -> usize {
+        match self {
+            Input::Wkb(v) => v.len(),
+            Input::Ragged { offsets, .. } => {
+                offsets.last().map_or(0, |o| o.len().saturating_sub(1))
+            }
+        }
+    }
+
+    /// Geometry `i`, `None` for NULL.
+    fn geometry(&self, i: usize) -> Result<Option<Geometry<f64>>, String> {
+        match self {
+            Input::Wkb(v) => v[i].map(wkb::read).transpose(),
+            Input::Ragged { null: Some(n), .. } if n[i] => Ok(None),
+            Input::Ragged {
+                multi,
+                coords,
+                offsets,
+                ..
+            } => {
+                let ring = |r: usize| {
+                    let (a, b) = (offsets[0][r] as usize, offsets[0][r + 1] as usize);
+                    LineString(
+                        coords[2 * a..2 * b]
+                            .chunks_exact(2)
+                            .map(|c| Coord { x: c[0], y: c[1] })
+                            .collect(),
+                    )
+                };
+                let polygon = |p: usize| {
+                    let (a, b) = (offsets[1][p] as usize, offsets[1][p + 1] as usize);
+                    let mut rings = (a..b).map(ring);
+                    let ext = rings.next().unwrap_or_else(|| LineString(Vec::new()));
+                    Polygon::new(ext, rings.collect())
+                };
+                let top = offsets.last().expect("checked");
+                let (a, b) = (top[i] as usize, top[i + 1] as usize);
+                Ok(Some(if *multi {
+                    Geometry::MultiPolygon(MultiPolygon((a..b).map(polygon).collect()))
+                } else {
+                    // Polygons: offsets[1] is the geometry level itself.
+                    let mut rings = (a..b).map(ring);
+                    let ext = rings.next().unwrap_or_else(|| LineString(Vec::new()));
+                    Geometry::Polygon(Polygon::new(ext, rings.collect()))
+                }))
+            }
+        }
+    }
+}
+
+/// Checks that ragged offsets are non-decreasing and within what they index.
+fn check_offsets(coords: usize, offsets: &[&[i64]]) -> Result<(), String> {
+    let mut bound = coords;
+    for (level, o) in offsets.iter().enumerate() {
+        if o.is_empty()
+            || o[0] != 0
+            || o.windows(2).any(|w| w[0] > w[1])
+            || o[o.len() - 1] as usize > bound
+        {
+            return Err(format!(
+                "ragged offsets at level {level} are not valid GeoArrow offsets"
+            ));
+        }
+        bound = o.len() - 1;
+    }
+    Ok(())
+}
+
+/// What the work gives back, owned, for the Python side.
+struct Done {
+    rows: Vec<i64>,
+    columns: Vec<ColumnData>,
+    rejected: Vec<Option<String>>,
+    geometry: Encoded,
+    counts: [u64; 4],
+    timings: [f64; 3],
+}
+
+enum Encoded {
+    Ragged(table::Ragged),
+    Wkb(Vec<Option<Vec<u8>>>),
+}
+
+/// Maps `f` over `items`, in parallel unless `par` is false.
+fn map<T: Sync, U: Send>(
+    items: &[T],
+    par: bool,
+    f: impl Fn(usize, &T) -> U + Sync + Send,
+) -> Vec<U> {
+    if par {
+        items.par_iter().enumerate().map(|(i, t)| f(i, t)).collect()
+    } else {
+        items.iter().enumerate().map(|(i, t)| f(i, t)).collect()
+    }
+}
+
+/// The features of the input (parsed, repaired parts kept as the command
+/// line keeps them).
+fn features(
+    input: &Input<'_>,
+    fids: Option<&[i64]>,
+    repaired: Option<&[bool]>,
+    par: bool,
+) -> Vec<Feature> {
+    let idx: Vec<usize> = (0..input.len()).collect();
+    map(&idx, par, |_, &i| {
+        let repaired = repaired.is_some_and(|r| r[i]);
+        let fid = fids.and_then(|f| u64::try_from(f[i]).ok());
+        let mut f = Feature {
+            fid,
+            attributes: Vec::new(),
+            geometry: None,
+            geometry_error: None,
+            source_wkb: None,
+            repaired,
+        };
+        match input.geometry(i) {
+            Ok(Some(g)) if repaired => match wkb::areal_parts(g) {
+                Ok(g) => f.geometry = Some(g),
+                Err(e) => f.geometry_error = Some(e),
+            },
+            Ok(g) => f.geometry = g,
+            Err(e) => f.geometry_error = Some(format!("unsupported geometry: {e}")),
+        }
+        f
+    })
+}
+
+/// The output rows of every feature, in input order, and the reason of
+/// each rejected one.
+fn outputs<'a, R>(
+    results: &'a [FeatureRows],
+    feats: &[Feature],
+    layer_rows: impl Fn(&'a FeatureRows) -> &'a [R],
+) -> (Vec<i64>, Vec<Out<'a, R>>, Vec<Option<String>>) {
+    let (mut idx, mut outs, mut reasons) = (Vec::new(), Vec::new(), Vec::new());
+    for (i, (r, f)) in results.iter().zip(feats).enumerate() {
+        let before = outs.len();
+        for row in layer_rows(r) {
+            idx.push(i as i64);
+            outs.push(Out::Row(row));
+            reasons.push(None);
+        }
+        for rej in &r.rows.rejected {
+            idx.push(i as i64);
+            outs.push(Out::Empty(f.fid));
+            reasons.push(Some(rej.reason.clone()));
+        }
+        if outs.len() == before {
+            // Filtered by `min_area`: a row all the same, never a lost one.
+            idx.push(i as i64);
+            outs.push(Out::Empty(f.fid));
+            reasons.push(None);
+        }
+    }
+    (idx, outs, reasons)
+}
+
+fn work(
+    input: &Input<'_>,
+    fids: Option<&[i64]>,
+    repaired: Option<&[bool]>,
+    params: &ProcessParams,
+    opts: &Options,
+) -> Result<Done, String> {
+    let par = opts.threads != Some(1);
+    let t0 = Instant::now();
+    let feats = features(input, fids, repaired, par);
+    let t1 = Instant::now();
+    let row_opts = RowOptions {
+        explode: opts.explode,
+        candidates: opts.candidates,
+        bars: false,
+        widths: false,
+    };
+    let results: Vec<FeatureRows> = map(&feats, par, |_, f| {
+        feature_rows(f, Skeletons::Computed, params, row_opts)
+    });
+    let t2 = Instant::now();
+    if opts.fail {
+        if let Some((f, rej)) = feats
+            .iter()
+            .zip(&results)
+            .find_map(|(f, r)| r.rows.rejected.first().map(|j| (f, j)))
+        {
+            let fid = f.fid.map_or_else(|| "(no fid)".into(), |x| x.to_string());
+            return Err(skeletonise::config::rejected_under_fail(&fid, &rej.reason));
+        }
+    }
+    let mut counts = [feats.len() as u64, 0, 0, 0];
+    for r in &results {
+        match r.status {
+            Status::Written(_) => counts[1] += 1,
+            Status::Rejected => counts[2] += 1,
+            Status::Filtered => counts[3] += 1,
+        }
+    }
+    let (rows, columns, rejected, lines) = if opts.candidates {
+        let (idx, outs, reasons) = outputs(&results, &feats, |r| &r.rows.candidates);
+        (
+            idx,
+            table::columns(&CANDIDATES, true, &outs),
+            reasons,
+            table::lines(&CANDIDATES, &outs),
+        )
+    } else {
+        let (idx, outs, reasons) = outputs(&results, &feats, |r| &r.rows.skeletons);
+        (
+            idx,
+            table::columns(&SKELETONS, opts.explode, &outs),
+            reasons,
+            table::lines(&SKELETONS, &outs),
+        )
+    };
+    let geometry = if opts.geoarrow_out {
+        Encoded::Ragged(table::ragged(&lines))
+    } else {
+        Encoded::Wkb(map(&lines, par, |_, g| {
+            g.as_ref().map(|m| {
+                let mut out = Vec::new();
+                wkb::write_lines(m, &mut out);
+                out
+            })
+        }))
+    };
+    let t3 = Instant::now();
+    Ok(Done {
+        rows,
+        columns,
+        rejected,
+        geometry,
+        counts,
+        timings: [
+            (t1 - t0).as_secs_f64(),
+            (t2 - t1).as_secs_f64(),
+            (t3 - t2).as_secs_f64(),
+        ],
+    })
+}
+
+/// Runs with the GIL released, in a pool of `threads` when given.
+fn detached(
+    py: Python<'_>,
+    input: &Input<'_>,
+    fids: Option<&[i64]>,
+    repaired: Option<&[bool]>,
+    params: &ProcessParams,
+    opts: &Options,
+) -> PyResult<Result<Done, String>> {
+    match opts.threads {
+        Some(0) => Err(PyValueError::new_err(
+            "threads must be ≥ 1 (or None for one per core)",
+        )),
+        Some(n) if n > 1 => {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build()
+                .map_err(|_| PyValueError::new_err(format!("cannot start {n} worker threads")))?;
+            Ok(py.detach(|| pool.install(|| work(input, fids, repaired, params, opts))))
+        }
+        _ => Ok(py.detach(|| work(input, fids, repaired, params, opts))),
+    }
+}
+
+/// `(type id, coords, offsets per level, null mask)` as the Python side
+/// passes `shapely.to_ragged_array`'s result.
+type RaggedTuple<'py> = (
+    i32,
+    PyReadonlyArray2<'py, f64>,
+    Vec<PyReadonlyArray1<'py, i64>>,
+    Option<PyReadonlyArray1<'py, bool>>,
+);
+
+/// The arrays of a [`RaggedTuple`], kept while their data are borrowed.
+struct RaggedArrays<'py> {
+    coords: PyReadonlyArray2<'py, f64>,
+    offsets: Vec<PyReadonlyArray1<'py, i64>>,
+    null: Option<PyReadonlyArray1<'py, bool>>,
+}
+
+/// `Pipeline.run`.
+pub fn run<'py>(
+    py: Python<'py>,
+    geometry: &Bound<'py, PyAny>,
+    fids: Option<PyReadonlyArray1<'py, i64>>,
+    repaired: Option<PyReadonlyArray1<'py, bool>>,
+    params: &ProcessParams,
+    opts: &Options,
+) -> PyResult<Bound<'py, PyAny>> {
+    let fids = fids
+        .as_ref()
+        .map(|a| a.as_slice())
+        .transpose()
+        .map_err(value_error)?;
+    let repaired = repaired
+        .as_ref()
+        .map(|a| a.as_slice())
+        .transpose()
+        .map_err(value_error)?;
+    // The Python objects stay alive (and borrowed) while their data are read.
+    let wkbs: Vec<Option<Bound<'py, PyBytes>>>;
+    let arrays: RaggedArrays<'py>;
+    let input = if let Ok(t) = geometry.cast::<PyTuple>() {
+        let (type_id, coords, offsets, null): RaggedTuple<'py> = t.extract()?;
+        let multi = match (type_id, offsets.len()) {
+            (3, 2) => false,
+            (6, 3) => true,
+            _ => {
+                return Err(PyValueError::new_err(format!(
+                    "ragged arrays of geometry type {type_id} with {} offset levels: only polygons (3, two levels) and multipolygons (6, three levels)",
+                    offsets.len()
+                )))
+            }
+        };
+        arrays = RaggedArrays {
+            coords,
+            offsets,
+            null,
+        };
+        let coords = arrays.coords.as_slice().map_err(value_error)?;
+        let offsets = arrays
+            .offsets
+            .iter()
+            .map(|o| o.as_slice())
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(value_error)?;
+        check_offsets(coords.len() / 2, &offsets).map_err(PyValueError::new_err)?;
+        let null = arrays
+            .null
+            .as_ref()
+            .map(|n| n.as_slice())
+            .transpose()
+            .map_err(value_error)?;
+        Input::Ragged {
+            multi,
+            coords,
+            offsets,
+            null,
+        }
+    } else {
+        wkbs = geometry.extract()?;
+        Input::Wkb(
+            wkbs.iter()
+                .map(|b| b.as_ref().map(|b| b.as_bytes()))
+                .collect(),
+        )
+    };
+    let n = input.len();
+    for (what, len) in [
+        ("fids", fids.map(<[i64]>::len)),
+        ("repaired", repaired.map(<[bool]>::len)),
+    ] {
+        if let Some(len) = len.filter(|&l| l != n) {
+            return Err(PyValueError::new_err(format!(
+                "{what} has {len} entries for {n} geometries"
+            )));
+        }
+    }
+    if let Input::Ragged { null: Some(nl), .. } = &input {
+        if nl.len() != n {
+            return Err(PyValueError::new_err(format!(
+                "null has {} entries for {n} geometries",
+                nl.len()
+            )));
+        }
+    }
+    let done =
+        detached(py, &input, fids, repaired, params, opts)?.map_err(RejectedError::new_err)?;
+    to_python(py, done)
+}
+
+fn value_error(e: impl std::fmt::Display) -> PyErr {
+    PyValueError::new_err(format!("arrays must be C-contiguous: {e}"))
+}
+
+fn to_python(py: Python<'_>, d: Done) -> PyResult<Bound<'_, PyAny>> {
+    let out = PyDict::new(py);
+    out.set_item("row", PyArray1::from_vec(py, d.rows))?;
+    let cols = PyList::empty(py);
+    for c in d.columns {
+        let values = match c.values {
+            Values::Int(v, null) => (PyArray1::from_vec(py, v), PyArray1::from_vec(py, null))
+                .into_pyobject(py)?
+                .into_any(),
+            Values::Real(v) => PyArray1::from_vec(py, v).into_any(),
+            Values::Text(v) => v.into_pyobject(py)?.into_any(),
+        };
+        cols.append((c.name, type_name(c.ty), values))?;
+    }
+    out.set_item("columns", cols)?;
+    out.set_item("rejected", d.rejected)?;
+    match d.geometry {
+        Encoded::Ragged(r) => out.set_item(
+            "geometry",
+            (
+                "geoarrow",
+                PyArray1::from_vec(py, r.coords),
+                PyArray1::from_vec(py, r.line_offsets),
+                PyArray1::from_vec(py, r.geom_offsets),
+                PyArray1::from_vec(py, r.null),
+            ),
+        )?,
+        Encoded::Wkb(w) => {
+            let list = PyList::empty(py);
+            for g in w {
+                match g {
+                    Some(b) => list.append(PyBytes::new(py, &b))?,
+                    None => list.append(py.None())?,
+                }
+            }
+            out.set_item("geometry", ("wkb", list))?;
+        }
+    }
+    let counts = PyDict::new(py);
+    for (k, v) in ["read", "written", "rejected", "filtered"]
+        .iter()
+        .zip(d.counts)
+    {
+        counts.set_item(k, v)?;
+    }
+    out.set_item("counts", counts)?;
+    let timings = PyDict::new(py);
+    for (k, v) in ["parse_s", "compute_s", "encode_s"].iter().zip(d.timings) {
+        timings.set_item(k, v)?;
+    }
+    out.set_item("timings", timings)?;
+    Ok(out.into_any())
+}

@@ -1,0 +1,208 @@
+"""`skeletonise.skeletonise` and `skeletonise.apply` on small shapes: columns, options,
+rejected rows, repairs, candidates, explode, exchange formats and the GIL."""
+
+from __future__ import annotations
+
+import threading
+import time
+
+import geopandas as gpd
+import numpy as np
+import pandas as pd
+import pytest
+import shapely
+from shapely.geometry import MultiPolygon, Point, Polygon, box
+
+import skeletonise
+from conftest import ROOT
+
+RIVER = box(0, 0, 100, 10)
+BOW_TIE = Polygon([(0, 0), (4, 4), (4, 0), (0, 6)])
+
+
+def test_columns_are_the_skeletons_layer_then_rejected_and_the_geometry():
+    names = [n for n, _ in skeletonise.columns("skeletons")]
+    assert names == [
+        "src_fid", "method", "bars", "hits", "coverage", "deviation", "deviation_parts",
+        "distortion_sum", "distortion", "components", "legs", "repaired",
+    ]
+    assert "polygon_part" in [n for n, _ in skeletonise.columns("skeletons", explode=True)]
+    out = skeletonise.skeletonise(gpd.GeoSeries([RIVER]))
+    assert list(out.columns) == names + ["rejected", "geometry"]
+    assert str(out["legs"].dtype) == "Int32" and str(out["src_fid"].dtype) == "Int64"
+    assert out["coverage"].dtype == np.float64
+
+
+def test_a_rectangle_gets_the_centre_line_from_ma():
+    out = skeletonise.skeletonise([RIVER])
+    row = out.iloc[0]
+    assert row["method"] == "MA" and row["legs"] == 1 and pd.isna(row["rejected"])
+    assert row["distortion"] < 1e-9 and row["coverage"] > 0.9
+    assert row.geometry.equals(shapely.MultiLineString([[(0, 5), (100, 5)]]))
+
+
+def test_every_row_comes_back_with_its_index_and_reason():
+    geoms = gpd.GeoSeries(
+        [RIVER, None, Point(1, 2), shapely.Polygon(), box(0, 0, 0.1, 0.1), BOW_TIE],
+        index=pd.Index([10, 11, 12, 13, 14, 15]),
+        crs="EPSG:3035",
+    )
+    out = skeletonise.skeletonise(geoms, min_area=1.0)
+    assert list(out.index) == [10, 11, 12, 13, 14, 15] and out.crs == geoms.crs
+    assert list(out["src_fid"]) == [10, 11, 12, 13, 14, 15]
+    r = out["rejected"]
+    assert pd.isna(r[10]) and out["method"][10] == "MA"
+    assert r[11].startswith("NULL geometry")
+    assert r[12] == "point geometry: only polygons and multipolygons can be skeletonised"
+    assert r[13].startswith("empty geometry")
+    # filtered by min_area: no skeleton, no reason
+    assert pd.isna(r[14]) and pd.isna(out["method"][14]) and out.geometry[14] is None
+    # repaired by make_valid (the default), as GDAL's MakeValid does in the command line
+    assert pd.isna(r[15]) and out["repaired"][15] == 1 and out["repaired"][10] == 0
+    assert out.attrs["skeletonise"]["counts"] == {"read": 6, "written": 2, "rejected": 3, "filtered": 1}
+
+
+def test_without_make_valid_an_invalid_polygon_is_rejected_with_the_reason():
+    out = skeletonise.skeletonise([BOW_TIE], make_valid=False)
+    assert "invalid polygon" in out["rejected"][0] and "make_valid" in out["rejected"][0]
+    assert out.geometry[0] is None
+
+
+def test_on_error_fail_raises_the_command_line_text():
+    with pytest.raises(skeletonise.RejectedError) as e:
+        skeletonise.skeletonise(gpd.GeoSeries([RIVER, Point(0, 0)], index=[5, 7]), on_error="fail")
+    assert str(e.value) == (
+        "feature 7 was rejected: point geometry: only polygons and multipolygons can be skeletonised "
+        "(on_error: fail stops the run; no output was written; use `on_error: reject` to list such "
+        "features in the `rejected` layer instead)"
+    )
+
+
+@pytest.mark.parametrize(
+    "kwargs, text",
+    [
+        ({"prune": {"ratoi": 1}}, "skeletonise(): `prune.ratoi`: unknown field `ratoi`, expected one of"),
+        ({"methods": ["MA", "XX"]}, "skeletonise(): `methods[1]`: unknown method `XX`; expected one of VD, DVD, CDT, StSk, MA"),
+        ({"min_area": -1}, "skeletonise(): `min_area`: min_area must be ≥ 0 (CRS units²)"),
+        ({"select": {"min_coverage": 2}}, "skeletonise(): `select.min_coverage`:"),
+        ({"on_error": "ignore"}, "skeletonise(): `on_error`: unknown variant `ignore`"),
+        ({"prune": 3}, "skeletonise(): `prune`: expected a mapping"),
+    ],
+)
+def test_options_are_validated_with_the_pipeline_file_messages(kwargs, text):
+    with pytest.raises(skeletonise.PipelineError) as e:
+        skeletonise.skeletonise([RIVER], **kwargs)
+    assert str(e.value).startswith(text), str(e.value)
+
+
+def test_option_messages_equal_the_pipeline_files(tmp_path):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("steps:\n  - skeleton: {methods: [CDT]}\n  - prune: {ratoi: 1}\n")
+    with pytest.raises(skeletonise.PipelineError) as from_file:
+        skeletonise.apply(gpd.GeoDataFrame(geometry=[RIVER]), bad)
+    with pytest.raises(skeletonise.PipelineError) as from_kwargs:
+        skeletonise.skeletonise([RIVER], methods=["CDT"], prune={"ratoi": 1})
+    file_text, kw_text = str(from_file.value), str(from_kwargs.value)
+    assert file_text.startswith(f"{bad}:3:13: `steps[1].prune.ratoi`: ")
+    assert file_text.split("`: ", 1)[1] == kw_text.split("`: ", 1)[1]
+
+
+def test_step_options_reach_the_steps():
+    wavy = shapely.buffer(shapely.LineString([(0, 0), (50, 20), (100, 0), (150, 20)]), 5)
+    trunk = skeletonise.skeletonise([wavy], prune="trunk", methods=["CDT", "MA"])
+    assert trunk["legs"][0] == 1 and trunk["method"][0] in ("CDT", "MA")
+    raw = skeletonise.skeletonise([wavy], prune=False, extend=False, methods=["CDT"])
+    assert raw["legs"][0] > 1
+    unscored = skeletonise.skeletonise([wavy], score=False, select=False, methods=["CDT"])
+    assert pd.isna(unscored["distortion"][0]) and unscored["method"][0] == "CDT"
+
+
+def test_candidates_give_every_method_one_row_and_one_chosen():
+    out = skeletonise.skeletonise(gpd.GeoSeries([RIVER, box(0, 0, 30, 20)], index=["a", "b"]), candidates=True)
+    assert list(out.columns) == [n for n, _ in skeletonise.columns("candidates")] + ["rejected", "geometry"]
+    assert list(out.index) == ["a"] * 5 + ["b"] * 5
+    assert list(out["method"][:5]) == ["MA", "StSk", "DVD", "CDT", "VD"]
+    assert out.groupby(level=0)["chosen"].sum().tolist() == [1, 1]
+    # a non-integer index: src_fid is the position
+    assert list(out["src_fid"]) == [0] * 5 + [1] * 5
+
+
+def test_explode_gives_one_row_per_polygon_part():
+    two = MultiPolygon([RIVER, box(200, 0, 260, 10)])
+    out = skeletonise.skeletonise(gpd.GeoSeries([two, RIVER], index=[3, 4]), explode=True)
+    assert list(out.index) == [3, 3, 4]
+    assert list(out["polygon_part"]) == [0, 1, 0]
+    whole = skeletonise.skeletonise([two])
+    assert len(whole) == 1 and whole.geometry[0].geom_type == "MultiLineString"
+
+
+def test_geoarrow_and_wkb_exchange_give_the_same_frame(islands):
+    sample = islands.geometry.iloc[:200]
+    a = skeletonise.skeletonise(sample, methods=["CDT", "MA"])
+    b = skeletonise.skeletonise(sample, methods=["CDT", "MA"], exchange="wkb", output="wkb")
+    assert a.attrs["skeletonise"]["exchange"] == "geoarrow" and b.attrs["skeletonise"]["exchange"] == "wkb"
+    pd.testing.assert_frame_equal(a.drop(columns="geometry"), b.drop(columns="geometry"))
+    assert shapely.equals_exact(a.geometry.values, b.geometry.values, tolerance=0).all()
+
+
+def test_wkb_in_any_byte_order_and_dimension():
+    z = shapely.force_3d(RIVER, 7.0)
+    for g in (z, shapely.from_wkb(shapely.to_wkb(RIVER, byte_order=0))):
+        out = skeletonise.skeletonise([g, Point(0, 0)], exchange="wkb")
+        assert out["method"][0] == "MA" and out["rejected"][1].startswith("point geometry")
+
+
+def test_threads_give_identical_results(islands):
+    sample = islands.geometry.iloc[:300]
+    one = skeletonise.skeletonise(sample, threads=1, methods=["MA", "StSk"])
+    two = skeletonise.skeletonise(sample, threads=2, methods=["MA", "StSk"])
+    pd.testing.assert_frame_equal(one.drop(columns="geometry"), two.drop(columns="geometry"))
+
+
+def test_the_gil_is_released_during_the_work(islands):
+    ticks = 0
+    done = threading.Event()
+
+    def work():
+        skeletonise.skeletonise(islands.geometry, methods=["MA", "StSk", "DVD"], threads=1)
+        done.set()
+
+    t = threading.Thread(target=work)
+    start = time.perf_counter()
+    t.start()
+    while not done.is_set():
+        ticks += 1
+        time.sleep(0.001)
+    t.join()
+    elapsed = time.perf_counter() - start
+    # With the GIL held for the whole run the loop would hardly move.
+    assert elapsed > 0.05 and ticks > 0.3 * elapsed / 0.001, (ticks, elapsed)
+
+
+def test_apply_keeps_columns_index_and_geometry_name(tmp_path):
+    gdf = gpd.GeoDataFrame(
+        {"name": ["a", "b"], "method": ["x", "y"], "area": [1.5, 2.5]},
+        geometry=[RIVER, Point(0, 0)],
+        index=pd.Index([100, 200], name="fid"),
+        crs="EPSG:3035",
+    ).rename_geometry("shape")
+    p = tmp_path / "steps.yaml"
+    p.write_text("steps:\n  - skeleton: {methods: [MA, CDT]}\n  - prune: {}\n  - extend: {}\n  - score: {}\n  - select: {}\n")
+    out = skeletonise.apply(gdf, p)
+    assert out.index.equals(gdf.index) and out.geometry.name == "shape" and out.crs == gdf.crs
+    assert list(out.columns[:3]) == ["name", "src_method", "area"]
+    assert list(out["name"]) == ["a", "b"] and list(out["src_method"]) == ["x", "y"]
+    assert out["method"][100] == "MA" and out["rejected"][200].startswith("point geometry")
+    assert list(out["src_fid"]) == [100, 200]
+
+
+def test_apply_on_an_empty_frame_gives_the_typed_empty_frame():
+    empty = gpd.GeoDataFrame({"k": pd.Series([], dtype="int64")}, geometry=gpd.GeoSeries([]), crs="EPSG:3035")
+    out = skeletonise.apply(empty, ROOT / "pipelines" / "islands.yaml")
+    assert len(out) == 0 and "method" in out.columns and "k" in out.columns
+    assert str(out["legs"].dtype) == "Int32"
+
+
+def test_describe_and_schema():
+    assert "MA    medial axis" in skeletonise.describe()
+    assert "steps" in skeletonise.schema()["properties"]

@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# Makes the Python environment under target/py-venv (nothing is installed system-wide):
+# maturin, pytest, GeoPandas, Dask from PyPI, then builds the package's abi3 wheel
+# (release) into target/wheels and installs it there. On a fresh Debian/Ubuntu machine it
+# first installs Python's venv module and headers (the binding's unit tests link to
+# libpython) when they are missing.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+venv=target/py-venv
+py=${PYTHON:-python3}
+has_libpython() {
+  "$1" -c 'import os, sys, sysconfig as s
+d, l = s.get_config_var("LIBDIR"), s.get_config_var("LDLIBRARY")
+sys.exit(0 if d and l and os.path.exists(os.path.join(d, l)) else 1)'
+}
+if ! command -v "$py" >/dev/null 2>&1 || ! "$py" -c 'import venv, ensurepip' 2>/dev/null || ! has_libpython "$py"; then
+  sudo=""
+  [ "$(id -u)" -eq 0 ] || sudo="sudo"
+  echo "installing: python3 python3-venv python3-dev" >&2
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq python3 python3-venv python3-dev >/dev/null
+  py=python3
+fi
+[ -x "$venv/bin/python" ] || "$py" -m venv "$venv"
+"$venv/bin/python" -m pip install -q --upgrade pip
+"$venv/bin/python" -m pip install -q maturin pytest geopandas dask distributed dask-geopandas pyarrow shapely pyogrio
+rm -rf target/wheels
+"$venv/bin/maturin" build --release --quiet -m python/Cargo.toml -i "$venv/bin/python" -o target/wheels
+"$venv/bin/python" -m pip install -q --force-reinstall --no-deps target/wheels/skeletonise-*.whl
