@@ -176,7 +176,7 @@ def test_the_gil_is_released_during_the_work(islands):
     t.join()
     elapsed = time.perf_counter() - start
     # With the GIL held for the whole run the loop would hardly move.
-    assert elapsed > 0.05 and ticks > 0.3 * elapsed / 0.001, (ticks, elapsed)
+    assert elapsed > 0.05 and ticks > 0.1 * elapsed / 0.001, (ticks, elapsed)
 
 
 def test_apply_keeps_columns_index_and_geometry_name(tmp_path):

@@ -1,0 +1,140 @@
+"""The measurements of scripts/bench-python.sh, one run each on this machine.
+
+1. The command line (`skeletonise run`, its own elapsed time, which includes
+   reading and writing the GeoPackage) against `skeletonise.apply` on the same
+   layer and pipeline: the Rust compute time inside the call, and the
+   conversion overhead (shapely ⇄ Rust, GeoDataFrame assembly) beside it.
+2. `pygeoops.centerline` (default options) on the same GeoSeries against the
+   whole `skeletonise.skeletonise` call, with its defaults (five methods,
+   pruning, extension, scoring, selection) and with one method (CDT, pruned
+   and extended, not scored: one centreline per polygon, as pygeoops makes).
+3. The exchange formats (GeoArrow, WKB) on a generated layer of N polygons.
+4. `examples/dask_islands.py` on that layer of N polygons (tiled,
+   rotated and scaled copies of the training islands) with 1 and 2 workers
+   (threads=1 in each: one core per worker).
+
+usage: bench_python.py SKELETONISE_BIN [N_POLYGONS]
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import pyogrio
+
+import skeletonise
+
+ROOT = Path(__file__).resolve().parents[1]
+TRAIN = ROOT / "tests/data/gshhg-train.gpkg"
+CASES = [
+    ("islands_hebrides", "islands.yaml"),
+    ("river_st_lawrence", "rivers.yaml"),
+    ("river_danube", "rivers.yaml"),
+    ("river_lena", "rivers.yaml"),
+]
+
+
+def cli_elapsed(binary: str, layer: str, pipeline: str) -> float:
+    with tempfile.TemporaryDirectory() as d:
+        out = Path(d) / "out.gpkg"
+        subprocess.run(
+            [binary, "run", str(ROOT / "pipelines" / pipeline), "-q", "-o", str(out),
+             "--set", f"input.layer={layer}", "--set", "output.candidates=false"],
+            check=True, cwd=ROOT, env=dict(os.environ, SKELETONISE_SRC=str(TRAIN)),
+        )
+        runs = pyogrio.read_dataframe(out, layer="skeletonise_runs")
+        return float(runs["elapsed_s"].iloc[0])
+
+
+def row(*cells) -> None:
+    print("| " + " | ".join(str(c) for c in cells) + " |")
+
+
+def main() -> None:
+    binary = sys.argv[1]
+    n = int(sys.argv[2]) if len(sys.argv) > 2 else 100_000
+    results: dict = {"cli_vs_python": [], "pygeoops": [], "dask": {}}
+
+    print("\n## The command line against skeletonise.apply (same pipeline, same layer)\n")
+    row("layer", "features", "CLI elapsed s (incl. GPKG I/O)", "Python compute s", "ratio",
+        "conversion s (to Rust + from Rust)", "parse+encode in Rust s", "Python total s")
+    row(*["---"] * 8)
+    for layer, pipeline in CASES:
+        gdf = pyogrio.read_dataframe(TRAIN, layer=layer, fid_as_index=True)
+        cli = cli_elapsed(binary, layer, pipeline)
+        out = skeletonise.apply(gdf, ROOT / "pipelines" / pipeline)
+        t = out.attrs["skeletonise"]["timings"]
+        conv = t["make_valid_s"] + t["to_rust_s"] + t["from_rust_s"]
+        rust_io = t["parse_s"] + t["encode_s"]
+        row(layer, len(gdf), f"{cli:.3f}", f"{t['compute_s']:.3f}", f"{t['compute_s'] / cli:.2f}",
+            f"{conv:.4f}", f"{rust_io:.4f}", f"{t['total_s']:.3f}")
+        results["cli_vs_python"].append({"layer": layer, "cli_s": cli, **t})
+
+    print("\n## pygeoops.centerline (defaults) against skeletonise.skeletonise, same GeoSeries\n")
+    print("defaults: five methods, pruned, extended, scored, best chosen; one method: CDT, pruned and")
+    print("extended, not scored (one centreline per polygon, as pygeoops makes)\n")
+    import pygeoops
+
+    row("layer", "features", "pygeoops s", "skeletonise defaults s", "speed-up", "skeletonise one method s", "speed-up")
+    row(*["---"] * 7)
+    for layer, _ in CASES:
+        geoms = pyogrio.read_dataframe(TRAIN, layer=layer, fid_as_index=True).geometry
+        t0 = time.perf_counter()
+        pygeoops.centerline(geoms)
+        peer = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        skeletonise.skeletonise(geoms)
+        ours = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        skeletonise.skeletonise(geoms, methods=["CDT"], score=False, select=False)
+        one = time.perf_counter() - t0
+        row(layer, len(geoms), f"{peer:.3f}", f"{ours:.3f}", f"{peer / ours:.1f}×", f"{one:.3f}", f"{peer / one:.1f}×")
+        results["pygeoops"].append({"layer": layer, "pygeoops_s": peer, "skeletonise_s": ours, "one_method_s": one})
+
+    data = ROOT / "target/bench/islands-generated.parquet"
+    script = [sys.executable, str(ROOT / "examples/dask_islands.py"), "--input", str(data)]
+    sys.path.insert(0, str(ROOT / "examples"))
+    import dask_islands
+
+    t0 = time.perf_counter()
+    dask_islands.generate(n, data)
+    print(f"(generated {data.relative_to(ROOT)} in {time.perf_counter() - t0:.1f} s)\n")
+    print("## Exchange formats on the generated layer (shapely → Rust → shapely; raw CDT, one thread)\n")
+    import geopandas as gpd
+
+    big = gpd.read_parquet(data).geometry
+    row("exchange", "to Rust s (Python side)", "parse in Rust s", "encode in Rust s", "from Rust s (Python side)", "sum s")
+    row(*["---"] * 6)
+    for ex in ("geoarrow", "wkb"):
+        out = skeletonise.skeletonise(big, methods=["CDT"], prune=False, extend=False, score=False, select=False,
+                                      threads=1, exchange=ex, output=ex)
+        t = out.attrs["skeletonise"]["timings"]
+        total = t["to_rust_s"] + t["parse_s"] + t["encode_s"] + t["from_rust_s"]
+        row(ex, f"{t['to_rust_s']:.3f}", f"{t['parse_s']:.3f}", f"{t['encode_s']:.3f}", f"{t['from_rust_s']:.3f}",
+            f"{total:.3f}")
+        results[f"exchange_{ex}"] = t
+    del big, out
+    print(f"\n## Dask: examples/dask_islands.py on {n} generated polygons, pipelines/islands.yaml\n")
+    row("workers", "partitions", "elapsed s", "rows", "rejected")
+    row(*["---"] * 5)
+    for workers in (1, 2):
+        p = subprocess.run(script + ["--workers", str(workers), "--partitions", "16"],
+                           check=True, capture_output=True, text=True, cwd=ROOT)
+        r = json.loads(p.stdout.strip().splitlines()[-1])
+        row(workers, r["partitions"], f"{r['elapsed_s']:.1f}", r["rows"], r["rejected"])
+        results["dask"][workers] = r
+    one, two = results["dask"][1]["elapsed_s"], results["dask"][2]["elapsed_s"]
+    print(f"\n2 workers against 1: {one / two:.2f}× faster")
+    out = ROOT / "target/bench/python.json"
+    out.write_text(json.dumps(results, indent=1))
+    print(f"\n(raw figures: {out.relative_to(ROOT)})")
+
+
+if __name__ == "__main__":
+    main()
