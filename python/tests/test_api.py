@@ -62,6 +62,16 @@ def test_every_row_comes_back_with_its_index_and_reason():
     assert out.attrs["skeletonise"]["counts"] == {"read": 6, "written": 2, "rejected": 3, "filtered": 1}
 
 
+def test_missing_and_empty_polygons_give_the_same_reasons_in_either_exchange():
+    geoms = gpd.GeoSeries([RIVER, None, shapely.Polygon(), MultiPolygon([RIVER])])
+    a = skeletonise.skeletonise(geoms, exchange="geoarrow")
+    b = skeletonise.skeletonise(geoms)
+    assert a.attrs["skeletonise"]["exchange"] == "geoarrow" and b.attrs["skeletonise"]["exchange"] == "wkb"
+    assert list(a["rejected"].isna()) == [True, False, False, True]
+    assert a["rejected"][1].startswith("NULL geometry") and a["rejected"][2].startswith("empty geometry")
+    pd.testing.assert_frame_equal(a.drop(columns="geometry"), b.drop(columns="geometry"))
+
+
 def test_without_make_valid_an_invalid_polygon_is_rejected_with_the_reason():
     out = skeletonise.skeletonise([BOW_TIE], make_valid=False)
     assert "invalid polygon" in out["rejected"][0] and "make_valid" in out["rejected"][0]
@@ -137,8 +147,10 @@ def test_explode_gives_one_row_per_polygon_part():
 
 
 def test_geoarrow_and_wkb_exchange_give_the_same_frame(islands):
+    with pytest.raises(ValueError, match="polygons and multipolygons only"):
+        skeletonise.skeletonise([RIVER, Point(0, 0)], exchange="geoarrow")
     sample = islands.geometry.iloc[:200]
-    a = skeletonise.skeletonise(sample, methods=["CDT", "MA"])
+    a = skeletonise.skeletonise(sample, methods=["CDT", "MA"], exchange="geoarrow", output="geoarrow")
     b = skeletonise.skeletonise(sample, methods=["CDT", "MA"], exchange="wkb", output="wkb")
     assert a.attrs["skeletonise"]["exchange"] == "geoarrow" and b.attrs["skeletonise"]["exchange"] == "wkb"
     pd.testing.assert_frame_equal(a.drop(columns="geometry"), b.drop(columns="geometry"))
@@ -148,7 +160,7 @@ def test_geoarrow_and_wkb_exchange_give_the_same_frame(islands):
 def test_wkb_in_any_byte_order_and_dimension():
     z = shapely.force_3d(RIVER, 7.0)
     for g in (z, shapely.from_wkb(shapely.to_wkb(RIVER, byte_order=0))):
-        out = skeletonise.skeletonise([g, Point(0, 0)], exchange="wkb")
+        out = skeletonise.skeletonise([g, Point(0, 0)])
         assert out["method"][0] == "MA" and out["rejected"][1].startswith("point geometry")
 
 
