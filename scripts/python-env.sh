@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Makes the Python environment under target/py-venv (nothing is installed system-wide):
-# maturin, pytest, GeoPandas, Dask from PyPI, then builds the package's abi3 wheel
-# (release) into target/wheels and installs it there. On a fresh Debian/Ubuntu machine it
+# maturin, pytest, GeoPandas, Dask from PyPI, then builds the package's abi3 wheel into
+# target/wheels and installs it there. The wheel is built with the cargo profile
+# $SKELETONISE_WHEEL_PROFILE (default release; CI uses `test`, which reuses what
+# scripts/test.sh compiled). On a fresh Debian/Ubuntu machine it
 # first installs Python's venv module and headers (the binding's unit tests link to
 # libpython) when they are missing.
 set -euo pipefail
@@ -25,5 +27,6 @@ fi
 "$venv/bin/python" -m pip install -q --upgrade pip
 "$venv/bin/python" -m pip install -q maturin pytest geopandas dask distributed dask-geopandas pyarrow shapely pyogrio
 rm -rf target/wheels
-"$venv/bin/maturin" build --release --quiet -m python/Cargo.toml -i "$venv/bin/python" -o target/wheels
+"$venv/bin/maturin" build --profile "${SKELETONISE_WHEEL_PROFILE:-release}" --quiet -m python/Cargo.toml \
+  -i "$venv/bin/python" -o target/wheels
 "$venv/bin/python" -m pip install -q --force-reinstall --no-deps target/wheels/skeletonise-*.whl
