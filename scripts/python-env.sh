@@ -2,8 +2,8 @@
 # Makes the Python environment under target/py-venv (nothing is installed system-wide):
 # maturin, pytest, GeoPandas, Dask from PyPI, then builds the package's abi3 wheel into
 # target/wheels and installs it there. The wheel is built with the cargo profile
-# $SKELETONISE_WHEEL_PROFILE (default release; CI uses `test`, which reuses what
-# scripts/test.sh compiled). On a fresh Debian/Ubuntu machine it
+# $SKELETONISE_WHEEL_PROFILE (default release; CI uses `dev`, whose dependencies
+# scripts/test.sh has compiled). On a fresh Debian/Ubuntu machine it
 # first installs Python's venv module and headers (the binding's unit tests link to
 # libpython) when they are missing.
 set -euo pipefail
