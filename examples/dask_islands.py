@@ -24,9 +24,10 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def generate(n: int, path: Path, seed: int = 1) -> Path:
+def generate(n: int, path: Path, files: int = 16, seed: int = 1) -> Path:
     """`n` polygons: copies of the training islands on a grid of tiles, each copy
-    rotated, scaled and shifted at random (affine, so every copy stays valid)."""
+    rotated, scaled and shifted at random (affine, so every copy stays valid),
+    written as a GeoParquet folder of `files` files (one Dask partition each)."""
     import geopandas as gpd
     import pandas as pd
     import pyogrio
@@ -55,19 +56,26 @@ def generate(n: int, path: Path, seed: int = 1) -> Path:
     tile = np.repeat(np.arange(tiles), len(base))[:n]
     gdf = gpd.GeoDataFrame({"tile": tile, "island": np.tile(np.arange(len(base)), tiles)[:n]},
                            geometry=geoms, crs=src.crs, index=pd.RangeIndex(1, n + 1, name="fid"))
-    path.parent.mkdir(parents=True, exist_ok=True)
-    gdf.to_parquet(path, index=True, row_group_size=max(1, n // 64))
+    import shutil
+
+    shutil.rmtree(path, ignore_errors=True)
+    path.mkdir(parents=True)
+    bounds = np.linspace(0, n, files + 1).astype(int)
+    for i, (a, b) in enumerate(zip(bounds[:-1], bounds[1:])):
+        gdf.iloc[a:b].to_parquet(path / f"part.{i:03d}.parquet", index=True)
     return path
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--input", type=Path, help="a GeoParquet file (default: the training islands)")
-    ap.add_argument("--generate", type=int, metavar="N", help="write N tiled copies of the islands to --input first")
+    ap.add_argument("--input", type=Path, help="a GeoParquet file or folder (default: the training islands)")
+    ap.add_argument("--generate", type=int, metavar="N",
+                    help="write N tiled copies of the islands to the folder --input first (16 files)")
     ap.add_argument("--pipeline", type=Path, default=ROOT / "pipelines/islands.yaml")
     ap.add_argument("--workers", type=int, default=2, help="local worker processes (without --scheduler)")
     ap.add_argument("--scheduler", help="address of a running scheduler instead of a local cluster")
-    ap.add_argument("--partitions", type=int, default=0, help="default: 4 per worker")
+    ap.add_argument("--partitions", type=int, default=0,
+                    help="default: one per file of --input, 4 per worker for the training islands")
     ap.add_argument("--output", type=Path, help="a GeoParquet folder the workers write")
     args = ap.parse_args()
 
@@ -78,7 +86,7 @@ def main() -> None:
     import skeletonise
 
     if args.generate:
-        args.input = args.input or ROOT / "target/bench/islands-generated.parquet"
+        args.input = args.input or ROOT / "target/bench/islands-generated"
         generate(args.generate, args.input)
 
     if args.scheduler:
@@ -88,12 +96,15 @@ def main() -> None:
                                            host="127.0.0.1", dashboard_address=None)
         client = distributed.Client(cluster)
     workers = len(client.scheduler_info()["workers"])
-    nparts = args.partitions or 4 * workers
     if args.input:
-        ddf = dask_geopandas.read_parquet(args.input).repartition(npartitions=nparts)
+        # Every worker reads its own files: no partition passes through one process.
+        ddf = dask_geopandas.read_parquet(args.input)
+        if args.partitions and args.partitions != ddf.npartitions:
+            ddf = ddf.repartition(npartitions=args.partitions)
     else:
         gdf = pyogrio.read_dataframe(ROOT / "tests/data/gshhg-train.gpkg", layer="islands_hebrides", fid_as_index=True)
-        ddf = dask_geopandas.from_geopandas(gdf, npartitions=nparts)
+        ddf = dask_geopandas.from_geopandas(gdf, npartitions=args.partitions or 4 * workers)
+    nparts = ddf.npartitions
 
     pipeline = str(args.pipeline.resolve())
     # The result's columns and types, from an empty partition (no work).
@@ -102,16 +113,17 @@ def main() -> None:
 
     start = time.perf_counter()
     if args.output:
-        skeletons.to_parquet(args.output)
-        summary = {}
+        skeletons.to_parquet(args.output, overwrite=True)
+        elapsed = time.perf_counter() - start
+        out = dask_geopandas.read_parquet(args.output)[["method", "rejected"]].compute()
     else:
         out = skeletons.compute()
-        summary = {
-            "rows": len(out),
-            "rejected": int(out["rejected"].notna().sum()),
-            "methods": out["method"].value_counts().to_dict(),
-        }
-    elapsed = time.perf_counter() - start
+        elapsed = time.perf_counter() - start
+    summary = {
+        "rows": len(out),
+        "rejected": int(out["rejected"].notna().sum()),
+        "methods": out["method"].value_counts().to_dict(),
+    }
     print(json.dumps({"workers": workers, "partitions": nparts, "elapsed_s": round(elapsed, 3), **summary}))
     client.close()
 

@@ -192,7 +192,9 @@ def _decode(geometry: tuple) -> np.ndarray:
     return out
 
 
-_DTYPES = {"int32": "Int32", "int64": "Int64", "real": "float64", "text": object}
+# Nullable integers and strings, so that an empty frame (a Dask meta) has types
+# that Arrow and GeoParquet know.
+_DTYPES = {"int32": "Int32", "int64": "Int64", "real": "float64", "text": "string"}
 
 
 def _column(kind: str, values: Any) -> Any:
@@ -201,7 +203,7 @@ def _column(kind: str, values: Any) -> Any:
         return pd.array(pd.arrays.IntegerArray(v, null), dtype=_DTYPES[kind])
     if kind == "real":
         return values
-    return np.asarray(values, dtype=object)
+    return pd.array(values, dtype=_DTYPES[kind])
 
 
 def _fids(index: pd.Index | None, n: int) -> np.ndarray:
@@ -247,7 +249,7 @@ def _run(
     layer = "candidates" if candidates else "skeletons"
     out_index = (index if index is not None else pd.RangeIndex(len(arr))).take(rows)
     tool: dict[str, Any] = {name: _column(kind, values) for name, kind, values in done["columns"]}
-    tool["rejected"] = np.asarray(done["rejected"], dtype=object)
+    tool["rejected"] = pd.array(done["rejected"], dtype="string")
     frame = pd.DataFrame(tool, index=out_index)
     if attributes is not None and len(attributes.columns) and _core.columns(layer, False)[1]:
         # Source fields first, renamed where they clash with the tool's (as the writer does).

@@ -30,7 +30,7 @@ def test_columns_are_the_skeletons_layer_then_rejected_and_the_geometry():
     out = skeletonise.skeletonise(gpd.GeoSeries([RIVER]))
     assert list(out.columns) == names + ["rejected", "geometry"]
     assert str(out["legs"].dtype) == "Int32" and str(out["src_fid"].dtype) == "Int64"
-    assert out["coverage"].dtype == np.float64
+    assert out["coverage"].dtype == np.float64 and str(out["method"].dtype) == "string"
 
 
 def test_a_rectangle_gets_the_centre_line_from_ma():
