@@ -58,6 +58,18 @@ def cli_elapsed(binary: str, layer: str, pipeline: str) -> float:
         return float(runs["elapsed_s"].iloc[0])
 
 
+def idle_cores(seconds: float = 5.0) -> float:
+    """Cores left idle by everything on the machine over `seconds` (/proc/stat)."""
+    def sample():
+        with open("/proc/stat") as f:
+            v = [int(x) for x in f.readline().split()[1:]]
+        return v[3] + v[4], sum(v)  # idle + iowait, all
+
+    (i0, t0), _ = sample(), time.sleep(seconds)
+    i1, t1 = sample()
+    return (os.cpu_count() or 1) * (i1 - i0) / max(1, t1 - t0)
+
+
 def row(*cells) -> None:
     print("| " + " | ".join(str(c) for c in cells) + " |")
 
@@ -66,7 +78,8 @@ def main() -> None:
     binary = sys.argv[1]
     n = int(sys.argv[2]) if len(sys.argv) > 2 else 100_000
     repeat = int(sys.argv[3]) if len(sys.argv) > 3 else 3
-    print(f"load average at the start: {os.getloadavg()[0]:.1f} ({os.cpu_count()} cores); best of {repeat} runs")
+    print(f"load average at the start: {os.getloadavg()[0]:.1f} ({os.cpu_count()} cores, "
+          f"{idle_cores():.1f} idle over 5 s); best of {repeat} runs")
     results: dict = {"cli_vs_python": [], "pygeoops": [], "dask": {}}
 
     print("\n## The command line against skeletonise.apply (same pipeline, same layer)\n")
@@ -141,17 +154,19 @@ def main() -> None:
     del big
     print(f"\n## Dask: examples/dask_islands.py on {n} generated polygons (16 GeoParquet files), pipelines/islands.yaml,")
     print("every worker reading its files and writing its partitions to GeoParquet\n")
-    row("workers", "partitions", "elapsed s (each run)", "best s", "rows", "rejected")
-    row(*["---"] * 6)
+    row("workers", "partitions", "elapsed s (each run)", "best s", "idle cores before each run", "rows", "rejected")
+    row(*["---"] * 7)
     runs: dict[int, list] = {1: [], 2: []}
+    idle: dict[int, list] = {1: [], 2: []}
     for workers in (1, 2, 2, 1):  # interleaved: a spell of other load hits both
+        idle[workers].append(idle_cores())
         p = subprocess.run(script + ["--workers", str(workers), "--output", str(ROOT / "target/bench/skeletons")],
                            check=True, capture_output=True, text=True, cwd=ROOT)
         runs[workers].append(json.loads(p.stdout.strip().splitlines()[-1]))
     for workers, rs in runs.items():
         best = min(rs, key=lambda r: r["elapsed_s"])
         row(workers, best["partitions"], ", ".join(f"{r['elapsed_s']:.1f}" for r in rs), f"{best['elapsed_s']:.1f}",
-            best["rows"], best["rejected"])
+            ", ".join(f"{c:.1f}" for c in idle[workers]), best["rows"], best["rejected"])
         results["dask"][workers] = {**best, "runs_s": [r["elapsed_s"] for r in rs]}
     one, two = results["dask"][1]["elapsed_s"], results["dask"][2]["elapsed_s"]
     print(f"\n2 workers against 1: {one / two:.2f}× faster")
