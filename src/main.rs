@@ -88,6 +88,9 @@ enum Command {
         /// Worker threads (default: one per core).
         #[arg(long)]
         threads: Option<usize>,
+        /// Without a terminal, log a progress line every so many seconds.
+        #[arg(long, value_name = "SECONDS", default_value_t = 10.0, value_parser = seconds)]
+        progress_every: f64,
     },
     /// Check a pipeline file and its input without processing anything.
     Validate {
@@ -175,6 +178,16 @@ impl ScoreArgs {
     }
 }
 
+/// A number of seconds ≥ 0 (a week at most).
+fn seconds(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if (0.0..=604_800.0).contains(&v) => Ok(v),
+        _ => Err(format!(
+            "`{s}` is not a number of seconds between 0 and 604800"
+        )),
+    }
+}
+
 fn init_logging(cli: &Cli) {
     let level = if cli.quiet {
         "warn"
@@ -210,8 +223,18 @@ fn run_error(e: RunError) -> ExitCode {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     init_logging(&cli);
+    skeletonise::io::gdal_errors::install();
+    if let Err(e) = skeletonise::io::signals::install() {
+        tracing::warn!(
+            "signal handlers not installed ({e}): a killed run may leave its temporary file"
+        );
+    }
     match &cli.command {
-        Command::Run { file, threads } => cmd_run(&cli, file, *threads),
+        Command::Run {
+            file,
+            threads,
+            progress_every,
+        } => cmd_run(&cli, file, *threads, *progress_every),
         Command::Validate { file } => cmd_validate(file),
         Command::Score(args) => cmd_score(args),
         Command::Methods => {
@@ -253,7 +276,7 @@ fn log_summary(s: &pipeline::RunSummary) {
     );
 }
 
-fn cmd_run(cli: &Cli, file: &PipelineArgs, threads: Option<usize>) -> ExitCode {
+fn cmd_run(cli: &Cli, file: &PipelineArgs, threads: Option<usize>, every: f64) -> ExitCode {
     let p = match file.load() {
         Ok(p) => p,
         Err(c) => return c,
@@ -264,6 +287,7 @@ fn cmd_run(cli: &Cli, file: &PipelineArgs, threads: Option<usize>) -> ExitCode {
             && std::io::stderr().is_terminal()
             && matches!(cli.log_format, LogFormat::Text),
         batch_size: None,
+        progress_every: Some(std::time::Duration::from_secs_f64(every)),
     };
     match pipeline::run(&p, &opts) {
         Ok(s) => {
@@ -282,13 +306,15 @@ fn cmd_validate(file: &PipelineArgs) -> ExitCode {
     match pipeline::validate(&p) {
         Ok(info) => {
             let fields: Vec<&str> = info.fields.iter().map(|f| f.name.as_str()).collect();
+            let n =
+                |c: Option<u64>| c.map_or_else(|| "an unknown number of".into(), |n| n.to_string());
             println!(
                 "{}: valid. input `{}` layer `{}`: {} features ({} after filters), CRS {}, fields: {}; output {}",
                 p.origin,
                 info.source,
                 info.layer,
-                info.total,
-                info.selected,
+                n(info.total),
+                n(info.selected),
                 info.crs_name,
                 fields.join(", "),
                 p.file.output.path

@@ -242,6 +242,8 @@ pub struct SkeletonRow {
     pub legs: usize,
     /// MakeValid changed the input.
     pub repaired: bool,
+    /// Why the scores are missing, when they are.
+    pub note: Option<String>,
 }
 
 impl Scored for SkeletonRow {
@@ -267,6 +269,7 @@ pub const SKELETONS: LayerDef<SkeletonRow> = LayerDef {
             col("components", Int32, |r: &SkeletonRow| int(r.components)),
             col("legs", Int32, |r: &SkeletonRow| int(r.legs)),
             col("repaired", Int32, |r: &SkeletonRow| int(i64::from(r.repaired))),
+            col("note", Text, |r: &SkeletonRow| r.note.as_deref().map_or(Cell::Null, text)),
         ],
     ),
 };
@@ -523,7 +526,8 @@ mod tests {
                 "distortion",
                 "components",
                 "legs",
-                "repaired"
+                "repaired",
+                "note"
             ]
         );
         let cands: Vec<&str> = CANDIDATES.column_names().collect();

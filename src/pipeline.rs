@@ -28,6 +28,9 @@ pub struct RunOptions {
     pub progress: bool,
     /// Features per batch (default 256).
     pub batch_size: Option<usize>,
+    /// Without a progress bar, log a progress line this often (default
+    /// [`PROGRESS_EVERY`]).
+    pub progress_every: Option<std::time::Duration>,
 }
 
 /// What a run did.
@@ -68,14 +71,23 @@ pub enum RunError {
     /// The thread pool could not be created.
     #[error("cannot start {0} worker threads")]
     Threads(usize),
+    /// More worker threads than make sense.
+    #[error("`--threads {asked}`: give between 1 and {MAX_THREADS} worker threads (this machine has {cores} cores), or leave it out for one per core")]
+    TooManyThreads {
+        /// Threads asked for.
+        asked: usize,
+        /// Cores of this machine.
+        cores: usize,
+    },
 }
 
 /// Checks everything `run` checks before processing: the input opens, the
 /// layer exists, the CRS is projected (or reprojected), the filter is valid
 /// and the output can be written. Returns what the source holds.
 pub fn validate(p: &Pipeline) -> Result<crate::io::SourceInfo, RunError> {
-    let reader = Reader::open(&p.file.input)?;
-    check_output(&p.file.output)?;
+    let mut reader = Reader::open(&p.file.input)?;
+    reader.probe()?;
+    check_output(&p.file.output, &[&p.file.input.source])?;
     Ok(reader.info().clone())
 }
 
@@ -106,6 +118,8 @@ pub struct Job<'a> {
     pub on_error: OnError,
     /// The skeletons when another tool made them.
     pub given: Option<&'a Given>,
+    /// Other data sources the job reads (never to be written over).
+    pub other_inputs: Vec<String>,
 }
 
 impl<'a> Job<'a> {
@@ -119,6 +133,7 @@ impl<'a> Job<'a> {
             params: p.process_params(),
             on_error: p.file.on_error,
             given: None,
+            other_inputs: Vec::new(),
         }
     }
 
@@ -176,18 +191,92 @@ impl Counts {
     }
 }
 
-fn progress_bar(show: bool, len: u64) -> ProgressBar {
-    if !show {
-        return ProgressBar::hidden();
+/// Progress: a bar on a terminal, otherwise a log line every
+/// [`PROGRESS_EVERY`] (features done, rate, time left) so that a scheduled
+/// job's log shows that a long run is alive.
+struct Progress {
+    bar: ProgressBar,
+    log: bool,
+    every: std::time::Duration,
+    total: Option<u64>,
+    done: u64,
+    started: Instant,
+    last: Instant,
+}
+
+/// How often a run without a terminal logs its progress.
+pub const PROGRESS_EVERY: std::time::Duration = std::time::Duration::from_secs(10);
+
+impl Progress {
+    fn new(terminal: bool, total: Option<u64>, every: std::time::Duration) -> Self {
+        let bar = match (terminal, total) {
+            (false, _) => ProgressBar::hidden(),
+            (true, Some(n)) => {
+                let b = ProgressBar::new(n);
+                b.set_style(
+                    ProgressStyle::with_template(
+                        "{spinner} {bar:40} {pos}/{len} features {elapsed_precise} (eta {eta})",
+                    )
+                    .unwrap_or_else(|_| ProgressStyle::default_bar()),
+                );
+                b
+            }
+            (true, None) => ProgressBar::new_spinner(),
+        };
+        let now = Instant::now();
+        Self {
+            bar,
+            log: !terminal,
+            every,
+            total,
+            done: 0,
+            started: now,
+            last: now,
+        }
     }
-    let b = ProgressBar::new(len);
-    b.set_style(
-        ProgressStyle::with_template(
-            "{spinner} {bar:40} {pos}/{len} features {elapsed_precise} (eta {eta})",
-        )
-        .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    b
+
+    fn add(&mut self, n: u64) {
+        self.done += n;
+        self.bar.inc(n);
+        if !self.log || self.last.elapsed() < self.every {
+            return;
+        }
+        self.last = Instant::now();
+        let secs = self.started.elapsed().as_secs_f64();
+        let rate = self.done as f64 / secs.max(1e-9);
+        let eta = self
+            .total
+            .filter(|_| rate > 0.0)
+            .map(|t| format!("{:.0} s", t.saturating_sub(self.done) as f64 / rate))
+            .unwrap_or_else(|| "unknown".into());
+        let of = self.total.map_or_else(|| "?".into(), |t| t.to_string());
+        tracing::info!(
+            done = self.done,
+            total = self.total,
+            rate = format!("{rate:.1}"),
+            "progress: {} of {of} features, {rate:.1}/s, {eta} left",
+            self.done
+        );
+    }
+
+    fn finish(&self) {
+        self.bar.finish_and_clear();
+    }
+}
+
+/// Most worker threads a run may ask for: beyond a few per core they only
+/// cost memory, and thousands make the thread pool's start crawl.
+pub const MAX_THREADS: usize = 256;
+
+/// The number of worker threads to run: `asked`, or one per core.
+pub fn worker_threads(asked: Option<usize>) -> Result<usize, RunError> {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    match asked {
+        None => Ok(rayon::current_num_threads()),
+        Some(0) => Err(RunError::TooManyThreads { asked: 0, cores }),
+        Some(n) if n > MAX_THREADS => Err(RunError::TooManyThreads { asked: n, cores }),
+        Some(n) => Ok(n),
+    }
 }
 
 /// Runs a job: read in batches → process each batch's features in parallel
@@ -195,10 +284,12 @@ fn progress_bar(show: bool, len: u64) -> ProgressBar {
 pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError> {
     let started = chrono::Utc::now();
     let clock = Instant::now();
+    let threads = worker_threads(opts.threads)?;
     let mut reader = Reader::open(job.input)?;
     let info = reader.info().clone();
-    let mut writer = Writer::create(job.output, &info)?;
-    let threads = opts.threads.unwrap_or_else(rayon::current_num_threads);
+    let mut inputs = vec![job.input.source.as_str()];
+    inputs.extend(job.other_inputs.iter().map(String::as_str));
+    let mut writer = Writer::create(job.output, &info, &inputs)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
@@ -209,11 +300,12 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
         layer = %info.layer,
         crs = %info.crs_name,
         features = info.selected,
-        filtered_by_source = info.total.saturating_sub(info.selected),
+        total_features = info.total,
         threads,
         "run started"
     );
-    let bar = progress_bar(opts.progress, info.selected);
+    let every = opts.progress_every.unwrap_or(PROGRESS_EVERY);
+    let mut progress = Progress::new(opts.progress, info.selected, every);
     let row_opts = RowOptions::from(job.output);
     let mut counts = Counts::default();
     let batch = opts.batch_size.unwrap_or(256).max(1);
@@ -231,15 +323,16 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
             rows.append(r.rows);
         }
         writer.write_batch(&rows)?;
-        bar.inc(features.len() as u64);
+        progress.add(features.len() as u64);
         Ok(())
     });
-    bar.finish_and_clear();
+    progress.finish();
     if let Err(e) = result {
         writer.abort();
         return Err(e);
     }
-    counts.filtered += info.total.saturating_sub(info.selected);
+    // What `where` and `bbox` kept back (unknown when the driver cannot count).
+    counts.filtered += info.total.map_or(0, |t| t.saturating_sub(counts.read));
     let elapsed_s = clock.elapsed().as_secs_f64();
     let record = RunRecord {
         name: job.name.clone(),

@@ -43,6 +43,29 @@ pub struct InputSpec {
 }
 
 impl InputSpec {
+    /// Checks the section: `(key, message)` of the first wrong option.
+    pub fn validate(&self) -> Result<(), (String, String)> {
+        if self.source.trim().is_empty() {
+            return Err(("source".into(), "give the input data source".into()));
+        }
+        if let Some([x0, y0, x1, y1]) = self.bbox {
+            if ![x0, y0, x1, y1].iter().all(|v| v.is_finite()) {
+                return Err((
+                    "bbox".into(),
+                    "bbox values must be finite numbers [xmin, ymin, xmax, ymax] in the source CRS"
+                        .into(),
+                ));
+            }
+            if x0 > x1 || y0 > y1 {
+                return Err((
+                    "bbox".into(),
+                    format!("bbox [{x0}, {y0}, {x1}, {y1}] is empty: xmin ≤ xmax and ymin ≤ ymax"),
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// A whole layer of a source by name: no filter, no reprojection.
     pub fn layer(source: &str, layer: &str) -> Self {
         Self {

@@ -48,7 +48,7 @@ impl PreparedPolygon {
     /// Normalises `polygon` (orientation, closing, duplicate vertices, degenerate
     /// holes dropped) and builds its boundary index.
     pub fn new(polygon: &Polygon<f64>) -> Result<Self, GeometryError> {
-        let polygon = ring::normalise_polygon(polygon)?;
+        let polygon = validity::split_touches(&ring::normalise_polygon(polygon)?);
         let boundary = Boundary::new(&polygon);
         let extent = boundary.extent();
         Ok(Self {

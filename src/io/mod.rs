@@ -2,7 +2,9 @@
 //! owned features with `geo` geometries; the [`writer`] writes the
 //! GeoPackage layers. No GDAL type leaves this module.
 
+pub mod gdal_errors;
 pub mod reader;
+pub mod signals;
 pub mod writer;
 
 pub use reader::{read_layer_polygons, FieldInfo, InputSpec, LayerRef, Reader, SourceInfo};
@@ -30,6 +32,14 @@ pub enum IoError {
         layer: String,
         /// Comma-separated names of the layers that exist.
         available: String,
+    },
+    /// Reading the source failed.
+    #[error("reading `{source_name}` failed: {reason}; the run stops, nothing is written")]
+    Read {
+        /// The data source string.
+        source_name: String,
+        /// GDAL's messages.
+        reason: String,
     },
     /// The attribute filter was rejected by OGR.
     #[error("invalid `input.where` filter `{filter}`: {reason}; use OGR SQL syntax, e.g. \"area_m2 > 1e6\"")]
@@ -80,10 +90,17 @@ pub enum IoError {
 }
 
 impl IoError {
+    /// A GDAL failure while doing `context`, with GDAL's own last message
+    /// (the error value alone often only says "returned error: '6'").
     pub(crate) fn gdal(context: impl Into<String>, e: impl std::fmt::Display) -> Self {
+        let e = e.to_string();
+        let reason = match gdal_errors::last_failure() {
+            Some(m) if !e.contains(&m) => format!("{m} ({e})"),
+            _ => e,
+        };
         IoError::Gdal {
             context: context.into(),
-            reason: e.to_string(),
+            reason,
         }
     }
 }

@@ -41,10 +41,10 @@ pub struct SourceInfo {
     pub srs_wkt: Option<String>,
     /// Human-readable name of that CRS.
     pub crs_name: String,
-    /// Features in the layer without filters.
-    pub total: u64,
-    /// Features that pass `where` and `bbox`.
-    pub selected: u64,
+    /// Features in the layer without filters (`None`: the driver cannot tell).
+    pub total: Option<u64>,
+    /// Features that pass `where` and `bbox` (`None`: the driver cannot tell).
+    pub selected: Option<u64>,
 }
 
 /// An open input layer.
@@ -99,6 +99,25 @@ fn target_srs(
     Ok(Some(traditional(srs)))
 }
 
+/// Whether two sources hand out geometries in the same CRS (`None` when
+/// either has none).
+pub fn same_crs(a: &SourceInfo, b: &SourceInfo) -> Option<bool> {
+    let srs = |i: &SourceInfo| {
+        i.srs_wkt
+            .as_deref()
+            .and_then(|w| SpatialRef::from_wkt(w).ok())
+    };
+    Some(srs(a)? == srs(b)?)
+}
+
+/// The feature count of a layer (as filtered), `None` when the driver cannot
+/// tell (it returns −1).
+fn count(layer: &gdal::vector::Layer<'_>) -> Option<u64> {
+    // SAFETY: the handle is valid for the lifetime of `layer`.
+    let n = unsafe { gdal_sys::OGR_L_GetFeatureCount(layer.c_layer(), 1) };
+    u64::try_from(n).ok()
+}
+
 fn traditional(mut s: SpatialRef) -> SpatialRef {
     s.set_axis_mapping_strategy(AxisMappingStrategy::TraditionalGisOrder);
     s
@@ -107,6 +126,8 @@ fn traditional(mut s: SpatialRef) -> SpatialRef {
 impl Reader {
     /// Opens the source and layer and checks filters and CRS; reads nothing.
     pub fn open(spec: &InputSpec) -> Result<Self, IoError> {
+        super::gdal_errors::install();
+        super::gdal_errors::clear();
         let dataset = Dataset::open_ex(
             &spec.source,
             DatasetOptions {
@@ -123,7 +144,7 @@ impl Reader {
             .layer(layer_index)
             .map_err(|e| IoError::gdal("opening the layer", e))?;
         let layer_name = layer.name();
-        let total = layer.feature_count();
+        let total = count(&layer);
         let fields = layer
             .defn()
             .fields()
@@ -134,13 +155,25 @@ impl Reader {
                 precision: f.precision(),
             })
             .collect();
-        let source_srs = layer.spatial_ref();
+        // A GeoPackage without a CRS reports an "Undefined geographic /
+        // Cartesian SRS": that is no CRS.
+        let source_srs = layer
+            .spatial_ref()
+            .filter(|s| !s.name().is_some_and(|n| n.starts_with("Undefined")));
         let target = target_srs(spec, source_srs.as_ref(), &layer_name)?;
         let out_srs = target.as_ref().or(source_srs.as_ref());
         let srs_wkt = out_srs.and_then(|s| s.to_wkt().ok());
         let crs_name = out_srs.map_or_else(|| "(no CRS)".into(), crs_name);
         Self::apply_filters(&mut layer, spec)?;
-        let selected = layer.feature_count();
+        let selected = count(&layer);
+        // Some drivers (GeoPackage) accept a bad filter and only report it
+        // when it is used: counting used it.
+        if let (Some(w), [first, ..]) = (&spec.where_, &super::gdal_errors::take_failures()[..]) {
+            return Err(IoError::BadWhere {
+                filter: w.clone(),
+                reason: first.clone(),
+            });
+        }
         let info = SourceInfo {
             source: spec.source.clone(),
             layer: layer_name,
@@ -181,6 +214,37 @@ impl Reader {
                 .ok_or_else(|| no_layer(format!("`{n}`"))),
             Some(other) => Err(no_layer(other.to_string())),
         }
+    }
+
+    /// Reads the first selected feature and drops it: a filter or a source
+    /// that fails only when read fails here (`validate`).
+    pub fn probe(&mut self) -> Result<(), IoError> {
+        let mut layer = self
+            .dataset
+            .layer(self.layer_index)
+            .map_err(|e| IoError::gdal("opening the layer", e))?;
+        Self::apply_filters(&mut layer, &self.spec)?;
+        super::gdal_errors::clear();
+        let _ = layer.features().next();
+        self.check_read()
+    }
+
+    /// The failures GDAL reported while reading, as an error.
+    fn check_read(&self) -> Result<(), IoError> {
+        let failures = super::gdal_errors::take_failures();
+        if failures.is_empty() {
+            return Ok(());
+        }
+        Err(match &self.spec.where_ {
+            Some(w) => IoError::BadWhere {
+                filter: w.clone(),
+                reason: failures.join("; "),
+            },
+            None => IoError::Read {
+                source_name: self.spec.source.clone(),
+                reason: failures.join("; "),
+            },
+        })
     }
 
     fn apply_filters(layer: &mut gdal::vector::Layer<'_>, spec: &InputSpec) -> Result<(), IoError> {
@@ -225,7 +289,10 @@ impl Reader {
         };
         let n_fields = self.info.fields.len();
         let mut buf = Vec::with_capacity(batch);
+        super::gdal_errors::clear();
         for f in layer.features() {
+            // Failures while fetching the feature are the source's.
+            self.check_read()?;
             let attributes = (0..n_fields)
                 .map(|i| value(f.field(i).ok().flatten()))
                 .collect();
@@ -251,12 +318,19 @@ impl Reader {
                     }
                     Err(e) => feat.geometry_error = Some(e),
                 }
+                // What GDAL reported while converting (a reprojection or a
+                // repair that failed) is this feature's reason, not the run's.
+                super::gdal_errors::clear();
             }
             buf.push(feat);
             if buf.len() >= batch {
                 on_batch(std::mem::take(&mut buf))?;
             }
         }
+        // A source that fails part way (a broken file, a dropped
+        // connection) ends the feature loop early: that is an error, not the
+        // end of the data.
+        self.check_read()?;
         if !buf.is_empty() {
             on_batch(buf)?;
         }

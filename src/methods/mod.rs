@@ -12,6 +12,7 @@
 //! parsing, help, schema and construction come from the entry. Every method returns a [`SkeletonGraph`] whose node radii are
 //! distances to ∂P, whose points lie in P and whose edges do not cross ∂P.
 
+pub mod budget;
 pub mod cdt;
 pub mod medial_axis;
 pub mod straight_skeleton;
@@ -124,6 +125,14 @@ pub enum MethodError {
         /// The configured cap.
         max: usize,
     },
+    /// The method ran out of its time budget on this polygon.
+    #[error("{method} stopped after {seconds} s on this polygon (`skeleton.timeout_s`); raise the budget, or leave {method} out for such polygons")]
+    TimedOut {
+        /// The method.
+        method: MethodId,
+        /// The budget, in seconds.
+        seconds: f64,
+    },
     /// The boundary could not be triangulated or diagrammed.
     #[error("{method} failed: {reason}")]
     Failed {
@@ -169,6 +178,14 @@ pub struct SkeletonParams {
     /// MA's options.
     #[serde(flatten)]
     pub medial_axis: medial_axis::MedialAxisOptions,
+    /// Most seconds one method may spend on one polygon part; past it that
+    /// method fails for that feature with the reason (0: no limit).
+    #[serde(default = "default_timeout_s")]
+    pub timeout_s: f64,
+}
+
+fn default_timeout_s() -> f64 {
+    120.0
 }
 
 impl SkeletonParams {
@@ -195,8 +212,19 @@ impl SkeletonParams {
         if let Some(d) = self.methods.iter().find(|m| !seen.insert(**m)) {
             return Err(("methods".into(), format!("method {d} is listed twice")));
         }
+        if !(self.timeout_s >= 0.0 && self.timeout_s.is_finite()) {
+            return Err((
+                "timeout_s".into(),
+                "timeout_s is a number of seconds ≥ 0 (0: no limit)".into(),
+            ));
+        }
         self.voronoi.validate()?;
         self.medial_axis.validate()
+    }
+
+    /// The time budget per method and polygon part (`None`: no limit).
+    pub fn budget(&self) -> Option<std::time::Duration> {
+        (self.timeout_s > 0.0).then(|| std::time::Duration::from_secs_f64(self.timeout_s))
     }
 }
 
@@ -207,6 +235,7 @@ impl Default for SkeletonParams {
             reference: default_reference(),
             voronoi: voronoi::VoronoiOptions::default(),
             medial_axis: medial_axis::MedialAxisOptions::default(),
+            timeout_s: default_timeout_s(),
         }
     }
 }

@@ -90,11 +90,11 @@ pub(super) fn part_skeletons(
     let raws: Vec<Result<crate::graph::SkeletonGraph, String>> = methods
         .par_iter()
         .map(|&m| {
-            params
-                .registry
-                .build(m, &params.skeleton)?
-                .skeletonise(p)
-                .map_err(|e| e.to_string())
+            let method = params.registry.build(m, &params.skeleton)?;
+            crate::methods::budget::with_deadline(m, params.skeleton.budget(), || {
+                method.skeletonise(p)
+            })
+            .map_err(|e| e.to_string())
         })
         .collect();
     let finish = |raw: &crate::graph::SkeletonGraph| {
@@ -103,18 +103,15 @@ pub(super) fn part_skeletons(
     let shared = params
         .prune
         .filter(|pr| pr.mode != PruneMode::None && pr.structure == Sharing::Shared);
-    let reference = shared.and_then(|_| {
+    // The first method in the reference order whose finished skeleton is
+    // not empty (a polygon thinner than MA's grid has no medial axis).
+    let trunk = params.prune.is_some_and(|pr| pr.mode == PruneMode::Trunk);
+    let structure = shared.and_then(|_| {
         params.skeleton.reference_order().into_iter().find_map(|m| {
-            methods
-                .iter()
-                .position(|&x| x == m)
-                .filter(|&k| raws[k].is_ok())
+            let k = methods.iter().position(|&x| x == m)?;
+            let g = finish(raws[k].as_ref().ok()?);
+            (!g.is_empty()).then(|| (k, Structure::of(&g, p, trunk), g))
         })
-    });
-    let structure = reference.map(|k| {
-        let g = finish(raws[k].as_ref().expect("the reference succeeded"));
-        let trunk = params.prune.is_some_and(|pr| pr.mode == PruneMode::Trunk);
-        (k, Structure::of(&g, p, trunk), g)
     });
     raws.par_iter()
         .enumerate()

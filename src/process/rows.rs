@@ -128,6 +128,17 @@ fn units(
     }
 }
 
+/// Why a scored skeleton has no scores, if it has none.
+fn score_note(s: &crate::score::Scores) -> Option<String> {
+    match (s.bars, s.hits) {
+        (0, _) => Some("the polygon has no bars to score its skeleton with; the scores are NULL".into()),
+        (n, 0) => Some(format!(
+            "none of the {n} bars hits the skeleton: the polygon is too thin to score at its scale (bars shorter than a millionth of its extent); the scores are NULL"
+        )),
+        _ => None,
+    }
+}
+
 fn rejected(f: &Feature, reason: String) -> RejectedRow {
     RejectedRow {
         src_fid: f.fid,
@@ -158,6 +169,7 @@ fn outcome_rows(
         components: chosen.components,
         legs: chosen.legs,
         repaired: f.repaired,
+        note: chosen.scores.and_then(|s| score_note(&s)),
     });
     if opts.widths {
         rows.widths.extend(chosen.widths.iter().map(|w| WidthRow {

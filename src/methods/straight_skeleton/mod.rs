@@ -277,6 +277,9 @@ impl<'a> Propagation<'a> {
         self.drain_work()?;
         while let Some(ev) = self.q.pop() {
             self.stats.pops += 1;
+            if self.stats.pops.is_multiple_of(4096) {
+                crate::methods::budget::check()?;
+            }
             if self.stats.pops > self.max_pops {
                 return Err(fail(format!(
                     "straight skeleton did not finish within {} events",
