@@ -224,6 +224,11 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     init_logging(&cli);
     skeletonise::io::gdal_errors::install();
+    // A panic (a bug; the per-feature path turns it into a rejection or a
+    // failed method) is logged in the run's log format, not printed raw.
+    std::panic::set_hook(Box::new(|info| {
+        tracing::error!(target: "skeletonise::panic", "internal error: {info}");
+    }));
     if let Err(e) = skeletonise::io::signals::install() {
         tracing::warn!(
             "signal handlers not installed ({e}): a killed run may leave its temporary file"

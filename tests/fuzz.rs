@@ -57,6 +57,7 @@ fn check(geom: &Geometry<f64>, p: &ProcessParams) -> Result<(), String> {
         .map_err(|_| "process panicked".to_string())?;
     match r {
         Processed::Filtered => Ok(()),
+        Processed::Rejected(reason) if reason.contains("internal error") => Err(reason),
         Processed::Rejected(reason) if !reason.trim().is_empty() => Ok(()),
         Processed::Rejected(_) => Err("rejected without a reason".into()),
         Processed::Done(o) => {
@@ -70,7 +71,11 @@ fn check(geom: &Geometry<f64>, p: &ProcessParams) -> Result<(), String> {
             let pp = PreparedPolygon::new(poly).map_err(|e| e.to_string())?;
             let tol = 1e-6 * pp.extent();
             for c in &o.candidates {
-                let Ok(s) = &c.result else { continue };
+                let s = match &c.result {
+                    Err(e) if e.contains("internal error") => return Err(e.clone()),
+                    Err(_) => continue,
+                    Ok(s) => s,
+                };
                 for l in &s.geometry.0 {
                     for &q in &l.0 {
                         if !pp.boundary().contains_with_tolerance(q, tol) {

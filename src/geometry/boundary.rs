@@ -71,6 +71,13 @@ pub struct Boundary {
     max: Coord<f64>,
 }
 
+/// A point every query can take: the R-tree's nearest-neighbour search
+/// cannot order NaN distances, so a non-finite point (from a degenerate
+/// computation upstream) gets "no answer" instead.
+fn finite(c: Coord<f64>) -> bool {
+    c.x.is_finite() && c.y.is_finite()
+}
+
 fn pt(c: Coord<f64>) -> [f64; 2] {
     [c.x, c.y]
 }
@@ -271,6 +278,9 @@ impl Boundary {
 
     /// Nearest boundary point to `p`: (point, segment index, distance).
     pub fn nearest(&self, p: Coord<f64>) -> Option<(Coord<f64>, usize, f64)> {
+        if !finite(p) {
+            return None;
+        }
         let n = self.tree.nearest_neighbor(&pt(p))?;
         let s = &self.segments[n.data as usize];
         let (c, _) = s.closest(p);
@@ -279,6 +289,9 @@ impl Boundary {
 
     /// Euclidean distance from `p` to ∂P (the radius of every skeleton node).
     pub fn distance(&self, p: Coord<f64>) -> f64 {
+        if !finite(p) {
+            return f64::NAN;
+        }
         self.tree
             .nearest_neighbor(&pt(p))
             .map(|n| n.geom().distance_2(&pt(p)).sqrt())
@@ -330,6 +343,9 @@ impl Boundary {
         q: Coord<f64>,
         clip: impl Fn(Coord<f64>, Coord<f64>) -> Option<(Coord<f64>, Coord<f64>)>,
     ) -> Option<(Coord<f64>, f64)> {
+        if !finite(q) {
+            return None;
+        }
         let mut best: Option<(Coord<f64>, f64)> = None;
         for (item, d2) in self.tree.nearest_neighbor_iter_with_distance_2(&pt(q)) {
             if best.is_some_and(|(_, bd)| d2.sqrt() > bd) {

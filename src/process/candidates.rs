@@ -91,10 +91,12 @@ pub(super) fn part_skeletons(
         .par_iter()
         .map(|&m| {
             let method = params.registry.build(m, &params.skeleton)?;
-            crate::methods::budget::with_deadline(m, params.skeleton.budget(), || {
-                method.skeletonise(p)
+            guarded(m, || {
+                crate::methods::budget::with_deadline(m, params.skeleton.budget(), || {
+                    method.skeletonise(p)
+                })
+                .map_err(|e| e.to_string())
             })
-            .map_err(|e| e.to_string())
         })
         .collect();
     let finish = |raw: &crate::graph::SkeletonGraph| {
@@ -117,17 +119,37 @@ pub(super) fn part_skeletons(
         .enumerate()
         .map(|(k, raw)| {
             let raw = raw.as_ref().map_err(Clone::clone)?;
-            let g = match &structure {
-                Some((r, _, g)) if *r == k => g.clone(),
-                Some((_, s, _)) => conform(raw, s, p),
-                None => finish(raw),
-            };
+            let g = guarded(methods[k], || {
+                Ok(match &structure {
+                    Some((r, _, g)) if *r == k => g.clone(),
+                    Some((_, s, _)) => conform(raw, s, p),
+                    None => finish(raw),
+                })
+            })?;
             Ok(PartSkeleton {
                 graph: g,
                 legs_raw: raw.leg_count(),
             })
         })
         .collect()
+}
+
+/// Runs one method's work on one polygon; a panic (a bug, which must never
+/// end the run) becomes that method's error for this feature.
+fn guarded<T>(
+    m: crate::methods::MethodId,
+    f: impl FnOnce() -> Result<T, String>,
+) -> Result<T, String> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).unwrap_or_else(|e| {
+        let what = e
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| e.downcast_ref::<String>().cloned())
+            .unwrap_or_default();
+        Err(format!(
+            "{m} failed with an internal error ({what}); the other methods still ran — please report this polygon"
+        ))
+    })
 }
 
 /// One candidate from its finished skeleton of every polygon part: scored

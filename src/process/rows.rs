@@ -73,7 +73,8 @@ pub fn feature_rows(
     }
     let mut methods = Vec::new();
     for (part, geom) in units(f.geometry.as_ref(), opts.explode) {
-        let processed = match skeletons {
+        // A panic is a bug; it must cost this feature, never the run.
+        let processed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| match skeletons {
             Skeletons::Computed => process(geom.as_ref(), params),
             Skeletons::Given { label, lines } => match lines {
                 Some(l) => process_given(geom.as_ref(), l, label, params),
@@ -81,7 +82,12 @@ pub fn feature_rows(
                     "{label}: no skeleton lines joined to this polygon; check the join key or the skeletons' location"
                 )),
             },
-        };
+        }))
+        .unwrap_or_else(|_| {
+            Processed::Rejected(
+                "internal error while processing this feature; the run went on — please report it".into(),
+            )
+        });
         let label = match skeletons {
             Skeletons::Computed => None,
             Skeletons::Given { label, .. } => Some(label),
