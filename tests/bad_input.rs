@@ -93,8 +93,8 @@ macro_rules! geometry_case {
     ($name:ident, $wkts:expr, $args:expr, $want:expr $(, $reason:expr)?) => {
         #[test]
         fn $name() {
-            let out = case(stringify!($name), 3035, &$wkts, &$args, $want);
-            $( assert!(rejected_reason(&out).contains($reason), "{}: {}", stringify!($name), rejected_reason(&out)); )?
+            let _out = case(stringify!($name), 3035, &$wkts, &$args, $want);
+            $( assert!(rejected_reason(&_out).contains($reason), "{}: {}", stringify!($name), rejected_reason(&_out)); )?
         }
     };
 }
