@@ -32,8 +32,9 @@ fn fails(code: i32, message: &'static str) -> Expect {
     }
 }
 
-/// Runs the pipeline `extra` steps over a layer of `wkts` (EPSG `epsg`)
-/// with `args` and checks the outcome; returns the output path.
+/// Runs `pipelines/compare-methods.yaml` over a layer of `wkts` (EPSG
+/// `epsg`) with `args` and checks the outcome; returns the directory (kept
+/// while the caller looks) and the output path.
 fn case(
     name: &str,
     epsg: u32,
@@ -58,7 +59,7 @@ fn case(
     ];
     argv.extend_from_slice(args);
     check(name, &argv, &out, want);
-    out
+    (d, out)
 }
 
 fn check(name: &str, argv: &[&str], out: &Path, want: Expect) {
@@ -93,7 +94,7 @@ macro_rules! geometry_case {
     ($name:ident, $wkts:expr, $args:expr, $want:expr $(, $reason:expr)?) => {
         #[test]
         fn $name() {
-            let _out = case(stringify!($name), 3035, &$wkts, &$args, $want);
+            let (_dir, _out) = case(stringify!($name), 3035, &$wkts, &$args, $want);
             $( assert!(rejected_reason(&_out).contains($reason), "{}: {}", stringify!($name), rejected_reason(&_out)); )?
         }
     };
