@@ -41,9 +41,9 @@ fn case(
     wkts: &[Option<&str>],
     args: &[&str],
     want: Expect,
-) -> std::path::PathBuf {
+) -> (tempfile::TempDir, std::path::PathBuf) {
     let d = tmp();
-    let dir = d.keep();
+    let dir = d.path().to_path_buf();
     let src = dir.join("in.gpkg");
     make_layer(&src, "bad", epsg, wkts);
     let out = dir.join("out.gpkg");
