@@ -279,6 +279,18 @@ fn log_summary(s: &pipeline::RunSummary) {
         "done: {} read, {} written, {} rejected, {} filtered in {:.2} s → {}",
         s.read, s.written, s.rejected, s.filtered, s.elapsed_s, s.output
     );
+    for (m, t) in &s.stages {
+        tracing::debug!(
+            method = %m,
+            skeleton_s = t.skeleton.as_secs_f64(),
+            prune_extend_s = t.prune_extend.as_secs_f64(),
+            score_s = t.score.as_secs_f64(),
+            "{m}: skeleton {:.2} s, prune and extend {:.2} s, score {:.2} s (thread time)",
+            t.skeleton.as_secs_f64(),
+            t.prune_extend.as_secs_f64(),
+            t.score.as_secs_f64()
+        );
+    }
 }
 
 fn cmd_run(cli: &Cli, file: &PipelineArgs, threads: Option<usize>, every: f64) -> ExitCode {

@@ -454,6 +454,9 @@ pub struct RunRecord {
     pub elapsed_s: f64,
     /// Worker threads.
     pub threads: usize,
+    /// Thread time per method and step, JSON (`{"MA": {"skeleton": s,
+    /// "prune_extend": s, "score": s}, …}`).
+    pub stage_seconds: String,
 }
 
 /// The `skeletonise_runs` attribute table.
@@ -475,6 +478,7 @@ pub const RUNS: LayerDef<RunRecord> = LayerDef {
         col("features_filtered", Int64, |r| int(r.filtered)),
         col("threads", Int64, |r| int(r.threads)),
         col("elapsed_s", Real, |r| Cell::Real(r.elapsed_s)),
+        col("stage_seconds", Text, |r| text(&r.stage_seconds)),
     ],
 };
 

@@ -9,13 +9,17 @@ use crate::config::{InputSpec, OnError, OutputSpec, Pipeline};
 use crate::feature::Feature;
 use crate::io::reader::Reader;
 use crate::io::writer::{check_output, Writer};
-use crate::io::IoError;
+use crate::io::{IoError, SourceInfo};
+use crate::methods::MethodId;
 use crate::output::{Rows, RunRecord};
-use crate::process::{feature_rows, FeatureRows, ProcessParams, RowOptions, Skeletons, Status};
+use crate::process::{
+    feature_rows, FeatureRows, ProcessParams, RowOptions, Skeletons, StageTimes, Status,
+};
 use geo::MultiLineString;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use std::collections::HashMap;
+use std::sync::mpsc;
 use std::time::Instant;
 use thiserror::Error;
 
@@ -52,6 +56,8 @@ pub struct RunSummary {
     pub output: String,
     /// Chosen method per feature, counted.
     pub methods: Vec<(String, u64)>,
+    /// Thread time each method spent, step by step, over the whole run.
+    pub stages: Vec<(MethodId, StageTimes)>,
 }
 
 /// Why a run failed.
@@ -162,6 +168,7 @@ struct Counts {
     filtered: u64,
     rows: u64,
     methods: std::collections::BTreeMap<String, u64>,
+    stages: Vec<(MethodId, StageTimes)>,
 }
 
 impl Counts {
@@ -187,6 +194,12 @@ impl Counts {
             }
         }
         self.rows += r.rows.skeletons.len() as u64;
+        for (m, t) in &r.times {
+            match self.stages.iter_mut().find(|(x, _)| x == m) {
+                Some((_, total)) => *total += *t,
+                None => self.stages.push((*m, *t)),
+            }
+        }
         Ok(())
     }
 }
@@ -279,58 +292,180 @@ pub fn worker_threads(asked: Option<usize>) -> Result<usize, RunError> {
     }
 }
 
-/// Runs a job: read in batches → process each batch's features in parallel
-/// → write in input order.
+/// What the reader thread hands over: a batch of features, or why reading
+/// failed.
+type Batch = Result<Vec<Feature>, IoError>;
+
+/// Batches the reader may read ahead of the workers, and the workers ahead
+/// of the writer: memory stays bounded by a few batches.
+const QUEUE: usize = 2;
+
+/// Runs a job: a reader thread reads batches, the worker threads process
+/// each batch's features in parallel, a writer thread writes them in input
+/// order — all three at once, so I/O overlaps the work and the output is the
+/// same for any thread count.
 pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError> {
     let started = chrono::Utc::now();
     let clock = Instant::now();
     let threads = worker_threads(opts.threads)?;
-    let mut reader = Reader::open(job.input)?;
-    let info = reader.info().clone();
-    let mut inputs = vec![job.input.source.as_str()];
-    inputs.extend(job.other_inputs.iter().map(String::as_str));
-    let mut writer = Writer::create(job.output, &info, &inputs)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
         .map_err(|_| RunError::Threads(threads))?;
-    tracing::info!(
-        pipeline = %job.name,
-        source = %info.source,
-        layer = %info.layer,
-        crs = %info.crs_name,
-        features = info.selected,
-        total_features = info.total,
-        threads,
-        "run started"
-    );
-    let every = opts.progress_every.unwrap_or(PROGRESS_EVERY);
-    let mut progress = Progress::new(opts.progress, info.selected, every);
-    let row_opts = RowOptions::from(job.output);
-    let mut counts = Counts::default();
     let batch = opts.batch_size.unwrap_or(256).max(1);
-    let result = reader.read::<RunError>(batch, job.params.prepare.make_valid, |features| {
-        let done: Vec<FeatureRows> = pool.install(|| {
-            features
-                .par_iter()
-                .map(|f| feature_rows(f, job.skeletons(f), &job.params, row_opts))
-                .collect()
+    let make_valid = job.params.prepare.make_valid;
+    std::thread::scope(|scope| {
+        // The reader opens the source on its own thread (GDAL handles stay on
+        // the thread that made them) and reports what it found first.
+        let (info_tx, info_rx) = mpsc::sync_channel::<Result<SourceInfo, IoError>>(1);
+        let (batch_tx, batch_rx) = mpsc::sync_channel::<Batch>(QUEUE);
+        let reader =
+            scope.spawn(move || read_batches(job.input, batch, make_valid, info_tx, batch_tx));
+        let info = match info_rx.recv() {
+            Ok(Ok(info)) => info,
+            Ok(Err(e)) => return Err(e.into()),
+            Err(_) => return Err(reader_gone(reader)),
+        };
+        let mut inputs = vec![job.input.source.as_str()];
+        inputs.extend(job.other_inputs.iter().map(String::as_str));
+        let writer = Writer::create(job.output, &info, &inputs)?;
+        tracing::info!(
+            pipeline = %job.name,
+            source = %info.source,
+            layer = %info.layer,
+            crs = %info.crs_name,
+            features = info.selected,
+            total_features = info.total,
+            threads,
+            "run started"
+        );
+        let (rows_tx, rows_rx) = mpsc::sync_channel::<Rows>(QUEUE);
+        let writing = scope.spawn(move || write_batches(writer, rows_rx));
+        let every = opts.progress_every.unwrap_or(PROGRESS_EVERY);
+        let mut progress = Progress::new(opts.progress, info.selected, every);
+        let row_opts = RowOptions::from(job.output);
+        let mut counts = Counts::default();
+        let mut work = || -> Result<(), RunError> {
+            for features in batch_rx.iter() {
+                let features = features?;
+                let done: Vec<FeatureRows> = pool.install(|| {
+                    features
+                        .par_iter()
+                        .map(|f| feature_rows(f, job.skeletons(f), &job.params, row_opts))
+                        .collect()
+                });
+                counts.read += features.len() as u64;
+                let mut rows = Rows::default();
+                for (f, r) in features.iter().zip(done) {
+                    counts.add(f, &r, job.on_error)?;
+                    rows.append(r.rows);
+                }
+                if rows_tx.send(rows).is_err() {
+                    // The writer stopped on an error; it says which below.
+                    break;
+                }
+                progress.add(features.len() as u64);
+            }
+            Ok(())
+        };
+        let result = work();
+        progress.finish();
+        // Stop the reader (if still reading) and let the writer drain.
+        drop(batch_rx);
+        drop(rows_tx);
+        let written = writing.join().unwrap_or_else(|_| {
+            Err(IoError::Output {
+                path: job.output.path.clone(),
+                reason: "the writer thread failed with an internal error; please report it".into(),
+            })
         });
-        counts.read += features.len() as u64;
-        let mut rows = Rows::default();
-        for (f, r) in features.iter().zip(done) {
-            counts.add(f, &r, job.on_error)?;
-            rows.append(r.rows);
+        let _ = reader.join();
+        let writer = match (result, written) {
+            (Err(e), Ok(mut w)) => {
+                w.abort();
+                return Err(e);
+            }
+            (Err(e), Err(_)) => return Err(e),
+            (Ok(()), Err(e)) => return Err(e.into()),
+            (Ok(()), Ok(w)) => w,
+        };
+        finish_run(job, &info, counts, threads, started, clock, writer)
+    })
+}
+
+/// The reader thread: opens the source, sends what it holds, then its
+/// features batch by batch until the source ends, an error, or nobody
+/// listens any more.
+fn read_batches(
+    input: &InputSpec,
+    batch: usize,
+    make_valid: bool,
+    info_tx: mpsc::SyncSender<Result<SourceInfo, IoError>>,
+    batch_tx: mpsc::SyncSender<Batch>,
+) {
+    let mut reader = match Reader::open(input) {
+        Ok(r) => r,
+        Err(e) => {
+            let _ = info_tx.send(Err(e));
+            return;
         }
-        writer.write_batch(&rows)?;
-        progress.add(features.len() as u64);
-        Ok(())
-    });
-    progress.finish();
-    if let Err(e) = result {
-        writer.abort();
-        return Err(e);
+    };
+    if info_tx.send(Ok(reader.info().clone())).is_err() {
+        return;
     }
+    let r = reader.read::<Stop>(batch, make_valid, |features| {
+        batch_tx.send(Ok(features)).map_err(|_| Stop::Gone)
+    });
+    if let Err(Stop::Failed(e)) = r {
+        let _ = batch_tx.send(Err(e));
+    }
+}
+
+/// Why the reader thread stops before the end of the source.
+enum Stop {
+    /// Nobody takes batches any more (the run stopped).
+    Gone,
+    /// Reading failed.
+    Failed(IoError),
+}
+
+impl From<IoError> for Stop {
+    fn from(e: IoError) -> Self {
+        Stop::Failed(e)
+    }
+}
+
+/// The writer thread: writes each batch of rows as it comes, in order.
+/// Returns the writer (to finish) or the first error (the file discarded).
+fn write_batches(mut writer: Writer, rows: mpsc::Receiver<Rows>) -> Result<Writer, IoError> {
+    for r in rows.iter() {
+        if let Err(e) = writer.write_batch(&r) {
+            writer.abort();
+            return Err(e);
+        }
+    }
+    Ok(writer)
+}
+
+/// The reader thread ended without a word: it panicked.
+fn reader_gone(reader: std::thread::ScopedJoinHandle<'_, ()>) -> RunError {
+    let _ = reader.join();
+    RunError::Io(IoError::Output {
+        path: String::new(),
+        reason: "the reader thread failed with an internal error; please report it".into(),
+    })
+}
+
+/// Records the run in the output and renames it into place.
+fn finish_run(
+    job: &Job<'_>,
+    info: &SourceInfo,
+    mut counts: Counts,
+    threads: usize,
+    started: chrono::DateTime<chrono::Utc>,
+    clock: Instant,
+    writer: Writer,
+) -> Result<RunSummary, RunError> {
     // What `where` and `bbox` kept back (unknown when the driver cannot count).
     counts.filtered += info.total.map_or(0, |t| t.saturating_sub(counts.read));
     let elapsed_s = clock.elapsed().as_secs_f64();
@@ -347,6 +482,7 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
         filtered: counts.filtered,
         elapsed_s,
         threads,
+        stage_seconds: stage_json(&counts.stages),
     };
     let out = writer.finish(&record)?;
     Ok(RunSummary {
@@ -358,5 +494,30 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
         elapsed_s,
         output: out.display().to_string(),
         methods: counts.methods.into_iter().collect(),
+        stages: counts.stages,
     })
+}
+
+/// Step times as JSON for `skeletonise_runs.stage_seconds`:
+/// `{"MA": {"skeleton": 1.2, "prune_extend": 0.3, "score": 0.4}, …}`.
+fn stage_json(stages: &[(MethodId, StageTimes)]) -> String {
+    let map: serde_json::Map<String, serde_json::Value> = stages
+        .iter()
+        .map(|(m, t)| {
+            (
+                m.to_string(),
+                serde_json::json!({
+                    "skeleton": round_ms(t.skeleton),
+                    "prune_extend": round_ms(t.prune_extend),
+                    "score": round_ms(t.score),
+                }),
+            )
+        })
+        .collect();
+    serde_json::Value::Object(map).to_string()
+}
+
+/// Seconds, to the millisecond.
+fn round_ms(d: std::time::Duration) -> f64 {
+    (d.as_secs_f64() * 1000.0).round() / 1000.0
 }

@@ -2,15 +2,16 @@
 //! skeletons part by part, the reference's structure, pruning, extension,
 //! scores, bars and widths.
 
-use super::{part_reason, CandidateSkeleton, ProcessParams};
+use super::{part_reason, CandidateSkeleton, ProcessParams, StageTimes};
 use crate::geometry::PreparedPolygon;
 use crate::graph::extend::prune_and_extend;
 use crate::graph::SkeletonGraph;
 use crate::methods::medial_axis::medial_axis_transform;
 use crate::score::defects::graph_of;
-use crate::score::{bars, metrics};
+use crate::score::{metrics, BarRays};
 use geo::MultiLineString;
 use rayon::prelude::*;
+use std::time::Instant;
 
 /// Every method's candidate for the polygon parts `prepared`, in `methods`
 /// order.
@@ -19,27 +20,39 @@ pub(super) fn computed(
     params: &ProcessParams,
 ) -> Vec<super::Candidate> {
     let n = prepared.len();
-    let per_part: Vec<Vec<Result<PartSkeleton, String>>> = prepared
+    let per_part: Vec<Vec<(Result<PartSkeleton, String>, StageTimes)>> = prepared
         .iter()
         .enumerate()
         .map(|(i, p)| {
             part_skeletons(p, params)
                 .into_iter()
-                .map(|r| r.map_err(|e| part_reason(i, n, &e)))
+                .map(|(r, t)| (r.map_err(|e| part_reason(i, n, &e)), t))
                 .collect()
         })
         .collect();
+    let clock = Instant::now();
+    let rays = bar_rays(prepared, params);
+    // The shared rays, split evenly between the methods.
+    let rays_share = clock.elapsed() / params.skeleton.methods.len().max(1) as u32;
     params
         .skeleton
         .methods
         .par_iter()
         .enumerate()
         .map(|(k, &m)| {
+            let mut time = StageTimes::default();
+            for (_, t) in per_part.iter().map(|r| &r[k]) {
+                time += *t;
+            }
             let parts: Result<Vec<PartSkeleton>, String> =
-                per_part.iter().map(|r| r[k].clone()).collect();
+                per_part.iter().map(|r| r[k].0.clone()).collect();
+            let clock = Instant::now();
+            let result = parts.map(|parts| finish(prepared, &rays, &parts, params));
+            time.score += clock.elapsed() + rays_share;
             super::Candidate {
                 method: m,
-                result: parts.map(|parts| finish(prepared, &parts, params)),
+                result,
+                time,
             }
         })
         .collect()
@@ -61,7 +74,7 @@ pub(super) fn given(
             legs_raw: legs,
         })
         .collect();
-    let mut c = finish(prepared, &parts, params);
+    let mut c = finish(prepared, &bar_rays(prepared, params), &parts, params);
     // The lines once, not once per polygon part.
     c.geometry = lines.clone();
     c.components = graph.components();
@@ -79,24 +92,35 @@ pub(super) struct PartSkeleton {
 
 /// Every method's finished skeleton of one polygon part, in `methods`
 /// order: raw skeletons in parallel, then the reference pruned and extended,
-/// then the others pruned to its structure (or each on its own).
+/// then the others pruned to its structure (or each on its own). With each
+/// result, the time its skeleton and its pruning took.
 pub(super) fn part_skeletons(
     p: &PreparedPolygon,
     params: &ProcessParams,
-) -> Vec<Result<PartSkeleton, String>> {
+) -> Vec<(Result<PartSkeleton, String>, StageTimes)> {
     use crate::graph::prune::{PruneMode, Structure as Sharing};
     use crate::graph::structure::{conform, Structure};
     let methods = &params.skeleton.methods;
-    let raws: Vec<Result<crate::graph::SkeletonGraph, String>> = methods
+    let raws: Vec<(Result<crate::graph::SkeletonGraph, String>, StageTimes)> = methods
         .par_iter()
         .map(|&m| {
-            let method = params.registry.build(m, &params.skeleton)?;
-            guarded(m, || {
-                crate::methods::budget::with_deadline(m, params.skeleton.budget(), || {
-                    method.skeletonise(p)
-                })
-                .map_err(|e| e.to_string())
-            })
+            let clock = Instant::now();
+            let raw = params
+                .registry
+                .build(m, &params.skeleton)
+                .and_then(|method| {
+                    guarded(m, || {
+                        crate::methods::budget::with_deadline(m, params.skeleton.budget(), || {
+                            method.skeletonise(p)
+                        })
+                        .map_err(|e| e.to_string())
+                    })
+                });
+            let time = StageTimes {
+                skeleton: clock.elapsed(),
+                ..StageTimes::default()
+            };
+            (raw, time)
         })
         .collect();
     let finish = |raw: &crate::graph::SkeletonGraph| {
@@ -108,28 +132,37 @@ pub(super) fn part_skeletons(
     // The first method in the reference order whose finished skeleton is
     // not empty (a polygon thinner than MA's grid has no medial axis).
     let trunk = params.prune.is_some_and(|pr| pr.mode == PruneMode::Trunk);
+    let mut reference_time = vec![std::time::Duration::ZERO; methods.len()];
     let structure = shared.and_then(|_| {
         params.skeleton.reference_order().into_iter().find_map(|m| {
             let k = methods.iter().position(|&x| x == m)?;
-            let g = finish(raws[k].as_ref().ok()?);
-            (!g.is_empty()).then(|| (k, Structure::of(&g, p, trunk), g))
+            let clock = Instant::now();
+            let g = finish(raws[k].0.as_ref().ok()?);
+            let found = (!g.is_empty()).then(|| (k, Structure::of(&g, p, trunk), g));
+            reference_time[k] += clock.elapsed();
+            found
         })
     });
     raws.par_iter()
         .enumerate()
-        .map(|(k, raw)| {
-            let raw = raw.as_ref().map_err(Clone::clone)?;
-            let g = guarded(methods[k], || {
-                Ok(match &structure {
-                    Some((r, _, g)) if *r == k => g.clone(),
-                    Some((_, s, _)) => conform(raw, s, p),
-                    None => finish(raw),
+        .map(|(k, (raw, time))| {
+            let clock = Instant::now();
+            let result = raw.as_ref().map_err(Clone::clone).and_then(|raw| {
+                let g = guarded(methods[k], || {
+                    Ok(match &structure {
+                        Some((r, _, g)) if *r == k => g.clone(),
+                        Some((_, s, _)) => conform(raw, s, p),
+                        None => finish(raw),
+                    })
+                })?;
+                Ok(PartSkeleton {
+                    graph: g,
+                    legs_raw: raw.leg_count(),
                 })
-            })?;
-            Ok(PartSkeleton {
-                graph: g,
-                legs_raw: raw.leg_count(),
-            })
+            });
+            let mut time = *time;
+            time.prune_extend = reference_time[k] + clock.elapsed();
+            (result, time)
         })
         .collect()
 }
@@ -152,11 +185,20 @@ fn guarded<T>(
     })
 }
 
+/// Every part's bars when the run scores (shared by all candidates).
+fn bar_rays(prepared: &[PreparedPolygon], params: &ProcessParams) -> Vec<BarRays> {
+    match params.score {
+        Some(_) => prepared.par_iter().map(BarRays::new).collect(),
+        None => Vec::new(),
+    }
+}
+
 /// One candidate from its finished skeleton of every polygon part: scored
 /// (branches numbered across the parts), with bars and widths when asked
 /// for.
 fn finish(
     prepared: &[PreparedPolygon],
+    rays: &[BarRays],
     parts: &[PartSkeleton],
     params: &ProcessParams,
 ) -> CandidateSkeleton {
@@ -165,13 +207,13 @@ fn finish(
     let mut widths = Vec::new();
     let (mut components, mut legs_raw, mut legs) = (0, 0, 0);
     let mut branch_offset = 0;
-    for (p, part) in prepared.iter().zip(parts) {
+    for (k, (p, part)) in prepared.iter().zip(parts).enumerate() {
         let g: &SkeletonGraph = &part.graph;
         legs_raw += part.legs_raw;
         legs += g.leg_count();
         components += g.components();
         if params.score.is_some() {
-            let mut b = bars(p, g);
+            let mut b = rays[k].cast(p, g);
             for bar in &mut b {
                 if let Some(h) = &mut bar.hit {
                     h.part += branch_offset;

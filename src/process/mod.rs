@@ -101,6 +101,37 @@ pub struct Candidate {
     pub method: MethodId,
     /// The skeleton, or why the method failed on this feature.
     pub result: Result<CandidateSkeleton, String>,
+    /// How long each step took for this method.
+    pub time: StageTimes,
+}
+
+/// Thread time one method spent on one feature, step by step (summed over
+/// polygon parts). Measurements, not results: any two compare equal, so
+/// that two runs' results can be compared whatever the clock said.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct StageTimes {
+    /// The raw skeleton.
+    pub skeleton: std::time::Duration,
+    /// Pruning and extension (for the reference method: also the structure
+    /// every other method is pruned to; for the others: conforming to it).
+    pub prune_extend: std::time::Duration,
+    /// Bars, hits, sides and metrics (the rays all methods share are split
+    /// evenly between them).
+    pub score: std::time::Duration,
+}
+
+impl PartialEq for StageTimes {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+impl std::ops::AddAssign for StageTimes {
+    fn add_assign(&mut self, o: Self) {
+        self.skeleton += o.skeleton;
+        self.prune_extend += o.prune_extend;
+        self.score += o.score;
+    }
 }
 
 /// A successful skeleton of one feature (all its polygon parts).
@@ -238,9 +269,15 @@ pub fn process_given(
     if lines.0.iter().all(|l| l.0.len() < 2) {
         return Processed::Rejected(format!("{label}: no skeleton lines joined to this polygon"));
     }
+    let clock = std::time::Instant::now();
+    let result = Ok(candidates::given(&prepared, lines, params));
     let candidate = Candidate {
         method: MethodId::EXTERNAL,
-        result: Ok(candidates::given(&prepared, lines, params)),
+        result,
+        time: StageTimes {
+            score: clock.elapsed(),
+            ..StageTimes::default()
+        },
     };
     choose(vec![candidate], prepared.len(), params)
 }

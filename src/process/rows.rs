@@ -3,8 +3,9 @@
 //! `score` takes them from another tool's lines ([`Skeletons`]); both go
 //! through the same steps from `score` on and give the same rows.
 
-use super::{process, process_given, FeatureOutcome, ProcessParams, Processed};
+use super::{process, process_given, FeatureOutcome, ProcessParams, Processed, StageTimes};
 use crate::feature::Feature;
+use crate::methods::MethodId;
 use crate::output::{BarRow, CandidateRow, RejectedRow, Rows, SkeletonRow, WidthRow};
 use geo::{Geometry, MultiLineString};
 
@@ -54,6 +55,8 @@ pub struct FeatureRows {
     pub rows: Rows,
     /// How the feature counts.
     pub status: Status,
+    /// Each method's step times on this feature (all its units).
+    pub times: Vec<(MethodId, StageTimes)>,
 }
 
 /// The output rows of one feature (see the module documentation).
@@ -69,9 +72,11 @@ pub fn feature_rows(
         return FeatureRows {
             rows,
             status: Status::Rejected,
+            times: Vec::new(),
         };
     }
     let mut methods = Vec::new();
+    let mut times: Vec<(MethodId, StageTimes)> = Vec::new();
     for (part, geom) in units(f.geometry.as_ref(), opts.explode) {
         // A panic is a bug; it must cost this feature, never the run.
         let processed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| match skeletons {
@@ -94,6 +99,12 @@ pub fn feature_rows(
         };
         match processed {
             Processed::Done(o) => {
+                for c in &o.candidates {
+                    match times.iter_mut().find(|(m, _)| *m == c.method) {
+                        Some((_, t)) => *t += c.time,
+                        None => times.push((c.method, c.time)),
+                    }
+                }
                 methods.push(outcome_rows(f, part, &o, label, opts, &mut rows));
             }
             Processed::Filtered => {}
@@ -113,7 +124,11 @@ pub fn feature_rows(
     } else {
         Status::Written(methods)
     };
-    FeatureRows { rows, status }
+    FeatureRows {
+        rows,
+        status,
+        times,
+    }
 }
 
 /// The units of work of a feature: the whole geometry, or with `explode`

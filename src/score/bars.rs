@@ -122,82 +122,93 @@ impl SkeletonIndex {
 /// start vertex, midpoint, end vertex (invalid vertex bars left out).
 /// `BarHit::part` indexes `skeleton.branches()`.
 pub fn bars(polygon: &PreparedPolygon, skeleton: &SkeletonGraph) -> Vec<Bar> {
-    let boundary = polygon.boundary();
-    let eps = REL_EPS * polygon.extent();
-    // No ray stays inside P for longer than the bounding box's diagonal.
-    let diagonal = norm(boundary.bbox_max() - boundary.bbox_min());
-    let sk = SkeletonIndex::new(skeleton);
-    let mut out = Vec::with_capacity(3 * polygon.vertex_count());
-    for ring in polygon.rings() {
-        let v = &ring.0[..ring.0.len() - 1];
-        let m = v.len();
-        let valid: Vec<bool> = (0..m)
-            .map(|i| vertex_bar_valid(v[(i + m - 1) % m], v[i], v[(i + 1) % m]))
-            .collect();
-        for i in 0..m {
-            let (a, b) = (v[i], v[(i + 1) % m]);
-            let u = left_normal(b - a);
-            let origins = [
-                (a, valid[i]),
-                ((a + b) * 0.5, true),
-                (b, valid[(i + 1) % m]),
-            ];
-            for (origin, ok) in origins {
-                if ok {
-                    let reach = Reach {
-                        start: norm(b - a),
-                        max: diagonal,
-                    };
-                    out.push(cast(boundary, &sk, origin, u, eps, reach));
+    BarRays::new(polygon).cast(polygon, skeleton)
+}
+
+/// A polygon's bars before they meet a skeleton: origin, direction and
+/// where each leaves P. They depend on the polygon alone, so every method's
+/// candidate is scored along the same rays, computed once.
+#[derive(Debug, Clone, Default)]
+pub struct BarRays {
+    rays: Vec<Ray>,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Ray {
+    origin: Coord<f64>,
+    dir: Coord<f64>,
+    /// Where the ray leaves P (ray parameter).
+    exit: f64,
+}
+
+impl BarRays {
+    /// The valid bars of `polygon` and their exits from P.
+    pub fn new(polygon: &PreparedPolygon) -> Self {
+        let boundary = polygon.boundary();
+        let eps = REL_EPS * polygon.extent();
+        // No ray stays inside P for longer than the bounding box's diagonal.
+        let diagonal = norm(boundary.bbox_max() - boundary.bbox_min());
+        let mut rays = Vec::with_capacity(3 * polygon.vertex_count());
+        for ring in polygon.rings() {
+            let v = &ring.0[..ring.0.len() - 1];
+            let m = v.len();
+            let valid: Vec<bool> = (0..m)
+                .map(|i| vertex_bar_valid(v[(i + m - 1) % m], v[i], v[(i + 1) % m]))
+                .collect();
+            for i in 0..m {
+                let (a, b) = (v[i], v[(i + 1) % m]);
+                let u = left_normal(b - a);
+                let origins = [
+                    (a, valid[i]),
+                    ((a + b) * 0.5, true),
+                    (b, valid[(i + 1) % m]),
+                ];
+                for (origin, ok) in origins {
+                    if ok {
+                        let exit = boundary
+                            .first_hit(origin, u, eps, f64::INFINITY)
+                            .map_or(diagonal, |h| h.t);
+                        rays.push(Ray {
+                            origin,
+                            dir: u,
+                            exit,
+                        });
+                    }
                 }
             }
         }
+        Self { rays }
     }
-    out
-}
 
-/// How far to look for the ray's exit from P: first up to `start`, then
-/// four times as far, up to `max` (no ray stays in P longer than the
-/// bounding box's diagonal).
-#[derive(Clone, Copy)]
-struct Reach {
-    start: f64,
-    max: f64,
-}
+    /// Number of bars.
+    pub fn len(&self) -> usize {
+        self.rays.len()
+    }
 
-/// Where the ray `origin + t·u`, t > eps, leaves P. A search growing from the
-/// local scale: an unbounded ray would test every boundary segment along it
-/// across the whole polygon (a wide river, a long coast), while the exit is
-/// usually near.
-fn exit(boundary: &Boundary, origin: Coord<f64>, u: Coord<f64>, eps: f64, reach: Reach) -> f64 {
-    let mut t = reach.start.max(eps);
-    loop {
-        let last = t >= reach.max;
-        let limit = if last { f64::INFINITY } else { t };
-        if let Some(h) = boundary.first_hit(origin, u, eps, limit) {
-            return h.t;
-        }
-        if last {
-            return reach.max;
-        }
-        t *= 4.0;
+    /// True when the polygon has no valid bar.
+    pub fn is_empty(&self) -> bool {
+        self.rays.is_empty()
+    }
+
+    /// The bars cast against `skeleton` (of the polygon the rays were made
+    /// for): hits and sides.
+    pub fn cast(&self, polygon: &PreparedPolygon, skeleton: &SkeletonGraph) -> Vec<Bar> {
+        let eps = REL_EPS * polygon.extent();
+        let sk = SkeletonIndex::new(skeleton);
+        self.rays
+            .iter()
+            .map(|r| cast(polygon.boundary(), &sk, r, eps))
+            .collect()
     }
 }
 
-/// One bar: its exit from P, its hit on the skeleton and the sides there.
-fn cast(
-    boundary: &Boundary,
-    sk: &SkeletonIndex,
-    origin: Coord<f64>,
-    u: Coord<f64>,
-    eps: f64,
-    reach: Reach,
-) -> Bar {
-    let t_exit = exit(boundary, origin, u, eps, reach);
-    let hit = sk.hit(origin, u, eps, t_exit).and_then(|(q, sigma)| {
+/// One bar: its hit on the skeleton before it leaves P, and the sides there.
+fn cast(boundary: &Boundary, sk: &SkeletonIndex, ray: &Ray, eps: f64) -> Bar {
+    let (origin, u) = (ray.origin, ray.dir);
+    let hit = sk.hit(origin, u, eps, ray.exit).and_then(|(q, sigma)| {
         let nu = left_normal(sigma.b - sigma.a);
-        let (_, d_left) = boundary.nearest_in_half_plane(q, nu)?;
-        let (_, d_right) = boundary.nearest_in_half_plane(q, -nu)?;
+        let [left, right] = boundary.nearest_on_both_sides(q, nu);
+        let ((_, d_left), (_, d_right)) = (left?, right?);
         // A hit on ∂P itself (a leaf at a corner reached along the boundary)
         // has no sides to compare: it is a miss.
         if d_left + d_right <= eps {
