@@ -7,7 +7,7 @@
 //! the scoring step's sides). Queries cost O(log n) on real data instead of a
 //! scan of all edges.
 
-use super::packed::{box_distance_2, box_meets_half_plane, ray_box, Bbox, PackedTree};
+use super::packed::{box_distance_2, box_half_plane_distance, ray_box, Bbox, PackedTree};
 use geo::{Coord, Polygon};
 use std::cell::Cell;
 use std::ops::ControlFlow;
@@ -301,53 +301,25 @@ impl Boundary {
         q: Coord<f64>,
         normal: Coord<f64>,
     ) -> Option<(Coord<f64>, f64)> {
-        let n = pt(normal);
-        self.nearest_clipped(
-            q,
-            |b| box_meets_half_plane(b, pt(q), n),
-            |a, b| clip_to_half_plane(a, b, q, normal),
-        )
+        self.nearest_in_half_plane_within(q, normal, f64::INFINITY)
     }
 
-    /// The nearest boundary points to `q` on either side of the line
-    /// through `q` across `normal`: [`Boundary::nearest_in_half_plane`] for
-    /// `normal` and for `−normal`, in one search.
-    pub fn nearest_on_both_sides(
+    /// [`Boundary::nearest_in_half_plane`] among the points at most `limit`
+    /// from `q` (`None` if there is none): a known boundary point in the
+    /// half-plane makes the search short.
+    pub fn nearest_in_half_plane_within(
         &self,
         q: Coord<f64>,
         normal: Coord<f64>,
-    ) -> [Option<(Coord<f64>, f64)>; 2] {
-        if !finite(q) {
-            return [None, None];
-        }
-        let normals = [normal, -normal];
-        let best: [Cell<Option<Found>>; 2] = [Cell::new(None), Cell::new(None)];
-        let cut = |k: usize| best[k].get().map_or(f64::INFINITY, |(_, d, _)| d);
-        self.tree.branch_and_bound(
-            |b| {
-                let d = box_distance_2(b, q.x, q.y).sqrt();
-                (0..2)
-                    .any(|k| d <= cut(k) && box_meets_half_plane(b, pt(q), pt(normals[k])))
-                    .then_some(d)
-            },
-            |i| {
-                let s = &self.segments[i as usize];
-                for (k, n) in normals.iter().enumerate() {
-                    if let Some((a, b)) = clip_to_half_plane(s.a, s.b, q, *n) {
-                        let c = closest_on_segment(a, b, q).0;
-                        let d = (c - q).x.hypot((c - q).y);
-                        if best[k]
-                            .get()
-                            .is_none_or(|(_, bd, bi)| d < bd || (d == bd && i < bi))
-                        {
-                            best[k].set(Some((c, d, i)));
-                        }
-                    }
-                }
-                cut(0).max(cut(1))
-            },
-        );
-        best.map(|b| b.get().map(|(c, d, _)| (c, d)))
+        limit: f64,
+    ) -> Option<(Coord<f64>, f64)> {
+        let n = pt(normal);
+        self.nearest_clipped(
+            q,
+            limit,
+            |b| box_half_plane_distance(b, pt(q), n),
+            |a, b| clip_to_half_plane(a, b, q, normal),
+        )
     }
 
     /// Nearest boundary point to `q` within the closed sector swept
@@ -369,7 +341,12 @@ impl Boundary {
         let n2 = Coord { x: to.y, y: -to.x };
         self.nearest_clipped(
             q,
-            |b| box_meets_half_plane(b, pt(q), pt(n1)) && box_meets_half_plane(b, pt(q), pt(n2)),
+            f64::INFINITY,
+            |b| {
+                let d1 = box_half_plane_distance(b, pt(q), pt(n1))?;
+                let d2 = box_half_plane_distance(b, pt(q), pt(n2))?;
+                Some(d1.max(d2))
+            },
             |a, b| {
                 let (a, b) = clip_to_half_plane(a, b, q, n1)?;
                 clip_to_half_plane(a, b, q, n2)
@@ -378,35 +355,34 @@ impl Boundary {
     }
 
     /// Nearest point to `q` of the boundary segments as `clip` cuts them
-    /// down (`None`: the whole segment is out), searching only boxes `keep`
-    /// accepts (some of the region can lie in them).
+    /// down (`None`: the whole segment is out); `bound` is a lower bound of
+    /// the distance to the region within a box (`None`: not in it).
     fn nearest_clipped(
         &self,
         q: Coord<f64>,
-        keep: impl Fn(&Bbox) -> bool,
+        limit: f64,
+        bound: impl Fn(&Bbox) -> Option<f64>,
         clip: impl Fn(Coord<f64>, Coord<f64>) -> Option<(Coord<f64>, Coord<f64>)>,
     ) -> Option<(Coord<f64>, f64)> {
         if !finite(q) {
             return None;
         }
         let best: Cell<Option<Found>> = Cell::new(None);
-        self.tree.branch_and_bound(
-            |b| keep(b).then(|| box_distance_2(b, q.x, q.y).sqrt()),
-            |i| {
-                let s = &self.segments[i as usize];
-                if let Some((a, b)) = clip(s.a, s.b) {
-                    let c = closest_on_segment(a, b, q).0;
-                    let d = (c - q).x.hypot((c - q).y);
-                    if best
+        self.tree.branch_and_bound(limit, bound, |i| {
+            let s = &self.segments[i as usize];
+            if let Some((a, b)) = clip(s.a, s.b) {
+                let c = closest_on_segment(a, b, q).0;
+                let d = (c - q).x.hypot((c - q).y);
+                if d <= limit
+                    && best
                         .get()
                         .is_none_or(|(_, bd, bi)| d < bd || (d == bd && i < bi))
-                    {
-                        best.set(Some((c, d, i)));
-                    }
+                {
+                    best.set(Some((c, d, i)));
                 }
-                best.get().map_or(f64::INFINITY, |(_, d, _)| d)
-            },
-        );
+            }
+            best.get().map_or(limit, |(_, d, _)| d)
+        });
         best.get().map(|(c, d, _)| (c, d))
     }
 

@@ -8,6 +8,7 @@
 //! The tree knows only boxes and item numbers: what an item is, and its
 //! exact distance or hit, is the caller's (see [`super::Boundary`]).
 
+use std::mem::MaybeUninit;
 use std::ops::ControlFlow;
 
 /// Children per node.
@@ -150,12 +151,13 @@ impl PackedTree {
             // A single item.
             return item(self.ids[root]).break_value();
         }
-        let mut stack = [0usize; STACK];
-        stack[0] = root;
+        let mut stack = [MaybeUninit::<usize>::uninit(); STACK];
+        stack[0] = MaybeUninit::new(root);
         let mut top = 1;
         while top > 0 {
             top -= 1;
-            let pos = stack[top];
+            // SAFETY: entries below `top` were written before.
+            let pos = unsafe { stack[top].assume_init() };
             for c in self.children(pos) {
                 if !node(&self.boxes[c]) {
                     continue;
@@ -165,7 +167,7 @@ impl PackedTree {
                         return Some(b);
                     }
                 } else {
-                    stack[top] = c;
+                    stack[top] = MaybeUninit::new(c);
                     top += 1;
                 }
             }
@@ -183,29 +185,42 @@ impl PackedTree {
     pub fn best(
         &self,
         bound: impl Fn(&Bbox) -> Bound,
+        item: impl FnMut(u32, f64) -> Bound,
+    ) -> Option<(f64, u32)> {
+        self.best_within(f64::INFINITY, bound, item)
+    }
+
+    /// [`Self::best`] among the items scoring at most `limit`.
+    pub fn best_within(
+        &self,
+        limit: f64,
+        bound: impl Fn(&Bbox) -> Bound,
         mut item: impl FnMut(u32, f64) -> Bound,
     ) -> Option<(f64, u32)> {
         let mut best: Option<(f64, u32)> = None;
         self.branch_and_bound(
+            limit,
             |b| bound(b),
             |id| {
-                let cut = best.map_or(f64::INFINITY, |(v, _)| v);
-                if let Some(v) = item(id, cut) {
+                let cut = best.map_or(limit, |(v, _)| v);
+                if let Some(v) = item(id, cut).filter(|&v| v <= limit) {
                     if best.is_none_or(|(bv, bi)| v < bv || (v == bv && id < bi)) {
                         best = Some((v, id));
                     }
                 }
-                best.map_or(f64::INFINITY, |(v, _)| v)
+                best.map_or(limit, |(v, _)| v)
             },
         );
         best
     }
 
-    /// The traversal under [`Self::best`] and the two-sided searches: `item`
-    /// returns the current cut-off (nodes and items whose bound exceeds it are
-    /// skipped; equal bounds are still visited for the tie rule).
+    /// The traversal under [`Self::best`] and the two-sided searches:
+    /// nodes in increasing order of their bound (best first), stopping when
+    /// the next bound exceeds the cut-off (`limit` at first, then what
+    /// `item` returns; equal bounds are still visited, for the tie rule).
     pub fn branch_and_bound(
         &self,
+        limit: f64,
         bound: impl Fn(&Bbox) -> Bound,
         mut item: impl FnMut(u32) -> f64,
     ) {
@@ -214,54 +229,95 @@ impl PackedTree {
             return;
         }
         let root = self.boxes.len() - 1;
-        let Some(rb) = bound(&self.boxes[root]) else {
+        let Some(rb) = bound(&self.boxes[root]).filter(|&b| b <= limit) else {
             return;
         };
         if root < n {
             item(self.ids[root]);
             return;
         }
-        let mut cut = f64::INFINITY;
-        // Entries (bound, position), children pushed farthest first so the
-        // nearest is popped next.
-        let mut stack = [(0.0f64, 0usize); STACK];
-        let mut top = 0;
-        stack[0] = (rb, root);
-        top += 1;
-        let mut kids = [(0.0f64, 0usize); NODE_SIZE];
-        while top > 0 {
-            top -= 1;
-            let (lb, pos) = stack[top];
-            if lb > cut {
-                continue;
-            }
-            let mut k = 0;
-            for c in self.children(pos) {
-                if let Some(b) = bound(&self.boxes[c]) {
-                    if b <= cut {
-                        kids[k] = (b, c);
-                        k += 1;
+        HEAP.with(|cell| {
+            // A query from inside a query (never done today) gets its own heap.
+            let mut own = Vec::new();
+            let mut borrowed = cell.try_borrow_mut();
+            let heap: &mut Vec<(f64, u32)> = match borrowed.as_mut() {
+                Ok(h) => h,
+                Err(_) => &mut own,
+            };
+            heap.clear();
+            let mut cut = limit;
+            push(heap, (rb, root as u32));
+            while let Some((lb, pos)) = pop(heap) {
+                if lb > cut {
+                    break;
+                }
+                let children = self.children(pos as usize);
+                if children.start < n {
+                    // Children are items: score every one that can still count.
+                    for c in children {
+                        if bound(&self.boxes[c]).is_some_and(|b| b <= cut) {
+                            cut = item(self.ids[c]);
+                        }
+                    }
+                    continue;
+                }
+                for c in children {
+                    if let Some(b) = bound(&self.boxes[c]) {
+                        if b <= cut {
+                            push(heap, (b, c as u32));
+                        }
                     }
                 }
             }
-            let kids = &mut kids[..k];
-            kids.sort_unstable_by(|a, b| b.0.total_cmp(&a.0));
-            if self.ids[pos] < n as u32 {
-                // Children are items: score them nearest first.
-                for &(b, c) in kids.iter().rev() {
-                    if b > cut {
-                        break;
-                    }
-                    cut = item(self.ids[c]);
-                }
-            } else {
-                for &e in kids.iter() {
-                    stack[top] = e;
-                    top += 1;
-                }
-            }
-        }
+        });
     }
+}
+
+thread_local! {
+    /// The best-first queue of the calling thread's queries, kept between
+    /// queries so that none allocates.
+    static HEAP: std::cell::RefCell<Vec<(f64, u32)>> = const { std::cell::RefCell::new(Vec::new()) };
+}
+
+/// Pushes onto a binary min-heap of (bound, position).
+fn push(heap: &mut Vec<(f64, u32)>, e: (f64, u32)) {
+    heap.push(e);
+    let mut i = heap.len() - 1;
+    while i > 0 {
+        let parent = (i - 1) / 2;
+        if heap[parent].0 <= heap[i].0 {
+            break;
+        }
+        heap.swap(parent, i);
+        i = parent;
+    }
+}
+
+/// Pops the least bound from a binary min-heap.
+fn pop(heap: &mut Vec<(f64, u32)>) -> Option<(f64, u32)> {
+    let last = heap.pop()?;
+    if heap.is_empty() {
+        return Some(last);
+    }
+    let top = std::mem::replace(&mut heap[0], last);
+    let n = heap.len();
+    let mut i = 0;
+    loop {
+        let (l, r) = (2 * i + 1, 2 * i + 2);
+        let mut m = i;
+        if l < n && heap[l].0 < heap[m].0 {
+            m = l;
+        }
+        if r < n && heap[r].0 < heap[m].0 {
+            m = r;
+        }
+        if m == i {
+            break;
+        }
+        heap.swap(i, m);
+        i = m;
+    }
+    Some(top)
 }
 
 fn union(a: Bbox, b: Bbox) -> Bbox {
@@ -304,6 +360,53 @@ pub fn ray_box(b: &Bbox, o: [f64; 2], d: [f64; 2], max_t: f64) -> Option<(f64, f
         }
     }
     Some((t0, t1))
+}
+
+/// A lower bound of the distance from `q` to the part of the box in the
+/// closed half-plane `(x − q) · n ≥ 0` (`None`: no part). The nearest point
+/// of the box, if in the half-plane; else the nearest point lies on the
+/// half-plane's edge, the line through `q` across `n`, and the bound is the
+/// distance along it to where it crosses the box. Shrunk by a relative
+/// 1e-9 so that rounding never makes it exceed the true distance.
+pub fn box_half_plane_distance(b: &Bbox, q: [f64; 2], n: [f64; 2]) -> Option<f64> {
+    let px = q[0].clamp(b[0], b[2]);
+    let py = q[1].clamp(b[1], b[3]);
+    let (dx, dy) = (px - q[0], py - q[1]);
+    let shrink = 1.0 - 1e-9;
+    if dx * n[0] + dy * n[1] >= 0.0 {
+        return Some((dx * dx + dy * dy).sqrt() * shrink);
+    }
+    // The edge line q + s·t.
+    let t = [-n[1], n[0]];
+    let (mut s0, mut s1) = (f64::NEG_INFINITY, f64::INFINITY);
+    for k in 0..2 {
+        let (l, h) = (b[k], b[k + 2]);
+        if t[k] == 0.0 {
+            if q[k] < l || q[k] > h {
+                return None;
+            }
+        } else {
+            let (mut a, mut c) = ((l - q[k]) / t[k], (h - q[k]) / t[k]);
+            if a > c {
+                std::mem::swap(&mut a, &mut c);
+            }
+            s0 = s0.max(a);
+            s1 = s1.min(c);
+        }
+    }
+    // A margin for rounding in the slab test: a box the edge only touches
+    // still counts.
+    let len = t[0].hypot(t[1]);
+    let slack = 1e-9 * (s0.abs().max(s1.abs()).min(1e300) + 1.0);
+    if s0 > s1 + slack {
+        return None;
+    }
+    let along = if s0 <= 0.0 && 0.0 <= s1 {
+        0.0
+    } else {
+        s0.abs().min(s1.abs())
+    };
+    Some(along * len * shrink)
 }
 
 /// True when some corner of the box is in the closed half-plane

@@ -2,6 +2,7 @@
 //! skeletons part by part, the reference's structure, pruning, extension,
 //! scores, bars and widths.
 
+use super::clock::CpuClock;
 use super::{part_reason, CandidateSkeleton, ProcessParams, StageTimes};
 use crate::geometry::PreparedPolygon;
 use crate::graph::extend::prune_and_extend;
@@ -11,7 +12,6 @@ use crate::score::defects::graph_of;
 use crate::score::{metrics, BarRays};
 use geo::MultiLineString;
 use rayon::prelude::*;
-use std::time::Instant;
 
 /// Every method's candidate for the polygon parts `prepared`, in `methods`
 /// order.
@@ -30,7 +30,7 @@ pub(super) fn computed(
                 .collect()
         })
         .collect();
-    let clock = Instant::now();
+    let clock = CpuClock::start();
     let rays = bar_rays(prepared, params);
     // The shared rays, split evenly between the methods.
     let rays_share = clock.elapsed() / params.skeleton.methods.len().max(1) as u32;
@@ -46,7 +46,7 @@ pub(super) fn computed(
             }
             let parts: Result<Vec<PartSkeleton>, String> =
                 per_part.iter().map(|r| r[k].0.clone()).collect();
-            let clock = Instant::now();
+            let clock = CpuClock::start();
             let result = parts.map(|parts| finish(prepared, &rays, &parts, params));
             time.score += clock.elapsed() + rays_share;
             super::Candidate {
@@ -104,7 +104,7 @@ pub(super) fn part_skeletons(
     let raws: Vec<(Result<crate::graph::SkeletonGraph, String>, StageTimes)> = methods
         .par_iter()
         .map(|&m| {
-            let clock = Instant::now();
+            let clock = CpuClock::start();
             let raw = params
                 .registry
                 .build(m, &params.skeleton)
@@ -136,7 +136,7 @@ pub(super) fn part_skeletons(
     let structure = shared.and_then(|_| {
         params.skeleton.reference_order().into_iter().find_map(|m| {
             let k = methods.iter().position(|&x| x == m)?;
-            let clock = Instant::now();
+            let clock = CpuClock::start();
             let g = finish(raws[k].0.as_ref().ok()?);
             let found = (!g.is_empty()).then(|| (k, Structure::of(&g, p, trunk), g));
             reference_time[k] += clock.elapsed();
@@ -146,7 +146,7 @@ pub(super) fn part_skeletons(
     raws.par_iter()
         .enumerate()
         .map(|(k, (raw, time))| {
-            let clock = Instant::now();
+            let clock = CpuClock::start();
             let result = raw.as_ref().map_err(Clone::clone).and_then(|raw| {
                 let g = guarded(methods[k], || {
                     Ok(match &structure {

@@ -4,6 +4,7 @@
 //! thread count.
 
 mod candidates;
+pub mod clock;
 pub mod rows;
 
 pub use rows::{feature_rows, FeatureRows, RowOptions, Skeletons, Status};
@@ -105,7 +106,7 @@ pub struct Candidate {
     pub time: StageTimes,
 }
 
-/// Thread time one method spent on one feature, step by step (summed over
+/// Thread CPU time one method spent on one feature, step by step (summed over
 /// polygon parts). Measurements, not results: any two compare equal, so
 /// that two runs' results can be compared whatever the clock said.
 #[derive(Debug, Clone, Copy, Default)]
@@ -269,7 +270,7 @@ pub fn process_given(
     if lines.0.iter().all(|l| l.0.len() < 2) {
         return Processed::Rejected(format!("{label}: no skeleton lines joined to this polygon"));
     }
-    let clock = std::time::Instant::now();
+    let clock = clock::CpuClock::start();
     let result = Ok(candidates::given(&prepared, lines, params));
     let candidate = Candidate {
         method: MethodId::EXTERNAL,

@@ -205,10 +205,23 @@ impl BarRays {
 /// One bar: its hit on the skeleton before it leaves P, and the sides there.
 fn cast(boundary: &Boundary, sk: &SkeletonIndex, ray: &Ray, eps: f64) -> Bar {
     let (origin, u) = (ray.origin, ray.dir);
+    let exit = origin + u * ray.exit;
     let hit = sk.hit(origin, u, eps, ray.exit).and_then(|(q, sigma)| {
         let nu = left_normal(sigma.b - sigma.a);
-        let [left, right] = boundary.nearest_on_both_sides(q, nu);
-        let ((_, d_left), (_, d_right)) = (left?, right?);
+        // The bar's origin and exit are boundary points: each bounds the
+        // nearest distance on its side, which keeps the searches short.
+        let side = |n: Coord<f64>| {
+            let seed = [origin, exit]
+                .into_iter()
+                .filter(|&c| dot(c - q, n) >= 0.0)
+                .map(|c| norm(c - q) * (1.0 + 1e-9))
+                .fold(f64::INFINITY, f64::min);
+            boundary
+                .nearest_in_half_plane_within(q, n, seed)
+                .or_else(|| boundary.nearest_in_half_plane(q, n))
+        };
+        let (_, d_left) = side(nu)?;
+        let (_, d_right) = side(-nu)?;
         // A hit on ∂P itself (a leaf at a corner reached along the boundary)
         // has no sides to compare: it is a miss.
         if d_left + d_right <= eps {
