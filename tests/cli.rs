@@ -54,6 +54,20 @@ fn demo_pipeline_runs_and_writes_every_layer() {
         .as_deref()
         .unwrap()
         .contains("name: demo"));
+    // The input as it reopens from anywhere (the report draws its polygons).
+    assert_eq!(
+        strings(&ds, "skeletonise_runs", "input_source"),
+        [Some(root(DEMO))]
+    );
+    assert_eq!(
+        strings(&ds, "skeletonise_runs", "input_layer"),
+        [Some("demo".into())]
+    );
+    assert_eq!(strings(&ds, "skeletonise_runs", "input_reproject"), [None]);
+    assert_eq!(
+        strings(&ds, "skeletonise_runs", "skeleton_layer"),
+        [Some("skeletons".into())]
+    );
     assert_eq!(count(&ds, "rejected"), 0);
     assert_eq!(count(&ds, "candidates"), 17 * 5);
     // Every feature has exactly one chosen candidate, and it is the method written.

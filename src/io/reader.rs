@@ -376,6 +376,17 @@ fn collect_polygons(g: &Geometry, out: &mut Geometry) -> Result<(), String> {
     Ok(())
 }
 
+/// The data source string as it opens from any working directory: an
+/// existing local path made absolute; anything else (`PG:…`, `/vsizip/…`,
+/// URLs) as given.
+pub fn absolute_source(source: &str) -> String {
+    let path = std::path::Path::new(source);
+    match path.is_relative().then(|| path.canonicalize()) {
+        Some(Ok(abs)) => abs.display().to_string(),
+        _ => source.to_string(),
+    }
+}
+
 /// A source FID and its geometry.
 pub type FidGeometry = (Option<u64>, geo::Geometry<f64>);
 
