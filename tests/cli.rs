@@ -611,3 +611,27 @@ fn reads_a_zipped_source_by_layer_index() {
     assert_eq!(code, 0, "{err}");
     assert_eq!(count(&open(&out), "skeletons"), 17);
 }
+
+#[test]
+fn a_where_filter_the_source_rejects_stops_the_run_with_the_reason() {
+    // GeoPackage hands the filter to SQLite, which rejects it only when it
+    // runs: the run must not go on and select nothing.
+    let d = tmp();
+    let out = d.path().join("o.gpkg");
+    let o = skeletonise(&[
+        "run",
+        "pipelines/demo.yaml",
+        "-o",
+        out.to_str().unwrap(),
+        "--set",
+        "input.where=\"no_such_field = 1\"",
+    ]);
+    let (code, err) = code_and_err(&o);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("invalid `input.where` filter `no_such_field = 1`")
+            && err.contains("no such column"),
+        "{err}"
+    );
+    assert!(!out.exists());
+}
