@@ -12,6 +12,7 @@ use crate::io::writer::{check_output, Writer};
 use crate::io::IoError;
 use crate::output::{Rows, RunRecord};
 use crate::process::{feature_rows, FeatureRows, ProcessParams, RowOptions, Skeletons, Status};
+use crate::reporting::{check_path, write_report, ReportError, ReportJob, ReportSummary};
 use geo::MultiLineString;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
@@ -49,6 +50,8 @@ pub struct RunSummary {
     pub output: String,
     /// Chosen method per feature, counted.
     pub methods: Vec<(String, u64)>,
+    /// The report written after the run (`output.report`).
+    pub report: Option<ReportSummary>,
 }
 
 /// Why a run failed.
@@ -68,6 +71,9 @@ pub enum RunError {
     /// The thread pool could not be created.
     #[error("cannot start {0} worker threads")]
     Threads(usize),
+    /// The run's output was written but its report was not.
+    #[error("the report failed ({0}); the GeoPackage was written, `skeletonise report` makes the report from it")]
+    Report(#[from] ReportError),
 }
 
 /// Checks everything `run` checks before processing: the input opens, the
@@ -76,6 +82,9 @@ pub enum RunError {
 pub fn validate(p: &Pipeline) -> Result<crate::io::SourceInfo, RunError> {
     let reader = Reader::open(&p.file.input)?;
     check_output(&p.file.output)?;
+    if let Some(html) = p.file.output.report_path() {
+        check_path(&html)?;
+    }
     Ok(reader.info().clone())
 }
 
@@ -133,9 +142,28 @@ impl<'a> Job<'a> {
     }
 }
 
-/// Runs the pipeline end to end.
+/// Runs the pipeline end to end, then writes its report when the output
+/// asks for one (`output.report`).
 pub fn run(p: &Pipeline, opts: &RunOptions) -> Result<RunSummary, RunError> {
-    run_job(&Job::of(p), opts)
+    let report = p
+        .file
+        .output
+        .report
+        .as_ref()
+        .zip(p.file.output.report_path());
+    if let Some((_, html)) = &report {
+        check_path(html)?;
+    }
+    let mut summary = run_job(&Job::of(p), opts)?;
+    if let Some((spec, html)) = report {
+        summary.report = Some(write_report(&ReportJob {
+            gpkg: summary.output.clone().into(),
+            html,
+            selection: spec.features.clone(),
+            polygons: None,
+        })?);
+    }
+    Ok(summary)
 }
 
 /// Counts of a run so far.
@@ -269,5 +297,6 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
         elapsed_s,
         output: out.display().to_string(),
         methods: counts.methods.into_iter().collect(),
+        report: None,
     })
 }

@@ -585,6 +585,15 @@ fn a_polygon_of_a_million_vertices() {
     let ds = open(&out);
     assert_eq!(count(&ds, "skeletons"), 1);
     assert_eq!(count(&ds, "rejected"), 0);
+    // Its report draws it within the display budget.
+    let html = d.path().join("o.html");
+    let (code, err) = code_and_err(&skeletonise(&["report", out.to_str().unwrap()]));
+    assert_eq!(code, 0, "{err}");
+    let size = std::fs::metadata(&html).unwrap().len() as usize;
+    assert!(
+        size < skeletonise::report::section_bound(1) + 100_000,
+        "{size} bytes"
+    );
 }
 
 /// Any OGR data source string: a GeoPackage inside a zip archive, read through

@@ -41,6 +41,14 @@ pub enum IoError {
         /// GDAL's message.
         reason: String,
     },
+    /// The file given as an output of a run cannot be read as one.
+    #[error("cannot read `{path}` as the output of `skeletonise run`: {reason}")]
+    NotAnOutput {
+        /// The file.
+        path: String,
+        /// Why.
+        reason: String,
+    },
     /// An attribute filter on a layer of an output GeoPackage was rejected.
     #[error("invalid filter `{filter}` on layer `{layer}` of `{path}`: {reason}; use OGR SQL on the layer's columns, e.g. \"distortion > 0.01\" or \"kind = 'lake'\"")]
     BadFilter {

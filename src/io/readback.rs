@@ -102,9 +102,13 @@ impl OutputFile {
                 ..Default::default()
             },
         )
-        .map_err(|e| IoError::Open {
-            source_name: shown.clone(),
-            reason: e.to_string(),
+        .map_err(|e| IoError::NotAnOutput {
+            path: shown.clone(),
+            reason: if path.exists() {
+                e.to_string()
+            } else {
+                "the file does not exist".into()
+            },
         })?;
         let mut file = Self {
             ds,
@@ -119,10 +123,13 @@ impl OutputFile {
             }
         }
         if !file.has_layer(&file.skeleton_layer) {
-            return Err(IoError::NoLayer {
-                source_name: file.path.clone(),
-                layer: format!("`{}` (skeletons)", file.skeleton_layer),
-                available: file.layer_names().join(", "),
+            return Err(IoError::NotAnOutput {
+                path: file.path.clone(),
+                reason: format!(
+                    "it has no skeleton layer `{}` (its layers: {})",
+                    file.skeleton_layer,
+                    file.layer_names().join(", ")
+                ),
             });
         }
         Ok(file)
