@@ -44,9 +44,14 @@ fn num(x: f64, kind: Num) -> String {
     if !x.is_finite() {
         return "–".into();
     }
+    // Values too small for the fixed decimals (StSk's exact segments on a
+    // convex part score ~10⁻¹²) in powers of ten rather than as zeros.
+    let tiny = x != 0.0 && x.abs() < 1e-3;
     match kind {
+        Num::Z if tiny && x.abs() < 5e-6 => format!("{x:.1e}"),
         Num::Z => format!("{x:.5}"),
         Num::Coverage => format!("{x:.3}"),
+        Num::Sig if tiny => format!("{x:.2e}"),
         Num::Sig => draw::sig(x, 3),
         Num::Mean => format!("{x:.1}"),
     }
@@ -570,5 +575,8 @@ mod tests {
             r#"<td data-key="z" data-value="">–</td>"#
         );
         assert_eq!(num(0.000031, Num::Z), "0.00003");
+        assert_eq!(num(2.94e-12, Num::Z), "2.9e-12");
+        assert_eq!(num(2.94e-10, Num::Sig), "2.94e-10");
+        assert_eq!(num(48.61, Num::Sig), "48.6");
     }
 }
