@@ -381,7 +381,7 @@ fn cmd_validate(file: &PipelineArgs) -> ExitCode {
         Ok(info) => {
             let fields: Vec<&str> = info.fields.iter().map(|f| f.name.as_str()).collect();
             println!(
-                "{}: valid. input `{}` layer `{}`: {} features ({} after filters), CRS {}, fields: {}; output {}",
+                "{}: valid. input `{}` layer `{}`: {} features ({} after filters), CRS {}, fields: {}; output {}{}",
                 p.origin,
                 info.source,
                 info.layer,
@@ -389,7 +389,11 @@ fn cmd_validate(file: &PipelineArgs) -> ExitCode {
                 info.selected,
                 info.crs_name,
                 fields.join(", "),
-                p.file.output.path
+                p.file.output.path,
+                p.file
+                    .output
+                    .report_path()
+                    .map_or_else(String::new, |r| format!(", report {}", r.display()))
             );
             ExitCode::SUCCESS
         }
