@@ -345,14 +345,22 @@ const SECTIONS_JS: &str = r#"Array.from(document.querySelectorAll('section.featu
 const SUMMARY_JS: &str = r#"Object.fromEntries(Array.from(document.querySelectorAll('#summary-table tbody tr')).map(r =>
   [r.dataset.method, Object.fromEntries(Array.from(r.querySelectorAll('td[data-key]')).map(c => [c.dataset.key, c.dataset.value]))]))"#;
 
-/// Where the first vertex of the first section's chosen skeleton is on
-/// screen (after scrolling it into view).
+/// Where the middle vertex of the first section's chosen skeleton is on
+/// screen (after scrolling it into view), from the path's relative moves.
 const VERTEX_JS: &str = r#"(() => {
   const f = document.querySelector('section.feature figure.panel.chosen');
   f.scrollIntoView({block: 'center'});
   const svg = f.querySelector('svg'), d = f.querySelector('path.skel').getAttribute('d');
-  const n = d.match(/-?\d+/g).map(Number);
-  const p = new DOMPoint(n[0], n[1]).matrixTransform(svg.getScreenCTM());
+  const pts = []; let x = 0, y = 0, mode = '';
+  const t = d.match(/[Mlz]|-?\d+/g);
+  for (let i = 0; i < t.length;) {
+    if (/[Mlz]/.test(t[i])) { mode = t[i]; i += 1; continue; }
+    const a = Number(t[i]), b = Number(t[i + 1]); i += 2;
+    if (mode === 'M') { x = a; y = b; mode = 'l'; } else { x += a; y += b; }
+    pts.push([x, y]);
+  }
+  const m = pts[Math.floor(pts.length / 2)];
+  const p = new DOMPoint(m[0], m[1]).matrixTransform(svg.getScreenCTM());
   return [p.x, p.y];
 })()"#;
 
@@ -407,7 +415,43 @@ fn check_summary(b: &mut Browser, gpkg: &Path) {
     }
 }
 
-fn check_interaction(b: &mut Browser) {
+/// The width the `widths` layer holds at the vertex the page names
+/// (`… at x = X, y = Y`, to within `resolution`).
+fn width_in_file(gpkg: &Path, info: &str, resolution: f64) -> Option<f64> {
+    let at = info.split(" at x = ").nth(1)?;
+    let (x, y) = at.split_once(", y = ")?;
+    let (x, y): (f64, f64) = (x.parse().ok()?, y.trim().parse().ok()?);
+    let ds = open(gpkg);
+    let lines = wkts(&ds, "widths");
+    let (starts, ends) = (
+        reals(&ds, "widths", "width_start"),
+        reals(&ds, "widths", "width_end"),
+    );
+    lines.iter().enumerate().find_map(|(i, w)| {
+        let w = w
+            .as_deref()?
+            .strip_prefix("LINESTRING (")?
+            .strip_suffix(')')?;
+        w.split(',').enumerate().find_map(|(k, pt)| {
+            let mut c = pt.split_whitespace().map(|v| v.parse::<f64>().unwrap());
+            let (px, py) = (c.next()?, c.next()?);
+            let near = (px - x).hypot(py - y) <= resolution;
+            near.then(|| if k == 0 { starts[i] } else { ends[i] })
+                .flatten()
+        })
+    })
+}
+
+/// The number after `label` in `text`.
+fn number_after(text: &str, label: &str) -> f64 {
+    text.split(label)
+        .nth(1)
+        .and_then(|v| v.split(' ').next())
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("no number after `{label}` in {text}"))
+}
+
+fn check_interaction(b: &mut Browser, gpkg: &Path) {
     let p = b.eval(VERTEX_JS);
     let (x, y) = (p[0].as_f64().unwrap(), p[1].as_f64().unwrap());
     b.click(x, y);
@@ -416,6 +460,21 @@ fn check_interaction(b: &mut Browser) {
     assert!(
         info.contains("node radius r = ") && info.contains("width 2r = "),
         "{info}"
+    );
+    // Inside the polygon the radius at a vertex of the skeleton is positive,
+    // and the width shown is the one the `widths` layer holds there.
+    assert!(number_after(info, "node radius r = ") > 0.0, "{info}");
+    let shown = number_after(info, "width 2r = ");
+    let scale: f64 = b
+        .eval("document.querySelector('section.feature').dataset.scale")
+        .as_str()
+        .unwrap()
+        .parse()
+        .unwrap();
+    let file = width_in_file(gpkg, info, 1.5 / scale).unwrap_or_else(|| panic!("{info}"));
+    assert!(
+        (shown - file).abs() <= 0.005 * file,
+        "{info}: the file says {file}"
     );
     assert_eq!(
         b.eval("document.querySelectorAll('section.feature g.pick circle').length"),
@@ -466,7 +525,7 @@ fn the_demo_report_works_in_a_real_browser() {
     b.eval("window.scrollTo(0, 0)");
     let shot = Path::new(env!("CARGO_TARGET_TMPDIR")).join("report-demo.png");
     b.screenshot(&shot);
-    check_interaction(&mut b);
+    check_interaction(&mut b, &gpkg);
     assert_eq!(
         b.errors(),
         Vec::<String>::new(),

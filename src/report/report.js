@@ -78,8 +78,10 @@
     section.querySelectorAll('g.pick').forEach(function (g) { while (g.firstChild) { g.removeChild(g.firstChild); } });
     if (isFinite(r)) { mark(svg, v, r * scale); }
     info.classList.add('picked');
+    // The position to the frame's resolution (1 / scale); r is exact.
+    var decimals = Math.max(0, Math.min(6, Math.ceil(Math.log10(scale))));
     info.textContent = method + ': node radius r = ' + fmt(r) + units + ', width 2r = ' + fmt(2 * r) + units +
-      ' at x = ' + x.toFixed(1) + ', y = ' + y.toFixed(1);
+      ' at x = ' + x.toFixed(decimals) + ', y = ' + y.toFixed(decimals);
   }
 
   function initSection(section) {
