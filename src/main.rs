@@ -204,10 +204,10 @@ struct ReportArgs {
     #[arg(long, value_name = "SRC")]
     polygons: Option<String>,
     /// Polygon layer (default: the layer the run read).
-    #[arg(long, value_name = "LAYER")]
+    #[arg(long, value_name = "LAYER", requires = "polygons")]
     polygons_layer: Option<String>,
     /// Reproject the polygons (default: as the run did).
-    #[arg(long, value_name = "CRS")]
+    #[arg(long, value_name = "CRS", requires = "polygons")]
     reproject: Option<String>,
 }
 
