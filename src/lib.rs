@@ -21,4 +21,6 @@ pub mod methods;
 pub mod output;
 pub mod pipeline;
 pub mod process;
+pub mod report;
+pub mod reporting;
 pub mod score;

@@ -440,8 +440,18 @@ pub struct RunRecord {
     pub tool_version: String,
     /// The pipeline text (with overrides).
     pub pipeline: String,
-    /// Input source and layer.
+    /// Input source and layer, for people.
     pub input: String,
+    /// The input source as it opens from any working directory (an existing
+    /// local path made absolute), for `skeletonise report` to reopen the
+    /// polygons.
+    pub input_source: String,
+    /// The input layer's name.
+    pub input_layer: String,
+    /// `input.reproject`, when the polygons were reprojected.
+    pub input_reproject: Option<String>,
+    /// The name of the skeleton layer (`output.layer`).
+    pub skeleton_layer: String,
     /// Features read.
     pub read: u64,
     /// Features written.
@@ -472,6 +482,12 @@ pub const RUNS: LayerDef<RunRecord> = LayerDef {
         col("tool_version", Text, |r| text(&r.tool_version)),
         col("pipeline", Text, |r| text(&r.pipeline)),
         col("input", Text, |r| text(&r.input)),
+        col("input_source", Text, |r| text(&r.input_source)),
+        col("input_layer", Text, |r| text(&r.input_layer)),
+        col("input_reproject", Text, |r| {
+            r.input_reproject.as_deref().map_or(Cell::Null, text)
+        }),
+        col("skeleton_layer", Text, |r| text(&r.skeleton_layer)),
         col("features_read", Int64, |r| int(r.read)),
         col("features_written", Int64, |r| int(r.written)),
         col("features_rejected", Int64, |r| int(r.rejected)),

@@ -15,6 +15,7 @@ use crate::output::{Rows, RunRecord};
 use crate::process::{
     feature_rows, FeatureRows, ProcessParams, RowOptions, Skeletons, StageTimes, Status,
 };
+use crate::reporting::{check_path, write_report, ReportError, ReportJob, ReportSummary};
 use geo::MultiLineString;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
@@ -58,6 +59,8 @@ pub struct RunSummary {
     pub methods: Vec<(String, u64)>,
     /// Thread time each method spent, step by step, over the whole run.
     pub stages: Vec<(MethodId, StageTimes)>,
+    /// The report written after the run (`output.report`).
+    pub report: Option<ReportSummary>,
 }
 
 /// Why a run failed.
@@ -85,6 +88,9 @@ pub enum RunError {
         /// Cores of this machine.
         cores: usize,
     },
+    /// The run's output was written but its report was not.
+    #[error("the report failed ({0}); the GeoPackage was written, `skeletonise report` makes the report from it")]
+    Report(#[from] ReportError),
 }
 
 /// Checks everything `run` checks before processing: the input opens, the
@@ -94,6 +100,9 @@ pub fn validate(p: &Pipeline) -> Result<crate::io::SourceInfo, RunError> {
     let mut reader = Reader::open(&p.file.input)?;
     reader.probe()?;
     check_output(&p.file.output, &[&p.file.input.source])?;
+    if let Some(html) = p.file.output.report_path() {
+        check_path(&html)?;
+    }
     Ok(reader.info().clone())
 }
 
@@ -154,9 +163,28 @@ impl<'a> Job<'a> {
     }
 }
 
-/// Runs the pipeline end to end.
+/// Runs the pipeline end to end, then writes its report when the output
+/// asks for one (`output.report`).
 pub fn run(p: &Pipeline, opts: &RunOptions) -> Result<RunSummary, RunError> {
-    run_job(&Job::of(p), opts)
+    let report = p
+        .file
+        .output
+        .report
+        .as_ref()
+        .zip(p.file.output.report_path());
+    if let Some((_, html)) = &report {
+        check_path(html)?;
+    }
+    let mut summary = run_job(&Job::of(p), opts)?;
+    if let Some((spec, html)) = report {
+        summary.report = Some(write_report(&ReportJob {
+            gpkg: summary.output.clone().into(),
+            html,
+            selection: spec.features.clone(),
+            polygons: None,
+        })?);
+    }
+    Ok(summary)
 }
 
 /// Counts of a run so far.
@@ -476,6 +504,10 @@ fn finish_run(
         tool_version: env!("CARGO_PKG_VERSION").to_string(),
         pipeline: job.provenance.clone(),
         input: format!("{} (layer {})", info.source, info.layer),
+        input_source: crate::io::reader::absolute_source(&info.source),
+        input_layer: info.layer.clone(),
+        input_reproject: job.input.reproject.clone(),
+        skeleton_layer: job.output.layer.clone(),
         read: counts.read,
         written: counts.written,
         rejected: counts.rejected,
@@ -495,6 +527,7 @@ fn finish_run(
         output: out.display().to_string(),
         methods: counts.methods.into_iter().collect(),
         stages: counts.stages,
+        report: None,
     })
 }
 

@@ -16,7 +16,7 @@
 pub mod locate;
 mod sections;
 
-pub use sections::{InputSpec, LayerRef, OutputSpec};
+pub use sections::{InputSpec, LayerRef, OutputSpec, ReportSpec};
 
 use crate::graph::extend::ExtendParams;
 use crate::graph::prune::PruneParams;
@@ -388,6 +388,17 @@ fn validate(f: &PipelineFile, _locs: &Locations) -> Result<(), (String, String)>
             "output.path".into(),
             "give the output GeoPackage path".into(),
         ));
+    }
+    if let Some(r) = &f.output.report {
+        r.features
+            .validate()
+            .map_err(|(k, m)| (format!("output.report.features.{k}"), m))?;
+        if f.output.report_path() == Some(std::path::PathBuf::from(&f.output.path)) {
+            return Err((
+                "output.report.path".into(),
+                "the report would overwrite the GeoPackage; give a path ending in .html".into(),
+            ));
+        }
     }
     Ok(())
 }

@@ -1,8 +1,10 @@
 //! Everything that touches GDAL: the [`reader`] turns any OGR source into
 //! owned features with `geo` geometries; the [`writer`] writes the
-//! GeoPackage layers. No GDAL type leaves this module.
+//! GeoPackage layers; [`readback`] reads an output GeoPackage back for the
+//! report. No GDAL type leaves this module.
 
 pub mod gdal_errors;
+pub mod readback;
 pub mod reader;
 pub mod signals;
 pub mod writer;
@@ -49,6 +51,26 @@ pub enum IoError {
         /// GDAL's message.
         reason: String,
     },
+    /// The file given as an output of a run cannot be read as one.
+    #[error("cannot read `{path}` as the output of `skeletonise run`: {reason}")]
+    NotAnOutput {
+        /// The file.
+        path: String,
+        /// Why.
+        reason: String,
+    },
+    /// An attribute filter on a layer of an output GeoPackage was rejected.
+    #[error("invalid filter `{filter}` on layer `{layer}` of `{path}`: {reason}; use OGR SQL on the layer's columns, e.g. \"distortion > 0.01\" or \"kind = 'lake'\"")]
+    BadFilter {
+        /// The GeoPackage.
+        path: String,
+        /// The layer filtered.
+        layer: String,
+        /// The filter text.
+        filter: String,
+        /// GDAL's message.
+        reason: String,
+    },
     /// A geographic CRS and no reprojection.
     #[error("layer `{layer}` has the geographic CRS {crs}; skeleton radii and scores need a projected CRS: add `input.reproject: EPSG:<code>` (e.g. the layer's UTM zone) to the pipeline")]
     Geographic {
@@ -87,6 +109,40 @@ pub enum IoError {
         /// GDAL's message.
         reason: String,
     },
+}
+
+/// Sets an OGR SQL attribute filter and makes the layer evaluate it once, so
+/// that a filter the driver only rejects when it runs it (GeoPackage passes
+/// it to SQLite) fails here, with the driver's message, instead of silently
+/// selecting nothing.
+pub(crate) fn set_filter(layer: &mut gdal::vector::Layer<'_>, filter: &str) -> Result<(), String> {
+    use gdal::vector::LayerAccess;
+    layer
+        .set_attribute_filter(filter)
+        .map_err(|e| e.to_string())?;
+    // SAFETY: GDAL's thread-local error state, read and reset around one
+    // call on this thread; the quiet handler keeps GDAL from printing it.
+    unsafe {
+        gdal_sys::CPLPushErrorHandler(Some(gdal_sys::CPLQuietErrorHandler));
+        gdal_sys::CPLErrorReset();
+    }
+    let _ = layer.feature_count();
+    let failed = unsafe {
+        let failed = gdal_sys::CPLGetLastErrorType() >= gdal_sys::CPLErr::CE_Failure;
+        let msg = std::ffi::CStr::from_ptr(gdal_sys::CPLGetLastErrorMsg())
+            .to_string_lossy()
+            .to_string();
+        gdal_sys::CPLErrorReset();
+        gdal_sys::CPLPopErrorHandler();
+        failed.then_some(msg)
+    };
+    match failed {
+        Some(msg) => {
+            layer.clear_attribute_filter();
+            Err(msg)
+        }
+        None => Ok(()),
+    }
 }
 
 impl IoError {

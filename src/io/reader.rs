@@ -249,12 +249,10 @@ impl Reader {
 
     fn apply_filters(layer: &mut gdal::vector::Layer<'_>, spec: &InputSpec) -> Result<(), IoError> {
         if let Some(w) = &spec.where_ {
-            layer
-                .set_attribute_filter(w)
-                .map_err(|e| IoError::BadWhere {
-                    filter: w.clone(),
-                    reason: e.to_string(),
-                })?;
+            super::set_filter(layer, w).map_err(|reason| IoError::BadWhere {
+                filter: w.clone(),
+                reason,
+            })?;
         }
         if let Some([x0, y0, x1, y1]) = spec.bbox {
             layer.set_spatial_filter_rect(x0, y0, x1, y1);
@@ -280,49 +278,13 @@ impl Reader {
             .layer(self.layer_index)
             .map_err(|e| IoError::gdal("opening the layer", e))?;
         Self::apply_filters(&mut layer, &self.spec)?;
-        let transform = match (&self.target, layer.spatial_ref()) {
-            (Some(t), Some(s)) => Some(
-                CoordTransform::new(&traditional(s), t)
-                    .map_err(|e| IoError::gdal("creating the coordinate transformation", e))?,
-            ),
-            _ => None,
-        };
-        let n_fields = self.info.fields.len();
+        let transform = self.transform(&layer)?;
         let mut buf = Vec::with_capacity(batch);
         super::gdal_errors::clear();
         for f in layer.features() {
             // Failures while fetching the feature are the source's.
             self.check_read()?;
-            let attributes = (0..n_fields)
-                .map(|i| value(f.field(i).ok().flatten()))
-                .collect();
-            let mut feat = Feature {
-                fid: f.fid(),
-                attributes,
-                geometry: None,
-                geometry_error: None,
-                source_wkb: None,
-                repaired: false,
-            };
-            // gdal hands out a wrapper around a null handle for NULL geometries.
-            // SAFETY: the handle is only compared with null.
-            let geometry = f
-                .geometry()
-                .filter(|g| unsafe { !g.c_geometry().is_null() });
-            if let Some(g) = geometry {
-                match convert(g, transform.as_ref(), make_valid) {
-                    Ok((geom, wkb, repaired)) => {
-                        feat.geometry = geom;
-                        feat.source_wkb = wkb;
-                        feat.repaired = repaired;
-                    }
-                    Err(e) => feat.geometry_error = Some(e),
-                }
-                // What GDAL reported while converting (a reprojection or a
-                // repair that failed) is this feature's reason, not the run's.
-                super::gdal_errors::clear();
-            }
-            buf.push(feat);
+            buf.push(self.feature(&f, transform.as_ref(), make_valid));
             if buf.len() >= batch {
                 on_batch(std::mem::take(&mut buf))?;
             }
@@ -336,10 +298,78 @@ impl Reader {
         }
         Ok(())
     }
+
+    /// Reads the features with the given FIDs, in that order, whatever the
+    /// filters; an FID the layer does not hold is left out.
+    pub fn read_fids(&self, fids: &[u64], make_valid: bool) -> Result<Vec<Feature>, IoError> {
+        let layer = self
+            .dataset
+            .layer(self.layer_index)
+            .map_err(|e| IoError::gdal("opening the layer", e))?;
+        let transform = self.transform(&layer)?;
+        Ok(fids
+            .iter()
+            .filter_map(|&fid| layer.feature(fid))
+            .map(|f| self.feature(&f, transform.as_ref(), make_valid))
+            .collect())
+    }
+
+    /// The transformation to the target CRS, when reprojecting.
+    fn transform(
+        &self,
+        layer: &gdal::vector::Layer<'_>,
+    ) -> Result<Option<CoordTransform>, IoError> {
+        match (&self.target, layer.spatial_ref()) {
+            (Some(t), Some(s)) => Ok(Some(
+                CoordTransform::new(&traditional(s), t)
+                    .map_err(|e| IoError::gdal("creating the coordinate transformation", e))?,
+            )),
+            _ => Ok(None),
+        }
+    }
+
+    /// One GDAL feature as an owned [`Feature`].
+    fn feature(
+        &self,
+        f: &gdal::vector::Feature<'_>,
+        transform: Option<&CoordTransform>,
+        make_valid: bool,
+    ) -> Feature {
+        let attributes = (0..self.info.fields.len())
+            .map(|i| value(f.field(i).ok().flatten()))
+            .collect();
+        let mut feat = Feature {
+            fid: f.fid(),
+            attributes,
+            geometry: None,
+            geometry_error: None,
+            source_wkb: None,
+            repaired: false,
+        };
+        // gdal hands out a wrapper around a null handle for NULL geometries.
+        // SAFETY: the handle is only compared with null.
+        let geometry = f
+            .geometry()
+            .filter(|g| unsafe { !g.c_geometry().is_null() });
+        if let Some(g) = geometry {
+            match convert(g, transform, make_valid) {
+                Ok((geom, wkb, repaired)) => {
+                    feat.geometry = geom;
+                    feat.source_wkb = wkb;
+                    feat.repaired = repaired;
+                }
+                Err(e) => feat.geometry_error = Some(e),
+            }
+            // What GDAL reported while converting (a reprojection or a
+            // repair that failed) is this feature's reason, not the run's.
+            super::gdal_errors::clear();
+        }
+        feat
+    }
 }
 
 /// A field value as the per-feature path carries it.
-fn value(v: Option<FieldValue>) -> Value {
+pub(super) fn value(v: Option<FieldValue>) -> Value {
     match v {
         None => Value::Null,
         Some(FieldValue::IntegerValue(i)) => Value::Integer(i),
@@ -448,6 +478,17 @@ fn collect_polygons(g: &Geometry, out: &mut Geometry) -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+/// The data source string as it opens from any working directory: an
+/// existing local path made absolute; anything else (`PG:…`, `/vsizip/…`,
+/// URLs) as given.
+pub fn absolute_source(source: &str) -> String {
+    let path = std::path::Path::new(source);
+    match path.is_relative().then(|| path.canonicalize()) {
+        Some(Ok(abs)) => abs.display().to_string(),
+        _ => source.to_string(),
+    }
 }
 
 /// A source FID and its geometry.

@@ -2,6 +2,8 @@
 //! GeoPackage files.
 #![allow(dead_code)]
 
+pub mod browser;
+
 use gdal::spatial_ref::SpatialRef;
 use gdal::vector::{
     Feature, FieldDefn, Geometry, LayerAccess, LayerOptions, OGRFieldType, OGRwkbGeometryType,
