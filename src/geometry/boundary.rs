@@ -281,7 +281,7 @@ impl Boundary {
         let (_, i) = self.nearest_segment(p)?;
         let s = &self.segments[i as usize];
         let (c, _) = s.closest(p);
-        Some((c, i as usize, (c - p).x.hypot((c - p).y)))
+        Some((c, i as usize, super::norm(c - p)))
     }
 
     /// Euclidean distance from `p` to ∂P (the radius of every skeleton node).
@@ -372,7 +372,7 @@ impl Boundary {
             let s = &self.segments[i as usize];
             if let Some((a, b)) = clip(s.a, s.b) {
                 let c = closest_on_segment(a, b, q).0;
-                let d = (c - q).x.hypot((c - q).y);
+                let d = super::norm(c - q);
                 if d <= limit
                     && best
                         .get()

@@ -16,6 +16,14 @@ pub use boundary::{Boundary, BoundarySegment, RayHit};
 use geo::{Coord, Polygon};
 use thiserror::Error;
 
+/// Length of a vector: `√(x² + y²)`, without `hypot`'s care for overflow
+/// (which costs several times as much and which projected coordinates never
+/// need).
+#[inline]
+pub fn norm(d: Coord<f64>) -> f64 {
+    (d.x * d.x + d.y * d.y).sqrt()
+}
+
 /// Why a polygon cannot be prepared for skeletonisation.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum GeometryError {

@@ -396,7 +396,7 @@ pub fn box_half_plane_distance(b: &Bbox, q: [f64; 2], n: [f64; 2]) -> Option<f64
     }
     // A margin for rounding in the slab test: a box the edge only touches
     // still counts.
-    let len = t[0].hypot(t[1]);
+    let len = (t[0] * t[0] + t[1] * t[1]).sqrt();
     let slack = 1e-9 * (s0.abs().max(s1.abs()).min(1e300) + 1.0);
     if s0 > s1 + slack {
         return None;

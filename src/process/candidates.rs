@@ -12,6 +12,7 @@ use crate::score::defects::graph_of;
 use crate::score::{metrics, BarRays};
 use geo::MultiLineString;
 use rayon::prelude::*;
+use std::time::Duration;
 
 /// Every method's candidate for the polygon parts `prepared`, in `methods`
 /// order.
@@ -30,10 +31,9 @@ pub(super) fn computed(
                 .collect()
         })
         .collect();
-    let clock = CpuClock::start();
-    let rays = bar_rays(prepared, params);
+    let (rays, rays_time) = bar_rays(prepared, params);
     // The shared rays, split evenly between the methods.
-    let rays_share = clock.elapsed() / params.skeleton.methods.len().max(1) as u32;
+    let rays_share = rays_time / params.skeleton.methods.len().max(1) as u32;
     params
         .skeleton
         .methods
@@ -46,9 +46,11 @@ pub(super) fn computed(
             }
             let parts: Result<Vec<PartSkeleton>, String> =
                 per_part.iter().map(|r| r[k].0.clone()).collect();
-            let clock = CpuClock::start();
             let result = parts.map(|parts| finish(prepared, &rays, &parts, params));
-            time.score += clock.elapsed() + rays_share;
+            let result = result.map(|(c, t)| {
+                time.score += t + rays_share;
+                c
+            });
             super::Candidate {
                 method: m,
                 result,
@@ -74,7 +76,7 @@ pub(super) fn given(
             legs_raw: legs,
         })
         .collect();
-    let mut c = finish(prepared, &bar_rays(prepared, params), &parts, params);
+    let (mut c, _) = finish(prepared, &bar_rays(prepared, params).0, &parts, params);
     // The lines once, not once per polygon part.
     c.geometry = lines.clone();
     c.components = graph.components();
@@ -110,7 +112,7 @@ pub(super) fn part_skeletons(
                 .build(m, &params.skeleton)
                 .and_then(|method| {
                     guarded(m, || {
-                        crate::methods::budget::with_deadline(m, params.skeleton.budget(), || {
+                        crate::methods::budget::with_budget(m, params.skeleton.budget(), || {
                             method.skeletonise(p)
                         })
                         .map_err(|e| e.to_string())
@@ -185,12 +187,25 @@ fn guarded<T>(
     })
 }
 
-/// Every part's bars when the run scores (shared by all candidates).
-fn bar_rays(prepared: &[PreparedPolygon], params: &ProcessParams) -> Vec<BarRays> {
-    match params.score {
-        Some(_) => prepared.par_iter().map(BarRays::new).collect(),
-        None => Vec::new(),
+/// Every part's bars when the run scores (shared by all candidates), and
+/// the CPU time they took over all threads.
+fn bar_rays(prepared: &[PreparedPolygon], params: &ProcessParams) -> (Vec<BarRays>, Duration) {
+    if params.score.is_none() {
+        return (Vec::new(), Duration::ZERO);
     }
+    // Per part, on one thread each (a part's rays may fan out to others,
+    // whose time the part's clock misses: counted as wall time then).
+    let timed: Vec<(BarRays, Duration)> = prepared
+        .par_iter()
+        .map(|p| {
+            let wall = std::time::Instant::now();
+            let cpu = CpuClock::start();
+            let r = BarRays::new(p);
+            (r, cpu.elapsed().max(wall.elapsed()))
+        })
+        .collect();
+    let time = timed.iter().map(|(_, t)| *t).sum();
+    (timed.into_iter().map(|(r, _)| r).collect(), time)
 }
 
 /// One candidate from its finished skeleton of every polygon part: scored
@@ -201,7 +216,12 @@ fn finish(
     rays: &[BarRays],
     parts: &[PartSkeleton],
     params: &ProcessParams,
-) -> CandidateSkeleton {
+) -> (CandidateSkeleton, Duration) {
+    // CPU time: the bars' own (over every thread that cast them), plus this
+    // thread's outside the casts (inside, it may run other work).
+    let clock = CpuClock::start();
+    let mut cast_time = Duration::ZERO;
+    let mut in_casts = Duration::ZERO;
     let mut lines = Vec::new();
     let mut all_bars = Vec::new();
     let mut widths = Vec::new();
@@ -213,7 +233,10 @@ fn finish(
         legs += g.leg_count();
         components += g.components();
         if params.score.is_some() {
-            let mut b = rays[k].cast(p, g);
+            let here = CpuClock::start();
+            let (mut b, t) = rays[k].cast_timed(p, g);
+            in_casts += here.elapsed();
+            cast_time += t;
             for bar in &mut b {
                 if let Some(h) = &mut bar.hit {
                     h.part += branch_offset;
@@ -231,7 +254,7 @@ fn finish(
     if !params.keep_bars {
         all_bars.clear();
     }
-    CandidateSkeleton {
+    let c = CandidateSkeleton {
         geometry: MultiLineString(lines),
         scores,
         components,
@@ -239,5 +262,6 @@ fn finish(
         legs,
         bars: all_bars,
         widths,
-    }
+    };
+    (c, cast_time + clock.elapsed().saturating_sub(in_casts))
 }

@@ -3,8 +3,13 @@
 use super::{metrics, Bar, BarHit, Scores};
 use crate::geometry::{boundary::orient, Boundary, BoundarySegment, PreparedPolygon};
 use crate::graph::{GraphBuilder, SkeletonGraph};
+use crate::process::clock::CpuClock;
 use geo::{Coord, MultiLineString};
+use rayon::prelude::*;
 use std::collections::HashMap;
+
+/// Bars per parallel task: a polygon with fewer is scored on one thread.
+const PAR_BARS: usize = 4096;
 
 /// Relative tolerance: hits closer than this × extent to the bar's origin are
 /// the origin itself (SPEC §6.2).
@@ -15,7 +20,7 @@ fn dot(a: Coord<f64>, b: Coord<f64>) -> f64 {
 }
 
 fn norm(a: Coord<f64>) -> f64 {
-    a.x.hypot(a.y)
+    crate::geometry::norm(a)
 }
 
 /// Left unit normal of the direction `d` (inward for a ring edge, since the
@@ -165,18 +170,24 @@ impl BarRays {
                 ];
                 for (origin, ok) in origins {
                     if ok {
-                        let exit = boundary
-                            .first_hit(origin, u, eps, f64::INFINITY)
-                            .map_or(diagonal, |h| h.t);
                         rays.push(Ray {
                             origin,
                             dir: u,
-                            exit,
+                            exit: diagonal,
                         });
                     }
                 }
             }
         }
+        // Where each ray leaves P: in parallel for a large polygon (one
+        // huge feature must not leave the other cores idle).
+        rays.par_chunks_mut(PAR_BARS).for_each(|chunk| {
+            for r in chunk {
+                if let Some(h) = boundary.first_hit(r.origin, r.dir, eps, f64::INFINITY) {
+                    r.exit = h.t;
+                }
+            }
+        });
         Self { rays }
     }
 
@@ -193,12 +204,38 @@ impl BarRays {
     /// The bars cast against `skeleton` (of the polygon the rays were made
     /// for): hits and sides.
     pub fn cast(&self, polygon: &PreparedPolygon, skeleton: &SkeletonGraph) -> Vec<Bar> {
+        self.cast_timed(polygon, skeleton).0
+    }
+
+    /// [`BarRays::cast`], and the CPU time it took over all threads (a
+    /// large polygon's bars are cast in parallel).
+    pub fn cast_timed(
+        &self,
+        polygon: &PreparedPolygon,
+        skeleton: &SkeletonGraph,
+    ) -> (Vec<Bar>, std::time::Duration) {
+        let clock = CpuClock::start();
         let eps = REL_EPS * polygon.extent();
         let sk = SkeletonIndex::new(skeleton);
-        self.rays
-            .iter()
-            .map(|r| cast(polygon.boundary(), &sk, r, eps))
-            .collect()
+        let mut time = clock.elapsed();
+        let chunks: Vec<(Vec<Bar>, std::time::Duration)> = self
+            .rays
+            .par_chunks(PAR_BARS)
+            .map(|chunk| {
+                let clock = CpuClock::start();
+                let bars: Vec<Bar> = chunk
+                    .iter()
+                    .map(|r| cast(polygon.boundary(), &sk, r, eps))
+                    .collect();
+                (bars, clock.elapsed())
+            })
+            .collect();
+        let mut bars = Vec::with_capacity(self.rays.len());
+        for (b, t) in chunks {
+            bars.extend(b);
+            time += t;
+        }
+        (bars, time)
     }
 }
 
