@@ -37,11 +37,16 @@ fn main() {
         let t = Instant::now();
         match straight_skeleton_with_stats(&pp) {
             Ok((g, s)) => println!(
-                "n = {n}: {:.3} s, {} edges, {} wavefront vertices, {} pops",
+                "n = {n}: {:.3} s, {} edges, {} wavefront vertices, {} pops, at most {} queued, {} edges tried (predicted {:.0}), {} candidates kept (predicted {:.0})",
                 t.elapsed().as_secs_f64(),
                 g.edges().len(),
                 s.vertices,
-                s.pops
+                s.pops,
+                s.max_queue,
+                s.tried,
+                s.predicted.0,
+                s.candidates,
+                s.predicted.1
             ),
             Err(e) => println!(
                 "n = {n}: error {e} after {:.3} s",

@@ -6,6 +6,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/deps.sh
+scripts/test-deps.sh
+# Installed above: the PostGIS test must run, not skip.
+export SKELETONISE_REQUIRE_POSTGIS=1
 cargo test --all-targets "$@"
 cargo test --doc
 # The core without GDAL, as the Python binding builds it (the GDAL-only targets are skipped).

@@ -103,6 +103,8 @@ fn read_all(r: &mut Reader) -> Result<Vec<Feature>, RunError> {
 /// through the same run as a pipeline's, with the joined lines in place of
 /// the methods' skeletons.
 pub fn score_external(job: &ScoreJob, keep_bars: bool) -> Result<RunSummary, RunError> {
+    // Before reading anything: the output must not be one of the inputs.
+    crate::io::writer::check_output(&job.output, &[&job.polygons.source, &job.skeletons.source])?;
     let given = Given {
         label: job.label.clone(),
         lines: join(job)?,
@@ -114,7 +116,7 @@ pub fn score_external(job: &ScoreJob, keep_bars: bool) -> Result<RunSummary, Run
     let params = ProcessParams {
         prepare: PrepareParams {
             make_valid: false,
-            min_area: 0.0,
+            ..PrepareParams::default()
         },
         score: Some(ScoreParams::default()),
         keep_bars,
@@ -131,6 +133,7 @@ pub fn score_external(job: &ScoreJob, keep_bars: bool) -> Result<RunSummary, Run
         params,
         on_error: OnError::Reject,
         given: Some(&given),
+        other_inputs: vec![job.skeletons.source.clone()],
     };
     run_job(&run, &RunOptions::default())
 }
@@ -139,6 +142,18 @@ pub fn score_external(job: &ScoreJob, keep_bars: bool) -> Result<RunSummary, Run
 fn join(job: &ScoreJob) -> Result<HashMap<u64, MultiLineString<f64>>, RunError> {
     let mut pr = Reader::open(&job.polygons)?;
     let mut sr = Reader::open(&job.skeletons)?;
+    if crate::io::reader::same_crs(pr.info(), sr.info()) == Some(false) {
+        return Err(RunError::Io(crate::io::IoError::Gdal {
+            context: format!(
+                "the skeletons `{}` (CRS {}) and the polygons `{}` (CRS {})",
+                job.skeletons.source,
+                sr.info().crs_name,
+                job.polygons.source,
+                pr.info().crs_name
+            ),
+            reason: "are in different CRSs, so no skeleton would meet its polygon; reproject one of them to the other's CRS first (e.g. with ogr2ogr -t_srs), or give both `--reproject EPSG:<code>`".into(),
+        }));
+    }
     let polygons = read_all(&mut pr)?;
     let skeletons = read_all(&mut sr)?;
     let assigned = match &job.join {

@@ -32,4 +32,7 @@ pub mod output;
 #[cfg(feature = "gdal")]
 pub mod pipeline;
 pub mod process;
+pub mod report;
+#[cfg(feature = "gdal")]
+pub mod reporting;
 pub mod score;

@@ -9,6 +9,11 @@ use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+/// mimalloc: the workers allocate and free many small graphs and vectors
+/// per polygon, which the system allocator serves more slowly.
+#[global_allocator]
+static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 const EXIT_RUNTIME: u8 = 1;
 const EXIT_REJECTED: u8 = 65;
 const EXIT_CONFIG: u8 = 78;
@@ -88,6 +93,9 @@ enum Command {
         /// Worker threads (default: one per core).
         #[arg(long)]
         threads: Option<usize>,
+        /// Without a terminal, log a progress line every so many seconds.
+        #[arg(long, value_name = "SECONDS", default_value_t = 10.0, value_parser = seconds)]
+        progress_every: f64,
     },
     /// Check a pipeline file and its input without processing anything.
     Validate {
@@ -96,6 +104,8 @@ enum Command {
     },
     /// Score skeletons made by any tool with the paper's metrics.
     Score(ScoreArgs),
+    /// Write the visual report of an output GeoPackage: every method's skeleton of the selected features side by side, with their scores (one self-contained HTML file).
+    Report(ReportArgs),
     /// List the methods and steps with their options.
     Methods,
     /// Print the JSON Schema of the pipeline file.
@@ -170,8 +180,95 @@ impl ScoreArgs {
                 bars: self.bars,
                 explode: false,
                 widths: false,
+                report: None,
             },
         }
+    }
+}
+
+/// A number of seconds ≥ 0 (a week at most).
+fn seconds(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if (0.0..=604_800.0).contains(&v) => Ok(v),
+        _ => Err(format!(
+            "`{s}` is not a number of seconds between 0 and 604800"
+        )),
+    }
+}
+
+/// The arguments of `skeletonise report`.
+#[derive(clap::Args)]
+struct ReportArgs {
+    /// The output GeoPackage of `skeletonise run` (or `score`).
+    gpkg: PathBuf,
+    /// The HTML file (default: beside the GeoPackage, extension .html).
+    #[arg(short = 'o', long = "output", value_name = "REPORT.html")]
+    output: Option<PathBuf>,
+    /// Show the N features on which the methods disagree most (default 20).
+    #[arg(long, value_name = "N", conflicts_with_all = ["fid", "where_"])]
+    top: Option<usize>,
+    /// Show these source FIDs (repeatable, or comma-separated).
+    #[arg(
+        long,
+        value_name = "FID",
+        value_delimiter = ',',
+        conflicts_with = "where_"
+    )]
+    fid: Vec<u64>,
+    /// Show the features whose skeleton row passes this OGR SQL filter, e.g. "kind = 'lake'".
+    #[arg(long = "where", value_name = "SQL")]
+    where_: Option<String>,
+    /// Polygon source, when not where `skeletonise_runs` says the run read it.
+    #[arg(long, value_name = "SRC")]
+    polygons: Option<String>,
+    /// Polygon layer (default: the layer the run read).
+    #[arg(long, value_name = "LAYER", requires = "polygons")]
+    polygons_layer: Option<String>,
+    /// Reproject the polygons (default: as the run did).
+    #[arg(long, value_name = "CRS", requires = "polygons")]
+    reproject: Option<String>,
+}
+
+impl ReportArgs {
+    fn job(&self) -> Result<skeletonise::reporting::ReportJob, String> {
+        use skeletonise::config::{InputSpec, LayerRef};
+        use skeletonise::report::Selection;
+        let selection = match (&self.top, self.fid.is_empty(), &self.where_) {
+            (Some(n), _, _) => Selection::Top(*n),
+            (None, false, _) => Selection::Fids(self.fid.clone()),
+            (None, true, Some(w)) => Selection::Where(w.clone()),
+            (None, true, None) => Selection::default(),
+        };
+        selection
+            .validate()
+            .map_err(|(k, m)| format!("--{k}: {m}"))?;
+        let recorded = skeletonise::io::readback::OutputFile::open(&self.gpkg)
+            .ok()
+            .and_then(|f| f.run().cloned());
+        let polygons = self.polygons.as_ref().map(|source| InputSpec {
+            source: source.clone(),
+            layer: self
+                .polygons_layer
+                .clone()
+                .or_else(|| recorded.as_ref().map(|r| r.input_layer.clone()))
+                .filter(|l| !l.is_empty())
+                .map(LayerRef::Name),
+            where_: None,
+            bbox: None,
+            reproject: self
+                .reproject
+                .clone()
+                .or_else(|| recorded.as_ref().and_then(|r| r.input_reproject.clone())),
+        });
+        Ok(skeletonise::reporting::ReportJob {
+            html: self
+                .output
+                .clone()
+                .unwrap_or_else(|| self.gpkg.with_extension("html")),
+            gpkg: self.gpkg.clone(),
+            selection,
+            polygons,
+        })
     }
 }
 
@@ -210,10 +307,26 @@ fn run_error(e: RunError) -> ExitCode {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     init_logging(&cli);
+    skeletonise::io::gdal_errors::install();
+    // A panic (a bug; the per-feature path turns it into a rejection or a
+    // failed method) is logged in the run's log format, not printed raw.
+    std::panic::set_hook(Box::new(|info| {
+        tracing::error!(target: "skeletonise::panic", "internal error: {info}");
+    }));
+    if let Err(e) = skeletonise::io::signals::install() {
+        tracing::warn!(
+            "signal handlers not installed ({e}): a killed run may leave its temporary file"
+        );
+    }
     match &cli.command {
-        Command::Run { file, threads } => cmd_run(&cli, file, *threads),
+        Command::Run {
+            file,
+            threads,
+            progress_every,
+        } => cmd_run(&cli, file, *threads, *progress_every),
         Command::Validate { file } => cmd_validate(file),
         Command::Score(args) => cmd_score(args),
+        Command::Report(args) => cmd_report(args),
         Command::Methods => {
             print!(
                 "{}",
@@ -251,9 +364,39 @@ fn log_summary(s: &pipeline::RunSummary) {
         "done: {} read, {} written, {} rejected, {} filtered in {:.2} s → {}",
         s.read, s.written, s.rejected, s.filtered, s.elapsed_s, s.output
     );
+    for (m, t) in &s.stages {
+        tracing::debug!(
+            method = %m,
+            skeleton_s = t.skeleton.as_secs_f64(),
+            prune_extend_s = t.prune_extend.as_secs_f64(),
+            score_s = t.score.as_secs_f64(),
+            "{m}: skeleton {:.2} s, prune and extend {:.2} s, score {:.2} s (thread CPU time)",
+            t.skeleton.as_secs_f64(),
+            t.prune_extend.as_secs_f64(),
+            t.score.as_secs_f64()
+        );
+    }
+    if let Some(r) = &s.report {
+        log_report(r);
+    }
 }
 
-fn cmd_run(cli: &Cli, file: &PipelineArgs, threads: Option<usize>) -> ExitCode {
+/// Logs the line of a written report.
+fn log_report(r: &skeletonise::reporting::ReportSummary) {
+    tracing::info!(
+        sections = r.sections,
+        bytes = r.bytes,
+        seconds = format!("{:.2}", r.seconds),
+        report = %r.path.display(),
+        "report: {} features, {} KB in {:.2} s → {}",
+        r.sections,
+        r.bytes.div_ceil(1000),
+        r.seconds,
+        r.path.display()
+    );
+}
+
+fn cmd_run(cli: &Cli, file: &PipelineArgs, threads: Option<usize>, every: f64) -> ExitCode {
     let p = match file.load() {
         Ok(p) => p,
         Err(c) => return c,
@@ -264,6 +407,7 @@ fn cmd_run(cli: &Cli, file: &PipelineArgs, threads: Option<usize>) -> ExitCode {
             && std::io::stderr().is_terminal()
             && matches!(cli.log_format, LogFormat::Text),
         batch_size: None,
+        progress_every: Some(std::time::Duration::from_secs_f64(every)),
     };
     match pipeline::run(&p, &opts) {
         Ok(s) => {
@@ -282,16 +426,22 @@ fn cmd_validate(file: &PipelineArgs) -> ExitCode {
     match pipeline::validate(&p) {
         Ok(info) => {
             let fields: Vec<&str> = info.fields.iter().map(|f| f.name.as_str()).collect();
+            let n =
+                |c: Option<u64>| c.map_or_else(|| "an unknown number of".into(), |n| n.to_string());
             println!(
-                "{}: valid. input `{}` layer `{}`: {} features ({} after filters), CRS {}, fields: {}; output {}",
+                "{}: valid. input `{}` layer `{}`: {} features ({} after filters), CRS {}, fields: {}; output {}{}",
                 p.origin,
                 info.source,
                 info.layer,
-                info.total,
-                info.selected,
+                n(info.total),
+                n(info.selected),
                 info.crs_name,
                 fields.join(", "),
-                p.file.output.path
+                p.file.output.path,
+                p.file
+                    .output
+                    .report_path()
+                    .map_or_else(String::new, |r| format!(", report {}", r.display()))
             );
             ExitCode::SUCCESS
         }
@@ -306,5 +456,25 @@ fn cmd_score(args: &ScoreArgs) -> ExitCode {
             ExitCode::SUCCESS
         }
         Err(e) => run_error(e),
+    }
+}
+
+fn cmd_report(args: &ReportArgs) -> ExitCode {
+    let job = match args.job() {
+        Ok(j) => j,
+        Err(e) => {
+            tracing::error!("{e}");
+            return ExitCode::from(2);
+        }
+    };
+    match skeletonise::reporting::write_report(&job) {
+        Ok(r) => {
+            log_report(&r);
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            tracing::error!("{e}");
+            ExitCode::from(EXIT_RUNTIME)
+        }
     }
 }

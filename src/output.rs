@@ -242,6 +242,8 @@ pub struct SkeletonRow {
     pub legs: usize,
     /// MakeValid changed the input.
     pub repaired: bool,
+    /// Why the scores are missing, when they are.
+    pub note: Option<String>,
 }
 
 impl Scored for SkeletonRow {
@@ -267,6 +269,7 @@ pub const SKELETONS: LayerDef<SkeletonRow> = LayerDef {
             col("components", Int32, |r: &SkeletonRow| int(r.components)),
             col("legs", Int32, |r: &SkeletonRow| int(r.legs)),
             col("repaired", Int32, |r: &SkeletonRow| int(i64::from(r.repaired))),
+            col("note", Text, |r: &SkeletonRow| r.note.as_deref().map_or(Cell::Null, text)),
         ],
     ),
 };
@@ -437,8 +440,18 @@ pub struct RunRecord {
     pub tool_version: String,
     /// The pipeline text (with overrides).
     pub pipeline: String,
-    /// Input source and layer.
+    /// Input source and layer, for people.
     pub input: String,
+    /// The input source as it opens from any working directory (an existing
+    /// local path made absolute), for `skeletonise report` to reopen the
+    /// polygons.
+    pub input_source: String,
+    /// The input layer's name.
+    pub input_layer: String,
+    /// `input.reproject`, when the polygons were reprojected.
+    pub input_reproject: Option<String>,
+    /// The name of the skeleton layer (`output.layer`).
+    pub skeleton_layer: String,
     /// Features read.
     pub read: u64,
     /// Features written.
@@ -451,6 +464,9 @@ pub struct RunRecord {
     pub elapsed_s: f64,
     /// Worker threads.
     pub threads: usize,
+    /// Thread time per method and step, JSON (`{"MA": {"skeleton": s,
+    /// "prune_extend": s, "score": s}, …}`).
+    pub stage_seconds: String,
 }
 
 /// The `skeletonise_runs` attribute table.
@@ -466,12 +482,19 @@ pub const RUNS: LayerDef<RunRecord> = LayerDef {
         col("tool_version", Text, |r| text(&r.tool_version)),
         col("pipeline", Text, |r| text(&r.pipeline)),
         col("input", Text, |r| text(&r.input)),
+        col("input_source", Text, |r| text(&r.input_source)),
+        col("input_layer", Text, |r| text(&r.input_layer)),
+        col("input_reproject", Text, |r| {
+            r.input_reproject.as_deref().map_or(Cell::Null, text)
+        }),
+        col("skeleton_layer", Text, |r| text(&r.skeleton_layer)),
         col("features_read", Int64, |r| int(r.read)),
         col("features_written", Int64, |r| int(r.written)),
         col("features_rejected", Int64, |r| int(r.rejected)),
         col("features_filtered", Int64, |r| int(r.filtered)),
         col("threads", Int64, |r| int(r.threads)),
         col("elapsed_s", Real, |r| Cell::Real(r.elapsed_s)),
+        col("stage_seconds", Text, |r| text(&r.stage_seconds)),
     ],
 };
 
@@ -523,7 +546,8 @@ mod tests {
                 "distortion",
                 "components",
                 "legs",
-                "repaired"
+                "repaired",
+                "note"
             ]
         );
         let cands: Vec<&str> = CANDIDATES.column_names().collect();

@@ -9,13 +9,18 @@ use crate::config::{InputSpec, OnError, OutputSpec, Pipeline};
 use crate::feature::Feature;
 use crate::io::reader::Reader;
 use crate::io::writer::{check_output, Writer};
-use crate::io::IoError;
+use crate::io::{IoError, SourceInfo};
+use crate::methods::MethodId;
 use crate::output::{Rows, RunRecord};
-use crate::process::{feature_rows, FeatureRows, ProcessParams, RowOptions, Skeletons, Status};
+use crate::process::{
+    feature_rows, FeatureRows, ProcessParams, RowOptions, Skeletons, StageTimes, Status,
+};
+use crate::reporting::{check_path, write_report, ReportError, ReportJob, ReportSummary};
 use geo::MultiLineString;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use std::collections::HashMap;
+use std::sync::mpsc;
 use std::time::Instant;
 use thiserror::Error;
 
@@ -28,6 +33,9 @@ pub struct RunOptions {
     pub progress: bool,
     /// Features per batch (default 256).
     pub batch_size: Option<usize>,
+    /// Without a progress bar, log a progress line this often (default
+    /// [`PROGRESS_EVERY`]).
+    pub progress_every: Option<std::time::Duration>,
 }
 
 /// What a run did.
@@ -49,6 +57,10 @@ pub struct RunSummary {
     pub output: String,
     /// Chosen method per feature, counted.
     pub methods: Vec<(String, u64)>,
+    /// Thread time each method spent, step by step, over the whole run.
+    pub stages: Vec<(MethodId, StageTimes)>,
+    /// The report written after the run (`output.report`).
+    pub report: Option<ReportSummary>,
 }
 
 /// Why a run failed.
@@ -68,14 +80,29 @@ pub enum RunError {
     /// The thread pool could not be created.
     #[error("cannot start {0} worker threads")]
     Threads(usize),
+    /// More worker threads than make sense.
+    #[error("`--threads {asked}`: give between 1 and {MAX_THREADS} worker threads (this machine has {cores} cores), or leave it out for one per core")]
+    TooManyThreads {
+        /// Threads asked for.
+        asked: usize,
+        /// Cores of this machine.
+        cores: usize,
+    },
+    /// The run's output was written but its report was not.
+    #[error("the report failed ({0}); the GeoPackage was written, `skeletonise report` makes the report from it")]
+    Report(#[from] ReportError),
 }
 
 /// Checks everything `run` checks before processing: the input opens, the
 /// layer exists, the CRS is projected (or reprojected), the filter is valid
 /// and the output can be written. Returns what the source holds.
 pub fn validate(p: &Pipeline) -> Result<crate::io::SourceInfo, RunError> {
-    let reader = Reader::open(&p.file.input)?;
-    check_output(&p.file.output)?;
+    let mut reader = Reader::open(&p.file.input)?;
+    reader.probe()?;
+    check_output(&p.file.output, &[&p.file.input.source])?;
+    if let Some(html) = p.file.output.report_path() {
+        check_path(&html)?;
+    }
     Ok(reader.info().clone())
 }
 
@@ -106,6 +133,8 @@ pub struct Job<'a> {
     pub on_error: OnError,
     /// The skeletons when another tool made them.
     pub given: Option<&'a Given>,
+    /// Other data sources the job reads (never to be written over).
+    pub other_inputs: Vec<String>,
 }
 
 impl<'a> Job<'a> {
@@ -119,6 +148,7 @@ impl<'a> Job<'a> {
             params: p.process_params(),
             on_error: p.file.on_error,
             given: None,
+            other_inputs: Vec::new(),
         }
     }
 
@@ -133,9 +163,28 @@ impl<'a> Job<'a> {
     }
 }
 
-/// Runs the pipeline end to end.
+/// Runs the pipeline end to end, then writes its report when the output
+/// asks for one (`output.report`).
 pub fn run(p: &Pipeline, opts: &RunOptions) -> Result<RunSummary, RunError> {
-    run_job(&Job::of(p), opts)
+    let report = p
+        .file
+        .output
+        .report
+        .as_ref()
+        .zip(p.file.output.report_path());
+    if let Some((_, html)) = &report {
+        check_path(html)?;
+    }
+    let mut summary = run_job(&Job::of(p), opts)?;
+    if let Some((spec, html)) = report {
+        summary.report = Some(write_report(&ReportJob {
+            gpkg: summary.output.clone().into(),
+            html,
+            selection: spec.features.clone(),
+            polygons: None,
+        })?);
+    }
+    Ok(summary)
 }
 
 /// Counts of a run so far.
@@ -147,6 +196,7 @@ struct Counts {
     filtered: u64,
     rows: u64,
     methods: std::collections::BTreeMap<String, u64>,
+    stages: Vec<(MethodId, StageTimes)>,
 }
 
 impl Counts {
@@ -172,74 +222,280 @@ impl Counts {
             }
         }
         self.rows += r.rows.skeletons.len() as u64;
+        for (m, t) in &r.times {
+            match self.stages.iter_mut().find(|(x, _)| x == m) {
+                Some((_, total)) => *total += *t,
+                None => self.stages.push((*m, *t)),
+            }
+        }
         Ok(())
     }
 }
 
-fn progress_bar(show: bool, len: u64) -> ProgressBar {
-    if !show {
-        return ProgressBar::hidden();
-    }
-    let b = ProgressBar::new(len);
-    b.set_style(
-        ProgressStyle::with_template(
-            "{spinner} {bar:40} {pos}/{len} features {elapsed_precise} (eta {eta})",
-        )
-        .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    b
+/// Progress: a bar on a terminal, otherwise a log line every
+/// [`PROGRESS_EVERY`] (features done, rate, time left) so that a scheduled
+/// job's log shows that a long run is alive.
+struct Progress {
+    bar: ProgressBar,
+    log: bool,
+    every: std::time::Duration,
+    total: Option<u64>,
+    done: u64,
+    started: Instant,
+    last: Instant,
 }
 
-/// Runs a job: read in batches → process each batch's features in parallel
-/// → write in input order.
+/// How often a run without a terminal logs its progress.
+pub const PROGRESS_EVERY: std::time::Duration = std::time::Duration::from_secs(10);
+
+impl Progress {
+    fn new(terminal: bool, total: Option<u64>, every: std::time::Duration) -> Self {
+        let bar = match (terminal, total) {
+            (false, _) => ProgressBar::hidden(),
+            (true, Some(n)) => {
+                let b = ProgressBar::new(n);
+                b.set_style(
+                    ProgressStyle::with_template(
+                        "{spinner} {bar:40} {pos}/{len} features {elapsed_precise} (eta {eta})",
+                    )
+                    .unwrap_or_else(|_| ProgressStyle::default_bar()),
+                );
+                b
+            }
+            (true, None) => ProgressBar::new_spinner(),
+        };
+        let now = Instant::now();
+        Self {
+            bar,
+            log: !terminal,
+            every,
+            total,
+            done: 0,
+            started: now,
+            last: now,
+        }
+    }
+
+    fn add(&mut self, n: u64) {
+        self.done += n;
+        self.bar.inc(n);
+        if !self.log || self.last.elapsed() < self.every {
+            return;
+        }
+        self.last = Instant::now();
+        let secs = self.started.elapsed().as_secs_f64();
+        let rate = self.done as f64 / secs.max(1e-9);
+        let eta = self
+            .total
+            .filter(|_| rate > 0.0)
+            .map(|t| format!("{:.0} s", t.saturating_sub(self.done) as f64 / rate))
+            .unwrap_or_else(|| "unknown".into());
+        let of = self.total.map_or_else(|| "?".into(), |t| t.to_string());
+        tracing::info!(
+            done = self.done,
+            total = self.total,
+            rate = format!("{rate:.1}"),
+            "progress: {} of {of} features, {rate:.1}/s, {eta} left",
+            self.done
+        );
+    }
+
+    fn finish(&self) {
+        self.bar.finish_and_clear();
+    }
+}
+
+/// Most worker threads a run may ask for: beyond a few per core they only
+/// cost memory, and thousands make the thread pool's start crawl.
+pub const MAX_THREADS: usize = 256;
+
+/// The number of worker threads to run: `asked`, or one per core.
+pub fn worker_threads(asked: Option<usize>) -> Result<usize, RunError> {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    match asked {
+        None => Ok(rayon::current_num_threads()),
+        Some(0) => Err(RunError::TooManyThreads { asked: 0, cores }),
+        Some(n) if n > MAX_THREADS => Err(RunError::TooManyThreads { asked: n, cores }),
+        Some(n) => Ok(n),
+    }
+}
+
+/// What the reader thread hands over: a batch of features, or why reading
+/// failed.
+type Batch = Result<Vec<Feature>, IoError>;
+
+/// Batches the reader may read ahead of the workers, and the workers ahead
+/// of the writer: memory stays bounded by a few batches.
+const QUEUE: usize = 2;
+
+/// Runs a job: a reader thread reads batches, the worker threads process
+/// each batch's features in parallel, a writer thread writes them in input
+/// order — all three at once, so I/O overlaps the work and the output is the
+/// same for any thread count.
 pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError> {
     let started = chrono::Utc::now();
     let clock = Instant::now();
-    let mut reader = Reader::open(job.input)?;
-    let info = reader.info().clone();
-    let mut writer = Writer::create(job.output, &info)?;
-    let threads = opts.threads.unwrap_or_else(rayon::current_num_threads);
+    let threads = worker_threads(opts.threads)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
         .map_err(|_| RunError::Threads(threads))?;
-    tracing::info!(
-        pipeline = %job.name,
-        source = %info.source,
-        layer = %info.layer,
-        crs = %info.crs_name,
-        features = info.selected,
-        filtered_by_source = info.total.saturating_sub(info.selected),
-        threads,
-        "run started"
-    );
-    let bar = progress_bar(opts.progress, info.selected);
-    let row_opts = RowOptions::from(job.output);
-    let mut counts = Counts::default();
     let batch = opts.batch_size.unwrap_or(256).max(1);
-    let result = reader.read::<RunError>(batch, job.params.prepare.make_valid, |features| {
-        let done: Vec<FeatureRows> = pool.install(|| {
-            features
-                .par_iter()
-                .map(|f| feature_rows(f, job.skeletons(f), &job.params, row_opts))
-                .collect()
+    let make_valid = job.params.prepare.make_valid;
+    std::thread::scope(|scope| {
+        // The reader opens the source on its own thread (GDAL handles stay on
+        // the thread that made them) and reports what it found first.
+        let (info_tx, info_rx) = mpsc::sync_channel::<Result<SourceInfo, IoError>>(1);
+        let (batch_tx, batch_rx) = mpsc::sync_channel::<Batch>(QUEUE);
+        let reader =
+            scope.spawn(move || read_batches(job.input, batch, make_valid, info_tx, batch_tx));
+        let info = match info_rx.recv() {
+            Ok(Ok(info)) => info,
+            Ok(Err(e)) => return Err(e.into()),
+            Err(_) => return Err(reader_gone(reader)),
+        };
+        let mut inputs = vec![job.input.source.as_str()];
+        inputs.extend(job.other_inputs.iter().map(String::as_str));
+        let writer = Writer::create(job.output, &info, &inputs)?;
+        tracing::info!(
+            pipeline = %job.name,
+            source = %info.source,
+            layer = %info.layer,
+            crs = %info.crs_name,
+            features = info.selected,
+            total_features = info.total,
+            threads,
+            "run started"
+        );
+        let (rows_tx, rows_rx) = mpsc::sync_channel::<Rows>(QUEUE);
+        let writing = scope.spawn(move || write_batches(writer, rows_rx));
+        let every = opts.progress_every.unwrap_or(PROGRESS_EVERY);
+        let mut progress = Progress::new(opts.progress, info.selected, every);
+        let row_opts = RowOptions::from(job.output);
+        let mut counts = Counts::default();
+        let mut work = || -> Result<(), RunError> {
+            for features in batch_rx.iter() {
+                let features = features?;
+                let done: Vec<FeatureRows> = pool.install(|| {
+                    features
+                        .par_iter()
+                        .map(|f| feature_rows(f, job.skeletons(f), &job.params, row_opts))
+                        .collect()
+                });
+                counts.read += features.len() as u64;
+                let mut rows = Rows::default();
+                for (f, r) in features.iter().zip(done) {
+                    counts.add(f, &r, job.on_error)?;
+                    rows.append(r.rows);
+                }
+                if rows_tx.send(rows).is_err() {
+                    // The writer stopped on an error; it says which below.
+                    break;
+                }
+                progress.add(features.len() as u64);
+            }
+            Ok(())
+        };
+        let result = work();
+        progress.finish();
+        // Stop the reader (if still reading) and let the writer drain.
+        drop(batch_rx);
+        drop(rows_tx);
+        let written = writing.join().unwrap_or_else(|_| {
+            Err(IoError::Output {
+                path: job.output.path.clone(),
+                reason: "the writer thread failed with an internal error; please report it".into(),
+            })
         });
-        counts.read += features.len() as u64;
-        let mut rows = Rows::default();
-        for (f, r) in features.iter().zip(done) {
-            counts.add(f, &r, job.on_error)?;
-            rows.append(r.rows);
+        let _ = reader.join();
+        let writer = match (result, written) {
+            (Err(e), Ok(mut w)) => {
+                w.abort();
+                return Err(e);
+            }
+            (Err(e), Err(_)) => return Err(e),
+            (Ok(()), Err(e)) => return Err(e.into()),
+            (Ok(()), Ok(w)) => w,
+        };
+        finish_run(job, &info, counts, threads, started, clock, writer)
+    })
+}
+
+/// The reader thread: opens the source, sends what it holds, then its
+/// features batch by batch until the source ends, an error, or nobody
+/// listens any more.
+fn read_batches(
+    input: &InputSpec,
+    batch: usize,
+    make_valid: bool,
+    info_tx: mpsc::SyncSender<Result<SourceInfo, IoError>>,
+    batch_tx: mpsc::SyncSender<Batch>,
+) {
+    let mut reader = match Reader::open(input) {
+        Ok(r) => r,
+        Err(e) => {
+            let _ = info_tx.send(Err(e));
+            return;
         }
-        writer.write_batch(&rows)?;
-        bar.inc(features.len() as u64);
-        Ok(())
-    });
-    bar.finish_and_clear();
-    if let Err(e) = result {
-        writer.abort();
-        return Err(e);
+    };
+    if info_tx.send(Ok(reader.info().clone())).is_err() {
+        return;
     }
-    counts.filtered += info.total.saturating_sub(info.selected);
+    let r = reader.read::<Stop>(batch, make_valid, |features| {
+        batch_tx.send(Ok(features)).map_err(|_| Stop::Gone)
+    });
+    if let Err(Stop::Failed(e)) = r {
+        let _ = batch_tx.send(Err(e));
+    }
+}
+
+/// Why the reader thread stops before the end of the source.
+enum Stop {
+    /// Nobody takes batches any more (the run stopped).
+    Gone,
+    /// Reading failed.
+    Failed(IoError),
+}
+
+impl From<IoError> for Stop {
+    fn from(e: IoError) -> Self {
+        Stop::Failed(e)
+    }
+}
+
+/// The writer thread: writes each batch of rows as it comes, in order.
+/// Returns the writer (to finish) or the first error (the file discarded).
+fn write_batches(mut writer: Writer, rows: mpsc::Receiver<Rows>) -> Result<Writer, IoError> {
+    for r in rows.iter() {
+        if let Err(e) = writer.write_batch(&r) {
+            writer.abort();
+            return Err(e);
+        }
+    }
+    Ok(writer)
+}
+
+/// The reader thread ended without a word: it panicked.
+fn reader_gone(reader: std::thread::ScopedJoinHandle<'_, ()>) -> RunError {
+    let _ = reader.join();
+    RunError::Io(IoError::Output {
+        path: String::new(),
+        reason: "the reader thread failed with an internal error; please report it".into(),
+    })
+}
+
+/// Records the run in the output and renames it into place.
+fn finish_run(
+    job: &Job<'_>,
+    info: &SourceInfo,
+    mut counts: Counts,
+    threads: usize,
+    started: chrono::DateTime<chrono::Utc>,
+    clock: Instant,
+    writer: Writer,
+) -> Result<RunSummary, RunError> {
+    // What `where` and `bbox` kept back (unknown when the driver cannot count).
+    counts.filtered += info.total.map_or(0, |t| t.saturating_sub(counts.read));
     let elapsed_s = clock.elapsed().as_secs_f64();
     let record = RunRecord {
         name: job.name.clone(),
@@ -248,12 +504,17 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
         tool_version: env!("CARGO_PKG_VERSION").to_string(),
         pipeline: job.provenance.clone(),
         input: format!("{} (layer {})", info.source, info.layer),
+        input_source: crate::io::reader::absolute_source(&info.source),
+        input_layer: info.layer.clone(),
+        input_reproject: job.input.reproject.clone(),
+        skeleton_layer: job.output.layer.clone(),
         read: counts.read,
         written: counts.written,
         rejected: counts.rejected,
         filtered: counts.filtered,
         elapsed_s,
         threads,
+        stage_seconds: stage_json(&counts.stages),
     };
     let out = writer.finish(&record)?;
     Ok(RunSummary {
@@ -265,5 +526,31 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
         elapsed_s,
         output: out.display().to_string(),
         methods: counts.methods.into_iter().collect(),
+        stages: counts.stages,
+        report: None,
     })
+}
+
+/// Step times as JSON for `skeletonise_runs.stage_seconds`:
+/// `{"MA": {"skeleton": 1.2, "prune_extend": 0.3, "score": 0.4}, …}`.
+fn stage_json(stages: &[(MethodId, StageTimes)]) -> String {
+    let map: serde_json::Map<String, serde_json::Value> = stages
+        .iter()
+        .map(|(m, t)| {
+            (
+                m.to_string(),
+                serde_json::json!({
+                    "skeleton": round_ms(t.skeleton),
+                    "prune_extend": round_ms(t.prune_extend),
+                    "score": round_ms(t.score),
+                }),
+            )
+        })
+        .collect();
+    serde_json::Value::Object(map).to_string()
+}
+
+/// Seconds, to the millisecond.
+fn round_ms(d: std::time::Duration) -> f64 {
+    (d.as_secs_f64() * 1000.0).round() / 1000.0
 }

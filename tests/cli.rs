@@ -54,6 +54,20 @@ fn demo_pipeline_runs_and_writes_every_layer() {
         .as_deref()
         .unwrap()
         .contains("name: demo"));
+    // The input as it reopens from anywhere (the report draws its polygons).
+    assert_eq!(
+        strings(&ds, "skeletonise_runs", "input_source"),
+        [Some(root(DEMO))]
+    );
+    assert_eq!(
+        strings(&ds, "skeletonise_runs", "input_layer"),
+        [Some("demo".into())]
+    );
+    assert_eq!(strings(&ds, "skeletonise_runs", "input_reproject"), [None]);
+    assert_eq!(
+        strings(&ds, "skeletonise_runs", "skeleton_layer"),
+        [Some("skeletons".into())]
+    );
     assert_eq!(count(&ds, "rejected"), 0);
     assert_eq!(count(&ds, "candidates"), 17 * 5);
     // Every feature has exactly one chosen candidate, and it is the method written.
@@ -343,28 +357,41 @@ fn on_error_fail_exits_65_and_writes_nothing() {
     );
 }
 
+/// Reading, working and writing overlap on their own threads; what is
+/// written must not depend on how many workers there are: every layer,
+/// row for row, over several batches (600 islands, batches of 256).
 #[test]
-fn output_is_identical_for_one_and_two_threads() {
+fn output_is_identical_for_one_two_and_three_threads() {
     let d = tmp();
     let mut results = Vec::new();
-    for t in ["1", "2"] {
+    for t in ["1", "2", "3"] {
         let out = d.path().join(format!("o{t}.gpkg"));
-        let p = pipeline(
-            d.path(),
-            &format!("p{t}.yaml"),
-            &basic_pipeline(
-                &root(TRAIN),
-                "lakes_scotland",
-                &out,
-                "  - prune: {}\n  - extend: {}\n",
-            ),
+        let o = skeletonise(&[
+            "run",
+            &root("pipelines/islands.yaml"),
+            "--set",
+            &format!("input.source={}", root(TRAIN)),
+            "--set",
+            "input.where=fid <= 600",
+            "-o",
+            out.to_str().unwrap(),
+            "--threads",
+            t,
+        ]);
+        assert_eq!(
+            o.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&o.stderr)
         );
-        let o = skeletonise(&["run", p.to_str().unwrap(), "--threads", t]);
-        assert_eq!(o.status.code(), Some(0));
-        results.push(wkts(&open(&out), "skeletons"));
+        results.push(common::canonical(&out));
     }
-    assert_eq!(results[0].len(), 18);
+    assert!(
+        results[0].matches('\n').count() > 600 * 5,
+        "candidates are written"
+    );
     assert_eq!(results[0], results[1]);
+    assert_eq!(results[0], results[2]);
 }
 
 #[test]
@@ -571,6 +598,15 @@ fn a_polygon_of_a_million_vertices() {
     let ds = open(&out);
     assert_eq!(count(&ds, "skeletons"), 1);
     assert_eq!(count(&ds, "rejected"), 0);
+    // Its report draws it within the display budget.
+    let html = d.path().join("o.html");
+    let (code, err) = code_and_err(&skeletonise(&["report", out.to_str().unwrap()]));
+    assert_eq!(code, 0, "{err}");
+    let size = std::fs::metadata(&html).unwrap().len() as usize;
+    assert!(
+        size < skeletonise::report::section_bound(1) + 100_000,
+        "{size} bytes"
+    );
 }
 
 /// Any OGR data source string: a GeoPackage inside a zip archive, read through
@@ -596,4 +632,28 @@ fn reads_a_zipped_source_by_layer_index() {
     let (code, err) = code_and_err(&skeletonise(&["run", p.to_str().unwrap()]));
     assert_eq!(code, 0, "{err}");
     assert_eq!(count(&open(&out), "skeletons"), 17);
+}
+
+#[test]
+fn a_where_filter_the_source_rejects_stops_the_run_with_the_reason() {
+    // GeoPackage hands the filter to SQLite, which rejects it only when it
+    // runs: the run must not go on and select nothing.
+    let d = tmp();
+    let out = d.path().join("o.gpkg");
+    let o = skeletonise(&[
+        "run",
+        "pipelines/demo.yaml",
+        "-o",
+        out.to_str().unwrap(),
+        "--set",
+        "input.where=\"no_such_field = 1\"",
+    ]);
+    let (code, err) = code_and_err(&o);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("invalid `input.where` filter `no_such_field = 1`")
+            && err.contains("no such column"),
+        "{err}"
+    );
+    assert!(!out.exists());
 }

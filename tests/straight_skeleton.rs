@@ -426,3 +426,66 @@ fn largest_lena_reach() {
         assert!(!pp.boundary().crosses(g.node(e.a).pos, g.node(e.b).pos));
     }
 }
+
+/// A circle of radius 10 000 with `n` vertices, each moved radially by a
+/// deterministic pseudo-random amount up to a quarter of the vertex
+/// spacing: rough at every scale, so nearly half the vertices are reflex
+/// and every reflex vertex's ray sees a large part of the boundary.
+fn noisy_circle(n: usize) -> Polygon<f64> {
+    let spacing = std::f64::consts::TAU * 10_000.0 / n as f64;
+    let mut state = 0x2545_f491_4f6c_dd1d_u64;
+    let pts: Vec<Coord<f64>> = (0..n)
+        .map(|i| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            let u = (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+            let t = i as f64 / n as f64 * std::f64::consts::TAU;
+            let r = 10_000.0 * (1.0 + 0.05 * (7.0 * t).sin()) + 0.5 * u * spacing;
+            Coord {
+                x: 5e5 + r * t.cos(),
+                y: 6e6 + r * t.sin(),
+            }
+        })
+        .collect();
+    Polygon::new(LineString(pts), vec![])
+}
+
+#[test]
+fn a_polygon_beyond_the_budget_is_declined_up_front_with_the_reason() {
+    use skeletonise::methods::budget::{with_budget, Budget};
+    use skeletonise::methods::{MethodError, MethodId};
+    use std::time::Duration;
+    let pp = PreparedPolygon::new(&noisy_circle(50_000)).unwrap();
+    // A second is far less than the quadratic split-event search needs here:
+    // the method predicts that from a sample and declines before it starts.
+    let one_second = Budget {
+        time: Some(Duration::from_secs(1)),
+        memory: None,
+    };
+    match with_budget(MethodId::STSK, one_second, || StraightSkeleton.skeletonise(&pp)) {
+        Err(MethodError::OverBudget { method, reason }) => {
+            assert_eq!(method, MethodId::STSK);
+            assert!(reason.contains("would need about"), "{reason}");
+            assert!(reason.contains("skeleton.timeout_s"), "{reason}");
+        }
+        other => panic!("expected OverBudget, got {:?}", other.map(|g| g.edges().len())),
+    }
+    // Memory: ten megabytes cannot hold this polygon's split events either.
+    let ten_megabytes = Budget {
+        time: None,
+        memory: Some(10_000_000),
+    };
+    match with_budget(MethodId::STSK, ten_megabytes, || StraightSkeleton.skeletonise(&pp)) {
+        Err(MethodError::OverBudget { reason, .. }) => {
+            assert!(reason.contains("skeleton.max_memory_mb"), "{reason}");
+        }
+        other => panic!("expected OverBudget, got {:?}", other.map(|g| g.edges().len())),
+    }
+    // The same budgets leave a small polygon alone.
+    let small = PreparedPolygon::new(&noisy_circle(400)).unwrap();
+    for b in [one_second, ten_megabytes] {
+        let g = with_budget(MethodId::STSK, b, || StraightSkeleton.skeletonise(&small)).unwrap();
+        assert!(g.edges().len() > 400);
+    }
+}

@@ -16,7 +16,7 @@
 pub mod locate;
 mod sections;
 
-pub use sections::{InputSpec, LayerRef, OutputSpec};
+pub use sections::{InputSpec, LayerRef, OutputSpec, ReportSpec};
 
 use crate::graph::extend::ExtendParams;
 use crate::graph::prune::PruneParams;
@@ -260,6 +260,8 @@ fn read_text(path: &std::path::Path, origin: &str) -> Result<String, ConfigError
 
 /// [`load`] from text; `origin` names it in errors.
 pub fn load_str(text: &str, origin: &str, overrides: &[String]) -> Result<Pipeline, ConfigError> {
+    // Editors on Windows save UTF-8 with a byte-order mark.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let file: PipelineFile = parse(text, origin, overrides, validate)?;
     Ok(Pipeline {
         file,
@@ -270,18 +272,35 @@ pub fn load_str(text: &str, origin: &str, overrides: &[String]) -> Result<Pipeli
 }
 
 /// Parses `text` as a `T` after overrides and substitution, then checks it
-/// with `check`; every error located in the text.
+/// with `check`; every error located in the text, or in the `--set` that
+/// gave the key.
 fn parse<T: serde::de::DeserializeOwned>(
     text: &str,
     origin: &str,
     overrides: &[String],
     check: impl Fn(&T) -> Result<(), (String, String)>,
 ) -> Result<T, ConfigError> {
-    let err = |position, key: &str, message: String| ConfigError {
-        origin: origin.to_string(),
-        position,
-        key: key.to_string(),
-        message,
+    // An error in a key that a `--set` gave is the override's, not the file's.
+    let overridden = |key: &str| {
+        let plain = strip_indices(key);
+        overrides.iter().find(|o| {
+            let k = o.split_once('=').map_or(o.as_str(), |(k, _)| k);
+            plain == k || plain.starts_with(&format!("{k}.")) || k.starts_with(&format!("{plain}."))
+        })
+    };
+    let err = |position, key: &str, message: String| match overridden(key) {
+        Some(o) if !key.is_empty() => ConfigError {
+            origin: format!("--set {o}"),
+            position: None,
+            key: key.to_string(),
+            message,
+        },
+        _ => ConfigError {
+            origin: origin.to_string(),
+            position,
+            key: key.to_string(),
+            message,
+        },
     };
     let mut value: Value = serde_yaml_ng::from_str(text).map_err(|e| {
         let pos = e.location().map(|l| (l.line(), l.column()));
@@ -331,10 +350,17 @@ fn unknown_skeleton_keys(root: &Value) -> Result<(), (String, String)> {
     let Some(steps) = root.get("steps").and_then(Value::as_sequence) else {
         return Ok(());
     };
-    let mut allowed = vec!["methods", "reference"];
+    // The step's keys as its type declares them (methods' options flattened in).
+    let schema = serde_json::to_value(schemars::schema_for!(SkeletonParams)).unwrap_or_default();
+    let mut allowed: Vec<&str> = schema["properties"]
+        .as_object()
+        .map(|p| p.keys().map(String::as_str).collect())
+        .unwrap_or_default();
     for e in crate::methods::BUILTIN {
         allowed.extend(e.options.iter().copied());
     }
+    allowed.sort_unstable();
+    allowed.dedup();
     for (i, step) in steps.iter().enumerate() {
         let Some(opts) = step.get("skeleton").and_then(Value::as_mapping) else {
             continue;
@@ -354,6 +380,21 @@ fn unknown_skeleton_keys(root: &Value) -> Result<(), (String, String)> {
         }
     }
     Ok(())
+}
+
+/// A key path without list indices: `steps[2].prune.ratio` → `steps.prune.ratio`.
+fn strip_indices(key: &str) -> String {
+    let mut out = String::with_capacity(key.len());
+    let mut depth = 0;
+    for c in key.chars() {
+        match c {
+            '[' => depth += 1,
+            ']' => depth -= 1,
+            _ if depth == 0 => out.push(c),
+            _ => {}
+        }
+    }
+    out
 }
 
 fn path_string(p: &serde_path_to_error::Path) -> String {
@@ -393,11 +434,25 @@ fn hint(msg: &str) -> String {
 
 fn validate(f: &PipelineFile) -> Result<(), (String, String)> {
     validate_steps(&f.steps)?;
+    f.input
+        .validate()
+        .map_err(|(k, m)| (format!("input.{k}"), m))?;
     if f.output.path.trim().is_empty() {
         return Err((
             "output.path".into(),
             "give the output GeoPackage path".into(),
         ));
+    }
+    if let Some(r) = &f.output.report {
+        r.features
+            .validate()
+            .map_err(|(k, m)| (format!("output.report.features.{k}"), m))?;
+        if f.output.report_path() == Some(std::path::PathBuf::from(&f.output.path)) {
+            return Err((
+                "output.report.path".into(),
+                "the report would overwrite the GeoPackage; give a path ending in .html".into(),
+            ));
+        }
     }
     Ok(())
 }
@@ -553,7 +608,18 @@ fn step_index(seq: &mut Vec<Value>, name: &str) -> Result<usize, String> {
 fn substitute_env(v: &mut Value, path: &str) -> Result<(), (String, String)> {
     match v {
         Value::String(s) if s.contains("${") => {
-            *s = expand(s).map_err(|m| (path.to_string(), m))?;
+            let whole = s.starts_with("${") && s.ends_with('}') && s.matches("${").count() == 1;
+            let text = expand(s).map_err(|m| (path.to_string(), m))?;
+            // A value that is one `${…}` takes the type its text has in YAML
+            // (`ratio: ${RATIO}` is a number); one with text around it is
+            // a string.
+            let typed = whole
+                .then(|| serde_yaml_ng::from_str::<Value>(&text).ok())
+                .flatten()
+                .filter(|t| {
+                    !matches!(t, Value::Mapping(_) | Value::Sequence(_) | Value::Tagged(_))
+                });
+            *v = typed.unwrap_or(Value::String(text));
         }
         Value::Mapping(m) => {
             for (k, val) in m.iter_mut() {

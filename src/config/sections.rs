@@ -1,7 +1,9 @@
 //! The `input` and `output` sections of a pipeline file.
 
+use crate::report::Selection;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
 
 /// A layer chosen by name or by index.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
@@ -43,6 +45,29 @@ pub struct InputSpec {
 }
 
 impl InputSpec {
+    /// Checks the section: `(key, message)` of the first wrong option.
+    pub fn validate(&self) -> Result<(), (String, String)> {
+        if self.source.trim().is_empty() {
+            return Err(("source".into(), "give the input data source".into()));
+        }
+        if let Some([x0, y0, x1, y1]) = self.bbox {
+            if ![x0, y0, x1, y1].iter().all(|v| v.is_finite()) {
+                return Err((
+                    "bbox".into(),
+                    "bbox values must be finite numbers [xmin, ymin, xmax, ymax] in the source CRS"
+                        .into(),
+                ));
+            }
+            if x0 > x1 || y0 > y1 {
+                return Err((
+                    "bbox".into(),
+                    format!("bbox [{x0}, {y0}, {x1}, {y1}] is empty: xmin ≤ xmax and ymin ≤ ymax"),
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// A whole layer of a source by name: no filter, no reprojection.
     pub fn layer(source: &str, layer: &str) -> Self {
         Self {
@@ -85,6 +110,38 @@ pub struct OutputSpec {
     /// medial axis transform, for deciding what is narrow enough to collapse.
     #[serde(default)]
     pub widths: bool,
+    /// Also write the visual report: one self-contained HTML file with every
+    /// method's skeleton of the selected features side by side, their score
+    /// tables and a summary of the run (`skeletonise report` makes it from
+    /// any output later).
+    #[serde(default)]
+    pub report: Option<ReportSpec>,
+}
+
+impl OutputSpec {
+    /// Where the report goes: `report.path`, or the GeoPackage's path with
+    /// the extension `.html`; `None` without a report.
+    pub fn report_path(&self) -> Option<PathBuf> {
+        let r = self.report.as_ref()?;
+        Some(match &r.path {
+            Some(p) => PathBuf::from(p),
+            None => PathBuf::from(&self.path).with_extension("html"),
+        })
+    }
+}
+
+/// The `output.report` section: the visual report written after the run.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ReportSpec {
+    /// Path of the HTML file; default the output's path with `.html`.
+    #[serde(default)]
+    pub path: Option<String>,
+    /// The features that get a section: `{top: N}` (default 20: those on
+    /// which the methods disagree most), `{fids: [..]}` or `{where: "SQL"}`
+    /// (OGR SQL on the skeleton layer's columns).
+    #[serde(default)]
+    pub features: Selection,
 }
 
 impl From<&OutputSpec> for crate::process::RowOptions {

@@ -7,11 +7,10 @@
 //! the scoring step's sides). Queries cost O(log n) on real data instead of a
 //! scan of all edges.
 
+use super::packed::{box_distance_2, box_half_plane_distance, ray_box, Bbox, PackedTree};
 use geo::{Coord, Polygon};
-use rstar::{
-    primitives::{GeomWithData, Line as RLine},
-    PointDistance, RTree, RTreeObject, SelectionFunction, AABB,
-};
+use std::cell::Cell;
+use std::ops::ControlFlow;
 
 /// One boundary edge, oriented as its ring (interior on the left).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -60,19 +59,61 @@ pub struct RayHit {
     pub segment: usize,
 }
 
-type Indexed = GeomWithData<RLine<[f64; 2]>, u32>;
-
-/// R-tree of the boundary segments of one polygon (all rings).
+/// Packed R-tree of the boundary segments of one polygon (all rings).
+///
+/// Where several segments answer a query equally well (a ray through a
+/// vertex, two segments at the same distance), the one with the lower index
+/// in [`Boundary::segments`] is the answer.
 #[derive(Debug, Clone)]
 pub struct Boundary {
     segments: Vec<BoundarySegment>,
-    tree: RTree<Indexed>,
+    tree: PackedTree,
     min: Coord<f64>,
     max: Coord<f64>,
 }
 
+/// A point every query can take: the R-tree's nearest-neighbour search
+/// cannot order NaN distances, so a non-finite point (from a degenerate
+/// computation upstream) gets "no answer" instead.
+fn finite(c: Coord<f64>) -> bool {
+    c.x.is_finite() && c.y.is_finite()
+}
+
 fn pt(c: Coord<f64>) -> [f64; 2] {
     [c.x, c.y]
+}
+
+/// A candidate answer of a nearest-point search: point, distance, segment.
+type Found = (Coord<f64>, f64, u32);
+
+fn bbox(s: &BoundarySegment) -> Bbox {
+    [
+        s.a.x.min(s.b.x),
+        s.a.y.min(s.b.y),
+        s.a.x.max(s.b.x),
+        s.a.y.max(s.b.y),
+    ]
+}
+
+/// Squared distance from `p` to segment `ab` (the nearest point computed as
+/// the projection parameter strictly inside (0, 1), else an end).
+fn segment_distance_2(a: Coord<f64>, b: Coord<f64>, p: Coord<f64>) -> f64 {
+    let dir = b - a;
+    let s = ((p - a).x * dir.x + (p - a).y * dir.y) / (dir.x * dir.x + dir.y * dir.y);
+    let n = if 0.0 < s && s < 1.0 {
+        a + dir * s
+    } else if s <= 0.0 {
+        a
+    } else {
+        b
+    };
+    let d = n - p;
+    d.x * d.x + d.y * d.y
+}
+
+/// True when two boxes share a point.
+fn boxes_meet(a: &Bbox, b: &Bbox) -> bool {
+    a[0] <= b[2] && a[2] >= b[0] && a[1] <= b[3] && a[3] >= b[1]
 }
 
 fn cross(a: Coord<f64>, b: Coord<f64>) -> f64 {
@@ -98,51 +139,6 @@ pub fn properly_cross(p: Coord<f64>, q: Coord<f64>, a: Coord<f64>, b: Coord<f64>
     let o3 = orient(a, b, p);
     let o4 = orient(a, b, q);
     o1 * o2 < 0.0 && o3 * o4 < 0.0
-}
-
-/// Selects the R-tree leaves whose envelope a ray (origin, dir, t ≤ max_t) meets.
-struct RaySelect {
-    o: Coord<f64>,
-    d: Coord<f64>,
-    max_t: f64,
-}
-
-impl RaySelect {
-    fn meets(&self, env: &AABB<[f64; 2]>) -> bool {
-        let (lo, hi) = (env.lower(), env.upper());
-        let mut t0 = 0.0f64;
-        let mut t1 = self.max_t;
-        for (o, d, l, h) in [
-            (self.o.x, self.d.x, lo[0], hi[0]),
-            (self.o.y, self.d.y, lo[1], hi[1]),
-        ] {
-            if d == 0.0 {
-                if o < l || o > h {
-                    return false;
-                }
-            } else {
-                let (mut a, mut b) = ((l - o) / d, (h - o) / d);
-                if a > b {
-                    std::mem::swap(&mut a, &mut b);
-                }
-                t0 = t0.max(a);
-                t1 = t1.min(b);
-                if t0 > t1 {
-                    return false;
-                }
-            }
-        }
-        true
-    }
-}
-
-impl SelectionFunction<Indexed> for RaySelect {
-    fn should_unpack_parent(&self, envelope: &AABB<[f64; 2]>) -> bool {
-        self.meets(envelope)
-    }
-    fn should_unpack_leaf(&self, leaf: &Indexed) -> bool {
-        self.meets(&leaf.envelope())
-    }
 }
 
 /// Intersection parameter of ray `o + t d` with segment `ab`: `(t, s)` where
@@ -218,11 +214,7 @@ impl Boundary {
 
     /// Indexes an explicit list of segments.
     pub fn from_segments(segments: Vec<BoundarySegment>) -> Self {
-        let items: Vec<Indexed> = segments
-            .iter()
-            .enumerate()
-            .map(|(i, s)| GeomWithData::new(RLine::new(pt(s.a), pt(s.b)), i as u32))
-            .collect();
+        let boxes: Vec<Bbox> = segments.iter().map(bbox).collect();
         let mut min = Coord {
             x: f64::INFINITY,
             y: f64::INFINITY,
@@ -241,7 +233,7 @@ impl Boundary {
         }
         Self {
             segments,
-            tree: RTree::bulk_load(items),
+            tree: PackedTree::new(&boxes),
             min,
             max,
         }
@@ -269,33 +261,65 @@ impl Boundary {
         self.max
     }
 
+    /// The segment nearest to `p` and its squared distance.
+    fn nearest_segment(&self, p: Coord<f64>) -> Option<(f64, u32)> {
+        let (x, y) = (p.x, p.y);
+        self.tree.best(
+            |b| Some(box_distance_2(b, x, y)),
+            |i, _| {
+                let s = &self.segments[i as usize];
+                Some(segment_distance_2(s.a, s.b, p))
+            },
+        )
+    }
+
     /// Nearest boundary point to `p`: (point, segment index, distance).
     pub fn nearest(&self, p: Coord<f64>) -> Option<(Coord<f64>, usize, f64)> {
-        let n = self.tree.nearest_neighbor(&pt(p))?;
-        let s = &self.segments[n.data as usize];
+        if !finite(p) {
+            return None;
+        }
+        let (_, i) = self.nearest_segment(p)?;
+        let s = &self.segments[i as usize];
         let (c, _) = s.closest(p);
-        Some((c, n.data as usize, (c - p).x.hypot((c - p).y)))
+        Some((c, i as usize, super::norm(c - p)))
     }
 
     /// Euclidean distance from `p` to ∂P (the radius of every skeleton node).
     pub fn distance(&self, p: Coord<f64>) -> f64 {
-        self.tree
-            .nearest_neighbor(&pt(p))
-            .map(|n| n.geom().distance_2(&pt(p)).sqrt())
+        if !finite(p) {
+            return f64::NAN;
+        }
+        self.nearest_segment(p)
+            .map(|(d2, _)| d2.sqrt())
             .unwrap_or(f64::INFINITY)
     }
 
     /// Nearest boundary point to `q` within the closed half-plane
     /// `(x − q) · normal ≥ 0`: `(point, distance)`.
-    ///
-    /// Visits segments in order of distance and stops as soon as the next
-    /// segment is farther than the best point found.
     pub fn nearest_in_half_plane(
         &self,
         q: Coord<f64>,
         normal: Coord<f64>,
     ) -> Option<(Coord<f64>, f64)> {
-        self.nearest_clipped(q, |a, b| clip_to_half_plane(a, b, q, normal))
+        self.nearest_in_half_plane_within(q, normal, f64::INFINITY)
+    }
+
+    /// [`Boundary::nearest_in_half_plane`] among the points at most `limit`
+    /// from `q` (`None` if there is none): a known boundary point in the
+    /// half-plane makes the search short.
+    pub fn nearest_in_half_plane_within(
+        &self,
+        q: Coord<f64>,
+        normal: Coord<f64>,
+        limit: f64,
+    ) -> Option<(Coord<f64>, f64)> {
+        let n = pt(normal);
+        self.nearest_clipped(
+            q,
+            limit,
+            |b| box_half_plane_distance(b, pt(q), n),
+            |a, b| clip_to_half_plane(a, b, q, normal),
+        )
     }
 
     /// Nearest boundary point to `q` within the closed sector swept
@@ -315,37 +339,51 @@ impl Boundary {
             y: from.x,
         };
         let n2 = Coord { x: to.y, y: -to.x };
-        self.nearest_clipped(q, |a, b| {
-            let (a, b) = clip_to_half_plane(a, b, q, n1)?;
-            clip_to_half_plane(a, b, q, n2)
-        })
+        self.nearest_clipped(
+            q,
+            f64::INFINITY,
+            |b| {
+                let d1 = box_half_plane_distance(b, pt(q), pt(n1))?;
+                let d2 = box_half_plane_distance(b, pt(q), pt(n2))?;
+                Some(d1.max(d2))
+            },
+            |a, b| {
+                let (a, b) = clip_to_half_plane(a, b, q, n1)?;
+                clip_to_half_plane(a, b, q, n2)
+            },
+        )
     }
 
     /// Nearest point to `q` of the boundary segments as `clip` cuts them
-    /// down (`None`: the whole segment is out). Visits segments in order of
-    /// distance and stops as soon as the next is farther than the best point
-    /// found.
+    /// down (`None`: the whole segment is out); `bound` is a lower bound of
+    /// the distance to the region within a box (`None`: not in it).
     fn nearest_clipped(
         &self,
         q: Coord<f64>,
+        limit: f64,
+        bound: impl Fn(&Bbox) -> Option<f64>,
         clip: impl Fn(Coord<f64>, Coord<f64>) -> Option<(Coord<f64>, Coord<f64>)>,
     ) -> Option<(Coord<f64>, f64)> {
-        let mut best: Option<(Coord<f64>, f64)> = None;
-        for (item, d2) in self.tree.nearest_neighbor_iter_with_distance_2(&pt(q)) {
-            if best.is_some_and(|(_, bd)| d2.sqrt() > bd) {
-                break;
-            }
-            let s = &self.segments[item.data as usize];
-            let Some((a, b)) = clip(s.a, s.b) else {
-                continue;
-            };
-            let c = closest_on_segment(a, b, q).0;
-            let d = (c - q).x.hypot((c - q).y);
-            if best.is_none_or(|(_, bd)| d < bd) {
-                best = Some((c, d));
-            }
+        if !finite(q) {
+            return None;
         }
-        best
+        let best: Cell<Option<Found>> = Cell::new(None);
+        self.tree.branch_and_bound(limit, bound, |i| {
+            let s = &self.segments[i as usize];
+            if let Some((a, b)) = clip(s.a, s.b) {
+                let c = closest_on_segment(a, b, q).0;
+                let d = super::norm(c - q);
+                if d <= limit
+                    && best
+                        .get()
+                        .is_none_or(|(_, bd, bi)| d < bd || (d == bd && i < bi))
+                {
+                    best.set(Some((c, d, i)));
+                }
+            }
+            best.get().map_or(limit, |(_, d, _)| d)
+        });
+        best.get().map(|(c, d, _)| (c, d))
     }
 
     /// First boundary point on the ray `origin + t · dir` with
@@ -357,34 +395,42 @@ impl Boundary {
         min_t: f64,
         max_t: f64,
     ) -> Option<RayHit> {
-        let sel = RaySelect {
-            o: origin,
-            d: dir,
-            max_t,
-        };
-        let mut best: Option<RayHit> = None;
-        for item in self.tree.locate_with_selection_function(sel) {
-            let s = &self.segments[item.data as usize];
-            if let Some((t, _)) = ray_segment(origin, dir, s.a, s.b) {
-                if t > min_t && t <= max_t && best.is_none_or(|b| t < b.t) {
-                    best = Some(RayHit {
-                        t,
-                        point: origin + dir * t,
-                        segment: item.data as usize,
-                    });
-                }
-            }
+        if !(finite(origin) && finite(dir)) {
+            return None;
         }
-        best
+        let (o, d) = (pt(origin), pt(dir));
+        let (t, i) = self.tree.best(
+            |b| ray_box(b, o, d, max_t).map(|(t0, _)| t0),
+            |i, _| {
+                let s = &self.segments[i as usize];
+                ray_segment(origin, dir, s.a, s.b)
+                    .map(|(t, _)| t)
+                    .filter(|&t| t > min_t && t <= max_t)
+            },
+        )?;
+        Some(RayHit {
+            t,
+            point: origin + dir * t,
+            segment: i as usize,
+        })
     }
 
     /// True when the open segment `pq` properly crosses a boundary segment.
     pub fn crosses(&self, p: Coord<f64>, q: Coord<f64>) -> bool {
-        let env = AABB::from_corners([p.x.min(q.x), p.y.min(q.y)], [p.x.max(q.x), p.y.max(q.y)]);
-        self.tree.locate_in_envelope_intersecting(&env).any(|item| {
-            let s = &self.segments[item.data as usize];
-            properly_cross(p, q, s.a, s.b)
-        })
+        let env = [p.x.min(q.x), p.y.min(q.y), p.x.max(q.x), p.y.max(q.y)];
+        self.tree
+            .visit(
+                |b| boxes_meet(b, &env),
+                |i| {
+                    let s = &self.segments[i as usize];
+                    if properly_cross(p, q, s.a, s.b) {
+                        ControlFlow::Break(())
+                    } else {
+                        ControlFlow::Continue(())
+                    }
+                },
+            )
+            .is_some()
     }
 
     /// True when the segment from `p` to the boundary point `q` meets ∂P only
@@ -403,36 +449,34 @@ impl Boundary {
     }
 
     /// Indices of the segments whose bounding box meets that of segment `pq`.
-    pub fn segments_near(&self, p: Coord<f64>, q: Coord<f64>) -> impl Iterator<Item = usize> + '_ {
-        let env = AABB::from_corners([p.x.min(q.x), p.y.min(q.y)], [p.x.max(q.x), p.y.max(q.y)]);
-        self.tree
-            .locate_in_envelope_intersecting(&env)
-            .map(|i| i.data as usize)
+    pub fn segments_near(&self, p: Coord<f64>, q: Coord<f64>) -> impl Iterator<Item = usize> {
+        let env = [p.x.min(q.x), p.y.min(q.y), p.x.max(q.x), p.y.max(q.y)];
+        let mut near = Vec::new();
+        self.tree.visit(
+            |b| boxes_meet(b, &env),
+            |i| {
+                near.push(i as usize);
+                ControlFlow::<()>::Continue(())
+            },
+        );
+        near.into_iter()
     }
 
     /// Crossing parity of the ray from `p` towards +x against the segments of
     /// the rings for which `ring` is true: `p` is inside the region those rings bound.
     pub fn contains_with_rings(&self, p: Coord<f64>, ring: impl Fn(u32) -> bool) -> bool {
-        let sel = RaySelect {
-            o: p,
-            d: Coord { x: 1.0, y: 0.0 },
-            max_t: (self.max.x - p.x).max(0.0) + 1.0,
-        };
+        let max_t = (self.max.x - p.x).max(0.0) + 1.0;
         let mut inside = false;
-        for item in self.tree.locate_with_selection_function(sel) {
-            let s = &self.segments[item.data as usize];
-            if !ring(s.ring) {
-                continue;
-            }
-            let (a, b) = (s.a, s.b);
-            if (a.y > p.y) != (b.y > p.y) {
-                let o = orient(a, b, p);
-                let upward = b.y > a.y;
-                if (upward && o > 0.0) || (!upward && o < 0.0) {
-                    inside = !inside;
+        self.tree.visit(
+            |b| ray_box(b, pt(p), [1.0, 0.0], max_t).is_some(),
+            |i| {
+                let s = &self.segments[i as usize];
+                if ring(s.ring) {
+                    inside ^= crosses_up(s, p);
                 }
-            }
-        }
+                ControlFlow::<()>::Continue(())
+            },
+        );
         inside
     }
 
@@ -440,6 +484,18 @@ impl Boundary {
     pub fn contains_with_tolerance(&self, p: Coord<f64>, tol: f64) -> bool {
         self.contains(p) || self.distance(p) <= tol
     }
+}
+
+/// True when the ray from `p` towards +x crosses `s` (half-open rule on
+/// vertices).
+fn crosses_up(s: &BoundarySegment, p: Coord<f64>) -> bool {
+    let (a, b) = (s.a, s.b);
+    if (a.y > p.y) == (b.y > p.y) {
+        return false;
+    }
+    let o = orient(a, b, p);
+    let upward = b.y > a.y;
+    (upward && o > 0.0) || (!upward && o < 0.0)
 }
 
 /// Segment `ab` clipped to the half-plane `(x − q) · n ≥ 0`, or `None` when

@@ -7,6 +7,7 @@
 
 pub mod boundary;
 pub mod densify;
+pub mod packed;
 pub mod ring;
 pub mod validity;
 
@@ -14,6 +15,14 @@ pub use boundary::{Boundary, BoundarySegment, RayHit};
 
 use geo::{Coord, Polygon};
 use thiserror::Error;
+
+/// Length of a vector: `√(x² + y²)`, without `hypot`'s care for overflow
+/// (which costs several times as much and which projected coordinates never
+/// need).
+#[inline]
+pub fn norm(d: Coord<f64>) -> f64 {
+    (d.x * d.x + d.y * d.y).sqrt()
+}
 
 /// Why a polygon cannot be prepared for skeletonisation.
 #[derive(Debug, Error, Clone, PartialEq)]
@@ -48,7 +57,7 @@ impl PreparedPolygon {
     /// Normalises `polygon` (orientation, closing, duplicate vertices, degenerate
     /// holes dropped) and builds its boundary index.
     pub fn new(polygon: &Polygon<f64>) -> Result<Self, GeometryError> {
-        let polygon = ring::normalise_polygon(polygon)?;
+        let polygon = validity::split_touches(&ring::normalise_polygon(polygon)?);
         let boundary = Boundary::new(&polygon);
         let extent = boundary.extent();
         Ok(Self {

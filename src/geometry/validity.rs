@@ -3,7 +3,8 @@
 //! million vertices is checked in about a second, not hours.
 //!
 //! A prepared polygon is invalid when two boundary edges cross, overlap, or
-//! touch anywhere other than at a vertex shared by two *different* rings; when
+//! touch anywhere other than at a single point of two *different* rings (a
+//! hole may touch the shell or another hole at a point, as OGC allows); when
 //! a ring doubles back on itself (a spike); when a hole lies outside the
 //! exterior ring or inside another hole. Each problem is reported with its
 //! position so that the user can find it.
@@ -67,9 +68,11 @@ fn pair_problem(s: &BoundarySegment, t: &BoundarySegment) -> Option<String> {
     // Touching: an end point of one on the other.
     for (p, seg) in [(t.a, s), (t.b, s), (s.a, t), (s.b, t)] {
         if on_segment(seg.a, seg.b, p) {
-            let at_vertex = p == seg.a || p == seg.b;
-            if at_vertex && s.ring != t.ring {
-                continue; // rings may touch at a shared vertex
+            if s.ring != t.ring {
+                // OGC: two rings may touch at a point (a vertex of one on
+                // the other, anywhere along it); `split_touches` makes such
+                // a point a vertex of both before the methods run.
+                continue;
             }
             let how = if s.ring == t.ring {
                 "touches itself"
@@ -155,6 +158,63 @@ pub fn problem(p: &PreparedPolygon) -> Option<String> {
     None
 }
 
+/// `polygon` (normalised, rings closed) with every point where a vertex of
+/// one ring lies inside an edge of another ring inserted into that edge, so
+/// that rings touching at a point share a vertex there (every method
+/// handles a shared vertex; a vertex in the middle of another ring's edge
+/// breaks triangulations).
+pub fn split_touches(polygon: &geo::Polygon<f64>) -> geo::Polygon<f64> {
+    use super::boundary::Boundary;
+    let rings: Vec<&geo::LineString<f64>> = std::iter::once(polygon.exterior())
+        .chain(polygon.interiors())
+        .collect();
+    if rings.len() < 2 {
+        return polygon.clone();
+    }
+    let b = Boundary::new(polygon);
+    // (ring, edge index) → points to insert.
+    let mut cuts: std::collections::BTreeMap<(u32, u32), Vec<Coord<f64>>> = Default::default();
+    for (r, ring) in rings.iter().enumerate() {
+        for &p in &ring.0[..ring.0.len() - 1] {
+            for j in b.segments_near(p, p) {
+                let s = &b.segments()[j];
+                if s.ring as usize != r && p != s.a && p != s.b && on_segment(s.a, s.b, p) {
+                    cuts.entry((s.ring, s.index)).or_default().push(p);
+                }
+            }
+        }
+    }
+    if cuts.is_empty() {
+        return polygon.clone();
+    }
+    let split = |r: usize, ring: &geo::LineString<f64>| {
+        let mut out = Vec::with_capacity(ring.0.len() + 2);
+        for (i, w) in ring.0.windows(2).enumerate() {
+            out.push(w[0]);
+            if let Some(ps) = cuts.get(&(r as u32, i as u32)) {
+                let d = w[1] - w[0];
+                let mut ps = ps.clone();
+                ps.sort_by(|p, q| {
+                    let t = |c: Coord<f64>| (c - w[0]).x * d.x + (c - w[0]).y * d.y;
+                    t(*p).total_cmp(&t(*q))
+                });
+                ps.dedup();
+                out.extend(ps);
+            }
+        }
+        out.push(ring.0[ring.0.len() - 1]);
+        geo::LineString(out)
+    };
+    geo::Polygon::new(
+        split(0, rings[0]),
+        rings[1..]
+            .iter()
+            .enumerate()
+            .map(|(k, r)| split(k + 1, r))
+            .collect(),
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -162,6 +222,19 @@ mod tests {
 
     fn check(p: geo::Polygon<f64>) -> Option<String> {
         problem(&PreparedPolygon::new(&p).unwrap())
+    }
+
+    #[test]
+    fn a_hole_touching_the_shell_inside_an_edge_is_valid_and_split_there() {
+        use geo::polygon;
+        let p = polygon!(
+            exterior: [(x: 0., y: 0.), (x: 100., y: 0.), (x: 100., y: 100.), (x: 0., y: 100.), (x: 0., y: 0.)],
+            interiors: [[(x: 0., y: 50.), (x: 30., y: 40.), (x: 30., y: 60.), (x: 0., y: 50.)]],
+        );
+        let pp = PreparedPolygon::new(&p).unwrap();
+        assert_eq!(problem(&pp), None);
+        // The shell got the touching point as a vertex.
+        assert!(pp.polygon().exterior().0.contains(&Coord { x: 0., y: 50. }));
     }
 
     #[test]

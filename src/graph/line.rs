@@ -20,7 +20,7 @@ pub fn point_at(line: &[Coord<f64>], s: f64) -> Coord<f64> {
     let mut left = s;
     for w in line.windows(2) {
         let d = w[1] - w[0];
-        let l = d.x.hypot(d.y);
+        let l = crate::geometry::norm(d);
         if l >= left && l > 0.0 {
             return w[0] + d * (left / l);
         }

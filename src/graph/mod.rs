@@ -100,7 +100,7 @@ impl Branch {
 /// Length of a polyline.
 pub fn polyline_length(c: &[Coord<f64>]) -> f64 {
     c.windows(2)
-        .map(|w| (w[1] - w[0]).x.hypot((w[1] - w[0]).y))
+        .map(|w| crate::geometry::norm(w[1] - w[0]))
         .sum()
 }
 

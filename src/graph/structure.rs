@@ -213,21 +213,28 @@ fn best_seeing(
 ) -> Option<NodeId> {
     let mut reach = start;
     loop {
-        let mut best: Option<(f64, f64, u32)> = None;
-        for item in tree.locate_within_distance([q.x, q.y], reach * reach) {
-            let n = item.data;
+        // Candidates in order of (score, distance, node); the first that
+        // sees q is the answer, so the costly visibility test runs only
+        // until then.
+        let mut keys: Vec<(f64, f64, u32)> = tree
+            .locate_within_distance([q.x, q.y], reach * reach)
+            .map(|item| {
+                let n = item.data;
+                let node = g.node(NodeId(n));
+                let d = (node.pos - q).x.hypot((node.pos - q).y);
+                (score(d, node.radius), d, n)
+            })
+            .collect();
+        keys.sort_unstable_by(|a, b| {
+            a.0.total_cmp(&b.0)
+                .then(a.1.total_cmp(&b.1))
+                .then(a.2.cmp(&b.2))
+        });
+        let seen = keys.into_iter().find(|&(_, d, n)| {
             let node = g.node(NodeId(n));
-            let d = (node.pos - q).x.hypot((node.pos - q).y);
-            let key = (score(d, node.radius), d, n);
-            if best.is_some_and(|bk| bk.partial_cmp(&key).is_some_and(|o| o.is_le())) {
-                continue;
-            }
-            if d > tol && !b.reaches(node.pos, q) {
-                continue;
-            }
-            best = Some(key);
-        }
-        if let Some((_, _, n)) = best {
+            d <= tol || b.reaches(node.pos, q)
+        });
+        if let Some((_, _, n)) = seen {
             return Some(NodeId(n));
         }
         if reach >= limit {

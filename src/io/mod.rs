@@ -1,8 +1,12 @@
 //! Everything that touches GDAL: the [`reader`] turns any OGR source into
 //! owned features with `geo` geometries; the [`writer`] writes the
-//! GeoPackage layers. No GDAL type leaves this module.
+//! GeoPackage layers; [`readback`] reads an output GeoPackage back for the
+//! report. No GDAL type leaves this module.
 
+pub mod gdal_errors;
+pub mod readback;
 pub mod reader;
+pub mod signals;
 pub mod writer;
 
 pub use reader::{read_layer_polygons, FieldInfo, InputSpec, LayerRef, Reader, SourceInfo};
@@ -31,9 +35,37 @@ pub enum IoError {
         /// Comma-separated names of the layers that exist.
         available: String,
     },
+    /// Reading the source failed.
+    #[error("reading `{source_name}` failed: {reason}; the run stops, nothing is written")]
+    Read {
+        /// The data source string.
+        source_name: String,
+        /// GDAL's messages.
+        reason: String,
+    },
     /// The attribute filter was rejected by OGR.
     #[error("invalid `input.where` filter `{filter}`: {reason}; use OGR SQL syntax, e.g. \"area_m2 > 1e6\"")]
     BadWhere {
+        /// The filter text.
+        filter: String,
+        /// GDAL's message.
+        reason: String,
+    },
+    /// The file given as an output of a run cannot be read as one.
+    #[error("cannot read `{path}` as the output of `skeletonise run`: {reason}")]
+    NotAnOutput {
+        /// The file.
+        path: String,
+        /// Why.
+        reason: String,
+    },
+    /// An attribute filter on a layer of an output GeoPackage was rejected.
+    #[error("invalid filter `{filter}` on layer `{layer}` of `{path}`: {reason}; use OGR SQL on the layer's columns, e.g. \"distortion > 0.01\" or \"kind = 'lake'\"")]
+    BadFilter {
+        /// The GeoPackage.
+        path: String,
+        /// The layer filtered.
+        layer: String,
         /// The filter text.
         filter: String,
         /// GDAL's message.
@@ -79,11 +111,52 @@ pub enum IoError {
     },
 }
 
+/// Sets an OGR SQL attribute filter and makes the layer evaluate it once, so
+/// that a filter the driver only rejects when it runs it (GeoPackage passes
+/// it to SQLite) fails here, with the driver's message, instead of silently
+/// selecting nothing.
+pub(crate) fn set_filter(layer: &mut gdal::vector::Layer<'_>, filter: &str) -> Result<(), String> {
+    use gdal::vector::LayerAccess;
+    layer
+        .set_attribute_filter(filter)
+        .map_err(|e| e.to_string())?;
+    // SAFETY: GDAL's thread-local error state, read and reset around one
+    // call on this thread; the quiet handler keeps GDAL from printing it.
+    unsafe {
+        gdal_sys::CPLPushErrorHandler(Some(gdal_sys::CPLQuietErrorHandler));
+        gdal_sys::CPLErrorReset();
+    }
+    let _ = layer.feature_count();
+    let failed = unsafe {
+        let failed = gdal_sys::CPLGetLastErrorType() >= gdal_sys::CPLErr::CE_Failure;
+        let msg = std::ffi::CStr::from_ptr(gdal_sys::CPLGetLastErrorMsg())
+            .to_string_lossy()
+            .to_string();
+        gdal_sys::CPLErrorReset();
+        gdal_sys::CPLPopErrorHandler();
+        failed.then_some(msg)
+    };
+    match failed {
+        Some(msg) => {
+            layer.clear_attribute_filter();
+            Err(msg)
+        }
+        None => Ok(()),
+    }
+}
+
 impl IoError {
+    /// A GDAL failure while doing `context`, with GDAL's own last message
+    /// (the error value alone often only says "returned error: '6'").
     pub(crate) fn gdal(context: impl Into<String>, e: impl std::fmt::Display) -> Self {
+        let e = e.to_string();
+        let reason = match gdal_errors::last_failure() {
+            Some(m) if !e.contains(&m) => format!("{m} ({e})"),
+            _ => e,
+        };
         IoError::Gdal {
             context: context.into(),
-            reason: e.to_string(),
+            reason,
         }
     }
 }

@@ -41,10 +41,10 @@ pub struct SourceInfo {
     pub srs_wkt: Option<String>,
     /// Human-readable name of that CRS.
     pub crs_name: String,
-    /// Features in the layer without filters.
-    pub total: u64,
-    /// Features that pass `where` and `bbox`.
-    pub selected: u64,
+    /// Features in the layer without filters (`None`: the driver cannot tell).
+    pub total: Option<u64>,
+    /// Features that pass `where` and `bbox` (`None`: the driver cannot tell).
+    pub selected: Option<u64>,
 }
 
 /// An open input layer.
@@ -99,6 +99,25 @@ fn target_srs(
     Ok(Some(traditional(srs)))
 }
 
+/// Whether two sources hand out geometries in the same CRS (`None` when
+/// either has none).
+pub fn same_crs(a: &SourceInfo, b: &SourceInfo) -> Option<bool> {
+    let srs = |i: &SourceInfo| {
+        i.srs_wkt
+            .as_deref()
+            .and_then(|w| SpatialRef::from_wkt(w).ok())
+    };
+    Some(srs(a)? == srs(b)?)
+}
+
+/// The feature count of a layer (as filtered), `None` when the driver cannot
+/// tell (it returns −1).
+fn count(layer: &gdal::vector::Layer<'_>) -> Option<u64> {
+    // SAFETY: the handle is valid for the lifetime of `layer`.
+    let n = unsafe { gdal_sys::OGR_L_GetFeatureCount(layer.c_layer(), 1) };
+    u64::try_from(n).ok()
+}
+
 fn traditional(mut s: SpatialRef) -> SpatialRef {
     s.set_axis_mapping_strategy(AxisMappingStrategy::TraditionalGisOrder);
     s
@@ -107,6 +126,8 @@ fn traditional(mut s: SpatialRef) -> SpatialRef {
 impl Reader {
     /// Opens the source and layer and checks filters and CRS; reads nothing.
     pub fn open(spec: &InputSpec) -> Result<Self, IoError> {
+        super::gdal_errors::install();
+        super::gdal_errors::clear();
         let dataset = Dataset::open_ex(
             &spec.source,
             DatasetOptions {
@@ -123,7 +144,7 @@ impl Reader {
             .layer(layer_index)
             .map_err(|e| IoError::gdal("opening the layer", e))?;
         let layer_name = layer.name();
-        let total = layer.feature_count();
+        let total = count(&layer);
         let fields = layer
             .defn()
             .fields()
@@ -134,13 +155,25 @@ impl Reader {
                 precision: f.precision(),
             })
             .collect();
-        let source_srs = layer.spatial_ref();
+        // A GeoPackage without a CRS reports an "Undefined geographic /
+        // Cartesian SRS": that is no CRS.
+        let source_srs = layer
+            .spatial_ref()
+            .filter(|s| !s.name().is_some_and(|n| n.starts_with("Undefined")));
         let target = target_srs(spec, source_srs.as_ref(), &layer_name)?;
         let out_srs = target.as_ref().or(source_srs.as_ref());
         let srs_wkt = out_srs.and_then(|s| s.to_wkt().ok());
         let crs_name = out_srs.map_or_else(|| "(no CRS)".into(), crs_name);
         Self::apply_filters(&mut layer, spec)?;
-        let selected = layer.feature_count();
+        let selected = count(&layer);
+        // Some drivers (GeoPackage) accept a bad filter and only report it
+        // when it is used: counting used it.
+        if let (Some(w), [first, ..]) = (&spec.where_, &super::gdal_errors::take_failures()[..]) {
+            return Err(IoError::BadWhere {
+                filter: w.clone(),
+                reason: first.clone(),
+            });
+        }
         let info = SourceInfo {
             source: spec.source.clone(),
             layer: layer_name,
@@ -183,14 +216,43 @@ impl Reader {
         }
     }
 
+    /// Reads the first selected feature and drops it: a filter or a source
+    /// that fails only when read fails here (`validate`).
+    pub fn probe(&mut self) -> Result<(), IoError> {
+        let mut layer = self
+            .dataset
+            .layer(self.layer_index)
+            .map_err(|e| IoError::gdal("opening the layer", e))?;
+        Self::apply_filters(&mut layer, &self.spec)?;
+        super::gdal_errors::clear();
+        let _ = layer.features().next();
+        self.check_read()
+    }
+
+    /// The failures GDAL reported while reading, as an error.
+    fn check_read(&self) -> Result<(), IoError> {
+        let failures = super::gdal_errors::take_failures();
+        if failures.is_empty() {
+            return Ok(());
+        }
+        Err(match &self.spec.where_ {
+            Some(w) => IoError::BadWhere {
+                filter: w.clone(),
+                reason: failures.join("; "),
+            },
+            None => IoError::Read {
+                source_name: self.spec.source.clone(),
+                reason: failures.join("; "),
+            },
+        })
+    }
+
     fn apply_filters(layer: &mut gdal::vector::Layer<'_>, spec: &InputSpec) -> Result<(), IoError> {
         if let Some(w) = &spec.where_ {
-            layer
-                .set_attribute_filter(w)
-                .map_err(|e| IoError::BadWhere {
-                    filter: w.clone(),
-                    reason: e.to_string(),
-                })?;
+            super::set_filter(layer, w).map_err(|reason| IoError::BadWhere {
+                filter: w.clone(),
+                reason,
+            })?;
         }
         if let Some([x0, y0, x1, y1]) = spec.bbox {
             layer.set_spatial_filter_rect(x0, y0, x1, y1);
@@ -216,56 +278,98 @@ impl Reader {
             .layer(self.layer_index)
             .map_err(|e| IoError::gdal("opening the layer", e))?;
         Self::apply_filters(&mut layer, &self.spec)?;
-        let transform = match (&self.target, layer.spatial_ref()) {
-            (Some(t), Some(s)) => Some(
-                CoordTransform::new(&traditional(s), t)
-                    .map_err(|e| IoError::gdal("creating the coordinate transformation", e))?,
-            ),
-            _ => None,
-        };
-        let n_fields = self.info.fields.len();
+        let transform = self.transform(&layer)?;
         let mut buf = Vec::with_capacity(batch);
+        super::gdal_errors::clear();
         for f in layer.features() {
-            let attributes = (0..n_fields)
-                .map(|i| value(f.field(i).ok().flatten()))
-                .collect();
-            let mut feat = Feature {
-                fid: f.fid(),
-                attributes,
-                geometry: None,
-                geometry_error: None,
-                source_wkb: None,
-                repaired: false,
-            };
-            // gdal hands out a wrapper around a null handle for NULL geometries.
-            // SAFETY: the handle is only compared with null.
-            let geometry = f
-                .geometry()
-                .filter(|g| unsafe { !g.c_geometry().is_null() });
-            if let Some(g) = geometry {
-                match convert(g, transform.as_ref(), make_valid) {
-                    Ok((geom, wkb, repaired)) => {
-                        feat.geometry = geom;
-                        feat.source_wkb = wkb;
-                        feat.repaired = repaired;
-                    }
-                    Err(e) => feat.geometry_error = Some(e),
-                }
-            }
-            buf.push(feat);
+            // Failures while fetching the feature are the source's.
+            self.check_read()?;
+            buf.push(self.feature(&f, transform.as_ref(), make_valid));
             if buf.len() >= batch {
                 on_batch(std::mem::take(&mut buf))?;
             }
         }
+        // A source that fails part way (a broken file, a dropped
+        // connection) ends the feature loop early: that is an error, not the
+        // end of the data.
+        self.check_read()?;
         if !buf.is_empty() {
             on_batch(buf)?;
         }
         Ok(())
     }
+
+    /// Reads the features with the given FIDs, in that order, whatever the
+    /// filters; an FID the layer does not hold is left out.
+    pub fn read_fids(&self, fids: &[u64], make_valid: bool) -> Result<Vec<Feature>, IoError> {
+        let layer = self
+            .dataset
+            .layer(self.layer_index)
+            .map_err(|e| IoError::gdal("opening the layer", e))?;
+        let transform = self.transform(&layer)?;
+        Ok(fids
+            .iter()
+            .filter_map(|&fid| layer.feature(fid))
+            .map(|f| self.feature(&f, transform.as_ref(), make_valid))
+            .collect())
+    }
+
+    /// The transformation to the target CRS, when reprojecting.
+    fn transform(
+        &self,
+        layer: &gdal::vector::Layer<'_>,
+    ) -> Result<Option<CoordTransform>, IoError> {
+        match (&self.target, layer.spatial_ref()) {
+            (Some(t), Some(s)) => Ok(Some(
+                CoordTransform::new(&traditional(s), t)
+                    .map_err(|e| IoError::gdal("creating the coordinate transformation", e))?,
+            )),
+            _ => Ok(None),
+        }
+    }
+
+    /// One GDAL feature as an owned [`Feature`].
+    fn feature(
+        &self,
+        f: &gdal::vector::Feature<'_>,
+        transform: Option<&CoordTransform>,
+        make_valid: bool,
+    ) -> Feature {
+        let attributes = (0..self.info.fields.len())
+            .map(|i| value(f.field(i).ok().flatten()))
+            .collect();
+        let mut feat = Feature {
+            fid: f.fid(),
+            attributes,
+            geometry: None,
+            geometry_error: None,
+            source_wkb: None,
+            repaired: false,
+        };
+        // gdal hands out a wrapper around a null handle for NULL geometries.
+        // SAFETY: the handle is only compared with null.
+        let geometry = f
+            .geometry()
+            .filter(|g| unsafe { !g.c_geometry().is_null() });
+        if let Some(g) = geometry {
+            match convert(g, transform, make_valid) {
+                Ok((geom, wkb, repaired)) => {
+                    feat.geometry = geom;
+                    feat.source_wkb = wkb;
+                    feat.repaired = repaired;
+                }
+                Err(e) => feat.geometry_error = Some(e),
+            }
+            // What GDAL reported while converting (a reprojection or a
+            // repair that failed) is this feature's reason, not the run's.
+            super::gdal_errors::clear();
+        }
+        feat
+    }
 }
 
 /// A field value as the per-feature path carries it.
-fn value(v: Option<FieldValue>) -> Value {
+pub(super) fn value(v: Option<FieldValue>) -> Value {
     match v {
         None => Value::Null,
         Some(FieldValue::IntegerValue(i)) => Value::Integer(i),
@@ -374,6 +478,17 @@ fn collect_polygons(g: &Geometry, out: &mut Geometry) -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+/// The data source string as it opens from any working directory: an
+/// existing local path made absolute; anything else (`PG:…`, `/vsizip/…`,
+/// URLs) as given.
+pub fn absolute_source(source: &str) -> String {
+    let path = std::path::Path::new(source);
+    match path.is_relative().then(|| path.canonicalize()) {
+        Some(Ok(abs)) => abs.display().to_string(),
+        _ => source.to_string(),
+    }
 }
 
 /// A source FID and its geometry.

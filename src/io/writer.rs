@@ -9,7 +9,7 @@
 //! output.
 
 use super::reader::{FieldInfo, SourceInfo};
-use super::IoError;
+use super::{signals, IoError};
 use crate::feature::Value;
 use crate::output::{
     Cell, Column, ColumnType, GeometryKind, LayerDef, Rows, RunRecord, Shape, When, BARS,
@@ -34,19 +34,52 @@ pub struct Writer {
     source_fields: Vec<(String, FieldInfo)>,
 }
 
-/// Checks that `spec.path` can be written (parent exists, no file in the way
-/// without `overwrite`) without creating anything.
-pub fn check_output(spec: &OutputSpec) -> Result<(), IoError> {
+/// Checks that `spec.path` can be written without harm, creating nothing
+/// that stays: a `.gpkg` path, not an existing device, FIFO or directory,
+/// not one of the `inputs` (data source strings; compared after resolving
+/// links, `/vsizip/`-style prefixes stripped), no file in the way without
+/// `overwrite`, and a directory the process may write to (probed by
+/// creating and removing a temporary file).
+pub fn check_output(spec: &OutputSpec, inputs: &[&str]) -> Result<(), IoError> {
     let path = Path::new(&spec.path);
+    let bad = |reason: String| IoError::Output {
+        path: spec.path.clone(),
+        reason,
+    };
+    let is_gpkg = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("gpkg"));
+    if !is_gpkg {
+        return Err(bad(
+            "the output is always a GeoPackage: give a path ending in `.gpkg` (`output.path` or `-o`)"
+                .into(),
+        ));
+    }
+    if let Ok(meta) = std::fs::metadata(path) {
+        if !meta.is_file() {
+            let what = if meta.is_dir() {
+                "a directory"
+            } else {
+                "not a regular file (a device, FIFO or socket)"
+            };
+            return Err(bad(format!(
+                "it is {what}; choose the path of a GeoPackage file"
+            )));
+        }
+    }
+    let target = resolved(path);
+    for input in inputs {
+        if let Some(src) = local_path(input) {
+            if resolved(&src) == target {
+                return Err(bad(format!(
+                    "it is the input `{input}`; writing it would destroy the data being read: choose another output path"
+                )));
+            }
+        }
+    }
     if path.exists() && !spec.overwrite {
         return Err(IoError::OutputExists {
             path: spec.path.clone(),
-        });
-    }
-    if path.is_dir() {
-        return Err(IoError::Output {
-            path: spec.path.clone(),
-            reason: "it is a directory; give a file name ending in .gpkg".into(),
         });
     }
     let parent = path
@@ -54,15 +87,60 @@ pub fn check_output(spec: &OutputSpec) -> Result<(), IoError> {
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
     if !parent.is_dir() {
-        return Err(IoError::Output {
-            path: spec.path.clone(),
-            reason: format!(
-                "directory `{}` does not exist; create it first",
-                parent.display()
-            ),
-        });
+        return Err(bad(format!(
+            "directory `{}` does not exist; create it first",
+            parent.display()
+        )));
     }
-    Ok(())
+    probe_writable(parent).map_err(|e| {
+        bad(format!(
+            "directory `{}` cannot be written ({e}); choose a directory you may write to",
+            parent.display()
+        ))
+    })
+}
+
+/// `path` with links resolved (its parent's when it does not exist yet).
+fn resolved(path: &Path) -> PathBuf {
+    if let Ok(p) = std::fs::canonicalize(path) {
+        return p;
+    }
+    let parent = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    match (std::fs::canonicalize(parent), path.file_name()) {
+        (Ok(p), Some(n)) => p.join(n),
+        _ => path.to_path_buf(),
+    }
+}
+
+/// The file behind an OGR data source string, when it is a local file
+/// (`PG:` and other connection strings are not).
+fn local_path(source: &str) -> Option<PathBuf> {
+    let s = source
+        .trim_start_matches("/vsizip/")
+        .trim_start_matches("/vsigzip/")
+        .trim_start_matches("/vsitar/");
+    if s.starts_with("/vsi")
+        || s.contains("://")
+        || s.split_once(':')
+            .is_some_and(|(a, _)| a.len() > 1 && !a.contains('/'))
+    {
+        return None;
+    }
+    // A path inside an archive: the archive is the file.
+    let archive = [".zip/", ".gz/", ".tar/"]
+        .iter()
+        .find_map(|ext| s.find(ext).map(|i| &s[..i + ext.len() - 1]));
+    Some(PathBuf::from(archive.unwrap_or(s)))
+}
+
+/// Creates and removes a file in `dir`.
+fn probe_writable(dir: &Path) -> std::io::Result<()> {
+    let probe = dir.join(format!(".skeletonise-probe-{}", std::process::id()));
+    std::fs::File::create(&probe)?;
+    std::fs::remove_file(&probe)
 }
 
 fn field(layer: &gdal::vector::Layer<'_>, name: &str, ty: u32) -> Result<(), IoError> {
@@ -142,21 +220,24 @@ fn to_gdal<G: ToGdal>(g: &G) -> Result<Geometry, IoError> {
 
 impl Writer {
     /// Creates the temporary GeoPackage and its layers. Fails, touching
-    /// nothing, when the output exists without `overwrite` or cannot be written.
-    pub fn create(spec: &OutputSpec, source: &SourceInfo) -> Result<Self, IoError> {
-        check_output(spec)?;
+    /// nothing, when the output is refused by [`check_output`] (`inputs` are
+    /// the data sources the run reads).
+    pub fn create(
+        spec: &OutputSpec,
+        source: &SourceInfo,
+        inputs: &[&str],
+    ) -> Result<Self, IoError> {
+        check_output(spec, inputs)?;
         let path = PathBuf::from(&spec.path);
-        let name = path
-            .file_name()
-            .map(|n| n.to_string_lossy().to_string())
-            .unwrap_or_else(|| "out.gpkg".into());
-        let tmp = path.with_file_name(format!(".{name}.{}.tmp.gpkg", std::process::id()));
+        signals::remove_stale(&path);
+        let tmp = signals::temporary_name(&path, std::process::id());
         let out_err = |e: gdal::errors::GdalError| IoError::Output {
             path: spec.path.clone(),
             reason: e.to_string(),
         };
         let driver = DriverManager::get_driver_by_name("GPKG").map_err(out_err)?;
         let _ = std::fs::remove_file(&tmp);
+        signals::register(&tmp);
         let mut ds = driver.create_vector_only(&tmp).map_err(out_err)?;
         let srs = source
             .srs_wkt
@@ -325,7 +406,9 @@ impl Writer {
                 path: self.spec.path.clone(),
             });
         }
-        std::fs::rename(&self.tmp, &self.path).map_err(|e| IoError::Output {
+        let renamed = std::fs::rename(&self.tmp, &self.path);
+        signals::unregister(&self.tmp);
+        renamed.map_err(|e| IoError::Output {
             path: self.spec.path.clone(),
             reason: format!("renaming the finished file into place failed: {e}"),
         })?;
@@ -336,6 +419,7 @@ impl Writer {
     pub fn abort(&mut self) {
         drop(self.ds.take());
         let _ = std::fs::remove_file(&self.tmp);
+        signals::unregister(&self.tmp);
     }
 }
 

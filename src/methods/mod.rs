@@ -12,6 +12,7 @@
 //! parsing, help, schema and construction come from the entry. Every method returns a [`SkeletonGraph`] whose node radii are
 //! distances to ∂P, whose points lie in P and whose edges do not cross ∂P.
 
+pub mod budget;
 pub mod cdt;
 pub mod medial_axis;
 pub mod straight_skeleton;
@@ -124,6 +125,25 @@ pub enum MethodError {
         /// The configured cap.
         max: usize,
     },
+    /// The method ran out of its time budget on this polygon.
+    #[error("{method} stopped after {seconds} s on this polygon (`skeleton.timeout_s`); raise the budget, or leave {method} out for such polygons")]
+    TimedOut {
+        /// The method.
+        method: MethodId,
+        /// The budget, in seconds.
+        seconds: f64,
+    },
+    /// The method predicted that this polygon would cost more than its
+    /// budget and did not start.
+    #[error(
+        "{method} skipped: it {reason}; raise the budget, or leave {method} out for such polygons"
+    )]
+    OverBudget {
+        /// The method.
+        method: MethodId,
+        /// The prediction and the budget it exceeds.
+        reason: String,
+    },
     /// The boundary could not be triangulated or diagrammed.
     #[error("{method} failed: {reason}")]
     Failed {
@@ -169,6 +189,24 @@ pub struct SkeletonParams {
     /// MA's options.
     #[serde(flatten)]
     pub medial_axis: medial_axis::MedialAxisOptions,
+    /// Most seconds one method may spend on one polygon part; past it that
+    /// method fails for that feature with the reason (0: no limit).
+    #[serde(default = "default_timeout_s")]
+    pub timeout_s: f64,
+    /// Most megabytes of working memory one method may use on one polygon
+    /// part (0: no limit). Only a method whose memory can grow faster than
+    /// its input checks it: the straight skeleton, whose split events are
+    /// quadratic in a large round polygon.
+    #[serde(default = "default_max_memory_mb")]
+    pub max_memory_mb: f64,
+}
+
+fn default_timeout_s() -> f64 {
+    120.0
+}
+
+fn default_max_memory_mb() -> f64 {
+    2048.0
 }
 
 impl SkeletonParams {
@@ -195,8 +233,29 @@ impl SkeletonParams {
         if let Some(d) = self.methods.iter().find(|m| !seen.insert(**m)) {
             return Err(("methods".into(), format!("method {d} is listed twice")));
         }
+        if !(self.timeout_s >= 0.0 && self.timeout_s.is_finite()) {
+            return Err((
+                "timeout_s".into(),
+                "timeout_s is a number of seconds ≥ 0 (0: no limit)".into(),
+            ));
+        }
+        if !(self.max_memory_mb >= 0.0 && self.max_memory_mb.is_finite()) {
+            return Err((
+                "max_memory_mb".into(),
+                "max_memory_mb is a number of megabytes ≥ 0 (0: no limit)".into(),
+            ));
+        }
         self.voronoi.validate()?;
         self.medial_axis.validate()
+    }
+
+    /// The budget per method and polygon part.
+    pub fn budget(&self) -> budget::Budget {
+        budget::Budget {
+            time: (self.timeout_s > 0.0)
+                .then(|| std::time::Duration::from_secs_f64(self.timeout_s)),
+            memory: (self.max_memory_mb > 0.0).then_some((self.max_memory_mb * 1e6) as u64),
+        }
     }
 }
 
@@ -207,6 +266,8 @@ impl Default for SkeletonParams {
             reference: default_reference(),
             voronoi: voronoi::VoronoiOptions::default(),
             medial_axis: medial_axis::MedialAxisOptions::default(),
+            timeout_s: default_timeout_s(),
+            max_memory_mb: default_max_memory_mb(),
         }
     }
 }

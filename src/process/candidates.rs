@@ -2,15 +2,17 @@
 //! skeletons part by part, the reference's structure, pruning, extension,
 //! scores, bars and widths.
 
-use super::{part_reason, CandidateSkeleton, ProcessParams};
+use super::clock::CpuClock;
+use super::{part_reason, CandidateSkeleton, ProcessParams, StageTimes};
 use crate::geometry::PreparedPolygon;
 use crate::graph::extend::prune_and_extend;
 use crate::graph::SkeletonGraph;
 use crate::methods::medial_axis::medial_axis_transform;
 use crate::score::defects::graph_of;
-use crate::score::{bars, metrics};
+use crate::score::{metrics, BarRays};
 use geo::MultiLineString;
 use rayon::prelude::*;
+use std::time::Duration;
 
 /// Every method's candidate for the polygon parts `prepared`, in `methods`
 /// order.
@@ -19,27 +21,40 @@ pub(super) fn computed(
     params: &ProcessParams,
 ) -> Vec<super::Candidate> {
     let n = prepared.len();
-    let per_part: Vec<Vec<Result<PartSkeleton, String>>> = prepared
+    let per_part: Vec<Vec<(Result<PartSkeleton, String>, StageTimes)>> = prepared
         .iter()
         .enumerate()
         .map(|(i, p)| {
             part_skeletons(p, params)
                 .into_iter()
-                .map(|r| r.map_err(|e| part_reason(i, n, &e)))
+                .map(|(r, t)| (r.map_err(|e| part_reason(i, n, &e)), t))
                 .collect()
         })
         .collect();
+    let (rays, rays_time) = bar_rays(prepared, params);
+    // The shared rays, split evenly between the methods.
+    let rays_share = rays_time / params.skeleton.methods.len().max(1) as u32;
     params
         .skeleton
         .methods
         .par_iter()
         .enumerate()
         .map(|(k, &m)| {
+            let mut time = StageTimes::default();
+            for (_, t) in per_part.iter().map(|r| &r[k]) {
+                time += *t;
+            }
             let parts: Result<Vec<PartSkeleton>, String> =
-                per_part.iter().map(|r| r[k].clone()).collect();
+                per_part.iter().map(|r| r[k].0.clone()).collect();
+            let result = parts.map(|parts| finish(prepared, &rays, &parts, params));
+            let result = result.map(|(c, t)| {
+                time.score += t + rays_share;
+                c
+            });
             super::Candidate {
                 method: m,
-                result: parts.map(|parts| finish(prepared, &parts, params)),
+                result,
+                time,
             }
         })
         .collect()
@@ -61,7 +76,7 @@ pub(super) fn given(
             legs_raw: legs,
         })
         .collect();
-    let mut c = finish(prepared, &parts, params);
+    let (mut c, _) = finish(prepared, &bar_rays(prepared, params).0, &parts, params);
     // The lines once, not once per polygon part.
     c.geometry = lines.clone();
     c.components = graph.components();
@@ -79,22 +94,35 @@ pub(super) struct PartSkeleton {
 
 /// Every method's finished skeleton of one polygon part, in `methods`
 /// order: raw skeletons in parallel, then the reference pruned and extended,
-/// then the others pruned to its structure (or each on its own).
+/// then the others pruned to its structure (or each on its own). With each
+/// result, the time its skeleton and its pruning took.
 pub(super) fn part_skeletons(
     p: &PreparedPolygon,
     params: &ProcessParams,
-) -> Vec<Result<PartSkeleton, String>> {
+) -> Vec<(Result<PartSkeleton, String>, StageTimes)> {
     use crate::graph::prune::{PruneMode, Structure as Sharing};
     use crate::graph::structure::{conform, Structure};
     let methods = &params.skeleton.methods;
-    let raws: Vec<Result<crate::graph::SkeletonGraph, String>> = methods
+    let raws: Vec<(Result<crate::graph::SkeletonGraph, String>, StageTimes)> = methods
         .par_iter()
         .map(|&m| {
-            params
+            let clock = CpuClock::start();
+            let raw = params
                 .registry
-                .build(m, &params.skeleton)?
-                .skeletonise(p)
-                .map_err(|e| e.to_string())
+                .build(m, &params.skeleton)
+                .and_then(|method| {
+                    guarded(m, || {
+                        crate::methods::budget::with_budget(m, params.skeleton.budget(), || {
+                            method.skeletonise(p)
+                        })
+                        .map_err(|e| e.to_string())
+                    })
+                });
+            let time = StageTimes {
+                skeleton: clock.elapsed(),
+                ..StageTimes::default()
+            };
+            (raw, time)
         })
         .collect();
     let finish = |raw: &crate::graph::SkeletonGraph| {
@@ -103,34 +131,81 @@ pub(super) fn part_skeletons(
     let shared = params
         .prune
         .filter(|pr| pr.mode != PruneMode::None && pr.structure == Sharing::Shared);
-    let reference = shared.and_then(|_| {
+    // The first method in the reference order whose finished skeleton is
+    // not empty (a polygon thinner than MA's grid has no medial axis).
+    let trunk = params.prune.is_some_and(|pr| pr.mode == PruneMode::Trunk);
+    let mut reference_time = vec![std::time::Duration::ZERO; methods.len()];
+    let structure = shared.and_then(|_| {
         params.skeleton.reference_order().into_iter().find_map(|m| {
-            methods
-                .iter()
-                .position(|&x| x == m)
-                .filter(|&k| raws[k].is_ok())
+            let k = methods.iter().position(|&x| x == m)?;
+            let clock = CpuClock::start();
+            let g = finish(raws[k].0.as_ref().ok()?);
+            let found = (!g.is_empty()).then(|| (k, Structure::of(&g, p, trunk), g));
+            reference_time[k] += clock.elapsed();
+            found
         })
-    });
-    let structure = reference.map(|k| {
-        let g = finish(raws[k].as_ref().expect("the reference succeeded"));
-        let trunk = params.prune.is_some_and(|pr| pr.mode == PruneMode::Trunk);
-        (k, Structure::of(&g, p, trunk), g)
     });
     raws.par_iter()
         .enumerate()
-        .map(|(k, raw)| {
-            let raw = raw.as_ref().map_err(Clone::clone)?;
-            let g = match &structure {
-                Some((r, _, g)) if *r == k => g.clone(),
-                Some((_, s, _)) => conform(raw, s, p),
-                None => finish(raw),
-            };
-            Ok(PartSkeleton {
-                graph: g,
-                legs_raw: raw.leg_count(),
-            })
+        .map(|(k, (raw, time))| {
+            let clock = CpuClock::start();
+            let result = raw.as_ref().map_err(Clone::clone).and_then(|raw| {
+                let g = guarded(methods[k], || {
+                    Ok(match &structure {
+                        Some((r, _, g)) if *r == k => g.clone(),
+                        Some((_, s, _)) => conform(raw, s, p),
+                        None => finish(raw),
+                    })
+                })?;
+                Ok(PartSkeleton {
+                    graph: g,
+                    legs_raw: raw.leg_count(),
+                })
+            });
+            let mut time = *time;
+            time.prune_extend = reference_time[k] + clock.elapsed();
+            (result, time)
         })
         .collect()
+}
+
+/// Runs one method's work on one polygon; a panic (a bug, which must never
+/// end the run) becomes that method's error for this feature.
+fn guarded<T>(
+    m: crate::methods::MethodId,
+    f: impl FnOnce() -> Result<T, String>,
+) -> Result<T, String> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).unwrap_or_else(|e| {
+        let what = e
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| e.downcast_ref::<String>().cloned())
+            .unwrap_or_default();
+        Err(format!(
+            "{m} failed with an internal error ({what}); the other methods still ran — please report this polygon"
+        ))
+    })
+}
+
+/// Every part's bars when the run scores (shared by all candidates), and
+/// the CPU time they took over all threads.
+fn bar_rays(prepared: &[PreparedPolygon], params: &ProcessParams) -> (Vec<BarRays>, Duration) {
+    if params.score.is_none() {
+        return (Vec::new(), Duration::ZERO);
+    }
+    // Per part, on one thread each (a part's rays may fan out to others,
+    // whose time the part's clock misses: counted as wall time then).
+    let timed: Vec<(BarRays, Duration)> = prepared
+        .par_iter()
+        .map(|p| {
+            let wall = std::time::Instant::now();
+            let cpu = CpuClock::start();
+            let r = BarRays::new(p);
+            (r, cpu.elapsed().max(wall.elapsed()))
+        })
+        .collect();
+    let time = timed.iter().map(|(_, t)| *t).sum();
+    (timed.into_iter().map(|(r, _)| r).collect(), time)
 }
 
 /// One candidate from its finished skeleton of every polygon part: scored
@@ -138,21 +213,30 @@ pub(super) fn part_skeletons(
 /// for.
 fn finish(
     prepared: &[PreparedPolygon],
+    rays: &[BarRays],
     parts: &[PartSkeleton],
     params: &ProcessParams,
-) -> CandidateSkeleton {
+) -> (CandidateSkeleton, Duration) {
+    // CPU time: the bars' own (over every thread that cast them), plus this
+    // thread's outside the casts (inside, it may run other work).
+    let clock = CpuClock::start();
+    let mut cast_time = Duration::ZERO;
+    let mut in_casts = Duration::ZERO;
     let mut lines = Vec::new();
     let mut all_bars = Vec::new();
     let mut widths = Vec::new();
     let (mut components, mut legs_raw, mut legs) = (0, 0, 0);
     let mut branch_offset = 0;
-    for (p, part) in prepared.iter().zip(parts) {
+    for (k, (p, part)) in prepared.iter().zip(parts).enumerate() {
         let g: &SkeletonGraph = &part.graph;
         legs_raw += part.legs_raw;
         legs += g.leg_count();
         components += g.components();
         if params.score.is_some() {
-            let mut b = bars(p, g);
+            let here = CpuClock::start();
+            let (mut b, t) = rays[k].cast_timed(p, g);
+            in_casts += here.elapsed();
+            cast_time += t;
             for bar in &mut b {
                 if let Some(h) = &mut bar.hit {
                     h.part += branch_offset;
@@ -170,7 +254,7 @@ fn finish(
     if !params.keep_bars {
         all_bars.clear();
     }
-    CandidateSkeleton {
+    let c = CandidateSkeleton {
         geometry: MultiLineString(lines),
         scores,
         components,
@@ -178,5 +262,6 @@ fn finish(
         legs,
         bars: all_bars,
         widths,
-    }
+    };
+    (c, cast_time + clock.elapsed().saturating_sub(in_casts))
 }

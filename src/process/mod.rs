@@ -4,6 +4,7 @@
 //! thread count.
 
 mod candidates;
+pub mod clock;
 pub mod rows;
 
 pub use rows::{feature_rows, FeatureRows, RowOptions, Skeletons, Status};
@@ -28,6 +29,9 @@ pub struct PrepareParams {
     /// Polygon parts smaller than this (CRS units²) are skipped; a feature all
     /// of whose parts are skipped is counted as filtered.
     pub min_area: f64,
+    /// A feature with more boundary vertices than this is rejected with the
+    /// reason, before any method runs (0: no limit).
+    pub max_vertices: usize,
 }
 
 impl PrepareParams {
@@ -48,6 +52,7 @@ impl Default for PrepareParams {
         Self {
             make_valid: true,
             min_area: 0.0,
+            max_vertices: 5_000_000,
         }
     }
 }
@@ -97,6 +102,37 @@ pub struct Candidate {
     pub method: MethodId,
     /// The skeleton, or why the method failed on this feature.
     pub result: Result<CandidateSkeleton, String>,
+    /// How long each step took for this method.
+    pub time: StageTimes,
+}
+
+/// Thread CPU time one method spent on one feature, step by step (summed over
+/// polygon parts). Measurements, not results: any two compare equal, so
+/// that two runs' results can be compared whatever the clock said.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct StageTimes {
+    /// The raw skeleton.
+    pub skeleton: std::time::Duration,
+    /// Pruning and extension (for the reference method: also the structure
+    /// every other method is pruned to; for the others: conforming to it).
+    pub prune_extend: std::time::Duration,
+    /// Bars, hits, sides and metrics (the rays all methods share are split
+    /// evenly between them).
+    pub score: std::time::Duration,
+}
+
+impl PartialEq for StageTimes {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+impl std::ops::AddAssign for StageTimes {
+    fn add_assign(&mut self, o: Self) {
+        self.skeleton += o.skeleton;
+        self.prune_extend += o.prune_extend;
+        self.score += o.score;
+    }
 }
 
 /// A successful skeleton of one feature (all its polygon parts).
@@ -234,9 +270,15 @@ pub fn process_given(
     if lines.0.iter().all(|l| l.0.len() < 2) {
         return Processed::Rejected(format!("{label}: no skeleton lines joined to this polygon"));
     }
+    let clock = clock::CpuClock::start();
+    let result = Ok(candidates::given(&prepared, lines, params));
     let candidate = Candidate {
         method: MethodId::EXTERNAL,
-        result: Ok(candidates::given(&prepared, lines, params)),
+        result,
+        time: StageTimes {
+            score: clock.elapsed(),
+            ..StageTimes::default()
+        },
     };
     choose(vec![candidate], prepared.len(), params)
 }
@@ -256,6 +298,16 @@ pub fn prepare(
     if parts.is_empty() {
         return Err(Processed::Filtered);
     }
+    let vertices: usize = parts
+        .iter()
+        .map(|p| p.exterior().0.len() + p.interiors().iter().map(|r| r.0.len()).sum::<usize>())
+        .sum();
+    if params.max_vertices > 0 && vertices > params.max_vertices {
+        return Err(Processed::Rejected(format!(
+            "the polygon has {vertices} vertices, more than `prepare.max_vertices` = {}; raise it, or simplify the polygon first",
+            params.max_vertices
+        )));
+    }
     let mut prepared = Vec::with_capacity(parts.len());
     for (i, p) in parts.iter().enumerate() {
         match PreparedPolygon::new(p) {
@@ -263,7 +315,7 @@ pub fn prepare(
             Err(e) => return Err(Processed::Rejected(part_reason(i, parts.len(), &e))),
         }
     }
-    if let Some(reason) = invalidity(&prepared) {
+    if let Some(reason) = invalidity(&prepared, params.make_valid) {
         return Err(Processed::Rejected(reason));
     }
     Ok(prepared)
@@ -317,18 +369,17 @@ fn rejection(candidates: &[Candidate]) -> String {
 }
 
 /// The reason a prepared polygon is invalid, if it is (self-intersection,
-/// crossing or touching rings, holes outside the shell).
-fn invalidity(parts: &[PreparedPolygon]) -> Option<String> {
+/// crossing or touching rings, holes outside the shell). The fix suggested
+/// depends on whether `make_valid` already ran.
+fn invalidity(parts: &[PreparedPolygon], make_valid: bool) -> Option<String> {
+    let fix = if make_valid {
+        "GDAL's MakeValid left it so; repair the source geometry"
+    } else {
+        "enable `prepare: { make_valid: true }` to repair it"
+    };
     parts.iter().enumerate().find_map(|(i, p)| {
-        crate::geometry::validity::problem(p).map(|err| {
-            part_reason(
-                i,
-                parts.len(),
-                &format!(
-                    "invalid polygon: {err}; enable `prepare: {{ make_valid: true }}` to repair it"
-                ),
-            )
-        })
+        crate::geometry::validity::problem(p)
+            .map(|err| part_reason(i, parts.len(), &format!("invalid polygon: {err}; {fix}")))
     })
 }
 
@@ -379,11 +430,28 @@ mod tests {
     }
 
     #[test]
+    fn more_vertices_than_max_vertices_is_rejected_before_any_method() {
+        let p = ProcessParams {
+            prepare: PrepareParams {
+                max_vertices: 3,
+                ..PrepareParams::default()
+            },
+            ..ProcessParams::all_steps()
+        };
+        let sq = polygon![(x: 0., y: 0.), (x: 1., y: 0.), (x: 1., y: 1.), (x: 0., y: 1.)];
+        let r = process(Some(&Geometry::Polygon(sq)), &p);
+        assert!(
+            matches!(r, Processed::Rejected(ref s) if s.contains("max_vertices")),
+            "{r:?}"
+        );
+    }
+
+    #[test]
     fn min_area_filters() {
         let p = ProcessParams {
             prepare: PrepareParams {
-                make_valid: true,
                 min_area: 100.0,
+                ..PrepareParams::default()
             },
             ..Default::default()
         };

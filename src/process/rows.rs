@@ -3,8 +3,9 @@
 //! `score` takes them from another tool's lines ([`Skeletons`]); both go
 //! through the same steps from `score` on and give the same rows.
 
-use super::{process, process_given, FeatureOutcome, ProcessParams, Processed};
+use super::{process, process_given, FeatureOutcome, ProcessParams, Processed, StageTimes};
 use crate::feature::Feature;
+use crate::methods::MethodId;
 use crate::output::{BarRow, CandidateRow, RejectedRow, Rows, SkeletonRow, WidthRow};
 use geo::{Geometry, MultiLineString};
 
@@ -54,6 +55,8 @@ pub struct FeatureRows {
     pub rows: Rows,
     /// How the feature counts.
     pub status: Status,
+    /// Each method's step times on this feature (all its units).
+    pub times: Vec<(MethodId, StageTimes)>,
 }
 
 /// The output rows of one feature (see the module documentation).
@@ -69,11 +72,14 @@ pub fn feature_rows(
         return FeatureRows {
             rows,
             status: Status::Rejected,
+            times: Vec::new(),
         };
     }
     let mut methods = Vec::new();
+    let mut times: Vec<(MethodId, StageTimes)> = Vec::new();
     for (part, geom) in units(f.geometry.as_ref(), opts.explode) {
-        let processed = match skeletons {
+        // A panic is a bug; it must cost this feature, never the run.
+        let processed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| match skeletons {
             Skeletons::Computed => process(geom.as_ref(), params),
             Skeletons::Given { label, lines } => match lines {
                 Some(l) => process_given(geom.as_ref(), l, label, params),
@@ -81,13 +87,24 @@ pub fn feature_rows(
                     "{label}: no skeleton lines joined to this polygon; check the join key or the skeletons' location"
                 )),
             },
-        };
+        }))
+        .unwrap_or_else(|_| {
+            Processed::Rejected(
+                "internal error while processing this feature; the run went on — please report it".into(),
+            )
+        });
         let label = match skeletons {
             Skeletons::Computed => None,
             Skeletons::Given { label, .. } => Some(label),
         };
         match processed {
             Processed::Done(o) => {
+                for c in &o.candidates {
+                    match times.iter_mut().find(|(m, _)| *m == c.method) {
+                        Some((_, t)) => *t += c.time,
+                        None => times.push((c.method, c.time)),
+                    }
+                }
                 methods.push(outcome_rows(f, part, &o, label, opts, &mut rows));
             }
             Processed::Filtered => {}
@@ -107,7 +124,11 @@ pub fn feature_rows(
     } else {
         Status::Written(methods)
     };
-    FeatureRows { rows, status }
+    FeatureRows {
+        rows,
+        status,
+        times,
+    }
 }
 
 /// The units of work of a feature: the whole geometry, or with `explode`
@@ -125,6 +146,17 @@ fn units(
         }
         (g, true) => vec![(Some(0), g.cloned())],
         (g, false) => vec![(None, g.cloned())],
+    }
+}
+
+/// Why a scored skeleton has no scores, if it has none.
+fn score_note(s: &crate::score::Scores) -> Option<String> {
+    match (s.bars, s.hits) {
+        (0, _) => Some("the polygon has no bars to score its skeleton with; the scores are NULL".into()),
+        (n, 0) => Some(format!(
+            "none of the {n} bars hits the skeleton: the polygon is too thin to score at its scale (bars shorter than a millionth of its extent); the scores are NULL"
+        )),
+        _ => None,
     }
 }
 
@@ -158,6 +190,7 @@ fn outcome_rows(
         components: chosen.components,
         legs: chosen.legs,
         repaired: f.repaired,
+        note: chosen.scores.and_then(|s| score_note(&s)),
     });
     if opts.widths {
         rows.widths.extend(chosen.widths.iter().map(|w| WidthRow {

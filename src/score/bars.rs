@@ -3,8 +3,13 @@
 use super::{metrics, Bar, BarHit, Scores};
 use crate::geometry::{boundary::orient, Boundary, BoundarySegment, PreparedPolygon};
 use crate::graph::{GraphBuilder, SkeletonGraph};
+use crate::process::clock::CpuClock;
 use geo::{Coord, MultiLineString};
+use rayon::prelude::*;
 use std::collections::HashMap;
+
+/// Bars per parallel task: a polygon with fewer is scored on one thread.
+const PAR_BARS: usize = 4096;
 
 /// Relative tolerance: hits closer than this × extent to the bar's origin are
 /// the origin itself (SPEC §6.2).
@@ -15,7 +20,7 @@ fn dot(a: Coord<f64>, b: Coord<f64>) -> f64 {
 }
 
 fn norm(a: Coord<f64>) -> f64 {
-    a.x.hypot(a.y)
+    crate::geometry::norm(a)
 }
 
 /// Left unit normal of the direction `d` (inward for a ring edge, since the
@@ -122,82 +127,138 @@ impl SkeletonIndex {
 /// start vertex, midpoint, end vertex (invalid vertex bars left out).
 /// `BarHit::part` indexes `skeleton.branches()`.
 pub fn bars(polygon: &PreparedPolygon, skeleton: &SkeletonGraph) -> Vec<Bar> {
-    let boundary = polygon.boundary();
-    let eps = REL_EPS * polygon.extent();
-    // No ray stays inside P for longer than the bounding box's diagonal.
-    let diagonal = norm(boundary.bbox_max() - boundary.bbox_min());
-    let sk = SkeletonIndex::new(skeleton);
-    let mut out = Vec::with_capacity(3 * polygon.vertex_count());
-    for ring in polygon.rings() {
-        let v = &ring.0[..ring.0.len() - 1];
-        let m = v.len();
-        let valid: Vec<bool> = (0..m)
-            .map(|i| vertex_bar_valid(v[(i + m - 1) % m], v[i], v[(i + 1) % m]))
-            .collect();
-        for i in 0..m {
-            let (a, b) = (v[i], v[(i + 1) % m]);
-            let u = left_normal(b - a);
-            let origins = [
-                (a, valid[i]),
-                ((a + b) * 0.5, true),
-                (b, valid[(i + 1) % m]),
-            ];
-            for (origin, ok) in origins {
-                if ok {
-                    let reach = Reach {
-                        start: norm(b - a),
-                        max: diagonal,
-                    };
-                    out.push(cast(boundary, &sk, origin, u, eps, reach));
+    BarRays::new(polygon).cast(polygon, skeleton)
+}
+
+/// A polygon's bars before they meet a skeleton: origin, direction and
+/// where each leaves P. They depend on the polygon alone, so every method's
+/// candidate is scored along the same rays, computed once.
+#[derive(Debug, Clone, Default)]
+pub struct BarRays {
+    rays: Vec<Ray>,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Ray {
+    origin: Coord<f64>,
+    dir: Coord<f64>,
+    /// Where the ray leaves P (ray parameter).
+    exit: f64,
+}
+
+impl BarRays {
+    /// The valid bars of `polygon` and their exits from P.
+    pub fn new(polygon: &PreparedPolygon) -> Self {
+        let boundary = polygon.boundary();
+        let eps = REL_EPS * polygon.extent();
+        // No ray stays inside P for longer than the bounding box's diagonal.
+        let diagonal = norm(boundary.bbox_max() - boundary.bbox_min());
+        let mut rays = Vec::with_capacity(3 * polygon.vertex_count());
+        for ring in polygon.rings() {
+            let v = &ring.0[..ring.0.len() - 1];
+            let m = v.len();
+            let valid: Vec<bool> = (0..m)
+                .map(|i| vertex_bar_valid(v[(i + m - 1) % m], v[i], v[(i + 1) % m]))
+                .collect();
+            for i in 0..m {
+                let (a, b) = (v[i], v[(i + 1) % m]);
+                let u = left_normal(b - a);
+                let origins = [
+                    (a, valid[i]),
+                    ((a + b) * 0.5, true),
+                    (b, valid[(i + 1) % m]),
+                ];
+                for (origin, ok) in origins {
+                    if ok {
+                        rays.push(Ray {
+                            origin,
+                            dir: u,
+                            exit: diagonal,
+                        });
+                    }
                 }
             }
         }
+        // Where each ray leaves P: in parallel for a large polygon (one
+        // huge feature must not leave the other cores idle).
+        rays.par_chunks_mut(PAR_BARS).for_each(|chunk| {
+            for r in chunk {
+                if let Some(h) = boundary.first_hit(r.origin, r.dir, eps, f64::INFINITY) {
+                    r.exit = h.t;
+                }
+            }
+        });
+        Self { rays }
     }
-    out
-}
 
-/// How far to look for the ray's exit from P: first up to `start`, then
-/// four times as far, up to `max` (no ray stays in P longer than the
-/// bounding box's diagonal).
-#[derive(Clone, Copy)]
-struct Reach {
-    start: f64,
-    max: f64,
-}
+    /// Number of bars.
+    pub fn len(&self) -> usize {
+        self.rays.len()
+    }
 
-/// Where the ray `origin + t·u`, t > eps, leaves P. A search growing from the
-/// local scale: an unbounded ray would test every boundary segment along it
-/// across the whole polygon (a wide river, a long coast), while the exit is
-/// usually near.
-fn exit(boundary: &Boundary, origin: Coord<f64>, u: Coord<f64>, eps: f64, reach: Reach) -> f64 {
-    let mut t = reach.start.max(eps);
-    loop {
-        let last = t >= reach.max;
-        let limit = if last { f64::INFINITY } else { t };
-        if let Some(h) = boundary.first_hit(origin, u, eps, limit) {
-            return h.t;
+    /// True when the polygon has no valid bar.
+    pub fn is_empty(&self) -> bool {
+        self.rays.is_empty()
+    }
+
+    /// The bars cast against `skeleton` (of the polygon the rays were made
+    /// for): hits and sides.
+    pub fn cast(&self, polygon: &PreparedPolygon, skeleton: &SkeletonGraph) -> Vec<Bar> {
+        self.cast_timed(polygon, skeleton).0
+    }
+
+    /// [`BarRays::cast`], and the CPU time it took over all threads (a
+    /// large polygon's bars are cast in parallel).
+    pub fn cast_timed(
+        &self,
+        polygon: &PreparedPolygon,
+        skeleton: &SkeletonGraph,
+    ) -> (Vec<Bar>, std::time::Duration) {
+        let clock = CpuClock::start();
+        let eps = REL_EPS * polygon.extent();
+        let sk = SkeletonIndex::new(skeleton);
+        let mut time = clock.elapsed();
+        let chunks: Vec<(Vec<Bar>, std::time::Duration)> = self
+            .rays
+            .par_chunks(PAR_BARS)
+            .map(|chunk| {
+                let clock = CpuClock::start();
+                let bars: Vec<Bar> = chunk
+                    .iter()
+                    .map(|r| cast(polygon.boundary(), &sk, r, eps))
+                    .collect();
+                (bars, clock.elapsed())
+            })
+            .collect();
+        let mut bars = Vec::with_capacity(self.rays.len());
+        for (b, t) in chunks {
+            bars.extend(b);
+            time += t;
         }
-        if last {
-            return reach.max;
-        }
-        t *= 4.0;
+        (bars, time)
     }
 }
 
-/// One bar: its exit from P, its hit on the skeleton and the sides there.
-fn cast(
-    boundary: &Boundary,
-    sk: &SkeletonIndex,
-    origin: Coord<f64>,
-    u: Coord<f64>,
-    eps: f64,
-    reach: Reach,
-) -> Bar {
-    let t_exit = exit(boundary, origin, u, eps, reach);
-    let hit = sk.hit(origin, u, eps, t_exit).and_then(|(q, sigma)| {
+/// One bar: its hit on the skeleton before it leaves P, and the sides there.
+fn cast(boundary: &Boundary, sk: &SkeletonIndex, ray: &Ray, eps: f64) -> Bar {
+    let (origin, u) = (ray.origin, ray.dir);
+    let exit = origin + u * ray.exit;
+    let hit = sk.hit(origin, u, eps, ray.exit).and_then(|(q, sigma)| {
         let nu = left_normal(sigma.b - sigma.a);
-        let (_, d_left) = boundary.nearest_in_half_plane(q, nu)?;
-        let (_, d_right) = boundary.nearest_in_half_plane(q, -nu)?;
+        // The bar's origin and exit are boundary points: each bounds the
+        // nearest distance on its side, which keeps the searches short.
+        let side = |n: Coord<f64>| {
+            let seed = [origin, exit]
+                .into_iter()
+                .filter(|&c| dot(c - q, n) >= 0.0)
+                .map(|c| norm(c - q) * (1.0 + 1e-9))
+                .fold(f64::INFINITY, f64::min);
+            boundary
+                .nearest_in_half_plane_within(q, n, seed)
+                .or_else(|| boundary.nearest_in_half_plane(q, n))
+        };
+        let (_, d_left) = side(nu)?;
+        let (_, d_right) = side(-nu)?;
         // A hit on ∂P itself (a leaf at a corner reached along the boundary)
         // has no sides to compare: it is a miss.
         if d_left + d_right <= eps {

@@ -66,7 +66,7 @@ pub mod defects;
 mod metrics;
 pub mod select;
 
-pub use bars::{bars, score_skeleton};
+pub use bars::{bars, score_skeleton, BarRays};
 pub use metrics::metrics;
 
 use geo::Coord;

@@ -2,6 +2,9 @@
 //! GeoPackage files.
 #![allow(dead_code)]
 
+#[cfg(feature = "gdal")]
+pub mod browser;
+
 use std::path::{Path, PathBuf};
 use std::process::Output;
 

@@ -1,0 +1,314 @@
+//! Reading an output GeoPackage back — the run record, the candidates, the
+//! skeleton rows and the bars — as the row types of [`crate::output`], so
+//! that the report works on the same data the writer wrote.
+
+use super::reader::value;
+use super::IoError;
+use crate::feature::Value;
+use crate::output::{
+    BarRow, CandidateRow, RunRecord, SkeletonRow, BARS, CANDIDATES, RUNS, SKELETONS,
+};
+use crate::score::Scores;
+use gdal::vector::{Feature, LayerAccess};
+use gdal::{Dataset, DatasetOptions, GdalOpenFlags};
+use std::collections::HashMap;
+use std::path::Path;
+
+/// An output GeoPackage opened for reading.
+pub struct OutputFile {
+    ds: Dataset,
+    path: String,
+    run: Option<RunRecord>,
+    skeleton_layer: String,
+}
+
+/// The column indices of one layer, by name.
+struct Fields(HashMap<String, usize>);
+
+impl Fields {
+    fn of(layer: &gdal::vector::Layer<'_>) -> Self {
+        Self(
+            layer
+                .defn()
+                .fields()
+                .enumerate()
+                .map(|(i, f)| (f.name(), i))
+                .collect(),
+        )
+    }
+
+    fn int(&self, f: &Feature<'_>, name: &str) -> Option<i64> {
+        let i = *self.0.get(name)?;
+        f.field_as_integer64(i).ok().flatten()
+    }
+
+    fn real(&self, f: &Feature<'_>, name: &str) -> Option<f64> {
+        let i = *self.0.get(name)?;
+        f.field_as_double(i).ok().flatten()
+    }
+
+    fn text(&self, f: &Feature<'_>, name: &str) -> Option<String> {
+        let i = *self.0.get(name)?;
+        f.field_as_string(i).ok().flatten()
+    }
+
+    fn count(&self, f: &Feature<'_>, name: &str) -> usize {
+        self.int(f, name)
+            .and_then(|v| usize::try_from(v).ok())
+            .unwrap_or(0)
+    }
+
+    fn fid(&self, f: &Feature<'_>) -> Option<u64> {
+        self.int(f, "src_fid").and_then(|v| u64::try_from(v).ok())
+    }
+
+    fn polygon_part(&self, f: &Feature<'_>) -> Option<usize> {
+        self.int(f, "polygon_part")
+            .and_then(|v| usize::try_from(v).ok())
+    }
+
+    /// The paper's scores of a row; `None` when the run did not score.
+    fn scores(&self, f: &Feature<'_>) -> Option<Scores> {
+        let bars = usize::try_from(self.int(f, "bars")?).ok()?;
+        let r = |n: &str| self.real(f, n).unwrap_or(f64::NAN);
+        Some(Scores {
+            bars,
+            hits: self.count(f, "hits"),
+            coverage: self.real(f, "coverage").unwrap_or(0.0),
+            deviation: r("deviation"),
+            deviation_parts: r("deviation_parts"),
+            distortion_sum: r("distortion_sum"),
+            distortion: r("distortion"),
+        })
+    }
+}
+
+fn lines(f: &Feature<'_>) -> Option<geo::MultiLineString<f64>> {
+    match f.geometry()?.to_geo().ok()? {
+        geo::Geometry::MultiLineString(m) => Some(m),
+        geo::Geometry::LineString(l) => Some(geo::MultiLineString(vec![l])),
+        _ => None,
+    }
+}
+
+impl OutputFile {
+    /// Opens a GeoPackage written by `skeletonise run` or `score`.
+    pub fn open(path: &Path) -> Result<Self, IoError> {
+        let shown = path.display().to_string();
+        let ds = Dataset::open_ex(
+            path,
+            DatasetOptions {
+                open_flags: GdalOpenFlags::GDAL_OF_VECTOR | GdalOpenFlags::GDAL_OF_READONLY,
+                ..Default::default()
+            },
+        )
+        .map_err(|e| IoError::NotAnOutput {
+            path: shown.clone(),
+            reason: if path.exists() {
+                e.to_string()
+            } else {
+                "the file does not exist".into()
+            },
+        })?;
+        let mut file = Self {
+            ds,
+            path: shown,
+            run: None,
+            skeleton_layer: SKELETONS.name.to_string(),
+        };
+        file.run = file.read_run()?;
+        if let Some(l) = file.run.as_ref().map(|r| r.skeleton_layer.clone()) {
+            if !l.is_empty() {
+                file.skeleton_layer = l;
+            }
+        }
+        if !file.has_layer(&file.skeleton_layer) {
+            return Err(IoError::NotAnOutput {
+                path: file.path.clone(),
+                reason: format!(
+                    "it has no skeleton layer `{}` (its layers: {})",
+                    file.skeleton_layer,
+                    file.layer_names().join(", ")
+                ),
+            });
+        }
+        Ok(file)
+    }
+
+    fn layer_names(&self) -> Vec<String> {
+        self.ds.layers().map(|l| l.name()).collect()
+    }
+
+    /// Whether the file has the layer `name`.
+    pub fn has_layer(&self, name: &str) -> bool {
+        self.layer_names().iter().any(|n| n == name)
+    }
+
+    /// The file's path.
+    pub fn path(&self) -> &str {
+        &self.path
+    }
+
+    /// The record of the run that wrote the file (the last one).
+    pub fn run(&self) -> Option<&RunRecord> {
+        self.run.as_ref()
+    }
+
+    /// The name of the skeleton layer.
+    pub fn skeleton_layer(&self) -> &str {
+        &self.skeleton_layer
+    }
+
+    /// The short name of the skeletons' CRS unit (`m` for metres), or `""`.
+    pub fn units(&self) -> String {
+        let srs = self
+            .ds
+            .layer_by_name(&self.skeleton_layer)
+            .ok()
+            .and_then(|l| l.spatial_ref());
+        match srs.and_then(|s| s.linear_units_name()).as_deref() {
+            Some("metre" | "meter" | "Meter" | "Metre") => "m".into(),
+            Some(other) => other.to_string(),
+            None => String::new(),
+        }
+    }
+
+    /// Every row of layer `name` that passes `filter` (OGR SQL), in file
+    /// order, made by `row`.
+    fn rows<R>(
+        &self,
+        name: &str,
+        filter: Option<&str>,
+        mut row: impl FnMut(&Fields, &Feature<'_>) -> R,
+    ) -> Result<Vec<R>, IoError> {
+        let mut layer = self
+            .ds
+            .layer_by_name(name)
+            .map_err(|e| IoError::gdal(format!("opening layer `{name}` of `{}`", self.path), e))?;
+        if let Some(w) = filter {
+            super::set_filter(&mut layer, w).map_err(|reason| IoError::BadFilter {
+                path: self.path.clone(),
+                layer: name.to_string(),
+                filter: w.to_string(),
+                reason,
+            })?;
+        }
+        let fields = Fields::of(&layer);
+        Ok(layer.features().map(|f| row(&fields, &f)).collect())
+    }
+
+    fn read_run(&self) -> Result<Option<RunRecord>, IoError> {
+        if !self.has_layer(RUNS.name) {
+            return Ok(None);
+        }
+        let runs = self.rows(RUNS.name, None, |c, f| {
+            let t = |n: &str| c.text(f, n).unwrap_or_default();
+            let n = |n: &str| c.int(f, n).and_then(|v| u64::try_from(v).ok()).unwrap_or(0);
+            RunRecord {
+                name: t("name"),
+                started_utc: t("started_utc"),
+                finished_utc: t("finished_utc"),
+                tool_version: t("tool_version"),
+                pipeline: t("pipeline"),
+                input: t("input"),
+                input_source: t("input_source"),
+                input_layer: t("input_layer"),
+                input_reproject: c.text(f, "input_reproject"),
+                skeleton_layer: t("skeleton_layer"),
+                read: n("features_read"),
+                written: n("features_written"),
+                rejected: n("features_rejected"),
+                filtered: n("features_filtered"),
+                elapsed_s: c.real(f, "elapsed_s").unwrap_or(f64::NAN),
+                threads: c.count(f, "threads"),
+                stage_seconds: t("stage_seconds"),
+            }
+        })?;
+        Ok(runs.into_iter().last())
+    }
+
+    /// The rows of `candidates` that pass `filter`, with their skeletons
+    /// when `geometry`.
+    pub fn candidates(
+        &self,
+        filter: Option<&str>,
+        geometry: bool,
+    ) -> Result<Vec<CandidateRow>, IoError> {
+        self.rows(CANDIDATES.name, filter, |c, f| CandidateRow {
+            src_fid: c.fid(f),
+            polygon_part: c.polygon_part(f),
+            method: c.text(f, "method").unwrap_or_default(),
+            geometry: if geometry { lines(f) } else { None },
+            scores: c.scores(f),
+            chosen: c.int(f, "chosen") == Some(1),
+            components: c.count(f, "components"),
+            legs_raw: c.count(f, "legs_raw"),
+            legs: c.count(f, "legs"),
+            error: c.text(f, "error"),
+        })
+    }
+
+    /// The source fields of the skeleton layer (its columns that are not the
+    /// tool's), in order.
+    pub fn source_fields(&self) -> Result<Vec<String>, IoError> {
+        let layer = self
+            .ds
+            .layer_by_name(&self.skeleton_layer)
+            .map_err(|e| IoError::gdal("opening the skeleton layer", e))?;
+        let tool: Vec<&str> = SKELETONS.column_names().collect();
+        Ok(layer
+            .defn()
+            .fields()
+            .map(|f| f.name())
+            .filter(|n| !tool.contains(&n.as_str()))
+            .collect())
+    }
+
+    /// The rows of the skeleton layer that pass `filter` (OGR SQL on its
+    /// columns), with the source fields as attributes and the skeletons when
+    /// `geometry`.
+    pub fn skeletons(
+        &self,
+        filter: Option<&str>,
+        geometry: bool,
+    ) -> Result<Vec<SkeletonRow>, IoError> {
+        let source = self.source_fields()?;
+        self.rows(&self.skeleton_layer, filter, |c, f| SkeletonRow {
+            src_fid: c.fid(f),
+            polygon_part: c.polygon_part(f),
+            attributes: source
+                .iter()
+                .map(|n| {
+                    c.0.get(n)
+                        .map_or(Value::Null, |&i| value(f.field(i).ok().flatten()))
+                })
+                .collect(),
+            geometry: geometry
+                .then(|| lines(f))
+                .flatten()
+                .unwrap_or_else(|| geo::MultiLineString(Vec::new())),
+            method: c.text(f, "method").unwrap_or_default(),
+            scores: c.scores(f),
+            components: c.count(f, "components"),
+            legs: c.count(f, "legs"),
+            repaired: c.int(f, "repaired") == Some(1),
+            note: c.text(f, "note"),
+        })
+    }
+
+    /// The rows of `bars` that pass `filter`.
+    pub fn bars(&self, filter: Option<&str>) -> Result<Vec<BarRow>, IoError> {
+        self.rows(BARS.name, filter, |c, f| BarRow {
+            src_fid: c.fid(f),
+            method: c.text(f, "method").unwrap_or_default(),
+            geometry: lines(f)
+                .and_then(|m| m.0.into_iter().next())
+                .unwrap_or_else(|| geo::LineString(Vec::new())),
+            d_left: c.real(f, "d_left"),
+            d_right: c.real(f, "d_right"),
+            delta_d: c.real(f, "delta_d"),
+            z: c.real(f, "z"),
+            branch: c.int(f, "branch").and_then(|v| usize::try_from(v).ok()),
+        })
+    }
+}

@@ -1,0 +1,454 @@
+//! What an unattended scheduled job must never do — destroy data, report
+//! success for a run that did nothing, reject a valid polygon, hang, write
+//! an empty row as a result — each through the real binary.
+
+mod common;
+use common::*;
+use std::path::Path;
+
+fn out_err(o: &std::process::Output) -> String {
+    format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    )
+}
+
+fn demo_copy(dir: &Path) -> String {
+    let p = dir.join("in.gpkg");
+    std::fs::copy(root(DEMO), &p).unwrap();
+    p.display().to_string()
+}
+
+// 1. The output can destroy the input or a system file.
+
+#[test]
+fn the_output_is_never_the_input() {
+    let d = tmp();
+    let input = demo_copy(d.path());
+    let before = std::fs::read(&input).unwrap();
+    let o = skeletonise(&[
+        "run",
+        "pipelines/demo.yaml",
+        "-i",
+        &input,
+        "-o",
+        &input,
+        "--set",
+        "output.overwrite=true",
+    ]);
+    let (code, err) = code_and_err(&o);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("it is the input"), "{err}");
+    assert_eq!(std::fs::read(&input).unwrap(), before, "the input changed");
+    // Through a symbolic link too, and in `validate`.
+    let link = d.path().join("link.gpkg");
+    std::os::unix::fs::symlink(&input, &link).unwrap();
+    let o = skeletonise(&[
+        "validate",
+        "pipelines/demo.yaml",
+        "-i",
+        &input,
+        "-o",
+        link.to_str().unwrap(),
+    ]);
+    assert_eq!(code_and_err(&o).0, 1, "{}", out_err(&o));
+    // `score` onto one of its inputs.
+    let o = skeletonise(&[
+        "score",
+        "--polygons",
+        &input,
+        "--skeletons",
+        &input,
+        "-o",
+        &input,
+        "--overwrite",
+    ]);
+    assert_eq!(code_and_err(&o).0, 1, "{}", out_err(&o));
+    assert!(out_err(&o).contains("it is the input"));
+    assert_eq!(std::fs::read(&input).unwrap(), before, "the input changed");
+}
+
+#[test]
+fn devices_directories_and_other_formats_are_refused_before_any_work() {
+    let d = tmp();
+    for (out, why) in [
+        ("/dev/null", "GeoPackage"),
+        (d.path().to_str().unwrap(), "GeoPackage"),
+        ("out.shp", "ending in `.gpkg`"),
+    ] {
+        let o = skeletonise(&[
+            "run",
+            "pipelines/demo.yaml",
+            "-o",
+            out,
+            "--set",
+            "output.overwrite=true",
+        ]);
+        let (code, err) = code_and_err(&o);
+        assert_eq!(code, 1, "{out}: {err}");
+        assert!(err.contains(why), "{out}: {err}");
+        assert!(!err.contains("run started"), "{out}: work began: {err}");
+    }
+    let fifo = d.path().join("pipe.gpkg");
+    assert!(std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap()
+        .success());
+    let o = skeletonise(&[
+        "run",
+        "pipelines/demo.yaml",
+        "-o",
+        fifo.to_str().unwrap(),
+        "--set",
+        "output.overwrite=true",
+    ]);
+    let (code, err) = code_and_err(&o);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("not a regular file"), "{err}");
+    assert!(std::fs::symlink_metadata(&fifo)
+        .unwrap()
+        .file_type()
+        .is_fifo());
+    assert!(Path::new("/dev/null")
+        .metadata()
+        .unwrap()
+        .file_type()
+        .is_char_device());
+    let o = skeletonise(&[
+        "score",
+        "--polygons",
+        DEMO,
+        "--skeletons",
+        DEMO,
+        "-o",
+        "x.shp",
+    ]);
+    assert!(out_err(&o).contains(".gpkg"), "{}", out_err(&o));
+}
+
+use std::os::unix::fs::FileTypeExt;
+
+// 2. A run that did nothing reports success.
+
+#[test]
+fn a_bad_where_clause_on_a_geopackage_is_an_error_in_run_and_validate() {
+    let d = tmp();
+    let out = d.path().join("o.gpkg");
+    for w in ["kind = = 1", "no_such_column > 1"] {
+        for cmd in ["run", "validate"] {
+            let o = skeletonise(&[
+                cmd,
+                "pipelines/demo.yaml",
+                "--set",
+                &format!("input.where={w}"),
+                "--set",
+                "on_error=fail",
+                "-o",
+                out.to_str().unwrap(),
+            ]);
+            let (code, err) = code_and_err(&o);
+            assert_eq!(code, 1, "{cmd} `{w}`: {err}");
+            assert!(err.contains("invalid `input.where`"), "{cmd} `{w}`: {err}");
+            assert!(!err.contains("18446744073709551615"), "{err}");
+            assert!(!out.exists(), "{cmd} wrote an output");
+        }
+    }
+}
+
+#[test]
+fn a_bbox_with_nan_is_an_invalid_pipeline() {
+    let o = skeletonise(&[
+        "validate",
+        "pipelines/demo.yaml",
+        "--set",
+        "input.bbox=[.nan, 0, 1, 1]",
+    ]);
+    let (code, err) = code_and_err(&o);
+    assert_eq!(code, 78, "{err}");
+    assert!(
+        err.contains("--set input.bbox") && err.contains("finite"),
+        "{err}"
+    );
+}
+
+// 3. A valid polygon is rejected.
+
+#[test]
+fn a_hole_touching_the_shell_inside_an_edge_is_skeletonised() {
+    let d = tmp();
+    let src = d.path().join("touch.gpkg");
+    make_layer(
+        &src,
+        "touch",
+        3035,
+        &[Some(
+            "POLYGON((0 0,100 0,100 100,0 100,0 0),(0 50,30 40,30 60,0 50))",
+        )],
+    );
+    let out = d.path().join("o.gpkg");
+    for make_valid in ["true", "false"] {
+        let o = skeletonise(&[
+            "run",
+            "pipelines/compare-methods.yaml",
+            "-i",
+            src.to_str().unwrap(),
+            "--set",
+            "input.layer=touch",
+            "--set",
+            &format!("steps.prepare.make_valid={make_valid}"),
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", out_err(&o));
+        let ds = open(&out);
+        assert_eq!(count(&ds, "skeletons"), 1, "make_valid {make_valid}");
+        assert_eq!(count(&ds, "rejected"), 0, "make_valid {make_valid}");
+        let errors = strings(&ds, "candidates", "error");
+        assert!(errors.iter().all(Option::is_none), "{errors:?}");
+    }
+}
+
+// 5. `--threads 10000` hangs.
+
+#[test]
+fn too_many_threads_is_a_clear_error_at_once() {
+    let t = std::time::Instant::now();
+    let o = skeletonise(&[
+        "run",
+        "pipelines/demo.yaml",
+        "--threads",
+        "10000",
+        "-o",
+        "/tmp/never.gpkg",
+    ]);
+    let (code, err) = code_and_err(&o);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("between 1 and 256"), "{err}");
+    assert!(t.elapsed().as_secs() < 20);
+}
+
+// 6. Degenerate scoring.
+
+#[test]
+fn a_polygon_too_thin_to_score_gets_a_skeleton_and_a_note() {
+    let d = tmp();
+    let src = d.path().join("thin.gpkg");
+    make_layer(
+        &src,
+        "thin",
+        3035,
+        &[Some("POLYGON((0 0,1000000 0,1000000 0.001,0 0.001,0 0))")],
+    );
+    let out = d.path().join("o.gpkg");
+    let o = skeletonise(&[
+        "run",
+        "pipelines/compare-methods.yaml",
+        "-i",
+        src.to_str().unwrap(),
+        "--set",
+        "input.layer=thin",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", out_err(&o));
+    let ds = open(&out);
+    assert_eq!(count(&ds, "skeletons"), 1);
+    let g = wkts(&ds, "skeletons");
+    assert!(
+        g[0].as_deref().is_some_and(|w| !w.contains("EMPTY")),
+        "{g:?}"
+    );
+    let note = strings(&ds, "skeletons", "note");
+    assert!(
+        note[0].as_deref().is_some_and(|n| n.contains("too thin")),
+        "{note:?}"
+    );
+    assert_eq!(reals(&ds, "skeletons", "distortion"), vec![None]);
+}
+
+// 7. `validate` passes what `run` then fails.
+
+#[test]
+fn validate_fails_where_run_would() {
+    let o = skeletonise(&[
+        "validate",
+        "pipelines/demo.yaml",
+        "-o",
+        "/proc/skeletonise.gpkg",
+    ]);
+    let (code, err) = code_and_err(&o);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("cannot be written"), "{err}");
+    let d = tmp();
+    let src = d.path().join("nocrs.gpkg");
+    let drv = gdal::DriverManager::get_driver_by_name("GPKG").unwrap();
+    let mut ds = drv.create_vector_only(&src).unwrap();
+    ds.create_layer(gdal::vector::LayerOptions {
+        name: "p",
+        ty: gdal::vector::OGRwkbGeometryType::wkbPolygon,
+        ..Default::default()
+    })
+    .unwrap();
+    drop(ds);
+    let o = skeletonise(&[
+        "validate",
+        "pipelines/demo.yaml",
+        "-i",
+        src.to_str().unwrap(),
+        "--set",
+        "input.layer=p",
+        "--set",
+        "input.reproject=EPSG:3035",
+        "-o",
+        d.path().join("o.gpkg").to_str().unwrap(),
+    ]);
+    let (code, err) = code_and_err(&o);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("no CRS to reproject from"), "{err}");
+}
+
+// 8. The small ones.
+
+#[test]
+fn score_refuses_skeletons_in_another_crs() {
+    let d = tmp();
+    let lines = d.path().join("lines.gpkg");
+    make_layer(&lines, "l", 32630, &[Some("LINESTRING(0 0,1 1)")]);
+    let o = skeletonise(&[
+        "score",
+        "--polygons",
+        DEMO,
+        "--skeletons",
+        lines.to_str().unwrap(),
+        "-o",
+        d.path().join("o.gpkg").to_str().unwrap(),
+    ]);
+    let (code, err) = code_and_err(&o);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("different CRSs"), "{err}");
+}
+
+#[test]
+fn a_pipeline_file_with_a_byte_order_mark_and_typed_variables_loads() {
+    let d = tmp();
+    let text = format!(
+        "\u{feff}input:\n  source: {}\nsteps:\n  - skeleton: {{ methods: [CDT] }}\n  - prune:\n      ratio: ${{RATIO}}\n  - score: {{}}\n  - select: {{ min_coverage: \"${{MINCOV:-0.5}}\" }}\noutput:\n  path: {}\n",
+        root(DEMO),
+        d.path().join("o.gpkg").display()
+    );
+    let p = pipeline(d.path(), "bom.yaml", &text);
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_skeletonise"))
+        .args(["run", p.to_str().unwrap()])
+        .env("RATIO", "2")
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", out_err(&o));
+}
+
+#[test]
+fn json_logs_have_no_raw_gdal_lines() {
+    let o = skeletonise(&[
+        "--log-format",
+        "json",
+        "run",
+        "pipelines/demo.yaml",
+        "--set",
+        "input.where=no_such_column > 1",
+        "-o",
+        "/tmp/never.gpkg",
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!err.is_empty());
+    for line in err.lines() {
+        assert!(
+            serde_json::from_str::<serde_json::Value>(line).is_ok(),
+            "not JSON: {line}"
+        );
+    }
+}
+
+#[test]
+fn a_wrong_override_is_blamed_on_the_override() {
+    let o = skeletonise(&[
+        "validate",
+        "pipelines/demo.yaml",
+        "--set",
+        "steps.prune.ratio=-1",
+    ]);
+    let (code, err) = code_and_err(&o);
+    assert_eq!(code, 78);
+    assert!(err.contains("--set steps.prune.ratio=-1"), "{err}");
+    assert!(!err.contains("demo.yaml:"), "{err}");
+}
+
+#[test]
+fn budgets_reject_a_feature_or_stop_a_method_with_the_reason() {
+    let d = tmp();
+    let out = d.path().join("o.gpkg");
+    let o = skeletonise(&[
+        "run",
+        "pipelines/demo.yaml",
+        "--set",
+        "steps.prepare.max_vertices=20",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", out_err(&o));
+    let ds = open(&out);
+    let reasons = strings(&ds, "rejected", "reason");
+    assert!(!reasons.is_empty());
+    assert!(reasons
+        .iter()
+        .all(|r| r.as_deref().is_some_and(|r| r.contains("max_vertices"))));
+    assert_eq!(count(&ds, "skeletons") + count(&ds, "rejected"), 17);
+    // A budget of a millisecond per method stops every method on a
+    // 12 000-vertex river reach: the feature is rejected with the reasons.
+    let o = skeletonise(&[
+        "run",
+        "pipelines/compare-methods.yaml",
+        "--set",
+        "input.layer=river_lena",
+        "--set",
+        "input.where=fid = 2",
+        "--set",
+        "steps.skeleton.timeout_s=0.001",
+        "-o",
+        out.to_str().unwrap(),
+        "--set",
+        "output.overwrite=true",
+    ]);
+    assert!(o.status.success(), "{}", out_err(&o));
+    let ds = open(&out);
+    let reasons = strings(&ds, "rejected", "reason");
+    assert_eq!(reasons.len(), 1, "{reasons:?}");
+    let r = reasons[0].clone().unwrap_or_default();
+    assert!(
+        r.contains("StSk stopped after 0.001 s") && r.contains("timeout_s"),
+        "{r}"
+    );
+}
+
+#[test]
+fn progress_lines_appear_in_logs_without_a_terminal() {
+    let o = skeletonise(&[
+        "run",
+        "pipelines/islands.yaml",
+        "--set",
+        "steps.skeleton.methods=[CDT]",
+        "--progress-every",
+        "0",
+        "-o",
+        "/tmp/skeletonise-progress.gpkg",
+        "--set",
+        "output.overwrite=true",
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        err.contains("progress: ") && err.contains("of 1192 features"),
+        "{err}"
+    );
+    let _ = std::fs::remove_file("/tmp/skeletonise-progress.gpkg");
+}
