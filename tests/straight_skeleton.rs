@@ -463,24 +463,34 @@ fn a_polygon_beyond_the_budget_is_declined_up_front_with_the_reason() {
         time: Some(Duration::from_secs(1)),
         memory: None,
     };
-    match with_budget(MethodId::STSK, one_second, || StraightSkeleton.skeletonise(&pp)) {
+    match with_budget(MethodId::STSK, one_second, || {
+        StraightSkeleton.skeletonise(&pp)
+    }) {
         Err(MethodError::OverBudget { method, reason }) => {
             assert_eq!(method, MethodId::STSK);
             assert!(reason.contains("would need about"), "{reason}");
             assert!(reason.contains("skeleton.timeout_s"), "{reason}");
         }
-        other => panic!("expected OverBudget, got {:?}", other.map(|g| g.edges().len())),
+        other => panic!(
+            "expected OverBudget, got {:?}",
+            other.map(|g| g.edges().len())
+        ),
     }
     // Memory: ten megabytes cannot hold this polygon's split events either.
     let ten_megabytes = Budget {
         time: None,
         memory: Some(10_000_000),
     };
-    match with_budget(MethodId::STSK, ten_megabytes, || StraightSkeleton.skeletonise(&pp)) {
+    match with_budget(MethodId::STSK, ten_megabytes, || {
+        StraightSkeleton.skeletonise(&pp)
+    }) {
         Err(MethodError::OverBudget { reason, .. }) => {
             assert!(reason.contains("skeleton.max_memory_mb"), "{reason}");
         }
-        other => panic!("expected OverBudget, got {:?}", other.map(|g| g.edges().len())),
+        other => panic!(
+            "expected OverBudget, got {:?}",
+            other.map(|g| g.edges().len())
+        ),
     }
     // The same budgets leave a small polygon alone.
     let small = PreparedPolygon::new(&noisy_circle(400)).unwrap();

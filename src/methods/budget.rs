@@ -94,8 +94,9 @@ pub fn afford(id: MethodId, seconds: f64, bytes: f64) -> Result<(), MethodError>
             return Err(MethodError::OverBudget {
                 method: id,
                 reason: format!(
-                    "would need about {seconds:.0} s on this polygon, more than the {:.0} s left of `skeleton.timeout_s`",
-                    left.as_secs_f64()
+                    "would need about {} s on this polygon, more than the {} s left of `skeleton.timeout_s`",
+                    seconds_text(seconds),
+                    seconds_text(left.as_secs_f64())
                 ),
             });
         }
@@ -113,6 +114,17 @@ pub fn afford(id: MethodId, seconds: f64, bytes: f64) -> Result<(), MethodError>
         }
     }
     Ok(())
+}
+
+/// Whole seconds from 10 s, tenths from 1 s, milliseconds below.
+fn seconds_text(s: f64) -> String {
+    if s >= 10.0 {
+        format!("{s:.0}")
+    } else if s >= 1.0 {
+        format!("{s:.1}")
+    } else {
+        format!("{s:.3}")
+    }
 }
 
 fn timed_out(method: MethodId, budget: Duration) -> MethodError {
