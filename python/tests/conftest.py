@@ -62,7 +62,8 @@ def assert_same_as_cli(frame, gpkg: Path, tol: float = 1e-9) -> None:
             worst = np.max(np.where(both_nan, 0.0, np.abs(a - b)), initial=0.0)
             assert not np.isnan(worst) and worst <= tol * max(1.0, np.nanmax(np.abs(b), initial=0.0)), (name, worst)
         elif kind == "text":
-            assert list(a.astype(object)) == list(b.astype(object)), name
+            missing = lambda v: None if pd.isna(v) else v  # pandas NA and GDAL's None alike
+            assert [missing(v) for v in a] == [missing(v) for v in b], name
         else:
             assert list(a.astype("Int64").fillna(-1)) == list(pd.Series(b).astype("Int64").fillna(-1)), name
     same = shapely.equals_exact(written.geometry.values, cli.geometry.values, tolerance=0)

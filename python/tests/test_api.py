@@ -24,7 +24,7 @@ def test_columns_are_the_skeletons_layer_then_rejected_and_the_geometry():
     names = [n for n, _ in skeletonise.columns("skeletons")]
     assert names == [
         "src_fid", "method", "bars", "hits", "coverage", "deviation", "deviation_parts",
-        "distortion_sum", "distortion", "components", "legs", "repaired",
+        "distortion_sum", "distortion", "components", "legs", "repaired", "note",
     ]
     assert "polygon_part" in [n for n, _ in skeletonise.columns("skeletons", explode=True)]
     out = skeletonise.skeletonise(gpd.GeoSeries([RIVER]))
