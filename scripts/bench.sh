@@ -95,11 +95,13 @@ grass_voronoi() { # grass_voronoi NAME SRC LAYER: v.voronoi -s time (import excl
   local epsg
   epsg=$("$PY" -c "import pyogrio,sys; print(pyogrio.read_info(sys.argv[1], layer=sys.argv[2])['crs'].split(':')[-1])" "$2" "$3")
   timeout "$GRASS_TIMEOUT" grass --tmp-location "EPSG:$epsg" --exec bash -c "
+    set -e
     v.in.ogr -o --q input='$2' layer='$3' output=poly
+    g.region --q vector=poly
     s=\$(date +%s.%N); v.voronoi -s --q input=poly output=skel; e=\$(date +%s.%N)
     echo \"voronoi_s \$(echo \"\$e - \$s\" | bc)\"
-  " >"$WORK/$1.log" 2>&1 || echo "voronoi_s timeout" >>"$WORK/$1.log"
-  sed -n 's/^voronoi_s //p' "$WORK/$1.log" | tail -1
+  " >"$WORK/$1.log" 2>&1 || echo "voronoi_s failed or timed out (${GRASS_TIMEOUT} s)" >>"$WORK/$1.log"
+  sed -n 's/^voronoi_s //p' "$WORK/$1.log" | tail -1 | awk '{ if ($1 + 0 > 0) printf "%.2f", $1; else print }'
 }
 
 OUT=$WORK/bench.md
@@ -109,7 +111,7 @@ OUT=$WORK/bench.md
   echo "$(nproc) CPUs ($(sed -n 's/^model name\s*: //p' /proc/cpuinfo | head -1)), $(free -g | awk '/Mem:/ {print $2}') GiB;" \
     "load average before the start: $(cut -d' ' -f1-3 /proc/loadavg)"
   echo "skeletonise $(git rev-parse --short HEAD)$(git diff --quiet || echo '+changes'), release build;" \
-    "pygeoops $("$PY" -c 'import pygeoops; print(pygeoops.__version__)'), $(grass --version 2>/dev/null | head -1)"
+    "pygeoops $("$PY" -c 'import pygeoops; print(pygeoops.__version__)'), $(grass --version 2>&1 | grep -m1 GRASS)"
   [ -n "${BASE:-}" ] && echo "older binary (BASE): $BASE"
   echo
 } >"$OUT"

@@ -231,6 +231,30 @@ struct Extender<'a> {
     len: Vec<f64>,
     tol: f64,
     max_t: f64,
+    /// `m` has no cycle: the subtree beyond an edge is the same for every
+    /// walk that reaches it, so its depth can be remembered.
+    forest: bool,
+    /// Depths of subtrees found during the current descent.
+    heights: std::cell::RefCell<Heights>,
+}
+
+/// Remembered subtree depths, by directed edge (`2·edge + 0` from its
+/// `a` end, `+ 1` from `b`), valid while `stamp` equals `generation`.
+struct Heights {
+    generation: u32,
+    stamp: Vec<u32>,
+    value: Vec<f64>,
+}
+
+impl Heights {
+    fn get(&self, k: usize) -> Option<f64> {
+        (self.stamp[k] == self.generation).then(|| self.value[k])
+    }
+
+    fn set(&mut self, k: usize, v: f64) {
+        self.stamp[k] = self.generation;
+        self.value[k] = v;
+    }
 }
 
 fn unit(v: Coord<f64>) -> Option<Coord<f64>> {
@@ -264,6 +288,13 @@ impl<'a> Extender<'a> {
                 .collect(),
             tol,
             max_t: 2.0 * span.x.hypot(span.y) + 1.0,
+            forest: m.edges().iter().all(|e| e.a != e.b)
+                && m.edges().len() + m.components() == m.nodes().len(),
+            heights: std::cell::RefCell::new(Heights {
+                generation: 1,
+                stamp: vec![0; 2 * m.edges().len()],
+                value: vec![0.0; 2 * m.edges().len()],
+            }),
         }
     }
 
@@ -317,6 +348,9 @@ impl<'a> Extender<'a> {
     /// through untaken edges plus the reach (radius) of its last node,
     /// explored up to `cap`.
     fn depth(&self, v: NodeId, e: EdgeId, taken: &[bool], cap: f64) -> f64 {
+        if self.forest {
+            return self.height(v, e, taken).min(cap);
+        }
         let mut best = 0.0f64;
         let mut stack = vec![(self.m.opposite(e, v), e, self.len[e.0 as usize])];
         let mut seen = std::collections::HashSet::new();
@@ -342,6 +376,47 @@ impl<'a> Extender<'a> {
             best = best.max(d + reach);
         }
         best.min(cap)
+    }
+
+    /// [`Self::depth`] without the cap, in a forest: the longest path from
+    /// `v` through `e` and untaken edges beyond it, plus the radius of its
+    /// last node. Every subtree is measured once per descent (the edges a
+    /// descent takes lie behind it, so the subtrees ahead stay the same);
+    /// the walk with a cap would measure the same subtree again at every
+    /// step, quadratic on a long descent.
+    fn height(&self, v: NodeId, e: EdgeId, taken: &[bool]) -> f64 {
+        let key =
+            |from: NodeId, e: EdgeId| 2 * e.0 as usize + usize::from(self.m.edge(e).a != from);
+        let mut h = self.heights.borrow_mut();
+        let mut stack = vec![(v, e, false)];
+        while let Some((from, e, ready)) = stack.pop() {
+            let k = key(from, e);
+            if h.get(k).is_some() {
+                continue;
+            }
+            let b = self.m.opposite(e, from);
+            let ahead = self.adj[b.0 as usize]
+                .iter()
+                .copied()
+                .filter(|&f| f != e && !taken[f.0 as usize]);
+            if ready {
+                let deepest = ahead
+                    .map(|f| h.get(key(b, f)).expect("measured before"))
+                    .reduce(f64::max);
+                h.set(
+                    k,
+                    self.len[e.0 as usize] + deepest.unwrap_or_else(|| self.radius(b)),
+                );
+            } else {
+                stack.push((from, e, true));
+                stack.extend(
+                    ahead
+                        .filter(|&f| h.get(key(b, f)).is_none())
+                        .map(|f| (b, f, false)),
+                );
+            }
+        }
+        h.get(key(v, e)).expect("measured")
     }
 
     /// The centred-end rule at node `v` (see the module documentation).
@@ -436,6 +511,7 @@ impl<'a> Extender<'a> {
     /// keeping the followed edges; records the end segment if the descent
     /// stops inside P.
     fn descend(&self, start: NodeId, mut d: Coord<f64>, st: &mut State) -> Descent {
+        self.heights.borrow_mut().generation += 1;
         let mut rec = Descent {
             edges: Vec::new(),
             segment: None,
@@ -645,5 +721,74 @@ impl<'a> Extender<'a> {
             .filter_map(|&c| Some((c, dot(self.departure(c, v)?, d))))
             .max_by(|a, b| a.1.total_cmp(&b.1).then(b.0.cmp(&a.0)))
             .map(|(c, _)| c)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A random tree of `n` nodes in the unit square's interior (each node
+    /// joined to a random earlier one), with random radii.
+    fn random_tree(n: usize, seed: u64) -> SkeletonGraph {
+        let mut s = seed;
+        let mut next = || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut g = SkeletonGraph::new();
+        let mut ids = Vec::new();
+        for i in 0..n {
+            let p = Coord {
+                x: 0.1 + 0.8 * next(),
+                y: 0.1 + 0.8 * next(),
+            };
+            let id = g.add_node(p, 0.1 * next(), None);
+            if i > 0 {
+                let j = (next() * i as f64) as usize;
+                g.add_edge(ids[j], id, Vec::new());
+            }
+            ids.push(id);
+        }
+        g
+    }
+
+    #[test]
+    fn remembered_subtree_depths_equal_the_walk() {
+        let ring = vec![(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0), (0.0, 0.0)];
+        let square = geo::Polygon::new(geo::LineString::from(ring), vec![]);
+        let polygon = PreparedPolygon::new(&square).unwrap();
+        for seed in 1..20u64 {
+            let g = random_tree(200, seed * 7919);
+            let mut e = Extender::new(&g, &polygon);
+            assert!(e.forest);
+            // Some edges taken, as kept edges and earlier steps would be.
+            let taken: Vec<bool> = (0..g.edges().len()).map(|i| i % 11 == 3).collect();
+            let mut remembered = Vec::new();
+            for (i, ed) in g.edges().iter().enumerate() {
+                for from in [ed.a, ed.b] {
+                    remembered.push(e.depth(from, EdgeId(i as u32), &taken, f64::INFINITY));
+                }
+            }
+            e.forest = false;
+            let mut k = 0;
+            for (i, ed) in g.edges().iter().enumerate() {
+                for from in [ed.a, ed.b] {
+                    let walked = e.depth(from, EdgeId(i as u32), &taken, f64::INFINITY);
+                    let r = remembered[k];
+                    assert!(
+                        (walked - r).abs() <= 1e-12 * walked.max(1.0),
+                        "{walked} {r}"
+                    );
+                    k += 1;
+                }
+            }
+        }
+        // A cycle: not a forest, so every depth is walked.
+        let mut g = random_tree(10, 3);
+        g.add_edge(NodeId(0), NodeId(9), Vec::new());
+        assert!(!Extender::new(&g, &polygon).forest);
     }
 }
