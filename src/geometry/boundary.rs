@@ -8,7 +8,7 @@
 //! scan of all edges.
 
 use super::packed::{box_distance_2, box_half_plane_distance, ray_box, Bbox, PackedTree};
-use geo::{Coord, Polygon};
+use geo::{Coord, LineString, Polygon};
 use std::cell::Cell;
 use std::ops::ControlFlow;
 
@@ -193,11 +193,13 @@ pub fn ray_segment(
 impl Boundary {
     /// Indexes every edge of every ring of `polygon` (rings must be closed).
     pub fn new(polygon: &Polygon<f64>) -> Self {
+        Self::from_rings(std::iter::once(polygon.exterior()).chain(polygon.interiors()))
+    }
+
+    /// Indexes every edge of `rings` (closed), numbered in the order given.
+    pub fn from_rings<'r>(rings: impl IntoIterator<Item = &'r LineString<f64>>) -> Self {
         let mut segments = Vec::new();
-        for (ri, ring) in std::iter::once(polygon.exterior())
-            .chain(polygon.interiors())
-            .enumerate()
-        {
+        for (ri, ring) in rings.into_iter().enumerate() {
             for (i, w) in ring.0.windows(2).enumerate() {
                 if w[0] != w[1] {
                     segments.push(BoundarySegment {

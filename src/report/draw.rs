@@ -8,7 +8,7 @@
 //! full-resolution boundary.
 
 use crate::geometry::boundary::closest_on_segment;
-use crate::geometry::{Boundary, BoundarySegment};
+use crate::geometry::Boundary;
 use crate::output::BarRow;
 use geo::{Coord, LineString};
 use std::fmt::Write as _;
@@ -232,20 +232,7 @@ pub fn simplify_within(
 /// The segments of every ring, in one index: distances to ∂P of a
 /// multipolygon.
 pub fn boundary_of(rings: &[LineString<f64>]) -> Boundary {
-    let mut segments = Vec::new();
-    for (ri, ring) in rings.iter().enumerate() {
-        for (i, w) in ring.0.windows(2).enumerate() {
-            if w[0] != w[1] {
-                segments.push(BoundarySegment {
-                    a: w[0],
-                    b: w[1],
-                    ring: ri as u32,
-                    index: i as u32,
-                });
-            }
-        }
-    }
-    Boundary::from_segments(segments)
+    Boundary::from_rings(rings)
 }
 
 /// `x` with `digits` significant digits, without trailing zeros.
