@@ -11,6 +11,7 @@
 
 #![warn(missing_docs)]
 
+pub mod collapse;
 pub mod config;
 pub mod external;
 pub mod feature;

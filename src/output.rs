@@ -44,6 +44,8 @@ pub enum GeometryKind {
     MultiLineString,
     /// LINESTRING.
     LineString,
+    /// POLYGON.
+    Polygon,
     /// Any geometry (the `rejected` layer keeps the input's).
     Unknown,
     /// An attribute table.
@@ -57,6 +59,8 @@ pub enum Shape<'a> {
     Lines(&'a geo::MultiLineString<f64>),
     /// One line.
     Line(geo::LineString<f64>),
+    /// One polygon.
+    Polygon(&'a geo::Polygon<f64>),
     /// A geometry as WKB.
     Wkb(&'a [u8]),
 }
@@ -68,6 +72,8 @@ pub enum When {
     Always,
     /// Only with `output.explode`.
     Explode,
+    /// Only when the pipeline has a `collapse` step.
+    Collapse,
 }
 
 /// One column of a layer.
@@ -89,6 +95,16 @@ pub const fn col<R>(name: &'static str, ty: ColumnType, get: fn(&R) -> Cell) -> 
         ty,
         get,
         when: When::Always,
+    }
+}
+
+/// A column written only when the pipeline collapses.
+pub const fn col_collapse<R>(name: &'static str, ty: ColumnType, get: fn(&R) -> Cell) -> Column<R> {
+    Column {
+        name,
+        ty,
+        get,
+        when: When::Collapse,
     }
 }
 
@@ -244,6 +260,9 @@ pub struct SkeletonRow {
     pub repaired: bool,
     /// Why the scores are missing, when they are.
     pub note: Option<String>,
+    /// With a `collapse` step: the lines where the polygon collapsed (true)
+    /// or the centreline through its kept areas (false).
+    pub collapsed: Option<bool>,
 }
 
 impl Scored for SkeletonRow {
@@ -270,8 +289,40 @@ pub const SKELETONS: LayerDef<SkeletonRow> = LayerDef {
             col("legs", Int32, |r: &SkeletonRow| int(r.legs)),
             col("repaired", Int32, |r: &SkeletonRow| int(i64::from(r.repaired))),
             col("note", Text, |r: &SkeletonRow| r.note.as_deref().map_or(Cell::Null, text)),
+            col_collapse("collapsed", Int32, |r: &SkeletonRow| r.collapsed.map_or(Cell::Null, |c| int(i64::from(c)))),
         ],
     ),
+};
+
+/// One row of the `areas` layer: a piece of a polygon kept as an area by
+/// the `collapse` step.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AreaRow {
+    /// Source FID.
+    pub src_fid: Option<u64>,
+    /// Index of the polygon part (with `explode`).
+    pub polygon_part: Option<usize>,
+    /// Source attributes.
+    pub attributes: Vec<Value>,
+    /// The piece.
+    pub geometry: geo::Polygon<f64>,
+    /// Cuts on its boundary, where collapsed lines meet it.
+    pub cuts: usize,
+}
+
+/// The `areas` layer (with a `collapse` step).
+pub const AREAS: LayerDef<AreaRow> = LayerDef {
+    name: "areas",
+    geometry: GeometryKind::Polygon,
+    shape: |r| Some(Shape::Polygon(&r.geometry)),
+    attributes: Some(|r| &r.attributes),
+    columns: &[
+        col("src_fid", Int64, |r| fid(r.src_fid)),
+        col_explode("polygon_part", Int32, |r| {
+            r.polygon_part.map_or(Cell::Null, int)
+        }),
+        col("cuts", Int32, |r| int(r.cuts)),
+    ],
 };
 
 /// One row of the `candidates` layer: one method's result for one feature.
@@ -509,6 +560,8 @@ pub struct Rows {
     pub bars: Vec<BarRow>,
     /// `widths` rows.
     pub widths: Vec<WidthRow>,
+    /// `areas` rows.
+    pub areas: Vec<AreaRow>,
     /// `rejected` rows.
     pub rejected: Vec<RejectedRow>,
 }
@@ -520,6 +573,7 @@ impl Rows {
         self.candidates.append(&mut other.candidates);
         self.bars.append(&mut other.bars);
         self.widths.append(&mut other.widths);
+        self.areas.append(&mut other.areas);
         self.rejected.append(&mut other.rejected);
     }
 }

@@ -356,7 +356,7 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
         };
         let mut inputs = vec![job.input.source.as_str()];
         inputs.extend(job.other_inputs.iter().map(String::as_str));
-        let writer = Writer::create(job.output, &info, &inputs)?;
+        let writer = Writer::create(job.output, &info, &inputs, job.params.collapse.is_some())?;
         tracing::info!(
             pipeline = %job.name,
             source = %info.source,

@@ -293,6 +293,7 @@ impl OutputFile {
             legs: c.count(f, "legs"),
             repaired: c.int(f, "repaired") == Some(1),
             note: c.text(f, "note"),
+            collapsed: c.int(f, "collapsed").map(|v| v == 1),
         })
     }
 

@@ -1,7 +1,9 @@
 //! Writer: the output GeoPackage (SPEC §9).
 //!
 //! Layers: `skeletons` (name configurable; one row per feature, or per part
-//! with `explode`), optional `candidates`, `bars` and `widths`, `rejected`,
+//! with `explode`; with a `collapse` step one per feature and value of
+//! `collapsed`), optional `candidates`, `bars` and `widths`, `areas` with a
+//! `collapse` step, `rejected`,
 //! and the attribute table `skeletonise_runs` — each created and filled from
 //! its description in [`crate::output`]. Everything is written to a temporary
 //! file beside the output, in one transaction per batch, and renamed over the
@@ -12,7 +14,7 @@ use super::reader::{FieldInfo, SourceInfo};
 use super::{signals, IoError};
 use crate::feature::Value;
 use crate::output::{
-    Cell, Column, ColumnType, GeometryKind, LayerDef, Rows, RunRecord, Shape, When, BARS,
+    Cell, Column, ColumnType, GeometryKind, LayerDef, Rows, RunRecord, Shape, When, AREAS, BARS,
     CANDIDATES, REJECTED, RUNS, SKELETONS, WIDTHS,
 };
 use gdal::spatial_ref::SpatialRef;
@@ -31,6 +33,8 @@ pub struct Writer {
     tmp: PathBuf,
     path: PathBuf,
     spec: OutputSpec,
+    /// The pipeline collapses: the `areas` layer and the `collapsed` column.
+    collapse: bool,
     source_fields: Vec<(String, FieldInfo)>,
 }
 
@@ -162,6 +166,7 @@ fn ogr_geometry(g: GeometryKind) -> u32 {
     match g {
         GeometryKind::MultiLineString => OGRwkbGeometryType::wkbMultiLineString,
         GeometryKind::LineString => OGRwkbGeometryType::wkbLineString,
+        GeometryKind::Polygon => OGRwkbGeometryType::wkbPolygon,
         GeometryKind::Unknown => OGRwkbGeometryType::wkbUnknown,
         GeometryKind::None => OGRwkbGeometryType::wkbNone,
     }
@@ -207,6 +212,7 @@ fn shape_to_gdal(s: Shape<'_>) -> Result<Geometry, IoError> {
     match s {
         Shape::Lines(l) => to_gdal(l),
         Shape::Line(l) => to_gdal(&l),
+        Shape::Polygon(p) => to_gdal(p),
         Shape::Wkb(w) => {
             Geometry::from_wkb(w).map_err(|e| IoError::gdal("reading a WKB geometry", e))
         }
@@ -221,11 +227,13 @@ fn to_gdal<G: ToGdal>(g: &G) -> Result<Geometry, IoError> {
 impl Writer {
     /// Creates the temporary GeoPackage and its layers. Fails, touching
     /// nothing, when the output is refused by [`check_output`] (`inputs` are
-    /// the data sources the run reads).
+    /// the data sources the run reads). `collapse`: the pipeline has a
+    /// `collapse` step (the `areas` layer, the `collapsed` column).
     pub fn create(
         spec: &OutputSpec,
         source: &SourceInfo,
         inputs: &[&str],
+        collapse: bool,
     ) -> Result<Self, IoError> {
         check_output(spec, inputs)?;
         let path = PathBuf::from(&spec.path);
@@ -268,6 +276,7 @@ impl Writer {
             tmp,
             path,
             spec: spec.clone(),
+            collapse,
             source_fields,
         };
         let r = (|| -> Result<(), IoError> {
@@ -281,6 +290,9 @@ impl Writer {
             }
             if spec.widths {
                 w.create_layer(&mut ds, &WIDTHS, WIDTHS.name, srs)?;
+            }
+            if collapse {
+                w.create_layer(&mut ds, &AREAS, AREAS.name, srs)?;
             }
             w.create_layer(&mut ds, &REJECTED, REJECTED.name, srs)?;
             w.create_layer(&mut ds, &RUNS, RUNS.name, None)?;
@@ -328,10 +340,12 @@ impl Writer {
 
     /// The columns of `def` this output has.
     fn columns<'d, R>(&self, def: &'d LayerDef<R>) -> impl Iterator<Item = &'d Column<R>> {
-        let explode = self.spec.explode;
-        def.columns
-            .iter()
-            .filter(move |c| c.when == When::Always || explode)
+        let (explode, collapse) = (self.spec.explode, self.collapse);
+        def.columns.iter().filter(move |c| match c.when {
+            When::Always => true,
+            When::Explode => explode,
+            When::Collapse => collapse,
+        })
     }
 
     /// Writes `rows` to the layer `name` described by `def`.
@@ -386,6 +400,7 @@ impl Writer {
             self.write_rows(&txn, &CANDIDATES, CANDIDATES.name, &rows.candidates)?;
             self.write_rows(&txn, &BARS, BARS.name, &rows.bars)?;
             self.write_rows(&txn, &WIDTHS, WIDTHS.name, &rows.widths)?;
+            self.write_rows(&txn, &AREAS, AREAS.name, &rows.areas)?;
             self.write_rows(&txn, &REJECTED, REJECTED.name, &rows.rejected)?;
             txn.commit()
                 .map_err(|e| IoError::gdal("committing a batch", e))

@@ -9,6 +9,7 @@ pub mod rows;
 
 pub use rows::{feature_rows, FeatureRows, RowOptions, Skeletons, Status};
 
+use crate::collapse::{collapse, CollapseParams, PartCollapse};
 use crate::geometry::PreparedPolygon;
 use crate::graph::extend::ExtendParams;
 use crate::graph::prune::PruneParams;
@@ -68,6 +69,9 @@ pub struct ProcessParams {
     pub prune: Option<PruneParams>,
     /// `extend` step, when present.
     pub extend: Option<ExtendParams>,
+    /// `collapse` step, when present: the chosen skeleton collapses the
+    /// polygon where it is narrow.
+    pub collapse: Option<CollapseParams>,
     /// `score` step, when present.
     pub score: Option<ScoreParams>,
     /// `select` step, when present.
@@ -153,6 +157,9 @@ pub struct CandidateSkeleton {
     /// The skeleton's segments with the disc radius at both ends (the medial
     /// axis transform for MA), when requested.
     pub widths: Vec<MatSegment>,
+    /// The finished skeleton graph of every polygon part, when the pipeline
+    /// collapses (the `collapse` step works on graphs).
+    pub graphs: Vec<crate::graph::SkeletonGraph>,
 }
 
 /// What the pipeline writes for one feature.
@@ -164,6 +171,9 @@ pub struct FeatureOutcome {
     pub chosen: usize,
     /// Polygon parts skeletonised.
     pub parts: usize,
+    /// The chosen skeleton's collapse, part by part, when the pipeline has a
+    /// `collapse` step.
+    pub collapse: Option<Vec<PartCollapse>>,
 }
 
 impl FeatureOutcome {
@@ -251,7 +261,19 @@ pub fn process(geom: Option<&Geometry<f64>>, params: &ProcessParams) -> Processe
         Err(other) => return other,
     };
     let candidates = candidates::computed(&prepared, params);
-    choose(candidates, prepared.len(), params)
+    let mut processed = choose(candidates, prepared.len(), params);
+    if let (Some(c), Processed::Done(o)) = (&params.collapse, &mut processed) {
+        let (_, chosen) = o.chosen();
+        o.collapse = Some(
+            chosen
+                .graphs
+                .iter()
+                .zip(&prepared)
+                .map(|(g, p)| collapse(g, p, c))
+                .collect(),
+        );
+    }
+    processed
 }
 
 /// Scores skeleton lines made by another tool (`label`) for one feature's
@@ -351,6 +373,7 @@ fn choose(candidates: Vec<Candidate>, parts: usize, params: &ProcessParams) -> P
             candidates,
             chosen,
             parts,
+            collapse: None,
         }),
         None => Processed::Rejected(rejection(&candidates)),
     }

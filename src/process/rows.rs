@@ -6,7 +6,7 @@
 use super::{process, process_given, FeatureOutcome, ProcessParams, Processed, StageTimes};
 use crate::feature::Feature;
 use crate::methods::MethodId;
-use crate::output::{BarRow, CandidateRow, RejectedRow, Rows, SkeletonRow, WidthRow};
+use crate::output::{AreaRow, BarRow, CandidateRow, RejectedRow, Rows, SkeletonRow, WidthRow};
 use geo::{Geometry, MultiLineString};
 
 /// Where a feature's skeletons come from.
@@ -180,18 +180,43 @@ fn outcome_rows(
     let name = |m: crate::methods::MethodId| label.map_or_else(|| m.to_string(), str::to_string);
     let (method, chosen) = o.chosen();
     let method = name(*method);
-    rows.skeletons.push(SkeletonRow {
+    let row = |geometry: MultiLineString<f64>, collapsed: Option<bool>| SkeletonRow {
         src_fid: f.fid,
         polygon_part: part,
         attributes: f.attributes.clone(),
-        geometry: chosen.geometry.clone(),
+        geometry,
         method: method.clone(),
         scores: chosen.scores,
         components: chosen.components,
         legs: chosen.legs,
         repaired: f.repaired,
         note: chosen.scores.and_then(|s| score_note(&s)),
-    });
+        collapsed,
+    };
+    match &o.collapse {
+        None => rows.skeletons.push(row(chosen.geometry.clone(), None)),
+        Some(parts) => {
+            let collapsed: Vec<_> = parts.iter().flat_map(|c| c.collapsed.clone()).collect();
+            let kept: Vec<_> = parts.iter().flat_map(|c| c.kept.clone()).collect();
+            let any_collapsed = !collapsed.is_empty();
+            if any_collapsed {
+                rows.skeletons
+                    .push(row(MultiLineString(collapsed), Some(true)));
+            }
+            // Every feature written has a skeleton row.
+            if !kept.is_empty() || !any_collapsed {
+                rows.skeletons.push(row(MultiLineString(kept), Some(false)));
+            }
+            rows.areas
+                .extend(parts.iter().flat_map(|c| &c.areas).map(|a| AreaRow {
+                    src_fid: f.fid,
+                    polygon_part: part,
+                    attributes: f.attributes.clone(),
+                    geometry: a.polygon.clone(),
+                    cuts: a.cuts,
+                }));
+        }
+    }
     if opts.widths {
         rows.widths.extend(chosen.widths.iter().map(|w| WidthRow {
             src_fid: f.fid,
