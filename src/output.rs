@@ -601,7 +601,8 @@ mod tests {
                 "components",
                 "legs",
                 "repaired",
-                "note"
+                "note",
+                "collapsed"
             ]
         );
         let cands: Vec<&str> = CANDIDATES.column_names().collect();

@@ -1,0 +1,540 @@
+//! The `collapse` step through the real binary, on constructed shapes and on
+//! the training layers: lines where the polygon is narrow, areas where it is
+//! wide, cut across the polygon where they meet, and the bounds —
+//! kept areas wider than width·(1 − tol) and collapsed lines narrower than
+//! width·(1 + tol) (except within one width of a cut or a line's end), no
+//! stretch shorter than `min_length`, every line end on a cut, on ∂P or on
+//! another line.
+
+mod common;
+use common::{code_and_err, make_layer, open, pipeline, skeletonise, tmp, TRAIN};
+use gdal::vector::LayerAccess;
+use geo::{Area, Coord, Geometry, LineString, MultiPolygon, Polygon};
+use skeletonise::geometry::PreparedPolygon;
+use std::path::Path;
+
+const TOL: f64 = 0.2;
+
+/// One row of `skeletons` or `areas`: src_fid, the `collapsed` flag (areas:
+/// None) and the geometry.
+struct Row {
+    src_fid: i64,
+    collapsed: Option<bool>,
+    geometry: Geometry<f64>,
+    id: Option<i64>,
+}
+
+fn rows(path: &Path, layer: &str) -> Vec<Row> {
+    let ds = open(path);
+    let mut l = ds.layer_by_name(layer).unwrap();
+    let defn = l.defn();
+    let idx = |n: &str| defn.field_index(n).ok();
+    let (fid, col, id) = (idx("src_fid").unwrap(), idx("collapsed"), idx("id"));
+    l.features()
+        .map(|f| Row {
+            src_fid: f.field_as_integer64(fid).unwrap().unwrap(),
+            collapsed: col.and_then(|c| f.field_as_integer(c).unwrap().map(|v| v == 1)),
+            geometry: f.geometry().unwrap().to_geo().unwrap(),
+            id: id.and_then(|c| f.field_as_integer64(c).unwrap()),
+        })
+        .collect()
+}
+
+fn lines(g: &Geometry<f64>) -> Vec<LineString<f64>> {
+    match g {
+        Geometry::MultiLineString(m) => m.0.clone(),
+        Geometry::LineString(l) => vec![l.clone()],
+        other => panic!("not lines: {other:?}"),
+    }
+}
+
+fn polygons(g: &Geometry<f64>) -> Vec<Polygon<f64>> {
+    match g {
+        Geometry::Polygon(p) => vec![p.clone()],
+        Geometry::MultiPolygon(m) => m.0.clone(),
+        other => panic!("not a polygon: {other:?}"),
+    }
+}
+
+/// The polygons of a layer by FID.
+fn sources(path: &str, layer: &str) -> std::collections::BTreeMap<i64, Vec<Polygon<f64>>> {
+    let ds = gdal::Dataset::open(path).unwrap();
+    let mut l = ds.layer_by_name(layer).unwrap();
+    l.features()
+        .map(|f| {
+            (
+                f.fid().unwrap() as i64,
+                polygons(&f.geometry().unwrap().to_geo().unwrap()),
+            )
+        })
+        .collect()
+}
+
+fn collapse_pipeline(dir: &Path, source: &str, layer: &str, collapse: &str) -> std::path::PathBuf {
+    let out = dir.join(format!("{layer}.gpkg"));
+    let text = format!(
+        "input: {{ source: {source}, layer: {layer} }}\nsteps:\n  - skeleton: {{ methods: [MA] }}\n  - prune: {{}}\n  - extend: {{}}\n  - collapse: {collapse}\n  - score: {{}}\n  - select: {{}}\noutput: {{ path: {}, overwrite: true }}\n",
+        out.display()
+    );
+    let p = pipeline(dir, &format!("{layer}.yaml"), &text);
+    let o = skeletonise(&["run", p.to_str().unwrap(), "-q"]);
+    assert!(o.status.success(), "{}", code_and_err(&o).1);
+    out
+}
+
+fn dist(a: Coord<f64>, b: Coord<f64>) -> f64 {
+    (a - b).x.hypot((a - b).y)
+}
+
+/// Distance from `c` to the boundary of any of `areas`.
+fn to_areas(c: Coord<f64>, areas: &[Polygon<f64>]) -> f64 {
+    use geo::{Distance, Euclidean};
+    areas
+        .iter()
+        .flat_map(|a| std::iter::once(a.exterior()).chain(a.interiors()))
+        .map(|r| Euclidean.distance(&geo::Point(c), r))
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Points along a line at most `step` apart, with their distance along it.
+fn samples(l: &LineString<f64>, step: f64) -> Vec<Coord<f64>> {
+    let mut out = vec![l.0[0]];
+    for w in l.0.windows(2) {
+        let n = (dist(w[0], w[1]) / step).ceil().max(1.0) as usize;
+        for k in 1..=n {
+            out.push(w[0] + (w[1] - w[0]) * (k as f64 / n as f64));
+        }
+    }
+    out
+}
+
+/// What the checks found on one layer.
+#[derive(Debug, Default)]
+struct Measured {
+    collapsed_max_width: f64,
+    kept_min_width: f64,
+    shortest_collapsed: f64,
+    shortest_kept: f64,
+    loose_ends: usize,
+    ends: usize,
+    areas: usize,
+    cuts: usize,
+}
+
+/// Checks one output against its polygons (see the module documentation).
+fn measure(
+    out: &Path,
+    polys: &std::collections::BTreeMap<i64, Vec<Polygon<f64>>>,
+    w: f64,
+) -> Measured {
+    let skel = rows(out, "skeletons");
+    let areas = rows(out, "areas");
+    let mut m = Measured {
+        collapsed_max_width: 0.0,
+        kept_min_width: f64::INFINITY,
+        shortest_collapsed: f64::INFINITY,
+        shortest_kept: f64::INFINITY,
+        ..Measured::default()
+    };
+    for (fid, parts) in polys {
+        let prepared: Vec<PreparedPolygon> = parts
+            .iter()
+            .map(|p| PreparedPolygon::new(p).unwrap())
+            .collect();
+        let r = |c: Coord<f64>| {
+            prepared
+                .iter()
+                .map(|p| p.boundary().distance(c))
+                .fold(f64::INFINITY, f64::min)
+        };
+        let area_polys: Vec<Polygon<f64>> = areas
+            .iter()
+            .filter(|a| a.src_fid == *fid)
+            .flat_map(|a| polygons(&a.geometry))
+            .collect();
+        m.areas += area_polys.len();
+        let area_sum: f64 = area_polys.iter().map(|a| a.unsigned_area()).sum();
+        let total: f64 = parts.iter().map(|p| p.unsigned_area()).sum();
+        assert!(
+            area_sum <= total * (1.0 + 1e-9),
+            "fid {fid}: areas exceed the polygon"
+        );
+        let of = |c: bool| -> Vec<LineString<f64>> {
+            skel.iter()
+                .filter(|s| s.src_fid == *fid && s.collapsed == Some(c))
+                .flat_map(|s| lines(&s.geometry))
+                .collect()
+        };
+        let (collapsed, kept) = (of(true), of(false));
+        let extent = parts
+            .iter()
+            .map(|p| PreparedPolygon::new(p).unwrap().extent())
+            .fold(0.0, f64::max);
+        let tol = 1e-6 * extent;
+        let all_ends: Vec<Coord<f64>> = collapsed
+            .iter()
+            .chain(&kept)
+            .flat_map(|l| [l.0[0], *l.0.last().unwrap()])
+            .collect();
+        // Cut points: line ends on an area's boundary, not on ∂P.
+        let cut_points: Vec<Coord<f64>> = all_ends
+            .iter()
+            .copied()
+            .filter(|&c| r(c) > tol && to_areas(c, &area_polys) <= tol)
+            .collect();
+        m.cuts += cut_points.len();
+        let on_bp = |c: Coord<f64>| r(c) <= tol;
+        for l in &collapsed {
+            for end in [l.0[0], *l.0.last().unwrap()] {
+                m.ends += 1;
+                let shared = all_ends.iter().filter(|&&e| dist(e, end) <= tol).count() > 1;
+                if !(on_bp(end) || to_areas(end, &area_polys) <= tol || shared) {
+                    m.loose_ends += 1;
+                }
+            }
+        }
+        // Widths, away from the cuts and from the lines' own ends on ∂P.
+        let near_end = |c: Coord<f64>| {
+            cut_points.iter().any(|&p| dist(p, c) < w)
+                || all_ends.iter().any(|&e| on_bp(e) && dist(e, c) < w)
+        };
+        for l in &collapsed {
+            for c in samples(l, w / 8.0).into_iter().filter(|&c| !near_end(c)) {
+                m.collapsed_max_width = m.collapsed_max_width.max(2.0 * r(c));
+            }
+        }
+        for l in &kept {
+            for c in samples(l, w / 8.0).into_iter().filter(|&c| !near_end(c)) {
+                m.kept_min_width = m.kept_min_width.min(2.0 * r(c));
+            }
+        }
+        // Stretch lengths: connected lines of one kind between changes.
+        for (lines, shortest) in [
+            (&collapsed, &mut m.shortest_collapsed),
+            (&kept, &mut m.shortest_kept),
+        ] {
+            for (len, meets_other) in stretches(lines, &cut_points, tol) {
+                if meets_other {
+                    *shortest = shortest.min(len);
+                }
+            }
+        }
+    }
+    m
+}
+
+/// Connected groups of `lines` (joined where ends coincide): total length
+/// and whether the group ends on a cut (meets the other kind).
+fn stretches(lines: &[LineString<f64>], cuts: &[Coord<f64>], tol: f64) -> Vec<(f64, bool)> {
+    use geo::{Euclidean, Length};
+    let n = lines.len();
+    let mut group: Vec<usize> = (0..n).collect();
+    fn find(g: &mut [usize], i: usize) -> usize {
+        if g[i] != i {
+            let r = find(g, g[i]);
+            g[i] = r;
+        }
+        g[i]
+    }
+    let ends = |l: &LineString<f64>| [l.0[0], *l.0.last().unwrap()];
+    for i in 0..n {
+        for j in i + 1..n {
+            if ends(&lines[i])
+                .iter()
+                .any(|a| ends(&lines[j]).iter().any(|b| dist(*a, *b) <= tol))
+            {
+                let (a, b) = (find(&mut group, i), find(&mut group, j));
+                group[a.max(b)] = a.min(b);
+            }
+        }
+    }
+    let mut out: std::collections::BTreeMap<usize, (f64, bool)> = Default::default();
+    for i in 0..n {
+        let g = find(&mut group, i);
+        let e = out.entry(g).or_default();
+        e.0 += Euclidean.length(&lines[i]);
+        e.1 |= ends(&lines[i])
+            .iter()
+            .any(|c| cuts.iter().any(|p| dist(*p, *c) <= tol));
+    }
+    out.into_values().collect()
+}
+
+fn wkt_layer(dir: &Path, wkts: &[&str]) -> String {
+    let src = dir.join("polygons.gpkg");
+    let w: Vec<Option<&str>> = wkts.iter().map(|w| Some(*w)).collect();
+    make_layer(&src, "shapes", 3857, &w);
+    src.display().to_string()
+}
+
+/// Two 1 km lakes joined by a 2 km channel 100 m wide.
+const DUMBBELL: &str = "POLYGON ((0 0, 1000 0, 1000 450, 3000 450, 3000 0, 4000 0, 4000 1000, 3000 1000, 3000 550, 1000 550, 1000 1000, 0 1000, 0 0))";
+
+#[test]
+fn a_dumbbell_gives_two_areas_joined_by_one_line_ending_on_their_cuts() {
+    let dir = tmp();
+    let src = wkt_layer(dir.path(), &[DUMBBELL]);
+    let out = collapse_pipeline(dir.path(), &src, "shapes", "{ width: 300 }");
+    let areas: Vec<Polygon<f64>> = rows(&out, "areas")
+        .iter()
+        .flat_map(|a| polygons(&a.geometry))
+        .collect();
+    assert_eq!(areas.len(), 2, "two lakes");
+    for a in &areas {
+        assert!(
+            a.unsigned_area() > 0.95e6 && a.unsigned_area() < 1.1e6,
+            "{}",
+            a.unsigned_area()
+        );
+    }
+    let skel = rows(&out, "skeletons");
+    let collapsed: Vec<LineString<f64>> = skel
+        .iter()
+        .filter(|s| s.collapsed == Some(true))
+        .flat_map(|s| lines(&s.geometry))
+        .collect();
+    assert_eq!(collapsed.len(), 1, "one line: {collapsed:?}");
+    let line = &collapsed[0];
+    let (a, b) = (line.0[0], *line.0.last().unwrap());
+    assert!(
+        to_areas(a, &areas) < 1e-3 && to_areas(b, &areas) < 1e-3,
+        "ends on the cuts: {a:?} {b:?}"
+    );
+    // The ends lie within one width of the channel's mouths (the line runs
+    // on into a lake until the lake is wider than the width).
+    assert!((a.x.min(b.x) - 1000.0).abs() < 300.0, "{a:?} {b:?}");
+    assert!((a.x.max(b.x) - 3000.0).abs() < 300.0, "{a:?} {b:?}");
+    assert!((a.y - 500.0).abs() < 1.0 && (b.y - 500.0).abs() < 1.0);
+    // The lake's centreline ends on the same points: lines and areas connect.
+    let kept_ends: Vec<Coord<f64>> = skel
+        .iter()
+        .filter(|s| s.collapsed == Some(false))
+        .flat_map(|s| lines(&s.geometry))
+        .flat_map(|l| [l.0[0], *l.0.last().unwrap()])
+        .collect();
+    for e in [a, b] {
+        assert!(
+            kept_ends.iter().any(|k| dist(*k, e) < 1e-9),
+            "{e:?} continues into the lake"
+        );
+    }
+    // Every source field is carried to both layers.
+    assert!(rows(&out, "areas").iter().all(|r| r.id == Some(0)));
+    assert!(skel.iter().all(|r| r.id == Some(0)));
+    let m = measure(&out, &sources(&src, "shapes"), 300.0);
+    assert_eq!(m.loose_ends, 0, "{m:?}");
+    assert!(m.collapsed_max_width < 300.0 * (1.0 + TOL), "{m:?}");
+}
+
+/// A 200 m wide river that widens around an island: the channels around it
+/// (800 m beside it, 700 m at its ends) are wider than the collapse width,
+/// the river above and below is not.
+const ISLAND_RIVER: &str = "POLYGON ((0 -100, 4000 -100, 4000 -1200, 6000 -1200, 6000 -100, 10000 -100, 10000 100, 6000 100, 6000 1200, 4000 1200, 4000 100, 0 100, 0 -100), (4700 -400, 4700 400, 5300 400, 5300 -400, 4700 -400))";
+
+#[test]
+fn a_river_with_an_island_wider_than_the_width_keeps_the_island_in_one_area() {
+    let dir = tmp();
+    let src = wkt_layer(dir.path(), &[ISLAND_RIVER]);
+    let out = collapse_pipeline(dir.path(), &src, "shapes", "{ width: 500 }");
+    let areas: Vec<Polygon<f64>> = rows(&out, "areas")
+        .iter()
+        .flat_map(|a| polygons(&a.geometry))
+        .collect();
+    assert_eq!(areas.len(), 1, "{areas:?}");
+    assert_eq!(
+        areas[0].interiors().len(),
+        1,
+        "the island is a hole of the area"
+    );
+    let collapsed: Vec<LineString<f64>> = rows(&out, "skeletons")
+        .iter()
+        .filter(|s| s.collapsed == Some(true))
+        .flat_map(|s| lines(&s.geometry))
+        .collect();
+    assert_eq!(collapsed.len(), 2, "upstream and downstream: {collapsed:?}");
+    for l in &collapsed {
+        let (a, b) = (l.0[0], *l.0.last().unwrap());
+        let (outer, inner) = if a.x < 1.0 || a.x > 9999.0 {
+            (a, b)
+        } else {
+            (b, a)
+        };
+        assert!(
+            outer.x < 1.0 || outer.x > 9999.0,
+            "one end on the river's cut end: {l:?}"
+        );
+        assert!(
+            to_areas(inner, &areas) < 1e-3,
+            "the other on the area's cut: {l:?}"
+        );
+    }
+    let m = measure(&out, &sources(&src, "shapes"), 500.0);
+    assert_eq!(m.loose_ends, 0, "{m:?}");
+    assert!(m.kept_min_width > 500.0 * (1.0 - TOL), "{m:?}");
+
+    // Narrower than the width all round: two lines around the island, no area.
+    let out = collapse_pipeline(dir.path(), &src, "shapes", "{ width: 2000 }");
+    assert_eq!(rows(&out, "areas").len(), 0);
+    let collapsed: Vec<LineString<f64>> = rows(&out, "skeletons")
+        .iter()
+        .flat_map(|s| lines(&s.geometry))
+        .collect();
+    let poly = &sources(&src, "shapes")[&1][0];
+    let island = Polygon::new(poly.interiors()[0].clone(), vec![]);
+    use geo::Intersects;
+    assert!(
+        collapsed.iter().all(|l| !l.intersects(&island)),
+        "no line crosses the island"
+    );
+    let ys: Vec<f64> = collapsed
+        .iter()
+        .flat_map(|l| l.0.iter().map(|c| c.y))
+        .collect();
+    assert!(
+        ys.iter().any(|&y| y > 700.0) && ys.iter().any(|&y| y < -700.0),
+        "a line in each channel"
+    );
+}
+
+#[test]
+fn whole_mode_collapses_a_polygon_entirely_or_keeps_it() {
+    let dir = tmp();
+    let src = wkt_layer(
+        dir.path(),
+        &[
+            DUMBBELL,
+            "POLYGON ((0 2000, 5000 2000, 5000 2100, 0 2100, 0 2000))",
+        ],
+    );
+    let out = collapse_pipeline(dir.path(), &src, "shapes", "{ width: 300, mode: whole }");
+    let areas = rows(&out, "areas");
+    assert_eq!(areas.len(), 1, "the dumbbell is mostly lake: kept");
+    assert_eq!(areas[0].src_fid, 1);
+    let a: MultiPolygon<f64> = MultiPolygon(polygons(&areas[0].geometry));
+    assert!(
+        (a.unsigned_area() - 2.2e6).abs() < 1.0,
+        "kept whole: {}",
+        a.unsigned_area()
+    );
+    let skel = rows(&out, "skeletons");
+    let collapsed: Vec<i64> = skel
+        .iter()
+        .filter(|s| s.collapsed == Some(true))
+        .map(|s| s.src_fid)
+        .collect();
+    assert_eq!(collapsed, vec![2], "the thin strip collapses");
+}
+
+fn real_layer(layer: &str, width: f64) -> Measured {
+    let dir = tmp();
+    let out = collapse_pipeline(
+        dir.path(),
+        &common::root(TRAIN),
+        layer,
+        &format!("{{ width: {width} }}"),
+    );
+    let m = measure(&out, &sources(TRAIN, layer), width);
+    eprintln!("{layer} width {width}: {m:?}");
+    m
+}
+
+/// The bounds on a real layer at a width that collapses part of it.
+fn assert_bounds(layer: &str, width: f64) {
+    let m = real_layer(layer, width);
+    assert!(
+        m.areas > 0 && m.cuts > 0,
+        "{layer}: something is kept and cut: {m:?}"
+    );
+    assert_eq!(
+        m.loose_ends, 0,
+        "{layer}: every line end on a cut, ∂P or a line: {m:?}"
+    );
+    assert!(
+        m.collapsed_max_width < width * (1.0 + TOL),
+        "{layer}: {m:?}"
+    );
+    assert!(m.kept_min_width > width * (1.0 - TOL), "{layer}: {m:?}");
+    assert!(
+        m.shortest_collapsed >= width,
+        "{layer}: min_length = width: {m:?}"
+    );
+    assert!(
+        m.shortest_kept >= width,
+        "{layer}: min_length = width: {m:?}"
+    );
+}
+
+#[test]
+fn river_lena_collapses_within_the_bounds() {
+    assert_bounds("river_lena", 1500.0);
+}
+
+#[test]
+fn river_st_lawrence_collapses_within_the_bounds() {
+    assert_bounds("river_st_lawrence", 1500.0);
+}
+
+#[test]
+fn lakes_scotland_collapse_within_the_bounds() {
+    assert_bounds("lakes_scotland", 1000.0);
+}
+
+#[test]
+fn bad_collapse_options_name_the_key_and_the_fix() {
+    let dir = tmp();
+    for (collapse, key, words) in [
+        ("{ width: -5 }", "collapse.width", "positive"),
+        (
+            "{ width: 100, tolerance: 1.5 }",
+            "collapse.tolerance",
+            "below 1",
+        ),
+        ("{ tolerance: 0.1 }", "collapse", "width"),
+        ("{ width: 100, mode: partly }", "collapse.mode", "partial"),
+    ] {
+        let text = format!(
+            "input: {{ source: {TRAIN} }}\nsteps:\n  - skeleton: {{ methods: [MA] }}\n  - collapse: {collapse}\noutput: {{ path: {}/o.gpkg }}\n",
+            dir.path().display()
+        );
+        let p = pipeline(dir.path(), "bad.yaml", &text);
+        let (code, err) = code_and_err(&skeletonise(&["validate", p.to_str().unwrap()]));
+        assert_eq!(code, 78, "{collapse}: {err}");
+        assert!(
+            err.contains(key) && err.contains(words),
+            "{collapse}: {err}"
+        );
+    }
+    // After `score` is the wrong place.
+    let text = format!(
+        "input: {{ source: {TRAIN} }}\nsteps:\n  - skeleton: {{ methods: [MA] }}\n  - score: {{}}\n  - collapse: {{ width: 100 }}\noutput: {{ path: {}/o.gpkg }}\n",
+        dir.path().display()
+    );
+    let p = pipeline(dir.path(), "order.yaml", &text);
+    let (code, err) = code_and_err(&skeletonise(&["validate", p.to_str().unwrap()]));
+    assert_eq!(code, 78, "{err}");
+    assert!(err.contains("collapse"), "{err}");
+}
+
+#[test]
+fn methods_lists_the_collapse_options() {
+    let o = skeletonise(&["methods"]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    for k in ["collapse", "width", "tolerance", "min_length", "mode"] {
+        assert!(text.contains(k), "{k} missing from:\n{text}");
+    }
+}
+
+#[test]
+fn without_collapse_there_is_no_areas_layer_and_no_collapsed_column() {
+    let dir = tmp();
+    let out = dir.path().join("plain.gpkg");
+    let text = common::basic_pipeline(TRAIN, "lakes_scotland", &out, "");
+    let p = pipeline(dir.path(), "plain.yaml", &text);
+    assert!(skeletonise(&["run", p.to_str().unwrap(), "-q"])
+        .status
+        .success());
+    let ds = open(&out);
+    assert!(ds.layer_by_name("areas").is_err());
+    let l = ds.layer_by_name("skeletons").unwrap();
+    assert!(l.defn().field_index("collapsed").is_err());
+}
