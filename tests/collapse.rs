@@ -249,11 +249,11 @@ fn stretches(lines: &[LineString<f64>], cuts: &[Coord<f64>], tol: f64) -> Vec<(f
         }
     }
     let mut out: std::collections::BTreeMap<usize, (f64, bool)> = Default::default();
-    for i in 0..n {
+    for (i, line) in lines.iter().enumerate() {
         let g = find(&mut group, i);
         let e = out.entry(g).or_default();
-        e.0 += Euclidean.length(&lines[i]);
-        e.1 |= ends(&lines[i])
+        e.0 += Euclidean.length(line);
+        e.1 |= ends(line)
             .iter()
             .any(|c| cuts.iter().any(|p| dist(*p, *c) <= tol));
     }

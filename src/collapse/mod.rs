@@ -167,27 +167,24 @@ fn lerp(a: Coord<f64>, b: Coord<f64>, t: f64) -> Coord<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::process::{process, ProcessParams, Processed};
-    use geo::{polygon, Area as _, Geometry};
+    use crate::graph::GraphBuilder;
+    use geo::{polygon, Area as _};
 
-    fn outcome(p: &Polygon<f64>, width: f64) -> Vec<PartCollapse> {
-        let params = ProcessParams {
-            collapse: Some(CollapseParams::new(width)),
-            ..ProcessParams::all_steps()
-        };
-        match process(Some(&Geometry::Polygon(p.clone())), &params) {
-            Processed::Done(o) => o.collapse.expect("collapse ran"),
-            other => panic!("{other:?}"),
-        }
+    /// A 100 × 10 rectangle's centreline collapsed at `width`.
+    fn rectangle(width: f64) -> PartCollapse {
+        let r = polygon![(x: 0., y: 0.), (x: 100., y: 0.), (x: 100., y: 10.), (x: 0., y: 10.)];
+        let p = PreparedPolygon::new(&r).unwrap();
+        let mut b = GraphBuilder::new();
+        b.segment(Coord { x: 0., y: 5. }, Coord { x: 100., y: 5. });
+        collapse(&b.finish(p.boundary()), &p, &CollapseParams::new(width))
     }
 
     #[test]
     fn a_narrow_rectangle_collapses_whole_and_a_wide_one_stays() {
-        let r = polygon![(x: 0., y: 0.), (x: 100., y: 0.), (x: 100., y: 10.), (x: 0., y: 10.)];
-        let narrow = &outcome(&r, 20.0)[0];
+        let narrow = &rectangle(20.0);
         assert!(narrow.areas.is_empty(), "{narrow:?}");
         assert!(!narrow.collapsed.is_empty());
-        let wide = &outcome(&r, 5.0)[0];
+        let wide = &rectangle(5.0);
         assert_eq!(wide.areas.len(), 1);
         assert!(wide.collapsed.is_empty(), "{wide:?}");
         assert!((wide.areas[0].polygon.unsigned_area() - 1000.0).abs() < 1e-6);
