@@ -160,6 +160,8 @@ impl ScoreArgs {
             where_: None,
             bbox: None,
             reproject: self.reproject.clone(),
+            merge_adjacent: false,
+            merge_by: None,
         };
         ScoreJob {
             polygons: spec(&self.polygons, &self.polygons_layer),
@@ -259,6 +261,8 @@ impl ReportArgs {
                 .reproject
                 .clone()
                 .or_else(|| recorded.as_ref().and_then(|r| r.input_reproject.clone())),
+            merge_adjacent: false,
+            merge_by: None,
         });
         Ok(skeletonise::reporting::ReportJob {
             html: self

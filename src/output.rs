@@ -74,6 +74,8 @@ pub enum When {
     Explode,
     /// Only when the pipeline has a `collapse` step.
     Collapse,
+    /// Only with `input.merge_adjacent`.
+    Merge,
 }
 
 /// One column of a layer.
@@ -105,6 +107,16 @@ pub const fn col_collapse<R>(name: &'static str, ty: ColumnType, get: fn(&R) -> 
         ty,
         get,
         when: When::Collapse,
+    }
+}
+
+/// A column written only with `input.merge_adjacent`.
+pub const fn col_merge<R>(name: &'static str, ty: ColumnType, get: fn(&R) -> Cell) -> Column<R> {
+    Column {
+        name,
+        ty,
+        get,
+        when: When::Merge,
     }
 }
 
@@ -263,6 +275,9 @@ pub struct SkeletonRow {
     /// With a `collapse` step: the lines where the polygon collapsed (true)
     /// or the centreline through its kept areas (false).
     pub collapsed: Option<bool>,
+    /// With `input.merge_adjacent`: the source FIDs dissolved into this
+    /// feature, comma-separated.
+    pub members: Option<String>,
 }
 
 impl Scored for SkeletonRow {
@@ -290,6 +305,7 @@ pub const SKELETONS: LayerDef<SkeletonRow> = LayerDef {
             col("repaired", Int32, |r: &SkeletonRow| int(i64::from(r.repaired))),
             col("note", Text, |r: &SkeletonRow| r.note.as_deref().map_or(Cell::Null, text)),
             col_collapse("collapsed", Int32, |r: &SkeletonRow| r.collapsed.map_or(Cell::Null, |c| int(i64::from(c)))),
+            col_merge("members", Text, |r: &SkeletonRow| r.members.as_deref().map_or(Cell::Null, text)),
         ],
     ),
 };
@@ -308,6 +324,8 @@ pub struct AreaRow {
     pub geometry: geo::Polygon<f64>,
     /// Cuts on its boundary, where collapsed lines meet it.
     pub cuts: usize,
+    /// With `input.merge_adjacent`: the source FIDs dissolved, comma-separated.
+    pub members: Option<String>,
 }
 
 /// The `areas` layer (with a `collapse` step).
@@ -322,6 +340,9 @@ pub const AREAS: LayerDef<AreaRow> = LayerDef {
             r.polygon_part.map_or(Cell::Null, int)
         }),
         col("cuts", Int32, |r| int(r.cuts)),
+        col_merge("members", Text, |r| {
+            r.members.as_deref().map_or(Cell::Null, text)
+        }),
     ],
 };
 
@@ -602,7 +623,8 @@ mod tests {
                 "legs",
                 "repaired",
                 "note",
-                "collapsed"
+                "collapsed",
+                "members"
             ]
         );
         let cands: Vec<&str> = CANDIDATES.column_names().collect();

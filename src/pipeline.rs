@@ -212,10 +212,10 @@ impl Counts {
             tracing::warn!(fid = f.fid, reason = %rej.reason, "feature rejected");
         }
         match &r.status {
-            Status::Rejected => self.rejected += 1,
-            Status::Filtered => self.filtered += 1,
+            Status::Rejected => self.rejected += f.source_count(),
+            Status::Filtered => self.filtered += f.source_count(),
             Status::Written(methods) => {
-                self.written += 1;
+                self.written += f.source_count();
                 for m in methods {
                     *self.methods.entry(m.clone()).or_default() += 1;
                 }
@@ -356,7 +356,13 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
         };
         let mut inputs = vec![job.input.source.as_str()];
         inputs.extend(job.other_inputs.iter().map(String::as_str));
-        let writer = Writer::create(job.output, &info, &inputs, job.params.collapse.is_some())?;
+        let writer = Writer::create(
+            job.output,
+            &info,
+            &inputs,
+            job.params.collapse.is_some(),
+            job.input.merge_adjacent,
+        )?;
         tracing::info!(
             pipeline = %job.name,
             source = %info.source,
@@ -382,7 +388,7 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
                         .map(|f| feature_rows(f, job.skeletons(f), &job.params, row_opts))
                         .collect()
                 });
-                counts.read += features.len() as u64;
+                counts.read += features.iter().map(Feature::source_count).sum::<u64>();
                 let mut rows = Rows::default();
                 for (f, r) in features.iter().zip(done) {
                     counts.add(f, &r, job.on_error)?;
@@ -441,11 +447,58 @@ fn read_batches(
     if info_tx.send(Ok(reader.info().clone())).is_err() {
         return;
     }
+    if input.merge_adjacent {
+        return read_merged(&mut reader, input, batch, make_valid, batch_tx);
+    }
     let r = reader.read::<Stop>(batch, make_valid, |features| {
         batch_tx.send(Ok(features)).map_err(|_| Stop::Gone)
     });
     if let Err(Stop::Failed(e)) = r {
         let _ = batch_tx.send(Err(e));
+    }
+}
+
+/// `input.merge_adjacent`: every feature read first, the adjacent ones
+/// dissolved into one per group, then sent in batches.
+fn read_merged(
+    reader: &mut Reader,
+    input: &InputSpec,
+    batch: usize,
+    make_valid: bool,
+    batch_tx: mpsc::SyncSender<Batch>,
+) {
+    let fields = &reader.info().fields;
+    let by = match &input.merge_by {
+        None => None,
+        Some(name) => match fields.iter().position(|f| &f.name == name) {
+            Some(i) => Some(i),
+            None => {
+                let names: Vec<&str> = fields.iter().map(|f| f.name.as_str()).collect();
+                let _ = batch_tx.send(Err(IoError::Read {
+                    source_name: input.source.clone(),
+                    reason: format!(
+                        "`input.merge_by`: the layer has no field `{name}`; its fields are {}",
+                        names.join(", ")
+                    ),
+                }));
+                return;
+            }
+        },
+    };
+    let mut all = Vec::new();
+    let r = reader.read::<Stop>(batch, make_valid, |features| {
+        all.extend(features);
+        Ok(())
+    });
+    if let Err(Stop::Failed(e)) = r {
+        let _ = batch_tx.send(Err(e));
+        return;
+    }
+    let merged = crate::process::merge::merge_adjacent(all, by);
+    for chunk in merged.chunks(batch) {
+        if batch_tx.send(Ok(chunk.to_vec())).is_err() {
+            return;
+        }
     }
 }
 

@@ -538,3 +538,118 @@ fn without_collapse_there_is_no_areas_layer_and_no_collapsed_column() {
     let l = ds.layer_by_name("skeletons").unwrap();
     assert!(l.defn().field_index("collapsed").is_err());
 }
+
+/// A river bend (an annulus sector 1 km wide, vertices every degree) cut
+/// into three reaches at 60° and 120°: the reaches share their seams'
+/// vertices.
+fn three_reaches() -> Vec<String> {
+    let at = |r: f64, deg: i32| {
+        let a = f64::from(deg).to_radians();
+        format!("{} {}", r * a.cos(), r * a.sin())
+    };
+    [(0, 60), (60, 120), (120, 180)]
+        .iter()
+        .map(|&(a0, a1)| {
+            let mut v: Vec<String> = (a0..=a1).map(|d| at(10_000.0, d)).collect();
+            v.extend((a0..=a1).rev().map(|d| at(9_000.0, d)));
+            v.push(v[0].clone());
+            format!("POLYGON (({}))", v.join(", "))
+        })
+        .collect()
+}
+
+/// Largest turn (degrees) between successive segments of `lines` at
+/// vertices within `radius` of `p`.
+fn max_turn_near(lines: &[LineString<f64>], p: Coord<f64>, radius: f64) -> f64 {
+    let mut worst: f64 = 0.0;
+    for l in lines {
+        for w in l.0.windows(3) {
+            if dist(w[1], p) > radius {
+                continue;
+            }
+            let (u, v) = (w[1] - w[0], w[2] - w[1]);
+            let turn = (u.x * v.y - u.y * v.x).atan2(u.x * v.x + u.y * v.y).abs();
+            worst = worst.max(turn.to_degrees());
+        }
+    }
+    worst
+}
+
+#[test]
+fn a_river_in_three_adjacent_reaches_gives_one_line_without_gap_or_kink_at_the_seams() {
+    let dir = tmp();
+    let reaches = three_reaches();
+    let wkts: Vec<&str> = reaches.iter().map(String::as_str).collect();
+    let src = wkt_layer(dir.path(), &wkts);
+    let out = dir.path().join("merged.gpkg");
+    let run = |extra: &str| {
+        let text = format!(
+            "input: {{ source: {src}, layer: shapes{extra} }}\nsteps:\n  - skeleton: {{ methods: [MA] }}\n  - prune: {{}}\n  - extend: {{}}\noutput: {{ path: {}, overwrite: true }}\n",
+            out.display()
+        );
+        let p = pipeline(dir.path(), "merge.yaml", &text);
+        let o = skeletonise(&["run", p.to_str().unwrap()]);
+        let (code, err) = code_and_err(&o);
+        assert_eq!(code, 0, "{err}");
+        err
+    };
+    let log = run(", merge_adjacent: true");
+    assert!(log.contains("3 read, 3 written"), "{log}");
+    let ds = open(&out);
+    assert_eq!(
+        common::strings(&ds, "skeletons", "members"),
+        vec![Some("1,2,3".to_string())]
+    );
+    assert_eq!(common::ints(&ds, "skeletons", "components"), vec![Some(1)]);
+    let rows = rows(&out, "skeletons");
+    let lines = lines(&rows[0].geometry);
+    // One line from one cut end to the other, through both seams.
+    let ends: Vec<Coord<f64>> = lines
+        .iter()
+        .flat_map(|l| [l.0[0], *l.0.last().unwrap()])
+        .collect();
+    assert_eq!(lines.len(), 1, "{lines:?}");
+    assert!(
+        ends.iter()
+            .any(|e| dist(*e, Coord { x: 9500.0, y: 0.0 }) < 20.0),
+        "{ends:?}"
+    );
+    assert!(
+        ends.iter()
+            .any(|e| dist(*e, Coord { x: -9500.0, y: 0.0 }) < 20.0),
+        "{ends:?}"
+    );
+    for deg in [60.0_f64, 120.0] {
+        let seam = Coord {
+            x: 9500.0 * deg.to_radians().cos(),
+            y: 9500.0 * deg.to_radians().sin(),
+        };
+        let near = lines
+            .iter()
+            .flat_map(|l| l.0.windows(2).map(|w| geo::Line::new(w[0], w[1])))
+            .map(|s| {
+                use geo::{Distance, Euclidean};
+                Euclidean.distance(&s, &geo::Point(seam))
+            })
+            .fold(f64::INFINITY, f64::min);
+        assert!(
+            near < 5.0,
+            "the line passes the seam at {deg}° in its middle: {near}"
+        );
+        let turn = max_turn_near(&lines, seam, 1500.0);
+        assert!(turn < 3.0, "no kink at the seam at {deg}°: {turn}°");
+    }
+    // Only within the same value of a field: every reach has its own `id`.
+    run(", merge_adjacent: true, merge_by: id");
+    assert_eq!(common::count(&open(&out), "skeletons"), 3);
+    // Without merging, three reaches give three lines.
+    run("");
+    let ds = open(&out);
+    assert_eq!(common::count(&ds, "skeletons"), 3);
+    assert!(ds
+        .layer_by_name("skeletons")
+        .unwrap()
+        .defn()
+        .field_index("members")
+        .is_err());
+}

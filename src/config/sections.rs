@@ -42,6 +42,12 @@ pub struct InputSpec {
     /// Target CRS (e.g. `EPSG:3035`); required when the source CRS is geographic.
     #[serde(default)]
     pub reproject: Option<String>,
+    /// Process polygons that share boundary (river reaches, tiles, map sheets) as one: each group is dissolved before skeletonising, and the `members` column lists its FIDs.
+    #[serde(default)]
+    pub merge_adjacent: bool,
+    /// With `merge_adjacent`: merge only polygons with the same value of this source field.
+    #[serde(default)]
+    pub merge_by: Option<String>,
 }
 
 impl InputSpec {
@@ -49,6 +55,13 @@ impl InputSpec {
     pub fn validate(&self) -> Result<(), (String, String)> {
         if self.source.trim().is_empty() {
             return Err(("source".into(), "give the input data source".into()));
+        }
+        if self.merge_by.is_some() && !self.merge_adjacent {
+            return Err((
+                "merge_by".into(),
+                "merge_by only applies with `merge_adjacent: true`; set it, or remove merge_by"
+                    .into(),
+            ));
         }
         if let Some([x0, y0, x1, y1]) = self.bbox {
             if ![x0, y0, x1, y1].iter().all(|v| v.is_finite()) {
@@ -76,6 +89,8 @@ impl InputSpec {
             where_: None,
             bbox: None,
             reproject: None,
+            merge_adjacent: false,
+            merge_by: None,
         }
     }
 }

@@ -294,6 +294,7 @@ impl OutputFile {
             repaired: c.int(f, "repaired") == Some(1),
             note: c.text(f, "note"),
             collapsed: c.int(f, "collapsed").map(|v| v == 1),
+            members: c.text(f, "members"),
         })
     }
 

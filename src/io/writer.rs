@@ -35,6 +35,8 @@ pub struct Writer {
     spec: OutputSpec,
     /// The pipeline collapses: the `areas` layer and the `collapsed` column.
     collapse: bool,
+    /// `input.merge_adjacent`: the `members` column.
+    merge: bool,
     source_fields: Vec<(String, FieldInfo)>,
 }
 
@@ -228,12 +230,14 @@ impl Writer {
     /// Creates the temporary GeoPackage and its layers. Fails, touching
     /// nothing, when the output is refused by [`check_output`] (`inputs` are
     /// the data sources the run reads). `collapse`: the pipeline has a
-    /// `collapse` step (the `areas` layer, the `collapsed` column).
+    /// `collapse` step (the `areas` layer, the `collapsed` column); `merge`:
+    /// the input merges adjacent polygons (the `members` column).
     pub fn create(
         spec: &OutputSpec,
         source: &SourceInfo,
         inputs: &[&str],
         collapse: bool,
+        merge: bool,
     ) -> Result<Self, IoError> {
         check_output(spec, inputs)?;
         let path = PathBuf::from(&spec.path);
@@ -277,6 +281,7 @@ impl Writer {
             path,
             spec: spec.clone(),
             collapse,
+            merge,
             source_fields,
         };
         let r = (|| -> Result<(), IoError> {
@@ -340,11 +345,12 @@ impl Writer {
 
     /// The columns of `def` this output has.
     fn columns<'d, R>(&self, def: &'d LayerDef<R>) -> impl Iterator<Item = &'d Column<R>> {
-        let (explode, collapse) = (self.spec.explode, self.collapse);
+        let (explode, collapse, merge) = (self.spec.explode, self.collapse, self.merge);
         def.columns.iter().filter(move |c| match c.when {
             When::Always => true,
             When::Explode => explode,
             When::Collapse => collapse,
+            When::Merge => merge,
         })
     }
 

@@ -5,6 +5,7 @@
 
 mod candidates;
 pub mod clock;
+pub mod merge;
 pub mod rows;
 
 pub use rows::{feature_rows, FeatureRows, RowOptions, Skeletons, Status};

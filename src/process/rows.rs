@@ -168,6 +168,17 @@ fn rejected(f: &Feature, reason: String) -> RejectedRow {
     }
 }
 
+/// The source FIDs a feature stands for, comma-separated (its own when it
+/// merged none).
+fn members_text(f: &Feature) -> Option<String> {
+    let fids: Vec<String> = if f.members.is_empty() {
+        f.fid.iter().map(u64::to_string).collect()
+    } else {
+        f.members.iter().map(u64::to_string).collect()
+    };
+    (!fids.is_empty()).then(|| fids.join(","))
+}
+
 /// Appends the rows of one processed unit; returns the chosen method's name.
 fn outcome_rows(
     f: &Feature,
@@ -180,6 +191,7 @@ fn outcome_rows(
     let name = |m: crate::methods::MethodId| label.map_or_else(|| m.to_string(), str::to_string);
     let (method, chosen) = o.chosen();
     let method = name(*method);
+    let members = members_text(f);
     let row = |geometry: MultiLineString<f64>, collapsed: Option<bool>| SkeletonRow {
         src_fid: f.fid,
         polygon_part: part,
@@ -192,6 +204,7 @@ fn outcome_rows(
         repaired: f.repaired,
         note: chosen.scores.and_then(|s| score_note(&s)),
         collapsed,
+        members: members.clone(),
     };
     match &o.collapse {
         None => rows.skeletons.push(row(chosen.geometry.clone(), None)),
@@ -214,6 +227,7 @@ fn outcome_rows(
                     attributes: f.attributes.clone(),
                     geometry: a.polygon.clone(),
                     cuts: a.cuts,
+                    members: members.clone(),
                 }));
         }
     }
