@@ -162,6 +162,7 @@ impl ScoreArgs {
             reproject: self.reproject.clone(),
             merge_adjacent: false,
             merge_by: None,
+            connect: None,
         };
         ScoreJob {
             polygons: spec(&self.polygons, &self.polygons_layer),
@@ -263,6 +264,7 @@ impl ReportArgs {
                 .or_else(|| recorded.as_ref().and_then(|r| r.input_reproject.clone())),
             merge_adjacent: false,
             merge_by: None,
+            connect: None,
         });
         Ok(skeletonise::reporting::ReportJob {
             html: self

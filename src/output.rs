@@ -476,6 +476,30 @@ pub const WIDTHS: LayerDef<WidthRow> = LayerDef {
     ],
 };
 
+/// One row of the `connections` layer: a leg added to a skeleton for a
+/// line of `input.connect`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ConnectionRow {
+    /// Source FID of the polygon.
+    pub src_fid: Option<u64>,
+    /// FID of the network line the leg serves.
+    pub line_fid: Option<u64>,
+    /// The leg, from the skeleton to the connection point on the boundary.
+    pub geometry: geo::LineString<f64>,
+}
+
+/// The `connections` layer (with `input.connect`).
+pub const CONNECTIONS: LayerDef<ConnectionRow> = LayerDef {
+    name: "connections",
+    geometry: GeometryKind::LineString,
+    shape: |r| Some(Shape::Line(r.geometry.clone())),
+    attributes: None,
+    columns: &[
+        col("src_fid", Int64, |r| fid(r.src_fid)),
+        col("line_fid", Int64, |r| fid(r.line_fid)),
+    ],
+};
+
 /// One row of the `rejected` layer.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RejectedRow {
@@ -583,6 +607,8 @@ pub struct Rows {
     pub widths: Vec<WidthRow>,
     /// `areas` rows.
     pub areas: Vec<AreaRow>,
+    /// `connections` rows.
+    pub connections: Vec<ConnectionRow>,
     /// `rejected` rows.
     pub rejected: Vec<RejectedRow>,
 }
@@ -595,6 +621,7 @@ impl Rows {
         self.bars.append(&mut other.bars);
         self.widths.append(&mut other.widths);
         self.areas.append(&mut other.areas);
+        self.connections.append(&mut other.connections);
         self.rejected.append(&mut other.rejected);
     }
 }

@@ -342,6 +342,11 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
         .map_err(|_| RunError::Threads(threads))?;
     let batch = opts.batch_size.unwrap_or(256).max(1);
     let make_valid = job.params.prepare.make_valid;
+    let mut params = job.params.clone();
+    if let Some(c) = &job.input.connect {
+        params.connect = Some(std::sync::Arc::new(read_network(c, job.input)?));
+    }
+    let params = &params;
     std::thread::scope(|scope| {
         // The reader opens the source on its own thread (GDAL handles stay on
         // the thread that made them) and reports what it found first.
@@ -362,6 +367,7 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
             &inputs,
             job.params.collapse.is_some(),
             job.input.merge_adjacent,
+            job.input.connect.is_some(),
         )?;
         tracing::info!(
             pipeline = %job.name,
@@ -385,7 +391,7 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
                 let done: Vec<FeatureRows> = pool.install(|| {
                     features
                         .par_iter()
-                        .map(|f| feature_rows(f, job.skeletons(f), &job.params, row_opts))
+                        .map(|f| feature_rows(f, job.skeletons(f), params, row_opts))
                         .collect()
                 });
                 counts.read += features.iter().map(Feature::source_count).sum::<u64>();
@@ -456,6 +462,27 @@ fn read_batches(
     if let Err(Stop::Failed(e)) = r {
         let _ = batch_tx.send(Err(e));
     }
+}
+
+/// The lines of `input.connect`.
+fn read_network(
+    c: &crate::config::ConnectSpec,
+    input: &InputSpec,
+) -> Result<crate::process::connect::Network, RunError> {
+    let mut reader = Reader::open(&c.input(input))?;
+    let mut lines = Vec::new();
+    reader.read::<IoError>(1024, false, |features| {
+        for f in features {
+            let mut ls = Vec::new();
+            if let Some(g) = &f.geometry {
+                crate::process::connect::lines_of(g, &mut ls);
+            }
+            lines.extend(ls.into_iter().map(|l| (f.fid, l)));
+        }
+        Ok(())
+    })?;
+    tracing::info!(source = %c.source, lines = lines.len(), "connect: line network read");
+    Ok(crate::process::connect::Network::new(lines, c.snap))
 }
 
 /// `input.merge_adjacent`: every feature read first, the adjacent ones

@@ -273,6 +273,7 @@ fn polygon_spec(file: &OutputFile, job: &ReportJob) -> Result<InputSpec, ReportE
         reproject: run.input_reproject.clone(),
         merge_adjacent: false,
         merge_by: None,
+        connect: None,
     })
 }
 

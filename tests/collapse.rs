@@ -653,3 +653,92 @@ fn a_river_in_three_adjacent_reaches_gives_one_line_without_gap_or_kink_at_the_s
         .field_index("members")
         .is_err());
 }
+
+#[test]
+fn a_line_network_touching_a_polygon_at_three_places_gets_three_legs_ending_there() {
+    let dir = tmp();
+    let src = wkt_layer(dir.path(), &[DUMBBELL]);
+    // Ends on the left lake's shore; crosses the right lake's shore; ends
+    // 4 m short of the channel's bank (within snap); far away.
+    make_layer(
+        Path::new(&src),
+        "rivers",
+        3857,
+        &[
+            Some("LINESTRING (-500 800, 0 800)"),
+            Some("LINESTRING (3500 1500, 3500 700)"),
+            Some("LINESTRING (2000 -300, 2000 446)"),
+            Some("LINESTRING (5000 0, 6000 0)"),
+        ],
+    );
+    let out = dir.path().join("connected.gpkg");
+    let text = format!(
+        "input: {{ source: {src}, layer: shapes, connect: {{ source: {src}, layer: rivers, snap: 10 }} }}\nsteps:\n  - skeleton: {{ methods: [MA] }}\n  - prune: {{}}\n  - extend: {{}}\n  - collapse: {{ width: 300 }}\noutput: {{ path: {} }}\n",
+        out.display()
+    );
+    let p = pipeline(dir.path(), "connect.yaml", &text);
+    let o = skeletonise(&["run", p.to_str().unwrap(), "-q"]);
+    assert!(o.status.success(), "{}", code_and_err(&o).1);
+    let ds = open(&out);
+    let mut l = ds.layer_by_name("connections").unwrap();
+    let legs: Vec<(i64, LineString<f64>)> = l
+        .features()
+        .map(|f| {
+            let fid = f
+                .field_as_integer64(f.field_index("line_fid").unwrap())
+                .unwrap()
+                .unwrap();
+            let Geometry::LineString(g) = f.geometry().unwrap().to_geo().unwrap() else {
+                panic!("a leg is a line")
+            };
+            (fid, g)
+        })
+        .collect();
+    let mut served: Vec<i64> = legs.iter().map(|(f, _)| *f).collect();
+    served.sort_unstable();
+    assert_eq!(
+        served,
+        vec![1, 2, 3],
+        "exactly three legs, one per touching line"
+    );
+    let want = [
+        (1, Coord { x: 0.0, y: 800.0 }),
+        (
+            2,
+            Coord {
+                x: 3500.0,
+                y: 1000.0,
+            },
+        ),
+        (
+            3,
+            Coord {
+                x: 2000.0,
+                y: 450.0,
+            },
+        ),
+    ];
+    let skel: Vec<LineString<f64>> = rows(&out, "skeletons")
+        .iter()
+        .flat_map(|r| lines(&r.geometry))
+        .collect();
+    for (fid, point) in want {
+        let (_, leg) = legs.iter().find(|(f, _)| *f == fid).unwrap();
+        let end = *leg.0.last().unwrap();
+        assert!(
+            dist(end, point) < 1e-6,
+            "line {fid}: leg ends at {end:?}, not {point:?}"
+        );
+        // The leg is part of the written skeleton, ending on the same point.
+        let skel_ends: Vec<Coord<f64>> = skel
+            .iter()
+            .flat_map(|l| [l.0[0], *l.0.last().unwrap()])
+            .collect();
+        assert!(
+            skel_ends.iter().any(|e| dist(*e, point) < 1e-6),
+            "line {fid}: the skeleton reaches {point:?}"
+        );
+    }
+    let m = measure(&out, &sources(&src, "shapes"), 300.0);
+    assert_eq!(m.loose_ends, 0, "{m:?}");
+}

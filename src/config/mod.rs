@@ -16,7 +16,7 @@
 pub mod locate;
 mod sections;
 
-pub use sections::{InputSpec, LayerRef, OutputSpec, ReportSpec};
+pub use sections::{ConnectSpec, InputSpec, LayerRef, OutputSpec, ReportSpec};
 
 use crate::collapse::CollapseParams;
 use crate::graph::extend::ExtendParams;

@@ -48,6 +48,40 @@ pub struct InputSpec {
     /// With `merge_adjacent`: merge only polygons with the same value of this source field.
     #[serde(default)]
     pub merge_by: Option<String>,
+    /// A line network (any OGR source and layer of lines, e.g. the rivers) to continue through the polygons: where a line touches or crosses a polygon's boundary (or ends within `snap` of it) the skeleton gets a leg to that point (layer `connections`).
+    #[serde(default)]
+    pub connect: Option<ConnectSpec>,
+}
+
+/// The `input.connect` section: the line network.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ConnectSpec {
+    /// Any OGR data source string of lines, in the input's CRS (reprojected with it).
+    pub source: String,
+    /// Layer name or zero-based index; default the first layer.
+    #[serde(default)]
+    pub layer: Option<LayerRef>,
+    /// A line end within this distance of a polygon's boundary connects (CRS units; default 0: only lines that touch or cross it).
+    #[serde(default)]
+    pub snap: f64,
+}
+
+impl ConnectSpec {
+    /// The network's lines as an input of their own (same reprojection as
+    /// the polygons).
+    pub fn input(&self, polygons: &InputSpec) -> InputSpec {
+        InputSpec {
+            source: self.source.clone(),
+            layer: self.layer.clone(),
+            where_: None,
+            bbox: None,
+            reproject: polygons.reproject.clone(),
+            merge_adjacent: false,
+            merge_by: None,
+            connect: None,
+        }
+    }
 }
 
 impl InputSpec {
@@ -62,6 +96,17 @@ impl InputSpec {
                 "merge_by only applies with `merge_adjacent: true`; set it, or remove merge_by"
                     .into(),
             ));
+        }
+        if let Some(c) = &self.connect {
+            if c.source.trim().is_empty() {
+                return Err((
+                    "connect.source".into(),
+                    "give the line network's data source".into(),
+                ));
+            }
+            if !(c.snap.is_finite() && c.snap >= 0.0) {
+                return Err(("connect.snap".into(), "snap must be ≥ 0 (CRS units)".into()));
+            }
         }
         if let Some([x0, y0, x1, y1]) = self.bbox {
             if ![x0, y0, x1, y1].iter().all(|v| v.is_finite()) {
@@ -91,6 +136,7 @@ impl InputSpec {
             reproject: None,
             merge_adjacent: false,
             merge_by: None,
+            connect: None,
         }
     }
 }

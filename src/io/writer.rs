@@ -15,7 +15,7 @@ use super::{signals, IoError};
 use crate::feature::Value;
 use crate::output::{
     Cell, Column, ColumnType, GeometryKind, LayerDef, Rows, RunRecord, Shape, When, AREAS, BARS,
-    CANDIDATES, REJECTED, RUNS, SKELETONS, WIDTHS,
+    CANDIDATES, CONNECTIONS, REJECTED, RUNS, SKELETONS, WIDTHS,
 };
 use gdal::spatial_ref::SpatialRef;
 use gdal::vector::{
@@ -231,13 +231,15 @@ impl Writer {
     /// nothing, when the output is refused by [`check_output`] (`inputs` are
     /// the data sources the run reads). `collapse`: the pipeline has a
     /// `collapse` step (the `areas` layer, the `collapsed` column); `merge`:
-    /// the input merges adjacent polygons (the `members` column).
+    /// the input merges adjacent polygons (the `members` column); `connect`:
+    /// the input has a line network (the `connections` layer).
     pub fn create(
         spec: &OutputSpec,
         source: &SourceInfo,
         inputs: &[&str],
         collapse: bool,
         merge: bool,
+        connect: bool,
     ) -> Result<Self, IoError> {
         check_output(spec, inputs)?;
         let path = PathBuf::from(&spec.path);
@@ -298,6 +300,9 @@ impl Writer {
             }
             if collapse {
                 w.create_layer(&mut ds, &AREAS, AREAS.name, srs)?;
+            }
+            if connect {
+                w.create_layer(&mut ds, &CONNECTIONS, CONNECTIONS.name, srs)?;
             }
             w.create_layer(&mut ds, &REJECTED, REJECTED.name, srs)?;
             w.create_layer(&mut ds, &RUNS, RUNS.name, None)?;
@@ -407,6 +412,7 @@ impl Writer {
             self.write_rows(&txn, &BARS, BARS.name, &rows.bars)?;
             self.write_rows(&txn, &WIDTHS, WIDTHS.name, &rows.widths)?;
             self.write_rows(&txn, &AREAS, AREAS.name, &rows.areas)?;
+            self.write_rows(&txn, &CONNECTIONS, CONNECTIONS.name, &rows.connections)?;
             self.write_rows(&txn, &REJECTED, REJECTED.name, &rows.rejected)?;
             txn.commit()
                 .map_err(|e| IoError::gdal("committing a batch", e))

@@ -249,7 +249,7 @@ fn finish(
         if params.keep_widths {
             widths.extend(medial_axis_transform(g, Some(p.boundary())));
         }
-        if params.collapse.is_some() {
+        if params.collapse.is_some() || params.connect.is_some() {
             graphs.push(g.clone());
         }
         lines.extend(g.to_multilinestring().0);

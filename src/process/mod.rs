@@ -5,6 +5,7 @@
 
 mod candidates;
 pub mod clock;
+pub mod connect;
 pub mod merge;
 pub mod rows;
 
@@ -73,6 +74,8 @@ pub struct ProcessParams {
     /// `collapse` step, when present: the chosen skeleton collapses the
     /// polygon where it is narrow.
     pub collapse: Option<CollapseParams>,
+    /// `input.connect`: the line network the chosen skeleton gets legs to.
+    pub connect: Option<std::sync::Arc<connect::Network>>,
     /// `score` step, when present.
     pub score: Option<ScoreParams>,
     /// `select` step, when present.
@@ -175,6 +178,8 @@ pub struct FeatureOutcome {
     /// The chosen skeleton's collapse, part by part, when the pipeline has a
     /// `collapse` step.
     pub collapse: Option<Vec<PartCollapse>>,
+    /// The legs added to the chosen skeleton for `input.connect`.
+    pub connections: Vec<connect::ConnectionLeg>,
 }
 
 impl FeatureOutcome {
@@ -263,6 +268,9 @@ pub fn process(geom: Option<&Geometry<f64>>, params: &ProcessParams) -> Processe
     };
     let candidates = candidates::computed(&prepared, params);
     let mut processed = choose(candidates, prepared.len(), params);
+    if let (Some(net), Processed::Done(o)) = (&params.connect, &mut processed) {
+        connect_chosen(o, &prepared, net);
+    }
     if let (Some(c), Processed::Done(o)) = (&params.collapse, &mut processed) {
         let (_, chosen) = o.chosen();
         o.collapse = Some(
@@ -275,6 +283,28 @@ pub fn process(geom: Option<&Geometry<f64>>, params: &ProcessParams) -> Processe
         );
     }
     processed
+}
+
+/// The chosen skeleton with a leg to every connection point of the
+/// network (its scores stay those of the skeleton without them).
+fn connect_chosen(o: &mut FeatureOutcome, prepared: &[PreparedPolygon], net: &connect::Network) {
+    let chosen = o.chosen;
+    let Ok(c) = &mut o.candidates[chosen].result else {
+        return;
+    };
+    let mut lines = Vec::new();
+    let (mut legs, mut components) = (0, 0);
+    for (g, p) in c.graphs.iter_mut().zip(prepared) {
+        let (with_legs, added) = connect::add_legs(g, p, &net.points(p));
+        *g = with_legs;
+        o.connections.extend(added);
+        legs += g.leg_count();
+        components += g.components();
+        lines.extend(g.to_multilinestring().0);
+    }
+    c.geometry = MultiLineString(lines);
+    c.legs = legs;
+    c.components = components;
 }
 
 /// Scores skeleton lines made by another tool (`label`) for one feature's
@@ -375,6 +405,7 @@ fn choose(candidates: Vec<Candidate>, parts: usize, params: &ProcessParams) -> P
             chosen,
             parts,
             collapse: None,
+            connections: Vec::new(),
         }),
         None => Processed::Rejected(rejection(&candidates)),
     }

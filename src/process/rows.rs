@@ -6,7 +6,9 @@
 use super::{process, process_given, FeatureOutcome, ProcessParams, Processed, StageTimes};
 use crate::feature::Feature;
 use crate::methods::MethodId;
-use crate::output::{AreaRow, BarRow, CandidateRow, RejectedRow, Rows, SkeletonRow, WidthRow};
+use crate::output::{
+    AreaRow, BarRow, CandidateRow, ConnectionRow, RejectedRow, Rows, SkeletonRow, WidthRow,
+};
 use geo::{Geometry, MultiLineString};
 
 /// Where a feature's skeletons come from.
@@ -231,6 +233,12 @@ fn outcome_rows(
                 }));
         }
     }
+    rows.connections
+        .extend(o.connections.iter().map(|c| ConnectionRow {
+            src_fid: f.fid,
+            line_fid: c.line_fid,
+            geometry: c.leg.clone(),
+        }));
     if opts.widths {
         rows.widths.extend(chosen.widths.iter().map(|w| WidthRow {
             src_fid: f.fid,
