@@ -28,6 +28,7 @@ fn reads_every_training_layer_with_its_fields() {
         reproject: None,
         merge_adjacent: false,
         merge_by: None,
+        connect: None,
     })
     .unwrap();
     let names: Vec<_> = r.info().fields.iter().map(|f| f.name.as_str()).collect();
