@@ -183,6 +183,7 @@ impl ScoreArgs {
                 bars: self.bars,
                 explode: false,
                 widths: false,
+                measures: Default::default(),
                 report: None,
             },
         }

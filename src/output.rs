@@ -61,6 +61,8 @@ pub enum Shape<'a> {
     Line(geo::LineString<f64>),
     /// One polygon.
     Polygon(&'a geo::Polygon<f64>),
+    /// Lines with an M value per vertex (line by line).
+    LinesM(&'a geo::MultiLineString<f64>, &'a [Vec<f64>]),
     /// A geometry as WKB.
     Wkb(&'a [u8]),
 }
@@ -278,6 +280,9 @@ pub struct SkeletonRow {
     /// With `input.merge_adjacent`: the source FIDs dissolved into this
     /// feature, comma-separated.
     pub members: Option<String>,
+    /// With `output.measures: width`: the M value of every vertex, line by
+    /// line (the local width 2r).
+    pub measures: Option<Vec<Vec<f64>>>,
 }
 
 impl Scored for SkeletonRow {
@@ -290,7 +295,12 @@ impl Scored for SkeletonRow {
 pub const SKELETONS: LayerDef<SkeletonRow> = LayerDef {
     name: "skeletons",
     geometry: GeometryKind::MultiLineString,
-    shape: |r| Some(Shape::Lines(&r.geometry)),
+    shape: |r| {
+        Some(match &r.measures {
+            Some(m) => Shape::LinesM(&r.geometry, m),
+            None => Shape::Lines(&r.geometry),
+        })
+    },
     attributes: Some(|r| &r.attributes),
     columns: columns!(SkeletonRow;
         [

@@ -742,3 +742,41 @@ fn a_line_network_touching_a_polygon_at_three_places_gets_three_legs_ending_ther
     let m = measure(&out, &sources(&src, "shapes"), 300.0);
     assert_eq!(m.loose_ends, 0, "{m:?}");
 }
+
+#[test]
+fn measures_width_gives_every_skeleton_vertex_its_local_width_as_m() {
+    let dir = tmp();
+    let src = wkt_layer(dir.path(), &[DUMBBELL]);
+    let out = dir.path().join("measured.gpkg");
+    for collapse in ["", "  - collapse: { width: 300 }\n"] {
+        let text = format!(
+            "input: {{ source: {src}, layer: shapes }}\nsteps:\n  - skeleton: {{ methods: [MA] }}\n  - prune: {{}}\n  - extend: {{}}\n{collapse}output: {{ path: {}, overwrite: true, measures: width }}\n",
+            out.display()
+        );
+        let p = pipeline(dir.path(), "measures.yaml", &text);
+        let o = skeletonise(&["run", p.to_str().unwrap(), "-q"]);
+        assert!(o.status.success(), "{}", code_and_err(&o).1);
+        let poly = &sources(&src, "shapes")[&1][0];
+        let boundary = PreparedPolygon::new(poly).unwrap();
+        let ds = open(&out);
+        let mut l = ds.layer_by_name("skeletons").unwrap();
+        let mut vertices = 0;
+        for f in l.features() {
+            let g = f.geometry().unwrap();
+            assert!(
+                gdal::vector::geometry_type_has_m(g.geometry_type()),
+                "XYM lines"
+            );
+            for i in 0..g.geometry_count() {
+                let mut pts = Vec::new();
+                g.get_geometry(i).get_points_zm(&mut pts);
+                for (x, y, _, m) in pts {
+                    let want = 2.0 * boundary.boundary().distance(Coord { x, y });
+                    assert!((m - want).abs() < 1e-6, "M {m} at ({x}, {y}), width {want}");
+                    vertices += 1;
+                }
+            }
+        }
+        assert!(vertices > 3, "{vertices} vertices");
+    }
+}

@@ -136,6 +136,11 @@ pub struct PartCollapse {
     /// The cuts between collapsed lines and kept areas, each from one
     /// boundary contact through the change point to the other.
     pub cuts: Vec<LineString<f64>>,
+    /// With `output.measures: width`: the local width at every vertex of
+    /// `collapsed`, line by line.
+    pub collapsed_measures: Vec<Vec<f64>>,
+    /// The same for `kept`.
+    pub kept_measures: Vec<Vec<f64>>,
 }
 
 /// Collapses polygon part `p` with its finished skeleton `g` (see the

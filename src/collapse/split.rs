@@ -112,6 +112,7 @@ pub(super) fn split(s: &Samples, p: &PreparedPolygon) -> PartCollapse {
         kept: kept_lines,
         areas,
         cuts,
+        ..PartCollapse::default()
     }
 }
 

@@ -16,7 +16,7 @@
 pub mod locate;
 mod sections;
 
-pub use sections::{ConnectSpec, InputSpec, LayerRef, OutputSpec, ReportSpec};
+pub use sections::{ConnectSpec, InputSpec, LayerRef, Measures, OutputSpec, ReportSpec};
 
 use crate::collapse::CollapseParams;
 use crate::graph::extend::ExtendParams;
@@ -142,6 +142,7 @@ impl Pipeline {
         }
         p.keep_bars = self.file.output.bars;
         p.keep_widths = self.file.output.widths;
+        p.keep_measures = self.file.output.measures == Measures::Width;
         p
     }
 

@@ -171,12 +171,26 @@ pub struct OutputSpec {
     /// medial axis transform, for deciding what is narrow enough to collapse.
     #[serde(default)]
     pub widths: bool,
+    /// `width`: the skeleton layer's lines carry an M value per vertex, the polygon's local width 2r there (XYM geometry), so that a symbol can be drawn with the river's real width; `none` (default): XY.
+    #[serde(default)]
+    pub measures: Measures,
     /// Also write the visual report: one self-contained HTML file with every
     /// method's skeleton of the selected features side by side, their score
     /// tables and a summary of the run (`skeletonise report` makes it from
     /// any output later).
     #[serde(default)]
     pub report: Option<ReportSpec>,
+}
+
+/// What the skeleton layer's M values hold (`output.measures`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "lowercase")]
+pub enum Measures {
+    /// No M values (XY lines).
+    #[default]
+    None,
+    /// The local width 2r at every vertex.
+    Width,
 }
 
 impl OutputSpec {
@@ -212,6 +226,7 @@ impl From<&OutputSpec> for crate::process::RowOptions {
             candidates: o.candidates,
             bars: o.bars,
             widths: o.widths,
+            measures: o.measures == Measures::Width,
         }
     }
 }

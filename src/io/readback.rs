@@ -84,7 +84,11 @@ impl Fields {
 }
 
 fn lines(f: &Feature<'_>) -> Option<geo::MultiLineString<f64>> {
-    match f.geometry()?.to_geo().ok()? {
+    let g = f.geometry()?.clone();
+    // M values (`output.measures`) are not part of the lines read back.
+    // SAFETY: the handle is the clone's own, valid while `g` lives.
+    unsafe { gdal_sys::OGR_G_SetMeasured(g.c_geometry(), 0) };
+    match g.to_geo().ok()? {
         geo::Geometry::MultiLineString(m) => Some(m),
         geo::Geometry::LineString(l) => Some(geo::MultiLineString(vec![l])),
         _ => None,
@@ -295,6 +299,7 @@ impl OutputFile {
             note: c.text(f, "note"),
             collapsed: c.int(f, "collapsed").map(|v| v == 1),
             members: c.text(f, "members"),
+            measures: None,
         })
     }
 

@@ -215,10 +215,25 @@ fn shape_to_gdal(s: Shape<'_>) -> Result<Geometry, IoError> {
         Shape::Lines(l) => to_gdal(l),
         Shape::Line(l) => to_gdal(&l),
         Shape::Polygon(p) => to_gdal(p),
+        Shape::LinesM(lines, m) => lines_m(lines, m),
         Shape::Wkb(w) => {
             Geometry::from_wkb(w).map_err(|e| IoError::gdal("reading a WKB geometry", e))
         }
     }
+}
+
+/// Lines with an M value per vertex as a GDAL MULTILINESTRING M.
+fn lines_m(lines: &geo::MultiLineString<f64>, m: &[Vec<f64>]) -> Result<Geometry, IoError> {
+    let err = |e| IoError::gdal("making a measured line", e);
+    let mut multi = Geometry::empty(OGRwkbGeometryType::wkbMultiLineStringM).map_err(err)?;
+    for (l, ms) in lines.0.iter().zip(m) {
+        let mut g = Geometry::empty(OGRwkbGeometryType::wkbLineStringM).map_err(err)?;
+        for (c, &w) in l.0.iter().zip(ms) {
+            g.add_point_m((c.x, c.y, w));
+        }
+        multi.add_geometry(g).map_err(err)?;
+    }
+    Ok(multi)
 }
 
 fn to_gdal<G: ToGdal>(g: &G) -> Result<Geometry, IoError> {
@@ -324,11 +339,20 @@ impl Writer {
         name: &str,
         srs: Option<&SpatialRef>,
     ) -> Result<(), IoError> {
+        // `output.measures: width`: the skeleton layer's lines carry M.
+        let measured = name == self.spec.layer
+            && def.geometry == GeometryKind::MultiLineString
+            && self.spec.measures == crate::config::Measures::Width;
+        let ty = if measured {
+            OGRwkbGeometryType::wkbMultiLineStringM
+        } else {
+            ogr_geometry(def.geometry)
+        };
         let l = ds
             .create_layer(LayerOptions {
                 name,
                 srs,
-                ty: ogr_geometry(def.geometry),
+                ty,
                 options: None,
             })
             .map_err(|e| IoError::gdal(format!("creating layer `{name}`"), e))?;

@@ -84,6 +84,9 @@ pub struct ProcessParams {
     pub keep_bars: bool,
     /// Keep the local widths of the skeleton (for the `widths` layer).
     pub keep_widths: bool,
+    /// The local width at every vertex of the written lines (M values,
+    /// `output.measures: width`).
+    pub keep_measures: bool,
     /// The methods `skeleton.methods` may name.
     pub registry: Registry,
 }
@@ -180,6 +183,9 @@ pub struct FeatureOutcome {
     pub collapse: Option<Vec<PartCollapse>>,
     /// The legs added to the chosen skeleton for `input.connect`.
     pub connections: Vec<connect::ConnectionLeg>,
+    /// With `output.measures: width`: the local width at every vertex of the
+    /// chosen skeleton, line by line.
+    pub measures: Option<Vec<Vec<f64>>>,
 }
 
 impl FeatureOutcome {
@@ -282,7 +288,36 @@ pub fn process(geom: Option<&Geometry<f64>>, params: &ProcessParams) -> Processe
                 .collect(),
         );
     }
+    if let (true, Processed::Done(o)) = (params.keep_measures, &mut processed) {
+        measure(o, &prepared);
+    }
     processed
+}
+
+/// The local width 2r (r: distance to the nearest polygon part's boundary)
+/// at every vertex of the outcome's lines, for M values.
+fn measure(o: &mut FeatureOutcome, prepared: &[PreparedPolygon]) {
+    let widths = |lines: &[geo::LineString<f64>]| -> Vec<Vec<f64>> {
+        lines
+            .iter()
+            .map(|l| {
+                l.0.iter()
+                    .map(|&c| {
+                        2.0 * prepared
+                            .iter()
+                            .map(|p| p.boundary().distance(c))
+                            .fold(f64::INFINITY, f64::min)
+                    })
+                    .collect()
+            })
+            .collect()
+    };
+    let (_, chosen) = o.chosen();
+    o.measures = Some(widths(&chosen.geometry.0));
+    for c in o.collapse.iter_mut().flatten() {
+        c.collapsed_measures = widths(&c.collapsed);
+        c.kept_measures = widths(&c.kept);
+    }
 }
 
 /// The chosen skeleton with a leg to every connection point of the
@@ -406,6 +441,7 @@ fn choose(candidates: Vec<Candidate>, parts: usize, params: &ProcessParams) -> P
             parts,
             collapse: None,
             connections: Vec::new(),
+            measures: None,
         }),
         None => Processed::Rejected(rejection(&candidates)),
     }

@@ -37,6 +37,8 @@ pub struct RowOptions {
     pub bars: bool,
     /// The chosen skeleton's local widths in `widths`.
     pub widths: bool,
+    /// M values (local width) on the skeleton layer's lines.
+    pub measures: bool,
 }
 
 /// How a feature counts in the run's summary.
@@ -194,7 +196,9 @@ fn outcome_rows(
     let (method, chosen) = o.chosen();
     let method = name(*method);
     let members = members_text(f);
-    let row = |geometry: MultiLineString<f64>, collapsed: Option<bool>| SkeletonRow {
+    let row = |geometry: MultiLineString<f64>,
+               collapsed: Option<bool>,
+               measures: Option<Vec<Vec<f64>>>| SkeletonRow {
         src_fid: f.fid,
         polygon_part: part,
         attributes: f.attributes.clone(),
@@ -207,20 +211,35 @@ fn outcome_rows(
         note: chosen.scores.and_then(|s| score_note(&s)),
         collapsed,
         members: members.clone(),
+        measures,
     };
     match &o.collapse {
-        None => rows.skeletons.push(row(chosen.geometry.clone(), None)),
+        None => rows
+            .skeletons
+            .push(row(chosen.geometry.clone(), None, o.measures.clone())),
         Some(parts) => {
             let collapsed: Vec<_> = parts.iter().flat_map(|c| c.collapsed.clone()).collect();
             let kept: Vec<_> = parts.iter().flat_map(|c| c.kept.clone()).collect();
+            let m = |of: fn(&crate::collapse::PartCollapse) -> &Vec<Vec<f64>>| {
+                o.measures
+                    .as_ref()
+                    .map(|_| parts.iter().flat_map(|c| of(c).clone()).collect::<Vec<_>>())
+            };
             let any_collapsed = !collapsed.is_empty();
             if any_collapsed {
-                rows.skeletons
-                    .push(row(MultiLineString(collapsed), Some(true)));
+                rows.skeletons.push(row(
+                    MultiLineString(collapsed),
+                    Some(true),
+                    m(|c| &c.collapsed_measures),
+                ));
             }
             // Every feature written has a skeleton row.
             if !kept.is_empty() || !any_collapsed {
-                rows.skeletons.push(row(MultiLineString(kept), Some(false)));
+                rows.skeletons.push(row(
+                    MultiLineString(kept),
+                    Some(false),
+                    m(|c| &c.kept_measures),
+                ));
             }
             rows.areas
                 .extend(parts.iter().flat_map(|c| &c.areas).map(|a| AreaRow {
