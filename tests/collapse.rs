@@ -729,6 +729,14 @@ fn a_line_network_touching_a_polygon_at_three_places_gets_three_legs_ending_ther
             dist(end, point) < 1e-6,
             "line {fid}: leg ends at {end:?}, not {point:?}"
         );
+        // It leaves the shore inwards (within 60° of the normal), never along it.
+        let start = leg.0[0];
+        let mid = start + (end - start) * 0.5;
+        let poly = PreparedPolygon::new(&sources(&src, "shapes")[&1][0]).unwrap();
+        assert!(
+            poly.boundary().distance(mid) >= 0.24 * dist(start, end),
+            "line {fid}: the leg {leg:?} runs along the boundary"
+        );
         // The leg is part of the written skeleton, ending on the same point.
         let skel_ends: Vec<Coord<f64>> = skel
             .iter()

@@ -178,25 +178,67 @@ pub fn add_legs(
 }
 
 /// The point of the skeleton's polylines nearest to `c` from which the
-/// straight segment to `c` stays inside P: (polyline, segment index, point).
+/// straight segment to `c` stays inside P and meets ∂P within 60° of its
+/// inward normal at `c` (so that a leg never runs along the shore):
+/// (polyline, segment index, point).
 fn nearest_visible(
     polylines: &[Vec<Coord<f64>>],
     p: &PreparedPolygon,
     c: Coord<f64>,
 ) -> Option<(usize, usize, Coord<f64>)> {
+    let b = p.boundary();
+    let (_, seg, _) = b.nearest(c)?;
+    let s = &b.segments()[seg];
+    let d = s.b - s.a;
+    let len = crate::geometry::norm(d);
+    if len == 0.0 {
+        return None;
+    }
+    let n = Coord {
+        x: -d.y / len,
+        y: d.x / len,
+    };
+    // The cone's edges: n turned by ∓60°.
+    let (cos, sin) = (0.5, 3f64.sqrt() / 2.0);
+    let right = Coord {
+        x: n.x * cos + n.y * sin,
+        y: -n.x * sin + n.y * cos,
+    };
+    let left = Coord {
+        x: n.x * cos - n.y * sin,
+        y: n.x * sin + n.y * cos,
+    };
+    let cross = |u: Coord<f64>, v: Coord<f64>| u.x * v.y - u.y * v.x;
     let mut candidates: Vec<(f64, usize, usize, Coord<f64>)> = Vec::new();
     for (k, l) in polylines.iter().enumerate() {
         for i in 0..l.len().saturating_sub(1) {
-            let (s, _) = crate::geometry::boundary::closest_on_segment(l[i], l[i + 1], c);
-            candidates.push((crate::geometry::norm(s - c), k, i, s));
+            // The part of the segment inside the cone: both half-planes.
+            let (a, z) = (l[i], l[i + 1]);
+            let (mut t0, mut t1) = (0.0_f64, 1.0_f64);
+            for (edge, sign) in [(right, 1.0), (left, -1.0)] {
+                let (fa, fz) = (sign * cross(edge, a - c), sign * cross(edge, z - c));
+                if fa < 0.0 && fz < 0.0 {
+                    t1 = -1.0;
+                } else if fa < 0.0 {
+                    t0 = t0.max(fa / (fa - fz));
+                } else if fz < 0.0 {
+                    t1 = t1.min(fa / (fa - fz));
+                }
+            }
+            if t0 > t1 {
+                continue;
+            }
+            let (pa, pz) = (a + (z - a) * t0, a + (z - a) * t1);
+            let (q, _) = crate::geometry::boundary::closest_on_segment(pa, pz, c);
+            candidates.push((crate::geometry::norm(q - c), k, i, q));
         }
     }
     candidates.sort_by(|a, b| a.0.total_cmp(&b.0));
     candidates
         .into_iter()
         .take(64)
-        .find(|&(_, _, _, s)| p.boundary().reaches(s, c))
-        .map(|(_, k, i, s)| (k, i, s))
+        .find(|&(_, _, _, q)| b.reaches(q, c))
+        .map(|(_, k, i, q)| (k, i, q))
 }
 
 #[cfg(test)]
