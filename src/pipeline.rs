@@ -97,9 +97,18 @@ pub enum RunError {
 /// layer exists, the CRS is projected (or reprojected), the filter is valid
 /// and the output can be written. Returns what the source holds.
 pub fn validate(p: &Pipeline) -> Result<crate::io::SourceInfo, RunError> {
-    let mut reader = Reader::open(&p.file.input)?;
+    let input = &p.file.input;
+    let mut reader = Reader::open(input)?;
     reader.probe()?;
-    check_output(&p.file.output, &[&p.file.input.source])?;
+    if let Some(reason) = merge_field(input, reader.info()).err() {
+        return Err(RunError::Io(reason));
+    }
+    let mut sources = vec![input.source.as_str()];
+    if let Some(c) = &input.connect {
+        Reader::open(&c.input(input))?.probe()?;
+        sources.push(c.source.as_str());
+    }
+    check_output(&p.file.output, &sources)?;
     if let Some(html) = p.file.output.report_path() {
         check_path(&html)?;
     }
@@ -360,6 +369,9 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
             Err(_) => return Err(reader_gone(reader)),
         };
         let mut inputs = vec![job.input.source.as_str()];
+        if let Some(c) = &job.input.connect {
+            inputs.push(c.source.as_str());
+        }
         inputs.extend(job.other_inputs.iter().map(String::as_str));
         let writer = Writer::create(
             job.output,
@@ -464,6 +476,29 @@ fn read_batches(
     }
 }
 
+/// The index of `input.merge_by` among the source's fields, or the error
+/// naming the fields there are.
+fn merge_field(input: &InputSpec, info: &SourceInfo) -> Result<Option<usize>, IoError> {
+    let Some(name) = &input.merge_by else {
+        return Ok(None);
+    };
+    let fields = &info.fields;
+    fields
+        .iter()
+        .position(|f| &f.name == name)
+        .map(Some)
+        .ok_or_else(|| {
+            let names: Vec<&str> = fields.iter().map(|f| f.name.as_str()).collect();
+            IoError::Read {
+                source_name: input.source.clone(),
+                reason: format!(
+                    "`input.merge_by`: the layer has no field `{name}`; its fields are {}",
+                    names.join(", ")
+                ),
+            }
+        })
+}
+
 /// The lines of `input.connect`.
 fn read_network(
     c: &crate::config::ConnectSpec,
@@ -494,23 +529,12 @@ fn read_merged(
     make_valid: bool,
     batch_tx: mpsc::SyncSender<Batch>,
 ) {
-    let fields = &reader.info().fields;
-    let by = match &input.merge_by {
-        None => None,
-        Some(name) => match fields.iter().position(|f| &f.name == name) {
-            Some(i) => Some(i),
-            None => {
-                let names: Vec<&str> = fields.iter().map(|f| f.name.as_str()).collect();
-                let _ = batch_tx.send(Err(IoError::Read {
-                    source_name: input.source.clone(),
-                    reason: format!(
-                        "`input.merge_by`: the layer has no field `{name}`; its fields are {}",
-                        names.join(", ")
-                    ),
-                }));
-                return;
-            }
-        },
+    let by = match merge_field(input, reader.info()) {
+        Ok(by) => by,
+        Err(e) => {
+            let _ = batch_tx.send(Err(e));
+            return;
+        }
     };
     let mut all = Vec::new();
     let r = reader.read::<Stop>(batch, make_valid, |features| {

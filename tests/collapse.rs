@@ -788,3 +788,45 @@ fn measures_width_gives_every_skeleton_vertex_its_local_width_as_m() {
         assert!(vertices > 3, "{vertices} vertices");
     }
 }
+
+#[test]
+fn bad_merge_and_connect_inputs_are_errors_before_any_work() {
+    let dir = tmp();
+    let src = wkt_layer(dir.path(), &[DUMBBELL]);
+    let out = dir.path().join("o.gpkg");
+    for (input, code, words) in [
+        (
+            ", merge_by: id",
+            78,
+            "merge_by only applies with `merge_adjacent: true`",
+        ),
+        (
+            ", merge_adjacent: true, merge_by: river",
+            1,
+            "no field `river`; its fields are id",
+        ),
+        (
+            ", connect: { source: /nonexistent/net.gpkg }",
+            1,
+            "/nonexistent/net.gpkg",
+        ),
+        (
+            ", connect: { source: SRC, snap: -1 }",
+            78,
+            "snap must be ≥ 0",
+        ),
+    ] {
+        let input = input.replace("SRC", &src);
+        let text = format!(
+            "input: {{ source: {src}, layer: shapes{input} }}\nsteps:\n  - skeleton: {{ methods: [MA] }}\noutput: {{ path: {} }}\n",
+            out.display()
+        );
+        let p = pipeline(dir.path(), "bad.yaml", &text);
+        for cmd in ["validate", "run"] {
+            let (c, err) = code_and_err(&skeletonise(&[cmd, p.to_str().unwrap()]));
+            assert_eq!(c, code, "{cmd} {input}: {err}");
+            assert!(err.contains(words), "{cmd} {input}: {err}");
+            assert!(!out.exists(), "{cmd} {input}: nothing written");
+        }
+    }
+}
