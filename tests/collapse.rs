@@ -637,6 +637,7 @@ fn a_river_in_three_adjacent_reaches_gives_one_line_without_gap_or_kink_at_the_s
             "the line passes the seam at {deg}° in its middle: {near}"
         );
         let turn = max_turn_near(&lines, seam, 1500.0);
+        eprintln!("seam at {deg}°: {near:.3} m from the line's middle, largest turn {turn:.2}°");
         assert!(turn < 3.0, "no kink at the seam at {deg}°: {turn}°");
     }
     // Only within the same value of a field: every reach has its own `id`.
