@@ -425,13 +425,26 @@ fn whole_mode_collapses_a_polygon_entirely_or_keeps_it() {
     assert_eq!(collapsed, vec![2], "the thin strip collapses");
 }
 
+/// `pipelines/collapse-rivers.yaml`, as shipped, on a training layer at
+/// `width`.
 fn real_layer(layer: &str, width: f64) -> Measured {
     let dir = tmp();
-    let out = collapse_pipeline(
-        dir.path(),
-        &common::root(TRAIN),
-        layer,
-        &format!("{{ width: {width} }}"),
+    let out = dir.path().join(format!("{layer}.gpkg"));
+    let o = skeletonise(&[
+        "run",
+        "pipelines/collapse-rivers.yaml",
+        "--set",
+        &format!("input.layer={layer}"),
+        "--set",
+        &format!("steps.collapse.width={width}"),
+        "-o",
+        out.to_str().unwrap(),
+        "-q",
+    ]);
+    assert!(o.status.success(), "{}", code_and_err(&o).1);
+    assert!(
+        common::count(&open(&out), "widths") > 0,
+        "the pipeline writes widths"
     );
     let m = measure(&out, &sources(TRAIN, layer), width);
     eprintln!("{layer} width {width}: {m:?}");
