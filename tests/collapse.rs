@@ -844,3 +844,34 @@ fn bad_merge_and_connect_inputs_are_errors_before_any_work() {
         }
     }
 }
+
+#[test]
+fn the_report_of_a_collapse_run_draws_each_feature_once_with_all_its_lines() {
+    let dir = tmp();
+    let src = wkt_layer(dir.path(), &[DUMBBELL]);
+    let page = |collapse: &str| {
+        let out = collapse_pipeline(dir.path(), &src, "shapes", collapse);
+        let html = dir.path().join("r.html");
+        let o = skeletonise(&[
+            "report",
+            out.to_str().unwrap(),
+            "-o",
+            html.to_str().unwrap(),
+            "-q",
+        ]);
+        assert!(o.status.success(), "{}", code_and_err(&o).1);
+        (
+            common::count(&open(&out), "skeletons"),
+            std::fs::read_to_string(&html).unwrap(),
+        )
+    };
+    // Width 1: nothing collapses, one row; width 300: two rows.
+    let (rows_plain, plain) = page("{ width: 1 }");
+    let (rows_collapsed, collapsed) = page("{ width: 300 }");
+    assert_eq!((rows_plain, rows_collapsed), (1, 2));
+    assert_eq!(
+        collapsed.matches("<path").count(),
+        plain.matches("<path").count(),
+        "the collapsed and kept rows are drawn as one skeleton"
+    );
+}

@@ -95,6 +95,28 @@ fn lines(f: &Feature<'_>) -> Option<geo::MultiLineString<f64>> {
     }
 }
 
+/// A `collapse` run writes a feature's skeleton in two rows (collapsed
+/// lines and the centreline through the kept areas), one after the other:
+/// one row again with all its lines, as a run without collapse writes it.
+fn whole_skeletons(rows: Vec<SkeletonRow>) -> Vec<SkeletonRow> {
+    let mut out: Vec<SkeletonRow> = Vec::with_capacity(rows.len());
+    for r in rows {
+        match out.last_mut() {
+            Some(prev)
+                if prev.collapsed.is_some()
+                    && r.collapsed.is_some()
+                    && prev.src_fid == r.src_fid
+                    && prev.polygon_part == r.polygon_part =>
+            {
+                prev.geometry.0.extend(r.geometry.0);
+                prev.collapsed = None;
+            }
+            _ => out.push(r),
+        }
+    }
+    out
+}
+
 impl OutputFile {
     /// Opens a GeoPackage written by `skeletonise run` or `score`.
     pub fn open(path: &Path) -> Result<Self, IoError> {
@@ -277,7 +299,7 @@ impl OutputFile {
         geometry: bool,
     ) -> Result<Vec<SkeletonRow>, IoError> {
         let source = self.source_fields()?;
-        self.rows(&self.skeleton_layer, filter, |c, f| SkeletonRow {
+        let rows = self.rows(&self.skeleton_layer, filter, |c, f| SkeletonRow {
             src_fid: c.fid(f),
             polygon_part: c.polygon_part(f),
             attributes: source
@@ -300,7 +322,8 @@ impl OutputFile {
             collapsed: c.int(f, "collapsed").map(|v| v == 1),
             members: c.text(f, "members"),
             measures: None,
-        })
+        })?;
+        Ok(whole_skeletons(rows))
     }
 
     /// The rows of `bars` that pass `filter`.
