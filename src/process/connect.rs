@@ -2,7 +2,8 @@
 //! through the polygons. Where a line touches or crosses ∂P — or ends within
 //! `snap` of it — that boundary point is a *connection point*, and the chosen
 //! skeleton gets a leg from its nearest point to it (a straight segment
-//! inside P), so that pruning cannot have removed it and the network runs
+//! inside P, leaving the boundary within 60° of its inward normal), so that
+//! pruning cannot have removed it and the network runs
 //! on through the polygon. The lines themselves are not modified; the
 //! `connections` layer lists every leg with the line it serves.
 
@@ -127,8 +128,9 @@ fn intersection(p: Coord<f64>, q: Coord<f64>, a: Coord<f64>, b: Coord<f64>) -> O
     ((0.0..=1.0).contains(&t) && (0.0..=1.0).contains(&u)).then(|| p + r * t)
 }
 
-/// `g` with a leg to every connection point: from the nearest point of the
-/// skeleton that sees the point (the edge split there), straight to it.
+/// `g` with a leg to every connection point: straight from the nearest
+/// point of the skeleton that sees it within 60° of the boundary's inward
+/// normal there (the edge split at that point).
 /// A point the skeleton already reaches (within `1e-9 × extent`) gets a
 /// zero-length leg, so that every connection point is listed.
 pub fn add_legs(
