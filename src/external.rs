@@ -17,7 +17,7 @@ use crate::io::reader::Reader;
 use crate::pipeline::{run_job, Given, Job, RunError, RunOptions, RunSummary};
 use crate::process::{polygon_parts, PrepareParams, ProcessParams};
 use crate::score::ScoreParams;
-use geo::{BoundingRect, Geometry, LineString, MultiLineString};
+use geo::{BoundingRect, LineString, MultiLineString};
 use rstar::{primitives::GeomWithData, primitives::Rectangle, RTree, AABB};
 use std::collections::HashMap;
 
@@ -51,15 +51,7 @@ pub struct ScoreJob {
     pub output: OutputSpec,
 }
 
-fn lines_of(g: &Geometry<f64>, out: &mut Vec<LineString<f64>>) {
-    match g {
-        Geometry::LineString(l) => out.push(l.clone()),
-        Geometry::MultiLineString(m) => out.extend(m.0.iter().cloned()),
-        Geometry::Line(l) => out.push(LineString(vec![l.start, l.end])),
-        Geometry::GeometryCollection(c) => c.iter().for_each(|g| lines_of(g, out)),
-        _ => {}
-    }
-}
+use crate::process::connect::lines_of;
 
 fn key_text(f: &Feature, field: Option<usize>) -> Option<String> {
     match field {

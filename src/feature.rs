@@ -60,6 +60,16 @@ pub struct Feature {
     pub source_wkb: Option<Vec<u8>>,
     /// Set when MakeValid changed the geometry.
     pub repaired: bool,
+    /// The source FIDs dissolved into this feature by `input.merge_adjacent`
+    /// (empty: the feature is only itself).
+    pub members: Vec<u64>,
+}
+
+impl Feature {
+    /// How many source features this one stands for.
+    pub fn source_count(&self) -> u64 {
+        self.members.len().max(1) as u64
+    }
 }
 
 impl Feature {
@@ -72,6 +82,7 @@ impl Feature {
             geometry_error: None,
             source_wkb: None,
             repaired: false,
+            members: Vec::new(),
         }
     }
 }

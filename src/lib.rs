@@ -19,6 +19,7 @@
 
 #![warn(missing_docs)]
 
+pub mod collapse;
 pub mod config;
 #[cfg(feature = "gdal")]
 pub mod external;

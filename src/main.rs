@@ -160,6 +160,9 @@ impl ScoreArgs {
             where_: None,
             bbox: None,
             reproject: self.reproject.clone(),
+            merge_adjacent: false,
+            merge_by: None,
+            connect: None,
         };
         ScoreJob {
             polygons: spec(&self.polygons, &self.polygons_layer),
@@ -180,6 +183,7 @@ impl ScoreArgs {
                 bars: self.bars,
                 explode: false,
                 widths: false,
+                measures: Default::default(),
                 report: None,
             },
         }
@@ -259,6 +263,9 @@ impl ReportArgs {
                 .reproject
                 .clone()
                 .or_else(|| recorded.as_ref().and_then(|r| r.input_reproject.clone())),
+            merge_adjacent: false,
+            merge_by: None,
+            connect: None,
         });
         Ok(skeletonise::reporting::ReportJob {
             html: self

@@ -44,6 +44,8 @@ pub enum GeometryKind {
     MultiLineString,
     /// LINESTRING.
     LineString,
+    /// POLYGON.
+    Polygon,
     /// Any geometry (the `rejected` layer keeps the input's).
     Unknown,
     /// An attribute table.
@@ -57,6 +59,10 @@ pub enum Shape<'a> {
     Lines(&'a geo::MultiLineString<f64>),
     /// One line.
     Line(geo::LineString<f64>),
+    /// One polygon.
+    Polygon(&'a geo::Polygon<f64>),
+    /// Lines with an M value per vertex (line by line).
+    LinesM(&'a geo::MultiLineString<f64>, &'a [Vec<f64>]),
     /// A geometry as WKB.
     Wkb(&'a [u8]),
 }
@@ -68,6 +74,10 @@ pub enum When {
     Always,
     /// Only with `output.explode`.
     Explode,
+    /// Only when the pipeline has a `collapse` step.
+    Collapse,
+    /// Only with `input.merge_adjacent`.
+    Merge,
 }
 
 /// One column of a layer.
@@ -89,6 +99,26 @@ pub const fn col<R>(name: &'static str, ty: ColumnType, get: fn(&R) -> Cell) -> 
         ty,
         get,
         when: When::Always,
+    }
+}
+
+/// A column written only when the pipeline collapses.
+pub const fn col_collapse<R>(name: &'static str, ty: ColumnType, get: fn(&R) -> Cell) -> Column<R> {
+    Column {
+        name,
+        ty,
+        get,
+        when: When::Collapse,
+    }
+}
+
+/// A column written only with `input.merge_adjacent`.
+pub const fn col_merge<R>(name: &'static str, ty: ColumnType, get: fn(&R) -> Cell) -> Column<R> {
+    Column {
+        name,
+        ty,
+        get,
+        when: When::Merge,
     }
 }
 
@@ -244,6 +274,15 @@ pub struct SkeletonRow {
     pub repaired: bool,
     /// Why the scores are missing, when they are.
     pub note: Option<String>,
+    /// With a `collapse` step: the lines where the polygon collapsed (true)
+    /// or the centreline through its kept areas (false).
+    pub collapsed: Option<bool>,
+    /// With `input.merge_adjacent`: the source FIDs dissolved into this
+    /// feature, comma-separated.
+    pub members: Option<String>,
+    /// With `output.measures: width`: the M value of every vertex, line by
+    /// line (the local width 2r).
+    pub measures: Option<Vec<Vec<f64>>>,
 }
 
 impl Scored for SkeletonRow {
@@ -256,7 +295,12 @@ impl Scored for SkeletonRow {
 pub const SKELETONS: LayerDef<SkeletonRow> = LayerDef {
     name: "skeletons",
     geometry: GeometryKind::MultiLineString,
-    shape: |r| Some(Shape::Lines(&r.geometry)),
+    shape: |r| {
+        Some(match &r.measures {
+            Some(m) => Shape::LinesM(&r.geometry, m),
+            None => Shape::Lines(&r.geometry),
+        })
+    },
     attributes: Some(|r| &r.attributes),
     columns: columns!(SkeletonRow;
         [
@@ -270,8 +314,46 @@ pub const SKELETONS: LayerDef<SkeletonRow> = LayerDef {
             col("legs", Int32, |r: &SkeletonRow| int(r.legs)),
             col("repaired", Int32, |r: &SkeletonRow| int(i64::from(r.repaired))),
             col("note", Text, |r: &SkeletonRow| r.note.as_deref().map_or(Cell::Null, text)),
+            col_collapse("collapsed", Int32, |r: &SkeletonRow| r.collapsed.map_or(Cell::Null, |c| int(i64::from(c)))),
+            col_merge("members", Text, |r: &SkeletonRow| r.members.as_deref().map_or(Cell::Null, text)),
         ],
     ),
+};
+
+/// One row of the `areas` layer: a piece of a polygon kept as an area by
+/// the `collapse` step.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AreaRow {
+    /// Source FID.
+    pub src_fid: Option<u64>,
+    /// Index of the polygon part (with `explode`).
+    pub polygon_part: Option<usize>,
+    /// Source attributes.
+    pub attributes: Vec<Value>,
+    /// The piece.
+    pub geometry: geo::Polygon<f64>,
+    /// Cuts on its boundary, where collapsed lines meet it.
+    pub cuts: usize,
+    /// With `input.merge_adjacent`: the source FIDs dissolved, comma-separated.
+    pub members: Option<String>,
+}
+
+/// The `areas` layer (with a `collapse` step).
+pub const AREAS: LayerDef<AreaRow> = LayerDef {
+    name: "areas",
+    geometry: GeometryKind::Polygon,
+    shape: |r| Some(Shape::Polygon(&r.geometry)),
+    attributes: Some(|r| &r.attributes),
+    columns: &[
+        col("src_fid", Int64, |r| fid(r.src_fid)),
+        col_explode("polygon_part", Int32, |r| {
+            r.polygon_part.map_or(Cell::Null, int)
+        }),
+        col("cuts", Int32, |r| int(r.cuts)),
+        col_merge("members", Text, |r| {
+            r.members.as_deref().map_or(Cell::Null, text)
+        }),
+    ],
 };
 
 /// One row of the `candidates` layer: one method's result for one feature.
@@ -404,6 +486,30 @@ pub const WIDTHS: LayerDef<WidthRow> = LayerDef {
     ],
 };
 
+/// One row of the `connections` layer: a leg added to a skeleton for a
+/// line of `input.connect`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ConnectionRow {
+    /// Source FID of the polygon.
+    pub src_fid: Option<u64>,
+    /// FID of the network line the leg serves.
+    pub line_fid: Option<u64>,
+    /// The leg, from the skeleton to the connection point on the boundary.
+    pub geometry: geo::LineString<f64>,
+}
+
+/// The `connections` layer (with `input.connect`).
+pub const CONNECTIONS: LayerDef<ConnectionRow> = LayerDef {
+    name: "connections",
+    geometry: GeometryKind::LineString,
+    shape: |r| Some(Shape::Line(r.geometry.clone())),
+    attributes: None,
+    columns: &[
+        col("src_fid", Int64, |r| fid(r.src_fid)),
+        col("line_fid", Int64, |r| fid(r.line_fid)),
+    ],
+};
+
 /// One row of the `rejected` layer.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RejectedRow {
@@ -509,6 +615,10 @@ pub struct Rows {
     pub bars: Vec<BarRow>,
     /// `widths` rows.
     pub widths: Vec<WidthRow>,
+    /// `areas` rows.
+    pub areas: Vec<AreaRow>,
+    /// `connections` rows.
+    pub connections: Vec<ConnectionRow>,
     /// `rejected` rows.
     pub rejected: Vec<RejectedRow>,
 }
@@ -520,6 +630,8 @@ impl Rows {
         self.candidates.append(&mut other.candidates);
         self.bars.append(&mut other.bars);
         self.widths.append(&mut other.widths);
+        self.areas.append(&mut other.areas);
+        self.connections.append(&mut other.connections);
         self.rejected.append(&mut other.rejected);
     }
 }
@@ -547,7 +659,9 @@ mod tests {
                 "components",
                 "legs",
                 "repaired",
-                "note"
+                "note",
+                "collapsed",
+                "members"
             ]
         );
         let cands: Vec<&str> = CANDIDATES.column_names().collect();

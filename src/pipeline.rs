@@ -97,9 +97,18 @@ pub enum RunError {
 /// layer exists, the CRS is projected (or reprojected), the filter is valid
 /// and the output can be written. Returns what the source holds.
 pub fn validate(p: &Pipeline) -> Result<crate::io::SourceInfo, RunError> {
-    let mut reader = Reader::open(&p.file.input)?;
+    let input = &p.file.input;
+    let mut reader = Reader::open(input)?;
     reader.probe()?;
-    check_output(&p.file.output, &[&p.file.input.source])?;
+    if let Some(reason) = merge_field(input, reader.info()).err() {
+        return Err(RunError::Io(reason));
+    }
+    let mut sources = vec![input.source.as_str()];
+    if let Some(c) = &input.connect {
+        Reader::open(&c.input(input))?.probe()?;
+        sources.push(c.source.as_str());
+    }
+    check_output(&p.file.output, &sources)?;
     if let Some(html) = p.file.output.report_path() {
         check_path(&html)?;
     }
@@ -212,10 +221,10 @@ impl Counts {
             tracing::warn!(fid = f.fid, reason = %rej.reason, "feature rejected");
         }
         match &r.status {
-            Status::Rejected => self.rejected += 1,
-            Status::Filtered => self.filtered += 1,
+            Status::Rejected => self.rejected += f.source_count(),
+            Status::Filtered => self.filtered += f.source_count(),
             Status::Written(methods) => {
-                self.written += 1;
+                self.written += f.source_count();
                 for m in methods {
                     *self.methods.entry(m.clone()).or_default() += 1;
                 }
@@ -342,6 +351,11 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
         .map_err(|_| RunError::Threads(threads))?;
     let batch = opts.batch_size.unwrap_or(256).max(1);
     let make_valid = job.params.prepare.make_valid;
+    let mut params = job.params.clone();
+    if let Some(c) = &job.input.connect {
+        params.connect = Some(std::sync::Arc::new(read_network(c, job.input)?));
+    }
+    let params = &params;
     std::thread::scope(|scope| {
         // The reader opens the source on its own thread (GDAL handles stay on
         // the thread that made them) and reports what it found first.
@@ -355,8 +369,18 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
             Err(_) => return Err(reader_gone(reader)),
         };
         let mut inputs = vec![job.input.source.as_str()];
+        if let Some(c) = &job.input.connect {
+            inputs.push(c.source.as_str());
+        }
         inputs.extend(job.other_inputs.iter().map(String::as_str));
-        let writer = Writer::create(job.output, &info, &inputs)?;
+        let writer = Writer::create(
+            job.output,
+            &info,
+            &inputs,
+            job.params.collapse.is_some(),
+            job.input.merge_adjacent,
+            job.input.connect.is_some(),
+        )?;
         tracing::info!(
             pipeline = %job.name,
             source = %info.source,
@@ -379,10 +403,10 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
                 let done: Vec<FeatureRows> = pool.install(|| {
                     features
                         .par_iter()
-                        .map(|f| feature_rows(f, job.skeletons(f), &job.params, row_opts))
+                        .map(|f| feature_rows(f, job.skeletons(f), params, row_opts))
                         .collect()
                 });
-                counts.read += features.len() as u64;
+                counts.read += features.iter().map(Feature::source_count).sum::<u64>();
                 let mut rows = Rows::default();
                 for (f, r) in features.iter().zip(done) {
                     counts.add(f, &r, job.on_error)?;
@@ -441,11 +465,91 @@ fn read_batches(
     if info_tx.send(Ok(reader.info().clone())).is_err() {
         return;
     }
+    if input.merge_adjacent {
+        return read_merged(&mut reader, input, batch, make_valid, batch_tx);
+    }
     let r = reader.read::<Stop>(batch, make_valid, |features| {
         batch_tx.send(Ok(features)).map_err(|_| Stop::Gone)
     });
     if let Err(Stop::Failed(e)) = r {
         let _ = batch_tx.send(Err(e));
+    }
+}
+
+/// The index of `input.merge_by` among the source's fields, or the error
+/// naming the fields there are.
+fn merge_field(input: &InputSpec, info: &SourceInfo) -> Result<Option<usize>, IoError> {
+    let Some(name) = &input.merge_by else {
+        return Ok(None);
+    };
+    let fields = &info.fields;
+    fields
+        .iter()
+        .position(|f| &f.name == name)
+        .map(Some)
+        .ok_or_else(|| {
+            let names: Vec<&str> = fields.iter().map(|f| f.name.as_str()).collect();
+            IoError::Read {
+                source_name: input.source.clone(),
+                reason: format!(
+                    "`input.merge_by`: the layer has no field `{name}`; its fields are {}",
+                    names.join(", ")
+                ),
+            }
+        })
+}
+
+/// The lines of `input.connect`.
+fn read_network(
+    c: &crate::config::ConnectSpec,
+    input: &InputSpec,
+) -> Result<crate::process::connect::Network, RunError> {
+    let mut reader = Reader::open(&c.input(input))?;
+    let mut lines = Vec::new();
+    reader.read::<IoError>(1024, false, |features| {
+        for f in features {
+            let mut ls = Vec::new();
+            if let Some(g) = &f.geometry {
+                crate::process::connect::lines_of(g, &mut ls);
+            }
+            lines.extend(ls.into_iter().map(|l| (f.fid, l)));
+        }
+        Ok(())
+    })?;
+    tracing::info!(source = %c.source, lines = lines.len(), "connect: line network read");
+    Ok(crate::process::connect::Network::new(lines, c.snap))
+}
+
+/// `input.merge_adjacent`: every feature read first, the adjacent ones
+/// dissolved into one per group, then sent in batches.
+fn read_merged(
+    reader: &mut Reader,
+    input: &InputSpec,
+    batch: usize,
+    make_valid: bool,
+    batch_tx: mpsc::SyncSender<Batch>,
+) {
+    let by = match merge_field(input, reader.info()) {
+        Ok(by) => by,
+        Err(e) => {
+            let _ = batch_tx.send(Err(e));
+            return;
+        }
+    };
+    let mut all = Vec::new();
+    let r = reader.read::<Stop>(batch, make_valid, |features| {
+        all.extend(features);
+        Ok(())
+    });
+    if let Err(Stop::Failed(e)) = r {
+        let _ = batch_tx.send(Err(e));
+        return;
+    }
+    let merged = crate::process::merge::merge_adjacent(all, by);
+    for chunk in merged.chunks(batch) {
+        if batch_tx.send(Ok(chunk.to_vec())).is_err() {
+            return;
+        }
     }
 }
 

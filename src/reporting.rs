@@ -271,6 +271,9 @@ fn polygon_spec(file: &OutputFile, job: &ReportJob) -> Result<InputSpec, ReportE
         where_: None,
         bbox: None,
         reproject: run.input_reproject.clone(),
+        merge_adjacent: false,
+        merge_by: None,
+        connect: None,
     })
 }
 

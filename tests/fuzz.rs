@@ -211,3 +211,63 @@ proptest! {
         }
     }
 }
+
+/// The `collapse` step on one polygon at `fraction` of its extent: no panic,
+/// kept areas inside the polygon and no larger than it, lines inside it.
+fn check_collapse(poly: &Polygon<f64>, fraction: f64) -> Result<(), String> {
+    use geo::Area;
+    let pp = PreparedPolygon::new(poly).map_err(|e| e.to_string())?;
+    let mut p = ProcessParams::all_steps();
+    p.collapse = Some(skeletonise::collapse::CollapseParams::new(
+        fraction * pp.extent(),
+    ));
+    let g = Geometry::Polygon(poly.clone());
+    let r = std::panic::catch_unwind(|| process(Some(&g), &p))
+        .map_err(|_| "process panicked".to_string())?;
+    let Processed::Done(o) = r else {
+        return Ok(());
+    };
+    let tol = 1e-6 * pp.extent();
+    let parts = o.collapse.ok_or("no collapse")?;
+    let area: f64 = parts
+        .iter()
+        .flat_map(|c| &c.areas)
+        .map(|a| a.polygon.unsigned_area())
+        .sum();
+    if area > poly.unsigned_area() * (1.0 + 1e-6) {
+        return Err(format!(
+            "areas {area} exceed the polygon {}",
+            poly.unsigned_area()
+        ));
+    }
+    for c in &parts {
+        let points = c
+            .areas
+            .iter()
+            .flat_map(|a| a.polygon.exterior().0.iter())
+            .chain(c.collapsed.iter().chain(&c.kept).flat_map(|l| l.0.iter()));
+        for &q in points {
+            if !pp.boundary().contains_with_tolerance(q, tol) {
+                return Err(format!("point {q:?} outside the polygon"));
+            }
+        }
+    }
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig {
+        cases: std::env::var("PROPTEST_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(48),
+        ..ProptestConfig::default()
+    })]
+
+    #[test]
+    fn random_polygons_with_holes_collapse_without_breaking(
+        p in polygon_strategy(),
+        fraction in prop::sample::select(vec![0.01, 0.05, 0.2, 0.6]),
+    ) {
+        if let Err(e) = check_collapse(&p, fraction) {
+            prop_assert!(false, "{e} (width {fraction} × extent): {:?}", p);
+        }
+    }
+}

@@ -26,6 +26,9 @@ fn reads_every_training_layer_with_its_fields() {
         where_: Some("area_m2 > 1e7".into()),
         bbox: None,
         reproject: None,
+        merge_adjacent: false,
+        merge_by: None,
+        connect: None,
     })
     .unwrap();
     let names: Vec<_> = r.info().fields.iter().map(|f| f.name.as_str()).collect();

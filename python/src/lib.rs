@@ -59,6 +59,20 @@ fn pipeline_error(e: ConfigError) -> PyErr {
     PipelineError::new_err(e.to_string())
 }
 
+impl Pipeline {
+    /// The steps, unless they need what only the command line writes: the
+    /// `collapse` step's kept areas are a second layer beside the lines.
+    fn supported(steps: config::Steps) -> PyResult<Self> {
+        if steps.process_params().collapse.is_some() {
+            return Err(PipelineError::new_err(
+                "the `collapse` step writes kept areas beside the lines and runs from the command line only \
+                 (`skeletonise run`); leave it out of the pipeline given to Python",
+            ));
+        }
+        Ok(Self { steps })
+    }
+}
+
 #[pymethods]
 impl Pipeline {
     /// Loads and validates a pipeline file (`input` and `output` may be
@@ -67,8 +81,8 @@ impl Pipeline {
     #[pyo3(signature = (path, overrides = Vec::new()))]
     fn load(path: std::path::PathBuf, overrides: Vec<String>) -> PyResult<Self> {
         config::load_steps(&path, &overrides)
-            .map(|steps| Self { steps })
             .map_err(pipeline_error)
+            .and_then(Self::supported)
     }
 
     /// Validates a steps document made from keyword options (JSON text);
@@ -76,7 +90,6 @@ impl Pipeline {
     #[staticmethod]
     fn from_options(text: &str, origin: &str) -> PyResult<Self> {
         config::load_steps_str(text, origin, &[])
-            .map(|steps| Self { steps })
             .map_err(|e| {
                 pipeline_error(ConfigError {
                     key: keyword_key(&e.key),
@@ -84,6 +97,7 @@ impl Pipeline {
                     ..e
                 })
             })
+            .and_then(Self::supported)
     }
 
     /// Whether the `prepare` step repairs invalid polygons.
@@ -165,7 +179,7 @@ fn columns(layer: &str, explode: bool) -> PyResult<(Vec<(&'static str, &'static 
         let cols = def
             .columns
             .iter()
-            .filter(|c| c.when == When::Always || explode)
+            .filter(|c| c.when == When::Always || (c.when == When::Explode && explode))
             .map(|c| (c.name, type_name(c.ty)))
             .collect();
         (cols, def.attributes.is_some())

@@ -159,6 +159,7 @@ fn features(
             geometry_error: None,
             source_wkb: None,
             repaired,
+            members: Vec::new(),
         };
         match input.geometry(i) {
             Ok(Some(g)) if repaired => match wkb::areal_parts(g) {
@@ -218,6 +219,7 @@ fn work(
         candidates: opts.candidates,
         bars: false,
         widths: false,
+        measures: false,
     };
     let results: Vec<FeatureRows> = map(&feats, par, |_, f| {
         feature_rows(f, Skeletons::Computed, params, row_opts)

@@ -39,7 +39,7 @@ pub struct ColumnData {
 pub fn columns<R>(def: &LayerDef<R>, explode: bool, rows: &[Out<'_, R>]) -> Vec<ColumnData> {
     def.columns
         .iter()
-        .filter(|c| c.when == When::Always || explode)
+        .filter(|c| c.when == When::Always || (c.when == When::Explode && explode))
         .map(|c| {
             let cell = |r: &Out<'_, R>| match r {
                 Out::Row(r) => (c.get)(r),
@@ -105,7 +105,8 @@ pub fn lines<'a, R>(
             Out::Row(r) => match (def.shape)(r) {
                 Some(Shape::Lines(m)) => Some(m.clone()),
                 Some(Shape::Line(l)) => Some(MultiLineString(vec![l])),
-                Some(Shape::Wkb(_)) | None => None,
+                Some(Shape::LinesM(m, _)) => Some(m.clone()),
+                Some(Shape::Polygon(_) | Shape::Wkb(_)) | None => None,
             },
             Out::Empty(_) => None,
         })

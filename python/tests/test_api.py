@@ -117,6 +117,13 @@ def test_option_messages_equal_the_pipeline_files(tmp_path):
     assert file_text.split("`: ", 1)[1] == kw_text.split("`: ", 1)[1]
 
 
+def test_a_collapse_pipeline_is_refused_with_the_reason():
+    # The collapse step's kept areas are a layer of their own, which only the command line writes.
+    with pytest.raises(skeletonise.PipelineError) as e:
+        skeletonise.apply(gpd.GeoDataFrame(geometry=[RIVER]), ROOT / "pipelines" / "collapse-rivers.yaml")
+    assert "`collapse` step" in str(e.value) and "skeletonise run" in str(e.value), str(e.value)
+
+
 def test_step_options_reach_the_steps():
     wavy = shapely.buffer(shapely.LineString([(0, 0), (50, 20), (100, 0), (150, 20)]), 5)
     trunk = skeletonise.skeletonise([wavy], prune="trunk", methods=["CDT", "MA"])

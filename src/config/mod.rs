@@ -16,8 +16,9 @@
 pub mod locate;
 mod sections;
 
-pub use sections::{InputSpec, LayerRef, OutputSpec, ReportSpec};
+pub use sections::{ConnectSpec, InputSpec, LayerRef, Measures, OutputSpec, ReportSpec};
 
+use crate::collapse::CollapseParams;
 use crate::graph::extend::ExtendParams;
 use crate::graph::prune::PruneParams;
 use crate::methods::SkeletonParams;
@@ -53,6 +54,8 @@ pub enum Step {
     Prune(PruneParams),
     /// Extension of legs to the boundary: `centred` continues along the method's own removed legs, or ends between them where they fork on both sides of the line.
     Extend(ExtendParams),
+    /// Partial collapse for map production: the chosen skeleton replaces the polygon where its local width 2r is below `width` (lines in the skeleton layer with `collapsed = 1`), the wider pieces stay areas (layer `areas`), cut across the polygon where the lines meet them.
+    Collapse(CollapseParams),
     /// The paper's metrics.
     Score(ScoreParams),
     /// Choice of the best method per feature: among the candidates with hits, those with coverage ≥ min(`min_coverage`, best coverage − `coverage_slack`) are eligible; the smallest `by` wins, distortions within `tie` of it counting as equal (the method listed first wins).
@@ -67,6 +70,7 @@ impl Step {
             Step::Skeleton(_) => "skeleton",
             Step::Prune(_) => "prune",
             Step::Extend(_) => "extend",
+            Step::Collapse(_) => "collapse",
             Step::Score(_) => "score",
             Step::Select(_) => "select",
         }
@@ -78,14 +82,16 @@ impl Step {
             Step::Prepare(p) => p.validate(),
             Step::Skeleton(p) => p.validate(),
             Step::Prune(p) => p.validate(),
+            Step::Collapse(p) => p.validate(),
             Step::Extend(_) | Step::Score(_) => Ok(()),
             Step::Select(p) => p.validate(),
         }
     }
 
     /// Steps in the only order they may appear in.
-    pub const ORDER: [&'static str; 6] =
-        ["prepare", "skeleton", "prune", "extend", "score", "select"];
+    pub const ORDER: [&'static str; 7] = [
+        "prepare", "skeleton", "prune", "extend", "collapse", "score", "select",
+    ];
 }
 
 /// The pipeline file as written.
@@ -97,7 +103,7 @@ pub struct PipelineFile {
     pub name: Option<String>,
     /// Where the polygons come from.
     pub input: InputSpec,
-    /// Steps, in the order prepare → skeleton → prune → extend → score → select; only `skeleton` is required.
+    /// Steps, in the order prepare → skeleton → prune → extend → collapse → score → select; only `skeleton` is required.
     pub steps: Vec<Step>,
     /// Where the GeoPackage goes.
     pub output: OutputSpec,
@@ -129,6 +135,7 @@ pub fn process_params(steps: &[Step], output: Option<&OutputSpec>) -> ProcessPar
             Step::Skeleton(x) => p.skeleton = x.clone(),
             Step::Prune(x) => p.prune = Some(*x),
             Step::Extend(x) => p.extend = Some(*x),
+            Step::Collapse(x) => p.collapse = Some(*x),
             Step::Score(x) => p.score = Some(*x),
             Step::Select(x) => p.select = Some(*x),
         }
@@ -136,6 +143,7 @@ pub fn process_params(steps: &[Step], output: Option<&OutputSpec>) -> ProcessPar
     if let Some(o) = output {
         p.keep_bars = o.bars;
         p.keep_widths = o.widths;
+        p.keep_measures = o.measures == Measures::Width;
     }
     p
 }

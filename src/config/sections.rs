@@ -42,6 +42,46 @@ pub struct InputSpec {
     /// Target CRS (e.g. `EPSG:3035`); required when the source CRS is geographic.
     #[serde(default)]
     pub reproject: Option<String>,
+    /// Process polygons that share boundary (river reaches, tiles, map sheets) as one: each group is dissolved before skeletonising, and the `members` column lists its FIDs.
+    #[serde(default)]
+    pub merge_adjacent: bool,
+    /// With `merge_adjacent`: merge only polygons with the same value of this source field.
+    #[serde(default)]
+    pub merge_by: Option<String>,
+    /// A line network (any OGR source and layer of lines, e.g. the rivers) to continue through the polygons: where a line touches or crosses a polygon's boundary (or ends within `snap` of it) the skeleton gets a leg to that point (layer `connections`).
+    #[serde(default)]
+    pub connect: Option<ConnectSpec>,
+}
+
+/// The `input.connect` section: the line network.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ConnectSpec {
+    /// Any OGR data source string of lines, in the input's CRS (reprojected with it).
+    pub source: String,
+    /// Layer name or zero-based index; default the first layer.
+    #[serde(default)]
+    pub layer: Option<LayerRef>,
+    /// A line end within this distance of a polygon's boundary connects (CRS units; default 0: only lines that touch or cross it).
+    #[serde(default)]
+    pub snap: f64,
+}
+
+impl ConnectSpec {
+    /// The network's lines as an input of their own (same reprojection as
+    /// the polygons).
+    pub fn input(&self, polygons: &InputSpec) -> InputSpec {
+        InputSpec {
+            source: self.source.clone(),
+            layer: self.layer.clone(),
+            where_: None,
+            bbox: None,
+            reproject: polygons.reproject.clone(),
+            merge_adjacent: false,
+            merge_by: None,
+            connect: None,
+        }
+    }
 }
 
 impl InputSpec {
@@ -49,6 +89,24 @@ impl InputSpec {
     pub fn validate(&self) -> Result<(), (String, String)> {
         if self.source.trim().is_empty() {
             return Err(("source".into(), "give the input data source".into()));
+        }
+        if self.merge_by.is_some() && !self.merge_adjacent {
+            return Err((
+                "merge_by".into(),
+                "merge_by only applies with `merge_adjacent: true`; set it, or remove merge_by"
+                    .into(),
+            ));
+        }
+        if let Some(c) = &self.connect {
+            if c.source.trim().is_empty() {
+                return Err((
+                    "connect.source".into(),
+                    "give the line network's data source".into(),
+                ));
+            }
+            if !(c.snap.is_finite() && c.snap >= 0.0) {
+                return Err(("connect.snap".into(), "snap must be ≥ 0 (CRS units)".into()));
+            }
         }
         if let Some([x0, y0, x1, y1]) = self.bbox {
             if ![x0, y0, x1, y1].iter().all(|v| v.is_finite()) {
@@ -76,6 +134,9 @@ impl InputSpec {
             where_: None,
             bbox: None,
             reproject: None,
+            merge_adjacent: false,
+            merge_by: None,
+            connect: None,
         }
     }
 }
@@ -110,12 +171,26 @@ pub struct OutputSpec {
     /// medial axis transform, for deciding what is narrow enough to collapse.
     #[serde(default)]
     pub widths: bool,
+    /// `width`: the skeleton layer's lines carry an M value per vertex, the polygon's local width 2r there (XYM geometry), so that a symbol can be drawn with the river's real width; `none` (default): XY.
+    #[serde(default)]
+    pub measures: Measures,
     /// Also write the visual report: one self-contained HTML file with every
     /// method's skeleton of the selected features side by side, their score
     /// tables and a summary of the run (`skeletonise report` makes it from
     /// any output later).
     #[serde(default)]
     pub report: Option<ReportSpec>,
+}
+
+/// What the skeleton layer's M values hold (`output.measures`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "lowercase")]
+pub enum Measures {
+    /// No M values (XY lines).
+    #[default]
+    None,
+    /// The local width 2r at every vertex.
+    Width,
 }
 
 impl OutputSpec {
@@ -151,6 +226,7 @@ impl From<&OutputSpec> for crate::process::RowOptions {
             candidates: o.candidates,
             bars: o.bars,
             widths: o.widths,
+            measures: o.measures == Measures::Width,
         }
     }
 }

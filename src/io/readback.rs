@@ -84,11 +84,37 @@ impl Fields {
 }
 
 fn lines(f: &Feature<'_>) -> Option<geo::MultiLineString<f64>> {
-    match f.geometry()?.to_geo().ok()? {
+    let g = f.geometry()?.clone();
+    // M values (`output.measures`) are not part of the lines read back.
+    // SAFETY: the handle is the clone's own, valid while `g` lives.
+    unsafe { gdal_sys::OGR_G_SetMeasured(g.c_geometry(), 0) };
+    match g.to_geo().ok()? {
         geo::Geometry::MultiLineString(m) => Some(m),
         geo::Geometry::LineString(l) => Some(geo::MultiLineString(vec![l])),
         _ => None,
     }
+}
+
+/// A `collapse` run writes a feature's skeleton in two rows (collapsed
+/// lines and the centreline through the kept areas), one after the other:
+/// one row again with all its lines, as a run without collapse writes it.
+fn whole_skeletons(rows: Vec<SkeletonRow>) -> Vec<SkeletonRow> {
+    let mut out: Vec<SkeletonRow> = Vec::with_capacity(rows.len());
+    for r in rows {
+        match out.last_mut() {
+            Some(prev)
+                if prev.collapsed.is_some()
+                    && r.collapsed.is_some()
+                    && prev.src_fid == r.src_fid
+                    && prev.polygon_part == r.polygon_part =>
+            {
+                prev.geometry.0.extend(r.geometry.0);
+                prev.collapsed = None;
+            }
+            _ => out.push(r),
+        }
+    }
+    out
 }
 
 impl OutputFile {
@@ -273,7 +299,7 @@ impl OutputFile {
         geometry: bool,
     ) -> Result<Vec<SkeletonRow>, IoError> {
         let source = self.source_fields()?;
-        self.rows(&self.skeleton_layer, filter, |c, f| SkeletonRow {
+        let rows = self.rows(&self.skeleton_layer, filter, |c, f| SkeletonRow {
             src_fid: c.fid(f),
             polygon_part: c.polygon_part(f),
             attributes: source
@@ -293,7 +319,11 @@ impl OutputFile {
             legs: c.count(f, "legs"),
             repaired: c.int(f, "repaired") == Some(1),
             note: c.text(f, "note"),
-        })
+            collapsed: c.int(f, "collapsed").map(|v| v == 1),
+            members: c.text(f, "members"),
+            measures: None,
+        })?;
+        Ok(whole_skeletons(rows))
     }
 
     /// The rows of `bars` that pass `filter`.

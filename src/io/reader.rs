@@ -345,6 +345,7 @@ impl Reader {
             geometry_error: None,
             source_wkb: None,
             repaired: false,
+            members: Vec::new(),
         };
         // gdal hands out a wrapper around a null handle for NULL geometries.
         // SAFETY: the handle is only compared with null.

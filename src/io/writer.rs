@@ -1,7 +1,9 @@
 //! Writer: the output GeoPackage (SPEC §9).
 //!
 //! Layers: `skeletons` (name configurable; one row per feature, or per part
-//! with `explode`), optional `candidates`, `bars` and `widths`, `rejected`,
+//! with `explode`; with a `collapse` step one per feature and value of
+//! `collapsed`), optional `candidates`, `bars` and `widths`, `areas` with a
+//! `collapse` step, `rejected`,
 //! and the attribute table `skeletonise_runs` — each created and filled from
 //! its description in [`crate::output`]. Everything is written to a temporary
 //! file beside the output, in one transaction per batch, and renamed over the
@@ -12,8 +14,8 @@ use super::reader::{FieldInfo, SourceInfo};
 use super::{signals, IoError};
 use crate::feature::Value;
 use crate::output::{
-    Cell, Column, ColumnType, GeometryKind, LayerDef, Rows, RunRecord, Shape, When, BARS,
-    CANDIDATES, REJECTED, RUNS, SKELETONS, WIDTHS,
+    Cell, Column, ColumnType, GeometryKind, LayerDef, Rows, RunRecord, Shape, When, AREAS, BARS,
+    CANDIDATES, CONNECTIONS, REJECTED, RUNS, SKELETONS, WIDTHS,
 };
 use gdal::spatial_ref::SpatialRef;
 use gdal::vector::{
@@ -31,6 +33,10 @@ pub struct Writer {
     tmp: PathBuf,
     path: PathBuf,
     spec: OutputSpec,
+    /// The pipeline collapses: the `areas` layer and the `collapsed` column.
+    collapse: bool,
+    /// `input.merge_adjacent`: the `members` column.
+    merge: bool,
     source_fields: Vec<(String, FieldInfo)>,
 }
 
@@ -162,6 +168,7 @@ fn ogr_geometry(g: GeometryKind) -> u32 {
     match g {
         GeometryKind::MultiLineString => OGRwkbGeometryType::wkbMultiLineString,
         GeometryKind::LineString => OGRwkbGeometryType::wkbLineString,
+        GeometryKind::Polygon => OGRwkbGeometryType::wkbPolygon,
         GeometryKind::Unknown => OGRwkbGeometryType::wkbUnknown,
         GeometryKind::None => OGRwkbGeometryType::wkbNone,
     }
@@ -207,10 +214,26 @@ fn shape_to_gdal(s: Shape<'_>) -> Result<Geometry, IoError> {
     match s {
         Shape::Lines(l) => to_gdal(l),
         Shape::Line(l) => to_gdal(&l),
+        Shape::Polygon(p) => to_gdal(p),
+        Shape::LinesM(lines, m) => lines_m(lines, m),
         Shape::Wkb(w) => {
             Geometry::from_wkb(w).map_err(|e| IoError::gdal("reading a WKB geometry", e))
         }
     }
+}
+
+/// Lines with an M value per vertex as a GDAL MULTILINESTRING M.
+fn lines_m(lines: &geo::MultiLineString<f64>, m: &[Vec<f64>]) -> Result<Geometry, IoError> {
+    let err = |e| IoError::gdal("making a measured line", e);
+    let mut multi = Geometry::empty(OGRwkbGeometryType::wkbMultiLineStringM).map_err(err)?;
+    for (l, ms) in lines.0.iter().zip(m) {
+        let mut g = Geometry::empty(OGRwkbGeometryType::wkbLineStringM).map_err(err)?;
+        for (c, &w) in l.0.iter().zip(ms) {
+            g.add_point_m((c.x, c.y, w));
+        }
+        multi.add_geometry(g).map_err(err)?;
+    }
+    Ok(multi)
 }
 
 fn to_gdal<G: ToGdal>(g: &G) -> Result<Geometry, IoError> {
@@ -221,11 +244,17 @@ fn to_gdal<G: ToGdal>(g: &G) -> Result<Geometry, IoError> {
 impl Writer {
     /// Creates the temporary GeoPackage and its layers. Fails, touching
     /// nothing, when the output is refused by [`check_output`] (`inputs` are
-    /// the data sources the run reads).
+    /// the data sources the run reads). `collapse`: the pipeline has a
+    /// `collapse` step (the `areas` layer, the `collapsed` column); `merge`:
+    /// the input merges adjacent polygons (the `members` column); `connect`:
+    /// the input has a line network (the `connections` layer).
     pub fn create(
         spec: &OutputSpec,
         source: &SourceInfo,
         inputs: &[&str],
+        collapse: bool,
+        merge: bool,
+        connect: bool,
     ) -> Result<Self, IoError> {
         check_output(spec, inputs)?;
         let path = PathBuf::from(&spec.path);
@@ -268,6 +297,8 @@ impl Writer {
             tmp,
             path,
             spec: spec.clone(),
+            collapse,
+            merge,
             source_fields,
         };
         let r = (|| -> Result<(), IoError> {
@@ -281,6 +312,12 @@ impl Writer {
             }
             if spec.widths {
                 w.create_layer(&mut ds, &WIDTHS, WIDTHS.name, srs)?;
+            }
+            if collapse {
+                w.create_layer(&mut ds, &AREAS, AREAS.name, srs)?;
+            }
+            if connect {
+                w.create_layer(&mut ds, &CONNECTIONS, CONNECTIONS.name, srs)?;
             }
             w.create_layer(&mut ds, &REJECTED, REJECTED.name, srs)?;
             w.create_layer(&mut ds, &RUNS, RUNS.name, None)?;
@@ -302,11 +339,20 @@ impl Writer {
         name: &str,
         srs: Option<&SpatialRef>,
     ) -> Result<(), IoError> {
+        // `output.measures: width`: the skeleton layer's lines carry M.
+        let measured = name == self.spec.layer
+            && def.geometry == GeometryKind::MultiLineString
+            && self.spec.measures == crate::config::Measures::Width;
+        let ty = if measured {
+            OGRwkbGeometryType::wkbMultiLineStringM
+        } else {
+            ogr_geometry(def.geometry)
+        };
         let l = ds
             .create_layer(LayerOptions {
                 name,
                 srs,
-                ty: ogr_geometry(def.geometry),
+                ty,
                 options: None,
             })
             .map_err(|e| IoError::gdal(format!("creating layer `{name}`"), e))?;
@@ -328,10 +374,13 @@ impl Writer {
 
     /// The columns of `def` this output has.
     fn columns<'d, R>(&self, def: &'d LayerDef<R>) -> impl Iterator<Item = &'d Column<R>> {
-        let explode = self.spec.explode;
-        def.columns
-            .iter()
-            .filter(move |c| c.when == When::Always || explode)
+        let (explode, collapse, merge) = (self.spec.explode, self.collapse, self.merge);
+        def.columns.iter().filter(move |c| match c.when {
+            When::Always => true,
+            When::Explode => explode,
+            When::Collapse => collapse,
+            When::Merge => merge,
+        })
     }
 
     /// Writes `rows` to the layer `name` described by `def`.
@@ -386,6 +435,8 @@ impl Writer {
             self.write_rows(&txn, &CANDIDATES, CANDIDATES.name, &rows.candidates)?;
             self.write_rows(&txn, &BARS, BARS.name, &rows.bars)?;
             self.write_rows(&txn, &WIDTHS, WIDTHS.name, &rows.widths)?;
+            self.write_rows(&txn, &AREAS, AREAS.name, &rows.areas)?;
+            self.write_rows(&txn, &CONNECTIONS, CONNECTIONS.name, &rows.connections)?;
             self.write_rows(&txn, &REJECTED, REJECTED.name, &rows.rejected)?;
             txn.commit()
                 .map_err(|e| IoError::gdal("committing a batch", e))

@@ -225,6 +225,7 @@ fn finish(
     let mut lines = Vec::new();
     let mut all_bars = Vec::new();
     let mut widths = Vec::new();
+    let mut graphs = Vec::new();
     let (mut components, mut legs_raw, mut legs) = (0, 0, 0);
     let mut branch_offset = 0;
     for (k, (p, part)) in prepared.iter().zip(parts).enumerate() {
@@ -248,6 +249,9 @@ fn finish(
         if params.keep_widths {
             widths.extend(medial_axis_transform(g, Some(p.boundary())));
         }
+        if params.collapse.is_some() || params.connect.is_some() {
+            graphs.push(g.clone());
+        }
         lines.extend(g.to_multilinestring().0);
     }
     let scores = params.score.map(|_| metrics(&all_bars));
@@ -262,6 +266,7 @@ fn finish(
         legs,
         bars: all_bars,
         widths,
+        graphs,
     };
     (c, cast_time + clock.elapsed().saturating_sub(in_casts))
 }

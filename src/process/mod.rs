@@ -5,10 +5,13 @@
 
 mod candidates;
 pub mod clock;
+pub mod connect;
+pub mod merge;
 pub mod rows;
 
 pub use rows::{feature_rows, FeatureRows, RowOptions, Skeletons, Status};
 
+use crate::collapse::{collapse, CollapseParams, PartCollapse};
 use crate::geometry::PreparedPolygon;
 use crate::graph::extend::ExtendParams;
 use crate::graph::prune::PruneParams;
@@ -68,6 +71,11 @@ pub struct ProcessParams {
     pub prune: Option<PruneParams>,
     /// `extend` step, when present.
     pub extend: Option<ExtendParams>,
+    /// `collapse` step, when present: the chosen skeleton collapses the
+    /// polygon where it is narrow.
+    pub collapse: Option<CollapseParams>,
+    /// `input.connect`: the line network the chosen skeleton gets legs to.
+    pub connect: Option<std::sync::Arc<connect::Network>>,
     /// `score` step, when present.
     pub score: Option<ScoreParams>,
     /// `select` step, when present.
@@ -76,6 +84,9 @@ pub struct ProcessParams {
     pub keep_bars: bool,
     /// Keep the local widths of the skeleton (for the `widths` layer).
     pub keep_widths: bool,
+    /// The local width at every vertex of the written lines (M values,
+    /// `output.measures: width`).
+    pub keep_measures: bool,
     /// The methods `skeleton.methods` may name.
     pub registry: Registry,
 }
@@ -153,6 +164,9 @@ pub struct CandidateSkeleton {
     /// The skeleton's segments with the disc radius at both ends (the medial
     /// axis transform for MA), when requested.
     pub widths: Vec<MatSegment>,
+    /// The finished skeleton graph of every polygon part, when the pipeline
+    /// collapses (the `collapse` step works on graphs).
+    pub graphs: Vec<crate::graph::SkeletonGraph>,
 }
 
 /// What the pipeline writes for one feature.
@@ -164,6 +178,14 @@ pub struct FeatureOutcome {
     pub chosen: usize,
     /// Polygon parts skeletonised.
     pub parts: usize,
+    /// The chosen skeleton's collapse, part by part, when the pipeline has a
+    /// `collapse` step.
+    pub collapse: Option<Vec<PartCollapse>>,
+    /// The legs added to the chosen skeleton for `input.connect`.
+    pub connections: Vec<connect::ConnectionLeg>,
+    /// With `output.measures: width`: the local width at every vertex of the
+    /// chosen skeleton, line by line.
+    pub measures: Option<Vec<Vec<f64>>>,
 }
 
 impl FeatureOutcome {
@@ -251,7 +273,73 @@ pub fn process(geom: Option<&Geometry<f64>>, params: &ProcessParams) -> Processe
         Err(other) => return other,
     };
     let candidates = candidates::computed(&prepared, params);
-    choose(candidates, prepared.len(), params)
+    let mut processed = choose(candidates, prepared.len(), params);
+    if let (Some(net), Processed::Done(o)) = (&params.connect, &mut processed) {
+        connect_chosen(o, &prepared, net);
+    }
+    if let (Some(c), Processed::Done(o)) = (&params.collapse, &mut processed) {
+        let (_, chosen) = o.chosen();
+        o.collapse = Some(
+            chosen
+                .graphs
+                .iter()
+                .zip(&prepared)
+                .map(|(g, p)| collapse(g, p, c))
+                .collect(),
+        );
+    }
+    if let (true, Processed::Done(o)) = (params.keep_measures, &mut processed) {
+        measure(o, &prepared);
+    }
+    processed
+}
+
+/// The local width 2r (r: distance to the nearest polygon part's boundary)
+/// at every vertex of the outcome's lines, for M values.
+fn measure(o: &mut FeatureOutcome, prepared: &[PreparedPolygon]) {
+    let widths = |lines: &[geo::LineString<f64>]| -> Vec<Vec<f64>> {
+        lines
+            .iter()
+            .map(|l| {
+                l.0.iter()
+                    .map(|&c| {
+                        2.0 * prepared
+                            .iter()
+                            .map(|p| p.boundary().distance(c))
+                            .fold(f64::INFINITY, f64::min)
+                    })
+                    .collect()
+            })
+            .collect()
+    };
+    let (_, chosen) = o.chosen();
+    o.measures = Some(widths(&chosen.geometry.0));
+    for c in o.collapse.iter_mut().flatten() {
+        c.collapsed_measures = widths(&c.collapsed);
+        c.kept_measures = widths(&c.kept);
+    }
+}
+
+/// The chosen skeleton with a leg to every connection point of the
+/// network (its scores stay those of the skeleton without them).
+fn connect_chosen(o: &mut FeatureOutcome, prepared: &[PreparedPolygon], net: &connect::Network) {
+    let chosen = o.chosen;
+    let Ok(c) = &mut o.candidates[chosen].result else {
+        return;
+    };
+    let mut lines = Vec::new();
+    let (mut legs, mut components) = (0, 0);
+    for (g, p) in c.graphs.iter_mut().zip(prepared) {
+        let (with_legs, added) = connect::add_legs(g, p, &net.points(p));
+        *g = with_legs;
+        o.connections.extend(added);
+        legs += g.leg_count();
+        components += g.components();
+        lines.extend(g.to_multilinestring().0);
+    }
+    c.geometry = MultiLineString(lines);
+    c.legs = legs;
+    c.components = components;
 }
 
 /// Scores skeleton lines made by another tool (`label`) for one feature's
@@ -351,6 +439,9 @@ fn choose(candidates: Vec<Candidate>, parts: usize, params: &ProcessParams) -> P
             candidates,
             chosen,
             parts,
+            collapse: None,
+            connections: Vec::new(),
+            measures: None,
         }),
         None => Processed::Rejected(rejection(&candidates)),
     }

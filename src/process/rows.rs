@@ -6,7 +6,9 @@
 use super::{process, process_given, FeatureOutcome, ProcessParams, Processed, StageTimes};
 use crate::feature::Feature;
 use crate::methods::MethodId;
-use crate::output::{BarRow, CandidateRow, RejectedRow, Rows, SkeletonRow, WidthRow};
+use crate::output::{
+    AreaRow, BarRow, CandidateRow, ConnectionRow, RejectedRow, Rows, SkeletonRow, WidthRow,
+};
 use geo::{Geometry, MultiLineString};
 
 /// Where a feature's skeletons come from.
@@ -35,6 +37,8 @@ pub struct RowOptions {
     pub bars: bool,
     /// The chosen skeleton's local widths in `widths`.
     pub widths: bool,
+    /// M values (local width) on the skeleton layer's lines.
+    pub measures: bool,
 }
 
 /// How a feature counts in the run's summary.
@@ -168,6 +172,17 @@ fn rejected(f: &Feature, reason: String) -> RejectedRow {
     }
 }
 
+/// The source FIDs a feature stands for, comma-separated (its own when it
+/// merged none).
+fn members_text(f: &Feature) -> Option<String> {
+    let fids: Vec<String> = if f.members.is_empty() {
+        f.fid.iter().map(u64::to_string).collect()
+    } else {
+        f.members.iter().map(u64::to_string).collect()
+    };
+    (!fids.is_empty()).then(|| fids.join(","))
+}
+
 /// Appends the rows of one processed unit; returns the chosen method's name.
 fn outcome_rows(
     f: &Feature,
@@ -180,18 +195,69 @@ fn outcome_rows(
     let name = |m: crate::methods::MethodId| label.map_or_else(|| m.to_string(), str::to_string);
     let (method, chosen) = o.chosen();
     let method = name(*method);
-    rows.skeletons.push(SkeletonRow {
+    let members = members_text(f);
+    let row = |geometry: MultiLineString<f64>,
+               collapsed: Option<bool>,
+               measures: Option<Vec<Vec<f64>>>| SkeletonRow {
         src_fid: f.fid,
         polygon_part: part,
         attributes: f.attributes.clone(),
-        geometry: chosen.geometry.clone(),
+        geometry,
         method: method.clone(),
         scores: chosen.scores,
         components: chosen.components,
         legs: chosen.legs,
         repaired: f.repaired,
         note: chosen.scores.and_then(|s| score_note(&s)),
-    });
+        collapsed,
+        members: members.clone(),
+        measures,
+    };
+    match &o.collapse {
+        None => rows
+            .skeletons
+            .push(row(chosen.geometry.clone(), None, o.measures.clone())),
+        Some(parts) => {
+            let collapsed: Vec<_> = parts.iter().flat_map(|c| c.collapsed.clone()).collect();
+            let kept: Vec<_> = parts.iter().flat_map(|c| c.kept.clone()).collect();
+            let m = |of: fn(&crate::collapse::PartCollapse) -> &Vec<Vec<f64>>| {
+                o.measures
+                    .as_ref()
+                    .map(|_| parts.iter().flat_map(|c| of(c).clone()).collect::<Vec<_>>())
+            };
+            let any_collapsed = !collapsed.is_empty();
+            if any_collapsed {
+                rows.skeletons.push(row(
+                    MultiLineString(collapsed),
+                    Some(true),
+                    m(|c| &c.collapsed_measures),
+                ));
+            }
+            // Every feature written has a skeleton row.
+            if !kept.is_empty() || !any_collapsed {
+                rows.skeletons.push(row(
+                    MultiLineString(kept),
+                    Some(false),
+                    m(|c| &c.kept_measures),
+                ));
+            }
+            rows.areas
+                .extend(parts.iter().flat_map(|c| &c.areas).map(|a| AreaRow {
+                    src_fid: f.fid,
+                    polygon_part: part,
+                    attributes: f.attributes.clone(),
+                    geometry: a.polygon.clone(),
+                    cuts: a.cuts,
+                    members: members.clone(),
+                }));
+        }
+    }
+    rows.connections
+        .extend(o.connections.iter().map(|c| ConnectionRow {
+            src_fid: f.fid,
+            line_fid: c.line_fid,
+            geometry: c.leg.clone(),
+        }));
     if opts.widths {
         rows.widths.extend(chosen.widths.iter().map(|w| WidthRow {
             src_fid: f.fid,

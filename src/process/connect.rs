@@ -1,0 +1,284 @@
+//! `input.connect`: a line network (rivers flowing in and out) continued
+//! through the polygons. Where a line touches or crosses ∂P — or ends within
+//! `snap` of it — that boundary point is a *connection point*, and the chosen
+//! skeleton gets a leg from its nearest point to it (a straight segment
+//! inside P, leaving the boundary within 60° of its inward normal), so that
+//! pruning cannot have removed it and the network runs
+//! on through the polygon. The lines themselves are not modified; the
+//! `connections` layer lists every leg with the line it serves.
+
+use crate::geometry::PreparedPolygon;
+use crate::graph::{GraphBuilder, SkeletonGraph};
+use geo::{BoundingRect, Coord, Geometry, LineString, Rect};
+
+/// The lines of a geometry, appended to `out` (other kinds are skipped).
+pub fn lines_of(g: &Geometry<f64>, out: &mut Vec<LineString<f64>>) {
+    match g {
+        Geometry::LineString(l) => out.push(l.clone()),
+        Geometry::MultiLineString(m) => out.extend(m.0.iter().cloned()),
+        Geometry::Line(l) => out.push(LineString(vec![l.start, l.end])),
+        Geometry::GeometryCollection(c) => c.iter().for_each(|g| lines_of(g, out)),
+        _ => {}
+    }
+}
+
+/// One line of the network.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NetworkLine {
+    /// Its FID in the connect source.
+    pub fid: Option<u64>,
+    /// The line.
+    pub line: LineString<f64>,
+    bbox: Rect<f64>,
+}
+
+/// The lines of `input.connect`, with the snap tolerance.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Network {
+    lines: Vec<NetworkLine>,
+    /// A line end within this distance of ∂P connects (CRS units).
+    pub snap: f64,
+}
+
+/// A leg added to a skeleton for a network line.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ConnectionLeg {
+    /// The network line's FID.
+    pub line_fid: Option<u64>,
+    /// From the skeleton to the connection point on ∂P.
+    pub leg: LineString<f64>,
+}
+
+impl Network {
+    /// The network of `lines` (FID, line) with tolerance `snap`.
+    pub fn new(lines: Vec<(Option<u64>, LineString<f64>)>, snap: f64) -> Self {
+        let lines = lines
+            .into_iter()
+            .filter_map(|(fid, line)| {
+                let bbox = line.bounding_rect()?;
+                Some(NetworkLine { fid, line, bbox })
+            })
+            .collect();
+        Self { lines, snap }
+    }
+
+    /// Number of lines.
+    pub fn len(&self) -> usize {
+        self.lines.len()
+    }
+
+    /// True when there is no line.
+    pub fn is_empty(&self) -> bool {
+        self.lines.is_empty()
+    }
+
+    /// The connection points of polygon part `p`: (line FID, point on ∂P),
+    /// each line's points at least `snap` apart (a line that runs along the
+    /// boundary connects once per stretch).
+    pub fn points(&self, p: &PreparedPolygon) -> Vec<(Option<u64>, Coord<f64>)> {
+        let b = p.boundary();
+        let (lo, hi) = (b.bbox_min(), b.bbox_max());
+        let tol = self.snap.max(1e-9 * p.extent());
+        let mut out: Vec<(Option<u64>, Coord<f64>)> = Vec::new();
+        for l in &self.lines {
+            let (a, z) = (l.bbox.min(), l.bbox.max());
+            if a.x > hi.x + tol || z.x < lo.x - tol || a.y > hi.y + tol || z.y < lo.y - tol {
+                continue;
+            }
+            let mut found: Vec<Coord<f64>> = Vec::new();
+            let mut add = |c: Coord<f64>| {
+                if found.iter().all(|f| crate::geometry::norm(*f - c) > tol) {
+                    found.push(c);
+                }
+            };
+            // Ends that touch ∂P, or come within snap of it.
+            for end in [l.line.0.first(), l.line.0.last()].into_iter().flatten() {
+                if let Some((c, _, d)) = b.nearest(*end) {
+                    if d <= tol {
+                        add(c);
+                    }
+                }
+            }
+            // Crossings.
+            for w in l.line.0.windows(2) {
+                for i in b.segments_near(w[0], w[1]) {
+                    let s = &b.segments()[i];
+                    if let Some(c) = intersection(w[0], w[1], s.a, s.b) {
+                        add(c);
+                    }
+                }
+            }
+            out.extend(found.into_iter().map(|c| (l.fid, c)));
+        }
+        out
+    }
+}
+
+/// The intersection point of segments `pq` and `ab`, when they meet (not
+/// parallel).
+fn intersection(p: Coord<f64>, q: Coord<f64>, a: Coord<f64>, b: Coord<f64>) -> Option<Coord<f64>> {
+    let (r, s) = (q - p, b - a);
+    let den = r.x * s.y - r.y * s.x;
+    if den == 0.0 {
+        return None;
+    }
+    let d = a - p;
+    let t = (d.x * s.y - d.y * s.x) / den;
+    let u = (d.x * r.y - d.y * r.x) / den;
+    ((0.0..=1.0).contains(&t) && (0.0..=1.0).contains(&u)).then(|| p + r * t)
+}
+
+/// `g` with a leg to every connection point: straight from the nearest
+/// point of the skeleton that sees it within 60° of the boundary's inward
+/// normal there (the edge split at that point).
+/// A point the skeleton already reaches (within `1e-9 × extent`) gets a
+/// zero-length leg, so that every connection point is listed.
+pub fn add_legs(
+    g: &SkeletonGraph,
+    p: &PreparedPolygon,
+    points: &[(Option<u64>, Coord<f64>)],
+) -> (SkeletonGraph, Vec<ConnectionLeg>) {
+    if points.is_empty() || g.is_empty() {
+        return (g.clone(), Vec::new());
+    }
+    let tol = 1e-9 * p.extent();
+    let mut polylines: Vec<Vec<Coord<f64>>> = (0..g.edges().len())
+        .map(|e| g.edge_coords(crate::graph::EdgeId(e as u32)))
+        .collect();
+    let mut legs = Vec::new();
+    for &(fid, c) in points {
+        let Some((k, i, s)) = nearest_visible(&polylines, p, c) else {
+            continue;
+        };
+        if crate::geometry::norm(s - c) <= tol {
+            // Already reached: the connection is listed with a zero-length leg.
+            legs.push(ConnectionLeg {
+                line_fid: fid,
+                leg: LineString(vec![c, c]),
+            });
+            continue;
+        }
+        // Split polyline k at s (after vertex i).
+        let line = std::mem::take(&mut polylines[k]);
+        let mut first: Vec<Coord<f64>> = line[..=i].to_vec();
+        let mut second: Vec<Coord<f64>> = vec![s];
+        second.extend_from_slice(&line[i + 1..]);
+        first.push(s);
+        polylines[k] = first;
+        polylines.push(second);
+        polylines.push(vec![s, c]);
+        legs.push(ConnectionLeg {
+            line_fid: fid,
+            leg: LineString(vec![s, c]),
+        });
+    }
+    let mut b = GraphBuilder::new();
+    for l in &polylines {
+        b.polyline(l);
+    }
+    (b.finish(p.boundary()), legs)
+}
+
+/// The point of the skeleton's polylines nearest to `c` from which the
+/// straight segment to `c` stays inside P and meets ∂P within 60° of its
+/// inward normal at `c` (so that a leg never runs along the shore):
+/// (polyline, segment index, point).
+fn nearest_visible(
+    polylines: &[Vec<Coord<f64>>],
+    p: &PreparedPolygon,
+    c: Coord<f64>,
+) -> Option<(usize, usize, Coord<f64>)> {
+    let b = p.boundary();
+    let (_, seg, _) = b.nearest(c)?;
+    let s = &b.segments()[seg];
+    let d = s.b - s.a;
+    let len = crate::geometry::norm(d);
+    if len == 0.0 {
+        return None;
+    }
+    let n = Coord {
+        x: -d.y / len,
+        y: d.x / len,
+    };
+    // The cone's edges: n turned by ∓60°.
+    let (cos, sin) = (0.5, 3f64.sqrt() / 2.0);
+    let right = Coord {
+        x: n.x * cos + n.y * sin,
+        y: -n.x * sin + n.y * cos,
+    };
+    let left = Coord {
+        x: n.x * cos - n.y * sin,
+        y: n.x * sin + n.y * cos,
+    };
+    let cross = |u: Coord<f64>, v: Coord<f64>| u.x * v.y - u.y * v.x;
+    let mut candidates: Vec<(f64, usize, usize, Coord<f64>)> = Vec::new();
+    for (k, l) in polylines.iter().enumerate() {
+        for i in 0..l.len().saturating_sub(1) {
+            // The part of the segment inside the cone: both half-planes.
+            let (a, z) = (l[i], l[i + 1]);
+            let (mut t0, mut t1) = (0.0_f64, 1.0_f64);
+            for (edge, sign) in [(right, 1.0), (left, -1.0)] {
+                let (fa, fz) = (sign * cross(edge, a - c), sign * cross(edge, z - c));
+                if fa < 0.0 && fz < 0.0 {
+                    t1 = -1.0;
+                } else if fa < 0.0 {
+                    t0 = t0.max(fa / (fa - fz));
+                } else if fz < 0.0 {
+                    t1 = t1.min(fa / (fa - fz));
+                }
+            }
+            if t0 > t1 {
+                continue;
+            }
+            let (pa, pz) = (a + (z - a) * t0, a + (z - a) * t1);
+            let (q, _) = crate::geometry::boundary::closest_on_segment(pa, pz, c);
+            candidates.push((crate::geometry::norm(q - c), k, i, q));
+        }
+    }
+    candidates.sort_by(|a, b| a.0.total_cmp(&b.0));
+    candidates
+        .into_iter()
+        .take(64)
+        .find(|&(_, _, _, q)| b.reaches(q, c))
+        .map(|(_, k, i, q)| (k, i, q))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use geo::polygon;
+
+    #[test]
+    fn a_line_crossing_and_one_ending_near_the_boundary_connect_once_each() {
+        let p = PreparedPolygon::new(
+            &polygon![(x: 0., y: 0.), (x: 100., y: 0.), (x: 100., y: 10.), (x: 0., y: 10.)],
+        )
+        .unwrap();
+        let net = Network::new(
+            vec![
+                (Some(1), LineString::from(vec![(-10., 5.), (20., 5.)])),
+                (Some(2), LineString::from(vec![(50., 30.), (50., 10.5)])),
+                (Some(3), LineString::from(vec![(50., 30.), (70., 30.)])),
+            ],
+            1.0,
+        );
+        let pts = net.points(&p);
+        assert_eq!(
+            pts,
+            vec![
+                (Some(1), Coord { x: 0., y: 5. }),
+                (Some(2), Coord { x: 50., y: 10. })
+            ]
+        );
+        let mut b = GraphBuilder::new();
+        b.segment(Coord { x: 5., y: 5. }, Coord { x: 95., y: 5. });
+        let (g, legs) = add_legs(&b.finish(p.boundary()), &p, &pts);
+        assert_eq!(legs.len(), 2);
+        assert_eq!(legs[1].leg, LineString::from(vec![(50., 5.), (50., 10.)]));
+        assert_eq!(
+            g.leg_count(),
+            3,
+            "the line's two legs and the new one at x = 50"
+        );
+    }
+}

@@ -1,0 +1,167 @@
+//! `input.merge_adjacent`: polygons that share boundary — river reaches,
+//! tiles, map sheets — become one feature before skeletonising, so that their
+//! skeleton is one line with no gap or kink at the former seams.
+//!
+//! Two polygons are adjacent when they share a boundary edge: both end
+//! vertices agree within [`SNAP`] CRS units (reaches and tiles cut from one
+//! source share their seam's vertices). Each connected group (optionally only
+//! among features with the same value of one field) is dissolved into one
+//! (multi)polygon; the merged feature takes the attributes of its member
+//! with the smallest FID and lists every member's FID.
+
+use crate::feature::Feature;
+use crate::graph::UnionFind;
+use geo::{Coord, Geometry, LineString, MultiPolygon, Polygon};
+use i_overlay::core::fill_rule::FillRule;
+use i_overlay::float::simplify::SimplifyShape;
+use std::collections::HashMap;
+
+/// An edge of a group: the group key and its two snapped end vertices.
+type EdgeKey = (String, (i64, i64), (i64, i64));
+
+/// Vertices of a shared edge agree within this many CRS units.
+pub const SNAP: f64 = 1e-6;
+
+/// The features with every group of adjacent polygons dissolved into one,
+/// in the order of each group's first member; `by`: merge only features
+/// whose attribute at this index has the same value.
+pub fn merge_adjacent(features: Vec<Feature>, by: Option<usize>) -> Vec<Feature> {
+    let n = features.len();
+    let mut uf = UnionFind::new(n);
+    // Each edge (quantised, unordered) → the first feature seen with it, per group key.
+    let mut edges: HashMap<EdgeKey, usize> = HashMap::new();
+    for (i, f) in features.iter().enumerate() {
+        let Some(parts) = polygons(f) else { continue };
+        let key = by
+            .and_then(|k| f.attributes.get(k))
+            .and_then(|v| v.as_text())
+            .unwrap_or_default();
+        for p in &parts {
+            for ring in std::iter::once(p.exterior()).chain(p.interiors()) {
+                for w in ring.0.windows(2) {
+                    let (a, b) = (snap(w[0]), snap(w[1]));
+                    if a == b {
+                        continue;
+                    }
+                    let e = (key.clone(), a.min(b), a.max(b));
+                    match edges.get(&e) {
+                        Some(&j) if j != i => uf.union(i, j),
+                        Some(_) => {}
+                        None => {
+                            edges.insert(e, i);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let mut groups: Vec<Vec<usize>> = vec![Vec::new(); n];
+    for i in 0..n {
+        groups[uf.find(i)].push(i);
+    }
+    let mut slots: Vec<Option<Feature>> = features.into_iter().map(Some).collect();
+    let mut out = Vec::with_capacity(n);
+    for (root, members) in groups.iter().enumerate() {
+        match members.len() {
+            0 => {}
+            1 => out.push(slots[root].take().expect("each feature once")),
+            _ => {
+                let group: Vec<Feature> = members
+                    .iter()
+                    .map(|&i| slots[i].take().expect("each feature once"))
+                    .collect();
+                out.push(dissolve(group));
+            }
+        }
+    }
+    out
+}
+
+/// The polygons of a readable polygon feature.
+fn polygons(f: &Feature) -> Option<Vec<Polygon<f64>>> {
+    if f.geometry_error.is_some() {
+        return None;
+    }
+    match f.geometry.as_ref()? {
+        Geometry::Polygon(p) => Some(vec![p.clone()]),
+        Geometry::MultiPolygon(m) => Some(m.0.clone()),
+        _ => None,
+    }
+}
+
+fn snap(c: Coord<f64>) -> (i64, i64) {
+    ((c.x / SNAP).round() as i64, (c.y / SNAP).round() as i64)
+}
+
+/// One feature from a group of adjacent ones (the first, by FID, gives the
+/// attributes).
+fn dissolve(mut group: Vec<Feature>) -> Feature {
+    group.sort_by_key(|f| f.fid);
+    let ring = |l: &LineString<f64>| -> Vec<[f64; 2]> {
+        let n = l.0.len().saturating_sub(1);
+        l.0[..n].iter().map(|c| [c.x, c.y]).collect()
+    };
+    let shapes: Vec<Vec<Vec<[f64; 2]>>> = group
+        .iter()
+        .flat_map(|f| polygons(f).unwrap_or_default())
+        .map(|p| {
+            // Exterior counter-clockwise, holes clockwise, for the non-zero rule.
+            let p = crate::geometry::ring::normalise_polygon(&p).unwrap_or(p);
+            std::iter::once(ring(p.exterior()))
+                .chain(p.interiors().iter().map(ring))
+                .collect()
+        })
+        .collect();
+    let closed = |c: &Vec<[f64; 2]>| {
+        let mut v: Vec<Coord<f64>> = c.iter().map(|p| Coord { x: p[0], y: p[1] }).collect();
+        if let Some(&f) = v.first() {
+            v.push(f);
+        }
+        LineString(v)
+    };
+    let merged: Vec<Polygon<f64>> = shapes
+        .simplify_shape(FillRule::NonZero)
+        .iter()
+        .filter(|s| !s.is_empty())
+        .map(|s| Polygon::new(closed(&s[0]), s[1..].iter().map(closed).collect()))
+        .collect();
+    let members: Vec<u64> = group.iter().filter_map(|f| f.fid).collect();
+    let repaired = group.iter().any(|f| f.repaired);
+    let mut first = group.swap_remove(0);
+    first.geometry = Some(match merged.len() {
+        1 => Geometry::Polygon(merged.into_iter().next().expect("one")),
+        _ => Geometry::MultiPolygon(MultiPolygon(merged)),
+    });
+    first.source_wkb = None;
+    first.repaired = repaired;
+    first.members = members;
+    first
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use geo::{polygon, Area};
+
+    fn square(fid: u64, x: f64) -> Feature {
+        Feature::from_geometry(
+            Some(fid),
+            Geometry::Polygon(
+                polygon![(x: x, y: 0.), (x: x + 1., y: 0.), (x: x + 1., y: 1.), (x: x, y: 1.)],
+            ),
+        )
+    }
+
+    #[test]
+    fn squares_sharing_an_edge_become_one_and_a_distant_one_stays() {
+        let out = merge_adjacent(vec![square(3, 1.0), square(1, 0.0), square(7, 5.0)], None);
+        assert_eq!(out.len(), 2);
+        let m = out.iter().find(|f| f.fid == Some(1)).expect("merged");
+        assert_eq!(m.members, vec![1, 3]);
+        let Some(Geometry::Polygon(p)) = &m.geometry else {
+            panic!("{:?}", m.geometry)
+        };
+        assert!((p.unsigned_area() - 2.0).abs() < 1e-9);
+        assert!(out.iter().any(|f| f.fid == Some(7) && f.members.is_empty()));
+    }
+}
