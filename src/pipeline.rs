@@ -397,30 +397,13 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
         let mut progress = Progress::new(opts.progress, info.selected, every);
         let row_opts = RowOptions::from(job.output);
         let mut counts = Counts::default();
-        let mut work = || -> Result<(), RunError> {
-            for features in batch_rx.iter() {
-                let features = features?;
-                let done: Vec<FeatureRows> = pool.install(|| {
-                    features
-                        .par_iter()
-                        .map(|f| feature_rows(f, job.skeletons(f), params, row_opts))
-                        .collect()
-                });
-                counts.read += features.iter().map(Feature::source_count).sum::<u64>();
-                let mut rows = Rows::default();
-                for (f, r) in features.iter().zip(done) {
-                    counts.add(f, &r, job.on_error)?;
-                    rows.append(r.rows);
-                }
-                if rows_tx.send(rows).is_err() {
-                    // The writer stopped on an error; it says which below.
-                    break;
-                }
-                progress.add(features.len() as u64);
-            }
-            Ok(())
+        let workers = Workers {
+            job,
+            params,
+            pool: &pool,
+            row_opts,
         };
-        let result = work();
+        let result = workers.compute(&batch_rx, &rows_tx, &mut counts, &mut progress);
         progress.finish();
         // Stop the reader (if still reading) and let the writer drain.
         drop(batch_rx);
@@ -443,6 +426,49 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
         };
         finish_run(job, &info, counts, threads, started, clock, writer)
     })
+}
+
+/// What the worker threads need for every batch.
+struct Workers<'a> {
+    job: &'a Job<'a>,
+    params: &'a ProcessParams,
+    pool: &'a rayon::ThreadPool,
+    row_opts: RowOptions,
+}
+
+impl Workers<'_> {
+    /// The workers' loop: every batch computed on the pool in parallel,
+    /// counted, and handed to the writer in the order read.
+    fn compute(
+        &self,
+        batches: &mpsc::Receiver<Batch>,
+        rows_tx: &mpsc::SyncSender<Rows>,
+        counts: &mut Counts,
+        progress: &mut Progress,
+    ) -> Result<(), RunError> {
+        let (job, params, row_opts) = (self.job, self.params, self.row_opts);
+        for features in batches.iter() {
+            let features = features?;
+            let done: Vec<FeatureRows> = self.pool.install(|| {
+                features
+                    .par_iter()
+                    .map(|f| feature_rows(f, job.skeletons(f), params, row_opts))
+                    .collect()
+            });
+            counts.read += features.iter().map(Feature::source_count).sum::<u64>();
+            let mut rows = Rows::default();
+            for (f, r) in features.iter().zip(done) {
+                counts.add(f, &r, job.on_error)?;
+                rows.append(r.rows);
+            }
+            if rows_tx.send(rows).is_err() {
+                // The writer stopped on an error; it says which below.
+                break;
+            }
+            progress.add(features.len() as u64);
+        }
+        Ok(())
+    }
 }
 
 /// The reader thread: opens the source, sends what it holds, then its

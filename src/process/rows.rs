@@ -217,40 +217,7 @@ fn outcome_rows(
         None => rows
             .skeletons
             .push(row(chosen.geometry.clone(), None, o.measures.clone())),
-        Some(parts) => {
-            let collapsed: Vec<_> = parts.iter().flat_map(|c| c.collapsed.clone()).collect();
-            let kept: Vec<_> = parts.iter().flat_map(|c| c.kept.clone()).collect();
-            let m = |of: fn(&crate::collapse::PartCollapse) -> &Vec<Vec<f64>>| {
-                o.measures
-                    .as_ref()
-                    .map(|_| parts.iter().flat_map(|c| of(c).clone()).collect::<Vec<_>>())
-            };
-            let any_collapsed = !collapsed.is_empty();
-            if any_collapsed {
-                rows.skeletons.push(row(
-                    MultiLineString(collapsed),
-                    Some(true),
-                    m(|c| &c.collapsed_measures),
-                ));
-            }
-            // Every feature written has a skeleton row.
-            if !kept.is_empty() || !any_collapsed {
-                rows.skeletons.push(row(
-                    MultiLineString(kept),
-                    Some(false),
-                    m(|c| &c.kept_measures),
-                ));
-            }
-            rows.areas
-                .extend(parts.iter().flat_map(|c| &c.areas).map(|a| AreaRow {
-                    src_fid: f.fid,
-                    polygon_part: part,
-                    attributes: f.attributes.clone(),
-                    geometry: a.polygon.clone(),
-                    cuts: a.cuts,
-                    members: members.clone(),
-                }));
-        }
+        Some(parts) => collapse_rows(f, part, parts, o, &members, &row, rows),
     }
     rows.connections
         .extend(o.connections.iter().map(|c| ConnectionRow {
@@ -267,6 +234,70 @@ fn outcome_rows(
             width_end: w.width_end(),
         }));
     }
+    candidate_rows(f, part, o, &name, opts, rows);
+    method
+}
+
+/// Makes a feature's skeleton row from its lines, `collapsed` and M values.
+type SkeletonRowOf<'a> =
+    dyn Fn(MultiLineString<f64>, Option<bool>, Option<Vec<Vec<f64>>>) -> SkeletonRow + 'a;
+
+/// The rows of a collapsed polygon part: its collapsed lines, the
+/// centreline through its kept areas (one of them at least, so that every
+/// feature written has a skeleton row), and the kept areas.
+fn collapse_rows(
+    f: &Feature,
+    part: Option<usize>,
+    parts: &[crate::collapse::PartCollapse],
+    o: &FeatureOutcome,
+    members: &Option<String>,
+    row: &SkeletonRowOf,
+    rows: &mut Rows,
+) {
+    let collapsed: Vec<_> = parts.iter().flat_map(|c| c.collapsed.clone()).collect();
+    let kept: Vec<_> = parts.iter().flat_map(|c| c.kept.clone()).collect();
+    let m = |of: fn(&crate::collapse::PartCollapse) -> &Vec<Vec<f64>>| {
+        o.measures
+            .as_ref()
+            .map(|_| parts.iter().flat_map(|c| of(c).clone()).collect::<Vec<_>>())
+    };
+    let any_collapsed = !collapsed.is_empty();
+    if any_collapsed {
+        rows.skeletons.push(row(
+            MultiLineString(collapsed),
+            Some(true),
+            m(|c| &c.collapsed_measures),
+        ));
+    }
+    // Every feature written has a skeleton row.
+    if !kept.is_empty() || !any_collapsed {
+        rows.skeletons.push(row(
+            MultiLineString(kept),
+            Some(false),
+            m(|c| &c.kept_measures),
+        ));
+    }
+    rows.areas
+        .extend(parts.iter().flat_map(|c| &c.areas).map(|a| AreaRow {
+            src_fid: f.fid,
+            polygon_part: part,
+            attributes: f.attributes.clone(),
+            geometry: a.polygon.clone(),
+            cuts: a.cuts,
+            members: members.clone(),
+        }));
+}
+
+/// Every method's `candidates` row and `bars` rows of one polygon part (as
+/// the options ask).
+fn candidate_rows(
+    f: &Feature,
+    part: Option<usize>,
+    o: &FeatureOutcome,
+    name: &dyn Fn(crate::methods::MethodId) -> String,
+    opts: RowOptions,
+    rows: &mut Rows,
+) {
     for (i, c) in o.candidates.iter().enumerate() {
         let cname = name(c.method);
         let ok = c.result.as_ref().ok();
@@ -297,5 +328,4 @@ fn outcome_rows(
             }));
         }
     }
-    method
 }
