@@ -223,9 +223,10 @@ impl BarRays {
             .par_chunks(PAR_BARS)
             .map(|chunk| {
                 let clock = CpuClock::start();
+                let mut recent = [NOWHERE; 2];
                 let bars: Vec<Bar> = chunk
                     .iter()
-                    .map(|r| cast(polygon.boundary(), &sk, r, eps))
+                    .map(|r| cast(polygon.boundary(), &sk, r, eps, &mut recent))
                     .collect();
                 (bars, clock.elapsed())
             })
@@ -239,16 +240,34 @@ impl BarRays {
     }
 }
 
+/// No point (never in a half-plane): the sides found before the first bar.
+const NOWHERE: Coord<f64> = Coord {
+    x: f64::NAN,
+    y: f64::NAN,
+};
+
 /// One bar: its hit on the skeleton before it leaves P, and the sides there.
-fn cast(boundary: &Boundary, sk: &SkeletonIndex, ray: &Ray, eps: f64) -> Bar {
+/// `recent` holds the side points of the bar cast before (bars come in
+/// boundary order, so they are usually near): boundary points that bound
+/// this bar's searches too.
+fn cast(
+    boundary: &Boundary,
+    sk: &SkeletonIndex,
+    ray: &Ray,
+    eps: f64,
+    recent: &mut [Coord<f64>; 2],
+) -> Bar {
     let (origin, u) = (ray.origin, ray.dir);
     let exit = origin + u * ray.exit;
     let hit = sk.hit(origin, u, eps, ray.exit).and_then(|(q, sigma)| {
         let nu = left_normal(sigma.b - sigma.a);
-        // The bar's origin and exit are boundary points: each bounds the
-        // nearest distance on its side, which keeps the searches short.
+        // The bar's origin and exit, and the previous bar's side points, are
+        // boundary points: each in a side's half-plane bounds the nearest
+        // distance there (never changing the answer), which keeps the
+        // searches short.
+        let seeds = [origin, exit, recent[0], recent[1]];
         let side = |n: Coord<f64>| {
-            let seed = [origin, exit]
+            let seed = seeds
                 .into_iter()
                 .filter(|&c| dot(c - q, n) >= 0.0)
                 .map(|c| norm(c - q) * (1.0 + 1e-9))
@@ -257,8 +276,9 @@ fn cast(boundary: &Boundary, sk: &SkeletonIndex, ray: &Ray, eps: f64) -> Bar {
                 .nearest_in_half_plane_within(q, n, seed)
                 .or_else(|| boundary.nearest_in_half_plane(q, n))
         };
-        let (_, d_left) = side(nu)?;
-        let (_, d_right) = side(-nu)?;
+        let (p_left, d_left) = side(nu)?;
+        let (p_right, d_right) = side(-nu)?;
+        *recent = [p_left, p_right];
         // A hit on ∂P itself (a leaf at a corner reached along the boundary)
         // has no sides to compare: it is a miss.
         if d_left + d_right <= eps {
