@@ -434,6 +434,51 @@ fn budgets_reject_a_feature_or_stop_a_method_with_the_reason() {
 }
 
 #[test]
+fn a_memory_budget_out_of_range_is_a_clear_error() {
+    let o = skeletonise(&[
+        "validate",
+        "pipelines/demo.yaml",
+        "--set",
+        "steps.skeleton.max_memory_mb=-1",
+    ]);
+    let (code, err) = code_and_err(&o);
+    assert_eq!(code, 78, "{err}");
+    assert!(
+        err.contains("max_memory_mb") && err.contains("megabytes ≥ 0"),
+        "{err}"
+    );
+}
+
+#[test]
+fn the_run_record_holds_every_methods_step_times() {
+    let d = tmp();
+    let out = d.path().join("o.gpkg");
+    let o = skeletonise(&[
+        "run",
+        "pipelines/compare-methods.yaml",
+        "--set",
+        "input.layer=islands_hebrides",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", out_err(&o));
+    let stages = strings(&open(&out), "skeletonise_runs", "stage_seconds");
+    let text = stages[0].clone().expect("stage_seconds is set");
+    let v: serde_json::Value = serde_json::from_str(&text).expect("stage_seconds is JSON");
+    for m in ["MA", "StSk", "DVD", "CDT", "VD"] {
+        let steps = &v[m];
+        for step in ["skeleton", "prune_extend", "score"] {
+            let t = steps[step].as_f64().unwrap_or(-1.0);
+            assert!(t >= 0.0, "{m}.{step} in {text}");
+        }
+        // Every method made and scored 1192 skeletons: time was spent
+        // (the record keeps milliseconds).
+        let spent = steps["skeleton"].as_f64().unwrap() + steps["score"].as_f64().unwrap();
+        assert!(spent > 0.0, "{m} in {text}");
+    }
+}
+
+#[test]
 fn progress_lines_appear_in_logs_without_a_terminal() {
     let o = skeletonise(&[
         "run",
