@@ -16,11 +16,7 @@ d, l = s.get_config_var("LIBDIR"), s.get_config_var("LDLIBRARY")
 sys.exit(0 if d and l and os.path.exists(os.path.join(d, l)) else 1)'
 }
 if ! command -v "$py" >/dev/null 2>&1 || ! "$py" -c 'import venv, ensurepip' 2>/dev/null || ! has_libpython "$py"; then
-  sudo=""
-  [ "$(id -u)" -eq 0 ] || sudo="sudo"
-  echo "installing: python3 python3-venv python3-dev" >&2
-  $sudo apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq python3 python3-venv python3-dev >/dev/null
+  scripts/apt-install.sh "for the Python package" python3 python3-venv python3-dev
   py=python3
 fi
 [ -x "$venv/bin/python" ] || "$py" -m venv "$venv"
