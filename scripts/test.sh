@@ -12,6 +12,8 @@ scripts/test-deps.sh
 export SKELETONISE_REQUIRE_POSTGIS=1
 cargo test --all-targets "$@"
 cargo test --doc
+# The patched dependency's own unit tests (vendor/boostvoronoi/PATCHES.md).
+CARGO_TARGET_DIR=$PWD/target/vendor cargo test --quiet --manifest-path vendor/boostvoronoi/Cargo.toml --lib
 # The core without GDAL, as the Python binding builds it (the GDAL-only targets are skipped).
 cargo test --no-default-features --all-targets "$@"
 # The Python package, built with the dev profile whose dependencies the runs above compiled

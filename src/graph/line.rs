@@ -55,12 +55,23 @@ pub fn end_width_point(coords: &[Coord<f64>], polygon: &PreparedPolygon) -> (f64
     // Arc length s grows with slope 1 and the radius at most with slope 1,
     // so s − 2 r(s) changes sign once on a medial line; sample it finely
     // enough and bisect the first sign change.
+    // f rises with slope at most 3 (s with slope 1, −2r with slope at most
+    // 2), so from f(s) < 0 it stays negative up to s + |f(s)|/3: samples
+    // there are skipped unevaluated (the same sample is the first at or
+    // above zero, the same answer).
     let steps = 64;
     let f = |s: f64| s - 2.0 * b.distance(point_at(coords, s));
     let mut lo = 0.0;
+    let mut negative_below = 0.0;
     for i in 1..=steps {
         let s = total * i as f64 / steps as f64;
-        if f(s) >= 0.0 {
+        if s < negative_below {
+            lo = s;
+            continue;
+        }
+        let v = f(s);
+        negative_below = s - v / 3.0 * (1.0 - 1e-9);
+        if v >= 0.0 {
             let mut hi = s;
             for _ in 0..30 {
                 let mid = 0.5 * (lo + hi);

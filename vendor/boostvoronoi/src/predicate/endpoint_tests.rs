@@ -1,0 +1,124 @@
+//! `pss_at_endpoint` (the closed-form circle of a polygon vertex and its own
+//! edge) against the general lazy/exact evaluation: the diagrams of many
+//! polygons, built both ways, have the same vertices and the same edges.
+
+use super::lazy_circle_formation::ENDPOINT_FAST_PATH;
+use crate::builder::Builder;
+use crate::diagram::Diagram;
+
+/// A small deterministic generator (no dependency for the test).
+struct Lcg(u64);
+
+impl Lcg {
+    fn next(&mut self) -> u64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        self.0 >> 33
+    }
+    fn unit(&mut self) -> f64 {
+        self.next() as f64 / (1u64 << 31) as f64
+    }
+}
+
+/// A star-shaped ring of `n` vertices around the origin, radius `r` with
+/// relative noise `noise`, on the integer grid.
+fn ring(rng: &mut Lcg, n: usize, r: f64, noise: f64) -> Vec<[i32; 2]> {
+    let mut pts: Vec<[i32; 2]> = Vec::new();
+    for k in 0..n {
+        let a = std::f64::consts::TAU * (k as f64 + 0.3 * rng.unit()) / n as f64;
+        let rr = r * (1.0 + noise * (rng.unit() - 0.5));
+        let p = [(rr * a.cos()).round() as i32, (rr * a.sin()).round() as i32];
+        if pts.last() != Some(&p) {
+            pts.push(p);
+        }
+    }
+    while pts.len() > 1 && pts.first() == pts.last() {
+        let _ = pts.pop();
+    }
+    pts
+}
+
+/// A river-like band: two nearly parallel digitised banks.
+fn band(rng: &mut Lcg, n: usize, len: f64, width: f64) -> Vec<[i32; 2]> {
+    let bank = |rng: &mut Lcg, y: f64| -> Vec<[i32; 2]> {
+        (0..n)
+            .map(|k| {
+                let x = len * k as f64 / (n - 1) as f64;
+                let wobble = 0.05 * width * (rng.unit() - 0.5);
+                [x.round() as i32, (y + wobble + 0.2 * width * (x / len * 7.0).sin()).round() as i32]
+            })
+            .collect()
+    };
+    let mut pts = bank(rng, 0.0);
+    let mut top = bank(rng, width);
+    top.reverse();
+    pts.extend(top);
+    pts.dedup();
+    pts
+}
+
+fn diagram(pts: &[[i32; 2]], fast: bool) -> Diagram {
+    ENDPOINT_FAST_PATH.with(|c| c.set(fast));
+    let segs: Vec<[i32; 4]> = (0..pts.len())
+        .map(|i| {
+            let (a, b) = (pts[i], pts[(i + 1) % pts.len()]);
+            [a[0], a[1], b[0], b[1]]
+        })
+        .collect();
+    let d = Builder::<i32>::default()
+        .with_segments(segs.iter())
+        .and_then(|b| b.build())
+        .expect("diagram");
+    ENDPOINT_FAST_PATH.with(|c| c.set(true));
+    d
+}
+
+fn same(a: &Diagram, b: &Diagram) -> Result<(), String> {
+    if a.vertices().len() != b.vertices().len() || a.edges().len() != b.edges().len() {
+        return Err(format!(
+            "{} vertices / {} edges against {} / {}",
+            a.vertices().len(),
+            a.edges().len(),
+            b.vertices().len(),
+            b.edges().len()
+        ));
+    }
+    for (i, (u, v)) in a.vertices().iter().zip(b.vertices()).enumerate() {
+        let tol = 1e-9 * (1.0 + u.x().abs().max(u.y().abs()));
+        if (u.x() - v.x()).abs() > tol || (u.y() - v.y()).abs() > tol {
+            return Err(format!("vertex {i}: ({}, {}) against ({}, {})", u.x(), u.y(), v.x(), v.y()));
+        }
+    }
+    for (i, (e, f)) in a.edges().iter().zip(b.edges()).enumerate() {
+        if e.vertex0() != f.vertex0() {
+            return Err(format!("edge {i} starts at another vertex"));
+        }
+    }
+    Ok(())
+}
+
+#[test]
+fn endpoint_circles_give_the_same_diagrams() {
+    let mut rng = Lcg(0x5eed);
+    let mut checked = 0;
+    for case in 0..400 {
+        let pts = match case % 4 {
+            0 => ring(&mut rng, 8 + case % 40, 1.0e3, 0.5),
+            1 => ring(&mut rng, 200, 3.0e7, 0.002),
+            2 => band(&mut rng, 60, 2.0e6, 4.0e4),
+            _ => band(&mut rng, 30, 5.0e3, 40.0),
+        };
+        if pts.len() < 3 {
+            continue;
+        }
+        let fast = diagram(&pts, true);
+        let general = diagram(&pts, false);
+        if let Err(e) = same(&fast, &general) {
+            panic!("case {case} ({} points): {e}", pts.len());
+        }
+        checked += 1;
+    }
+    assert!(checked > 350);
+}
