@@ -308,40 +308,30 @@ impl ExtendedInt {
         }
     }
 
+    /// The product of the magnitudes `c1[..sz1]`·`c2[..sz2]` (schoolbook, on
+    /// a stack buffer, into a fresh `self`): the same chunks as the
+    /// column-wise original — the low `sz1 + sz2 − 1` chunks, and the top one
+    /// when it is not zero — without a bounds-checked `SmallVec` access per
+    /// partial product (patched for skeletonise, see PATCHES.md).
     fn mul_slice(&mut self, c1: &[Wrapping<u32>], sz1: usize, c2: &[Wrapping<u32>], sz2: usize) {
-        let mut cur: u64 = 0;
-        let mut nxt: u64;
-        let mut tmp: u64;
-
-        self.count_ = (sz1 + sz2 - 1_usize) as i32;
-
-        for _i in self.chunks_.len()..(self.count_ as usize) {
-            self.chunks_.push(Wrapping(0));
-        }
-
-        for shift in 0..(self.count_ as usize) {
-            nxt = 0;
-            for (first, c1_first) in c1.iter().enumerate().take(shift + 1) {
-                if first >= sz1 {
-                    break;
-                }
-                let second = shift - first;
-                if second >= sz2 {
-                    continue;
-                }
-
-                tmp = (c1_first.0 as u64) * (c2[second].0 as u64);
-                cur += tmp & 0xFFFF_FFFF;
-                nxt += tmp >> 32;
+        const MAX: usize = 128;
+        let n = sz1 + sz2;
+        assert!(n <= MAX, "ExtendedInt product of {n} chunks");
+        let mut r = [0_u32; MAX];
+        for (i, a) in c1[..sz1].iter().enumerate() {
+            let a = a.0 as u64;
+            let mut carry = 0_u64;
+            for (j, b) in c2[..sz2].iter().enumerate() {
+                let t = a * (b.0 as u64) + (r[i + j] as u64) + carry;
+                r[i + j] = t as u32;
+                carry = t >> 32;
             }
-
-            self.chunks_[shift] = Wrapping((cur & 0xFFFF_FFFF) as u32);
-            cur = nxt + (cur >> 32);
+            r[i + sz2] = carry as u32;
         }
-        if cur != 0 {
-            self.chunks_.push(Wrapping(cur as u32));
-            self.count_ += 1;
-        }
+        let len = if r[n - 1] != 0 { n } else { n - 1 };
+        self.chunks_.clear();
+        self.chunks_.extend(r[..len].iter().map(|&c| Wrapping(c)));
+        self.count_ = len as i32;
     }
 }
 
