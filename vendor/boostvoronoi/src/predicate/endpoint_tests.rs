@@ -1,6 +1,7 @@
-//! `pss_at_endpoint` (the closed-form circle of a polygon vertex and its own
-//! edge) against the general lazy/exact evaluation: the diagrams of many
-//! polygons, built both ways, have the same vertices and the same edges.
+//! The closed-form circle events (`pss_at_endpoint`: a polygon vertex and its
+//! own edge; `sss_chain`: three consecutive edges) against the general
+//! lazy/exact evaluation: the diagrams of many polygons, built both ways,
+//! have the same vertices and the same edges.
 
 use super::lazy_circle_formation::ENDPOINT_FAST_PATH;
 use crate::builder::Builder;

@@ -659,7 +659,7 @@ pub(crate) fn pss<I: InputType>(
 
 #[cfg(test)]
 thread_local! {
-    /// Tests turn [`pss_at_endpoint`] off to compare with the general path.
+    /// Tests turn the closed forms ([`pss_at_endpoint`], [`sss_chain`]) off to compare with the general path.
     pub(crate) static ENDPOINT_FAST_PATH: std::cell::Cell<bool> = const { std::cell::Cell::new(true) };
 }
 
@@ -763,6 +763,86 @@ fn pss_at_endpoint<I: InputType>(
     Some((c_x.dif(), c_y.dif(), lower_x))
 }
 
+/// The circle of [`sss`] when one segment (`m`) shares an end point with
+/// each of the two others, which share none — three consecutive edges of a
+/// polygon, the common case. With `v`, `w` the shared end points, `g = w − v`,
+/// and `k(d') = R(d')·g / (|d'||d| + d'·d)` for a neighbour's direction `d'`
+/// (`R` the right normal, `d` m's direction; the tangent of half the angle
+/// between the two lines), the centre is `v + ρ·(k_a·g + R(d))` with
+/// `ρ = 1 / (k_a − k_b)` and radius `ρ·|d|`. The general formula intersects
+/// the three lines, which are nearly parallel on a digitised shore, and then
+/// almost always needs the exact evaluation; this one has no cancellation
+/// but in `k_a − k_b` (an S-bend), which its error bound reports. The
+/// circle lies right of the three sites' directions. Returns `c_x`, `c_y`,
+/// `lower_x` with their error bounds, or `None` when the case does not apply.
+fn sss_chain<I: InputType>(
+    site1: &vse::SiteEvent<I>,
+    site2: &vse::SiteEvent<I>,
+    site3: &vse::SiteEvent<I>,
+) -> Option<(rf::RobustFpt, rf::RobustFpt, rf::RobustFpt)> {
+    let shared = |a: &vse::SiteEvent<I>, b: &vse::SiteEvent<I>| {
+        [a.point0(), a.point1()]
+            .into_iter()
+            .find(|&p| p == b.point0() || p == b.point1())
+    };
+    let sites = [site1, site2, site3];
+    let (m, a, b, v, w) = (0..3).find_map(|m| {
+        let (a, b) = (sites[(m + 1) % 3], sites[(m + 2) % 3]);
+        let (v, w) = (shared(sites[m], a)?, shared(sites[m], b)?);
+        (v != w && shared(a, b).is_none()).then_some((sites[m], a, b, v, w))
+    })?;
+    let i = |x: I| cast::<I, i64>(x);
+    let dir = |s: &vse::SiteEvent<I>| {
+        [i(s.point1().x) - i(s.point0().x), i(s.point1().y) - i(s.point0().y)]
+    };
+    let (d, d_a, d_b) = (dir(m), dir(a), dir(b));
+    let g = [i(w.x) - i(v.x), i(w.y) - i(v.y)];
+    let f = |x: i64| x as f64;
+    let len = |d: [i64; 2]| {
+        rf::RobustFpt::new((f(d[0]) * f(d[0]) + f(d[1]) * f(d[1])).sqrt(), 2_f64)
+    };
+    let l_m = len(d);
+    // tan of half the angle between the neighbour's line and m's, signed.
+    let half_tan = |dn: [i64; 2]| -> Option<rf::RobustFpt> {
+        let num = rf::RobustFpt::new(robust_cross_product::<i64>(g[0], g[1], dn[0], dn[1]), 1_f64);
+        let dot = rf::RobustFpt::new(
+            robust_cross_product::<i64>(dn[0], -dn[1], d[1], d[0]),
+            1_f64,
+        );
+        let ll = len(dn) * l_m;
+        let den = if dot.is_neg() {
+            // |d'||d| + d'·d = (d'×d)² / (|d'||d| − d'·d) without cancellation.
+            let cross = robust_cross_product::<i64>(dn[0], dn[1], d[0], d[1]);
+            rf::RobustFpt::new(cross * cross, 1_f64) / (ll - dot)
+        } else {
+            ll + dot
+        };
+        den.is_pos().then(|| num / den)
+    };
+    let (k_a, k_b) = (half_tan(d_a)?, half_tan(d_b)?);
+    let mut k = rf::RobustDif::from(k_a);
+    k -= k_b;
+    let k = k.dif();
+    if !k.is_pos() {
+        return None;
+    }
+    let rho = rf::RobustFpt::from(1_f64) / k;
+    let coordinate = |vc: i64, gc: i64, rc: i64| {
+        let mut inner = rf::RobustDif::default();
+        inner += k_a * rf::RobustFpt::from(f(gc));
+        inner += rf::RobustFpt::from(f(rc));
+        let mut c = rf::RobustDif::from(rf::RobustFpt::from(f(vc)));
+        c += rho * inner.dif();
+        c
+    };
+    // R(d) = (d.y, −d.x).
+    let c_x = coordinate(i(v.x), g[0], d[1]);
+    let c_y = coordinate(i(v.y), g[1], -d[0]);
+    let mut lower_x = c_x;
+    lower_x += rho * l_m;
+    Some((c_x.dif(), c_y.dif(), lower_x.dif()))
+}
+
 /// Lazy evaluation of segment, segment, segment circle events
 pub(crate) fn sss<I: InputType>(
     site1: &vse::SiteEvent<I>,
@@ -770,6 +850,17 @@ pub(crate) fn sss<I: InputType>(
     site3: &vse::SiteEvent<I>,
     mut c_event: CircleEvent,
 ) -> Option<CircleEvent> {
+    if let Some((c_x, c_y, lower_x)) =
+        sss_chain(site1, site2, site3).filter(|_| endpoint_fast_path())
+    {
+        let ulps = ULPSX2 as f64;
+        let (rx, ry, rl) = (c_x.ulp() > ulps, c_y.ulp() > ulps, lower_x.ulp() > ulps);
+        c_event.set_3(c_x.fpv(), c_y.fpv(), lower_x.fpv());
+        if rx || ry || rl {
+            exact_circle_formation::sss(site1, site2, site3, &mut c_event, rx, ry, rl);
+        }
+        return Some(c_event);
+    }
     let a1 = rf::RobustFpt::from(cast::<I, f64>(site1.x1()) - cast::<I, f64>(site1.x0()));
     let b1 = rf::RobustFpt::from(cast::<I, f64>(site1.y1()) - cast::<I, f64>(site1.y0()));
     let c1 = rf::RobustFpt::new(
