@@ -236,6 +236,18 @@ impl PackedTree {
             item(self.ids[root]);
             return;
         }
+        let top = self.children(root);
+        if top.start < n {
+            // One leaf (a small polygon): its items in order, as the heap
+            // would visit them, without the heap.
+            let mut cut = limit;
+            for c in top {
+                if bound(&self.boxes[c]).is_some_and(|b| b <= cut) {
+                    cut = item(self.ids[c]);
+                }
+            }
+            return;
+        }
         HEAP.with(|cell| {
             // A query from inside a query (never done today) gets its own heap.
             let mut own = Vec::new();
