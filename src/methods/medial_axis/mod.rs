@@ -13,7 +13,10 @@
 //! # How
 //!
 //! 1. **Grid.** The diagram is built by [`boostvoronoi`] (Boost.Polygon's
-//!    robust sweep), which takes integer input. Coordinates are quantised
+//!    robust sweep; the workspace patches it with closed-form circle events
+//!    for a vertex and its own edge and for three consecutive edges, which
+//!    the general formulas sent to the exact big-integer evaluation —
+//!    `vendor/boostvoronoi/PATCHES.md`), which takes integer input. Coordinates are quantised
 //!    relative to the polygon's bounding-box corner on a grid of spacing
 //!    `2^-k < extent / 2^26` (**resolution < 1.5e-8 × extent**,
 //!    independent of where the polygon lies — 1e7 m coordinates are as exact
