@@ -836,7 +836,11 @@ impl<'a> Propagation<'a> {
 
     /// The cost of the propagation, predicted from a sample of the input's
     /// reflex vertices: (edges to try, candidates to keep) over all of them.
-    fn predict(&self) -> (f64, f64) {
+    /// The first eighth of the sample is spread over the whole polygon;
+    /// when its estimate already makes `hopeless` true (far beyond the
+    /// budget), that estimate is returned without the rest — on a huge
+    /// polygon each sampled vertex can cost a scan of every edge.
+    fn predict(&self, hopeless: impl Fn((f64, f64)) -> bool) -> (f64, f64) {
         let reflex: Vec<VertexId> = (0..self.w.vertices.len() as u32)
             .map(VertexId)
             .filter(|&v| self.w.v(v).reflex)
@@ -845,16 +849,34 @@ impl<'a> Propagation<'a> {
             return (0.0, 0.0);
         }
         let step = reflex.len().div_ceil(PREDICTION_SAMPLE);
+        let sample: Vec<VertexId> = reflex.iter().copied().step_by(step).collect();
+        // Every eighth sampled vertex first, then the others.
+        let first = sample.iter().step_by(8).copied();
+        let rest = sample
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| i % 8 != 0)
+            .map(|(_, &z)| z);
         let (mut tried, mut kept, mut sampled) = (0usize, 0usize, 0usize);
-        for &z in reflex.iter().step_by(step) {
+        let estimate = |tried: usize, kept: usize, sampled: usize| {
+            let scale = reflex.len() as f64 / sampled.max(1) as f64;
+            (tried as f64 * scale, kept as f64 * scale)
+        };
+        let first_count = sample.len().div_ceil(8);
+        for z in first.chain(rest) {
             if let Some((lines, t_max)) = self.candidate_lines(z) {
                 tried += lines.len();
                 kept += split_candidates(&self.w, z, lines.into_iter(), t_max, self.tol).len();
             }
             sampled += 1;
+            if sampled == first_count && sampled < sample.len() {
+                let partial = estimate(tried, kept, sampled);
+                if hopeless(partial) {
+                    return partial;
+                }
+            }
         }
-        let scale = reflex.len() as f64 / sampled.max(1) as f64;
-        (tried as f64 * scale, kept as f64 * scale)
+        estimate(tried, kept, sampled)
     }
 
     fn push_candidate(&mut self, v: VertexId, i: u32) {
@@ -869,7 +891,16 @@ impl<'a> Propagation<'a> {
 fn propagate(polygon: &PreparedPolygon, search: Search) -> Result<(Vec<Arc>, Stats), MethodError> {
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         let p = Propagation::new(polygon, search);
-        let predicted = p.predict();
+        // Declined after the first eighth of the sample when that already
+        // predicts four times the budget.
+        let predicted = p.predict(|(tries, kept)| {
+            crate::methods::budget::afford(
+                MethodId::STSK,
+                tries * SECONDS_PER_TRY / 4.0,
+                kept * CANDIDATE_BYTES as f64 / 4.0,
+            )
+            .is_err()
+        });
         crate::methods::budget::afford(
             MethodId::STSK,
             predicted.0 * SECONDS_PER_TRY,
@@ -1009,6 +1040,39 @@ mod tests {
         StraightSkeleton
             .skeletonise(&PreparedPolygon::new(&p).unwrap())
             .unwrap()
+    }
+
+    /// The early estimate (the first eighth of the sample, spread over the
+    /// polygon) is near the whole sample's, so declining on it at four
+    /// times the budget declines only what the whole sample would.
+    #[test]
+    fn early_prediction_is_near_the_full_one() {
+        let n = 4000;
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let ring: Vec<(f64, f64)> = (0..n)
+            .map(|i| {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                let u = (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+                let t = i as f64 / n as f64 * std::f64::consts::TAU;
+                let r = 1000.0 * (1.0 + 0.05 * (7.0 * t).sin()) + 1.5 * u;
+                (r * t.cos(), r * t.sin())
+            })
+            .collect();
+        let pp = PreparedPolygon::new(&geo::Polygon::new(ring.into(), vec![])).unwrap();
+        let p = Propagation::new(&pp, Search::Near(1.0));
+        let full = p.predict(|_| false);
+        let early = p.predict(|_| true);
+        assert!(full.0 > 0.0 && full.1 > 0.0, "{full:?}");
+        // A different number: the early one stopped after fewer samples.
+        assert_ne!(early, full);
+        for (e, f) in [(early.0, full.0), (early.1, full.1)] {
+            assert!(
+                e > 0.5 * f && e < 2.0 * f,
+                "early {early:?} against full {full:?}"
+            );
+        }
     }
 
     #[test]
