@@ -265,14 +265,33 @@ impl Boundary {
 
     /// The segment nearest to `p` and its squared distance.
     fn nearest_segment(&self, p: Coord<f64>) -> Option<(f64, u32)> {
+        self.nearest_segment_within(p, f64::INFINITY)
+    }
+
+    /// The nearest segment among those within squared distance `limit2`.
+    fn nearest_segment_within(&self, p: Coord<f64>, limit2: f64) -> Option<(f64, u32)> {
         let (x, y) = (p.x, p.y);
-        self.tree.best(
+        self.tree.best_within(
+            limit2,
             |b| Some(box_distance_2(b, x, y)),
             |i, _| {
                 let s = &self.segments[i as usize];
                 Some(segment_distance_2(s.a, s.b, p))
             },
         )
+    }
+
+    /// [`Boundary::nearest`] among the points at most `limit` from `p`
+    /// (`None` if there is none): a known upper bound of the distance keeps
+    /// the search short and never changes the answer.
+    pub fn nearest_within(&self, p: Coord<f64>, limit: f64) -> Option<(Coord<f64>, usize, f64)> {
+        if !finite(p) {
+            return None;
+        }
+        let (_, i) = self.nearest_segment_within(p, limit * limit)?;
+        let s = &self.segments[i as usize];
+        let (c, _) = s.closest(p);
+        Some((c, i as usize, super::norm(c - p)))
     }
 
     /// Nearest boundary point to `p`: (point, segment index, distance).
