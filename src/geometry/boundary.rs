@@ -315,6 +315,19 @@ impl Boundary {
             .unwrap_or(f64::INFINITY)
     }
 
+    /// [`Boundary::distance`] when it is known to be at most `bound` (up to
+    /// rounding): the bound keeps the search short and never changes the
+    /// answer.
+    pub fn distance_within(&self, p: Coord<f64>, bound: f64) -> f64 {
+        let limit = bound * (1.0 + 1e-9) + f64::MIN_POSITIVE;
+        if !finite(p) || !limit.is_finite() {
+            return self.distance(p);
+        }
+        self.nearest_segment_within(p, limit * limit)
+            .map(|(d2, _)| d2.sqrt())
+            .unwrap_or_else(|| self.distance(p))
+    }
+
     /// Nearest boundary point to `q` within the closed half-plane
     /// `(x − q) · normal ≥ 0`: `(point, distance)`.
     pub fn nearest_in_half_plane(

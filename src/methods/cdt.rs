@@ -166,7 +166,7 @@ impl SkeletonMethod for Cdt {
 
     fn skeletonise(&self, polygon: &PreparedPolygon) -> Result<SkeletonGraph, MethodError> {
         let triangles = inside_triangles(polygon)?;
-        let mut b = GraphBuilder::new();
+        let mut b = Nodes::default();
         for t in &triangles {
             let c = t.corners;
             let m = |i: usize| mid(c[i], c[(i + 1) % 3]);
@@ -175,26 +175,58 @@ impl SkeletonMethod for Cdt {
                 1 => {
                     // Opposite vertex of inner edge i is corner i+2.
                     let i = inner[0];
-                    b.segment(m(i), c[(i + 2) % 3]);
+                    b.segment(m(i), c[(i + 2) % 3], c[0]);
                 }
                 2 => {
-                    b.segment(m(inner[0]), m(inner[1]));
+                    b.segment(m(inner[0]), m(inner[1]), c[0]);
                 }
                 3 => {
                     let g = centroid(&c);
                     for i in 0..3 {
-                        b.segment(g, m(i));
+                        b.segment(g, m(i), c[0]);
                     }
                 }
                 _ => {
                     let g = centroid(&c);
                     for corner in c {
-                        b.segment(g, corner);
+                        b.segment(g, corner, c[0]);
                     }
                 }
             }
         }
         Ok(b.finish(polygon.boundary()))
+    }
+}
+
+/// The graph being built, with an upper bound of every node's distance to
+/// ∂P: its distance to a corner of a triangle it lies in (the corners are
+/// vertices of ∂P). The bound keeps each radius search short and never
+/// changes the radius.
+#[derive(Default)]
+struct Nodes {
+    graph: GraphBuilder,
+    bound: Vec<f64>,
+}
+
+impl Nodes {
+    fn segment(&mut self, p: Coord<f64>, q: Coord<f64>, corner: Coord<f64>) {
+        for x in [p, q] {
+            let id = self.graph.node(x).0 as usize;
+            if self.bound.len() <= id {
+                self.bound.resize(id + 1, f64::INFINITY);
+            }
+            let d = x - corner;
+            self.bound[id] = self.bound[id].min(d.x.hypot(d.y));
+        }
+        self.graph.segment(p, q);
+    }
+
+    fn finish(self, boundary: &crate::geometry::Boundary) -> SkeletonGraph {
+        let mut g = self.graph.finish_raw();
+        for (n, &bound) in g.nodes_mut().iter_mut().zip(&self.bound) {
+            n.radius = boundary.distance_within(n.pos, bound);
+        }
+        g
     }
 }
 
