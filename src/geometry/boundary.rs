@@ -296,13 +296,7 @@ impl Boundary {
 
     /// Nearest boundary point to `p`: (point, segment index, distance).
     pub fn nearest(&self, p: Coord<f64>) -> Option<(Coord<f64>, usize, f64)> {
-        if !finite(p) {
-            return None;
-        }
-        let (_, i) = self.nearest_segment(p)?;
-        let s = &self.segments[i as usize];
-        let (c, _) = s.closest(p);
-        Some((c, i as usize, super::norm(c - p)))
+        self.nearest_within(p, f64::INFINITY)
     }
 
     /// Euclidean distance from `p` to ∂P (the radius of every skeleton node).
@@ -572,6 +566,46 @@ mod tests {
         assert!(!b.contains(Coord { x: 11.0, y: 5.0 }));
         assert!(b.crosses(Coord { x: 2.0, y: 5.0 }, Coord { x: 5.0, y: 5.0 }));
         assert!(!b.crosses(Coord { x: 1.0, y: 1.0 }, Coord { x: 3.0, y: 9.0 }));
+    }
+
+    /// The bounded searches give the unbounded answers: the same nearest
+    /// point within any limit at or above its distance, none below it, and
+    /// `distance_within` the true distance even from a wrong bound.
+    #[test]
+    fn bounded_searches_agree_with_unbounded_ones() {
+        let n = 600;
+        let ring: Vec<(f64, f64)> = (0..n)
+            .map(|i| {
+                let t = i as f64 / n as f64 * std::f64::consts::TAU;
+                let r = 100.0 + 7.0 * (13.0 * t).sin() + 3.0 * (41.0 * t).cos();
+                (r * t.cos(), r * t.sin())
+            })
+            .collect();
+        let b = Boundary::new(&geo::Polygon::new(ring.into(), vec![]));
+        for k in 0..200 {
+            let a = k as f64 * 0.7;
+            let p = Coord {
+                x: (k % 90) as f64 * a.cos(),
+                y: (k % 90) as f64 * a.sin(),
+            };
+            let (c, i, d) = b.nearest(p).unwrap();
+            assert_eq!(
+                b.nearest_within(p, d * (1.0 + 1e-6)),
+                Some((c, i, d)),
+                "{p:?}"
+            );
+            assert_eq!(
+                b.nearest_within(p, 10.0 * d + 1.0),
+                Some((c, i, d)),
+                "{p:?}"
+            );
+            if d > 0.0 {
+                assert_eq!(b.nearest_within(p, 0.5 * d), None, "{p:?}");
+            }
+            for bound in [0.5 * d, d, 3.0 * d + 5.0] {
+                assert_eq!(b.distance_within(p, bound), b.distance(p), "{p:?} {bound}");
+            }
+        }
     }
 
     #[test]
