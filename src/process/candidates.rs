@@ -21,17 +21,23 @@ pub(super) fn computed(
     params: &ProcessParams,
 ) -> Vec<super::Candidate> {
     let n = prepared.len();
-    let per_part: Vec<Vec<(Result<PartSkeleton, String>, StageTimes)>> = prepared
-        .iter()
-        .enumerate()
-        .map(|(i, p)| {
-            part_skeletons(p, params)
-                .into_iter()
-                .map(|(r, t)| (r.map_err(|e| part_reason(i, n, &e)), t))
+    // The bars' rays depend on the polygon alone: found while the methods
+    // work (on one huge polygon they fill a core the methods leave idle).
+    let (per_part, (rays, rays_time)) = rayon::join(
+        || -> Vec<Vec<(Result<PartSkeleton, String>, StageTimes)>> {
+            prepared
+                .iter()
+                .enumerate()
+                .map(|(i, p)| {
+                    part_skeletons(p, params)
+                        .into_iter()
+                        .map(|(r, t)| (r.map_err(|e| part_reason(i, n, &e)), t))
+                        .collect()
+                })
                 .collect()
-        })
-        .collect();
-    let (rays, rays_time) = bar_rays(prepared, params);
+        },
+        || bar_rays(prepared, params),
+    );
     // The shared rays, split evenly between the methods.
     let rays_share = rays_time / params.skeleton.methods.len().max(1) as u32;
     params
@@ -103,9 +109,40 @@ pub(super) fn part_skeletons(
     use crate::graph::prune::{PruneMode, Structure as Sharing};
     use crate::graph::structure::{conform, Structure};
     let methods = &params.skeleton.methods;
-    let raws: Vec<(Result<crate::graph::SkeletonGraph, String>, StageTimes)> = methods
+    let finish = |raw: &crate::graph::SkeletonGraph| {
+        prune_and_extend(raw, p, params.prune.as_ref(), params.extend.as_ref())
+    };
+    let shared = params
+        .prune
+        .filter(|pr| pr.mode != PruneMode::None && pr.structure == Sharing::Shared);
+    let trunk = params.prune.is_some_and(|pr| pr.mode == PruneMode::Trunk);
+    // The reference: the first method in the reference order whose finished
+    // skeleton is not empty (a polygon thinner than MA's grid has no medial
+    // axis). The first listed one is finished in its own task, as soon as
+    // its raw skeleton is there, while the other methods' are still being
+    // made (the others wait for the structure; on one huge polygon this
+    // keeps both cores busy).
+    let order: Vec<usize> = shared.map_or_else(Vec::new, |_| {
+        params
+            .skeleton
+            .reference_order()
+            .into_iter()
+            .filter_map(|m| methods.iter().position(|&x| x == m))
+            .collect()
+    });
+    let reference_of = |k: usize, raw: &crate::graph::SkeletonGraph| {
+        let g = finish(raw);
+        (!g.is_empty()).then(|| (k, Structure::of(&g, p, trunk), g))
+    };
+    type Reference = Option<(usize, Structure, crate::graph::SkeletonGraph)>;
+    let raws: Vec<(
+        Result<crate::graph::SkeletonGraph, String>,
+        StageTimes,
+        Reference,
+    )> = methods
         .par_iter()
-        .map(|&m| {
+        .enumerate()
+        .map(|(k, &m)| {
             let clock = CpuClock::start();
             let raw = params
                 .registry
@@ -118,40 +155,38 @@ pub(super) fn part_skeletons(
                         .map_err(|e| e.to_string())
                     })
                 });
-            let time = StageTimes {
+            let mut time = StageTimes {
                 skeleton: clock.elapsed(),
                 ..StageTimes::default()
             };
-            (raw, time)
+            let clock = CpuClock::start();
+            let reference = match &raw {
+                Ok(g) if order.first() == Some(&k) => reference_of(k, g),
+                _ => None,
+            };
+            time.prune_extend = clock.elapsed();
+            (raw, time, reference)
         })
         .collect();
-    let finish = |raw: &crate::graph::SkeletonGraph| {
-        prune_and_extend(raw, p, params.prune.as_ref(), params.extend.as_ref())
-    };
-    let shared = params
-        .prune
-        .filter(|pr| pr.mode != PruneMode::None && pr.structure == Sharing::Shared);
-    // The first method in the reference order whose finished skeleton is
-    // not empty (a polygon thinner than MA's grid has no medial axis).
-    let trunk = params.prune.is_some_and(|pr| pr.mode == PruneMode::Trunk);
     let mut reference_time = vec![std::time::Duration::ZERO; methods.len()];
-    let structure = shared.and_then(|_| {
-        params.skeleton.reference_order().into_iter().find_map(|m| {
-            let k = methods.iter().position(|&x| x == m)?;
+    let first = raws.iter().find_map(|r| r.2.as_ref());
+    let fallback = match first {
+        Some(_) => None,
+        None => order.iter().skip(1).find_map(|&k| {
             let clock = CpuClock::start();
-            let g = finish(raws[k].0.as_ref().ok()?);
-            let found = (!g.is_empty()).then(|| (k, Structure::of(&g, p, trunk), g));
+            let found = reference_of(k, raws[k].0.as_ref().ok()?);
             reference_time[k] += clock.elapsed();
             found
-        })
-    });
+        }),
+    };
+    let structure = first.or(fallback.as_ref());
     raws.par_iter()
         .enumerate()
-        .map(|(k, (raw, time))| {
+        .map(|(k, (raw, time, _))| {
             let clock = CpuClock::start();
             let result = raw.as_ref().map_err(Clone::clone).and_then(|raw| {
                 let g = guarded(methods[k], || {
-                    Ok(match &structure {
+                    Ok(match structure {
                         Some((r, _, g)) if *r == k => g.clone(),
                         Some((_, s, _)) => conform(raw, s, p),
                         None => finish(raw),
@@ -163,7 +198,7 @@ pub(super) fn part_skeletons(
                 })
             });
             let mut time = *time;
-            time.prune_extend = reference_time[k] + clock.elapsed();
+            time.prune_extend += reference_time[k] + clock.elapsed();
             (result, time)
         })
         .collect()
@@ -193,17 +228,7 @@ fn bar_rays(prepared: &[PreparedPolygon], params: &ProcessParams) -> (Vec<BarRay
     if params.score.is_none() {
         return (Vec::new(), Duration::ZERO);
     }
-    // Per part, on one thread each (a part's rays may fan out to others,
-    // whose time the part's clock misses: counted as wall time then).
-    let timed: Vec<(BarRays, Duration)> = prepared
-        .par_iter()
-        .map(|p| {
-            let wall = std::time::Instant::now();
-            let cpu = CpuClock::start();
-            let r = BarRays::new(p);
-            (r, cpu.elapsed().max(wall.elapsed()))
-        })
-        .collect();
+    let timed: Vec<(BarRays, Duration)> = prepared.par_iter().map(BarRays::timed).collect();
     let time = timed.iter().map(|(_, t)| *t).sum();
     (timed.into_iter().map(|(r, _)| r).collect(), time)
 }

@@ -520,6 +520,75 @@ mod tests {
         assert!(!o.chosen().1.geometry.0.is_empty());
     }
 
+    /// Every listed method's candidates on an L-shaped polygon with every
+    /// step, the reference given.
+    fn candidates_of(
+        methods: Vec<MethodId>,
+        reference: MethodId,
+        max_points: usize,
+    ) -> Vec<Candidate> {
+        let mut p = ProcessParams::all_steps();
+        p.skeleton.methods = methods;
+        p.skeleton.reference = reference;
+        p.skeleton.voronoi.max_points = max_points;
+        let l = polygon![
+            (x: 0., y: 0.), (x: 40., y: 0.), (x: 40., y: 6.), (x: 6., y: 6.),
+            (x: 6., y: 30.), (x: 0., y: 30.)
+        ];
+        let Processed::Done(o) = process(Some(&Geometry::Polygon(l)), &p) else {
+            panic!("the L-shape is skeletonised")
+        };
+        o.candidates
+    }
+
+    /// The end points of the lines, sorted.
+    fn ends(c: &CandidateSkeleton) -> Vec<(f64, f64)> {
+        let mut e: Vec<(f64, f64)> = c
+            .geometry
+            .0
+            .iter()
+            .flat_map(|l| [l.0[0], l.0[l.0.len() - 1]])
+            .map(|p| (p.x, p.y))
+            .collect();
+        e.sort_by(|a, b| a.partial_cmp(b).unwrap());
+        e
+    }
+
+    #[test]
+    fn a_failed_reference_hands_over_to_the_next_in_the_reference_order() {
+        // DVD is the reference but cannot densify into 5 points: StSk, next in
+        // the order (CDT comes later), gives the structure, as it does when it
+        // is the only method, and CDT's legs reach its contacts.
+        let c = candidates_of(
+            vec![MethodId::DVD, MethodId::CDT, MethodId::STSK],
+            MethodId::DVD,
+            5,
+        );
+        assert!(c[0]
+            .result
+            .as_ref()
+            .is_err_and(|e| e.contains("max_points")));
+        let (cdt, stsk) = (c[1].result.as_ref().unwrap(), c[2].result.as_ref().unwrap());
+        let alone = candidates_of(vec![MethodId::STSK], MethodId::STSK, 5);
+        let alone = alone[0].result.as_ref().unwrap();
+        assert!(!stsk.geometry.0.is_empty());
+        assert_eq!(stsk.geometry, alone.geometry);
+        assert_eq!(ends(cdt), ends(stsk));
+        let own = candidates_of(vec![MethodId::CDT], MethodId::CDT, 5);
+        assert_ne!(
+            ends(own[0].result.as_ref().unwrap()),
+            ends(stsk),
+            "the test tells them apart"
+        );
+        // The reference listed after another method: DVD (densified now)
+        // reaches CDT's contacts.
+        let c = candidates_of(vec![MethodId::DVD, MethodId::CDT], MethodId::CDT, 100_000);
+        let (dvd, cdt) = (c[0].result.as_ref().unwrap(), c[1].result.as_ref().unwrap());
+        assert_eq!(cdt.geometry, own[0].result.as_ref().unwrap().geometry);
+        assert!(dvd.legs_raw > cdt.legs, "{dvd:?}");
+        assert_eq!(ends(dvd), ends(cdt));
+    }
+
     #[test]
     fn more_vertices_than_max_vertices_is_rejected_before_any_method() {
         let p = ProcessParams {

@@ -149,6 +149,13 @@ struct Ray {
 impl BarRays {
     /// The valid bars of `polygon` and their exits from P.
     pub fn new(polygon: &PreparedPolygon) -> Self {
+        Self::timed(polygon).0
+    }
+
+    /// [`BarRays::new`], and the CPU time it took over all threads (a large
+    /// polygon's exits are found in parallel).
+    pub fn timed(polygon: &PreparedPolygon) -> (Self, std::time::Duration) {
+        let clock = CpuClock::start();
         let boundary = polygon.boundary();
         let eps = REL_EPS * polygon.extent();
         // No ray stays inside P for longer than the bounding box's diagonal.
@@ -181,14 +188,20 @@ impl BarRays {
         }
         // Where each ray leaves P: in parallel for a large polygon (one
         // huge feature must not leave the other cores idle).
-        rays.par_chunks_mut(PAR_BARS).for_each(|chunk| {
-            for r in chunk {
-                if let Some(h) = boundary.first_hit(r.origin, r.dir, eps, f64::INFINITY) {
-                    r.exit = h.t;
+        let mut time = clock.elapsed();
+        time += rays
+            .par_chunks_mut(PAR_BARS)
+            .map(|chunk| {
+                let clock = CpuClock::start();
+                for r in chunk {
+                    if let Some(h) = boundary.first_hit(r.origin, r.dir, eps, f64::INFINITY) {
+                        r.exit = h.t;
+                    }
                 }
-            }
-        });
-        Self { rays }
+                clock.elapsed()
+            })
+            .sum::<std::time::Duration>();
+        (Self { rays }, time)
     }
 
     /// Number of bars.
@@ -217,26 +230,31 @@ impl BarRays {
         let clock = CpuClock::start();
         let eps = REL_EPS * polygon.extent();
         let sk = SkeletonIndex::new(skeleton);
-        let mut time = clock.elapsed();
-        let chunks: Vec<(Vec<Bar>, std::time::Duration)> = self
+        let time = clock.elapsed();
+        // Written in place, chunk by chunk on the threads that cast them
+        // (the bars of a huge polygon are tens of megabytes: no copy).
+        let mut bars: Vec<Bar> = self
             .rays
-            .par_chunks(PAR_BARS)
-            .map(|chunk| {
-                let clock = CpuClock::start();
-                let mut recent = [NOWHERE; 2];
-                let bars: Vec<Bar> = chunk
-                    .iter()
-                    .map(|r| cast(polygon.boundary(), &sk, r, eps, &mut recent))
-                    .collect();
-                (bars, clock.elapsed())
+            .par_iter()
+            .map(|r| Bar {
+                origin: r.origin,
+                dir: r.dir,
+                hit: None,
             })
             .collect();
-        let mut bars = Vec::with_capacity(self.rays.len());
-        for (b, t) in chunks {
-            bars.extend(b);
-            time += t;
-        }
-        (bars, time)
+        let cast_time: std::time::Duration = bars
+            .par_chunks_mut(PAR_BARS)
+            .zip(self.rays.par_chunks(PAR_BARS))
+            .map(|(bars, rays)| {
+                let clock = CpuClock::start();
+                let mut recent = [NOWHERE; 2];
+                for (bar, r) in bars.iter_mut().zip(rays) {
+                    bar.hit = cast(polygon.boundary(), &sk, r, eps, &mut recent);
+                }
+                clock.elapsed()
+            })
+            .sum();
+        (bars, time + cast_time)
     }
 }
 
@@ -246,7 +264,7 @@ const NOWHERE: Coord<f64> = Coord {
     y: f64::NAN,
 };
 
-/// One bar: its hit on the skeleton before it leaves P, and the sides there.
+/// One bar's hit on the skeleton before it leaves P, and the sides there.
 /// `recent` holds the side points of the bar cast before (bars come in
 /// boundary order, so they are usually near): boundary points that bound
 /// this bar's searches too.
@@ -256,10 +274,10 @@ fn cast(
     ray: &Ray,
     eps: f64,
     recent: &mut [Coord<f64>; 2],
-) -> Bar {
+) -> Option<BarHit> {
     let (origin, u) = (ray.origin, ray.dir);
     let exit = origin + u * ray.exit;
-    let hit = sk.hit(origin, u, eps, ray.exit).and_then(|(q, sigma)| {
+    sk.hit(origin, u, eps, ray.exit).and_then(|(q, sigma)| {
         let nu = left_normal(sigma.b - sigma.a);
         // The bar's origin and exit, and the previous bar's side points, are
         // boundary points: each in a side's half-plane bounds the nearest
@@ -290,12 +308,7 @@ fn cast(
             d_right,
             part: sigma.ring as usize,
         })
-    });
-    Bar {
-        origin,
-        dir: u,
-        hit,
-    }
+    })
 }
 
 /// Scores skeleton linework made by any tool against `polygon`: the lines
