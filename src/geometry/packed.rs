@@ -374,55 +374,11 @@ pub fn ray_box(b: &Bbox, o: [f64; 2], d: [f64; 2], max_t: f64) -> Option<(f64, f
     Some((t0, t1))
 }
 
-/// A lower bound of the distance from `q` to the part of the box in the
-/// closed half-plane `(x − q) · n ≥ 0` (`None`: no part). The nearest point
-/// of the box, if in the half-plane; else the nearest point lies on the
-/// half-plane's edge, the line through `q` across `n`, and the bound is the
-/// distance along it to where it crosses the box. Shrunk by a relative
-/// 1e-9 so that rounding never makes it exceed the true distance.
-pub fn box_half_plane_distance(b: &Bbox, q: [f64; 2], n: [f64; 2]) -> Option<f64> {
-    let px = q[0].clamp(b[0], b[2]);
-    let py = q[1].clamp(b[1], b[3]);
-    let (dx, dy) = (px - q[0], py - q[1]);
-    let shrink = 1.0 - 1e-9;
-    if dx * n[0] + dy * n[1] >= 0.0 {
-        return Some((dx * dx + dy * dy).sqrt() * shrink);
-    }
-    // The edge line q + s·t.
-    let t = [-n[1], n[0]];
-    let (mut s0, mut s1) = (f64::NEG_INFINITY, f64::INFINITY);
-    for k in 0..2 {
-        let (l, h) = (b[k], b[k + 2]);
-        if t[k] == 0.0 {
-            if q[k] < l || q[k] > h {
-                return None;
-            }
-        } else {
-            let (mut a, mut c) = ((l - q[k]) / t[k], (h - q[k]) / t[k]);
-            if a > c {
-                std::mem::swap(&mut a, &mut c);
-            }
-            s0 = s0.max(a);
-            s1 = s1.min(c);
-        }
-    }
-    // A margin for rounding in the slab test: a box the edge only touches
-    // still counts.
-    let len = (t[0] * t[0] + t[1] * t[1]).sqrt();
-    let slack = 1e-9 * (s0.abs().max(s1.abs()).min(1e300) + 1.0);
-    if s0 > s1 + slack {
-        return None;
-    }
-    let along = if s0 <= 0.0 && 0.0 <= s1 {
-        0.0
-    } else {
-        s0.abs().min(s1.abs())
-    };
-    Some(along * len * shrink)
-}
-
 /// True when some corner of the box is in the closed half-plane
-/// `(x − q) · n ≥ 0`.
+/// `(x − q) · n ≥ 0`. Safe under rounding for points in the box: the test
+/// is on the corner farthest along `n`, and `(x − q) · n` computed in
+/// floating point never decreases as `x` moves towards that corner, so a
+/// point of the box that tests inside makes the corner test inside too.
 pub fn box_meets_half_plane(b: &Bbox, q: [f64; 2], n: [f64; 2]) -> bool {
     // The corner farthest along n.
     let x = if n[0] >= 0.0 { b[2] } else { b[0] };
