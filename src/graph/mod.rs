@@ -20,7 +20,7 @@ pub mod structure;
 
 use crate::geometry::Boundary;
 use geo::{Coord, LineString, MultiLineString};
-use std::collections::HashMap;
+use rustc_hash::FxHashMap as HashMap;
 
 /// Typed index of a node.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -297,7 +297,7 @@ impl SkeletonGraph {
     /// Unused nodes are dropped.
     pub fn merged(&self) -> SkeletonGraph {
         let mut g = SkeletonGraph::new();
-        let mut map: HashMap<NodeId, NodeId> = HashMap::new();
+        let mut map: HashMap<NodeId, NodeId> = HashMap::default();
         let mut id = |g: &mut SkeletonGraph, n: NodeId| -> NodeId {
             *map.entry(n).or_insert_with(|| {
                 let nd = self.node(n);
@@ -316,7 +316,7 @@ impl SkeletonGraph {
     /// A copy keeping only the edges for which `keep` is true; unused nodes dropped.
     pub fn filter_edges(&self, mut keep: impl FnMut(EdgeId, &Edge) -> bool) -> SkeletonGraph {
         let mut g = SkeletonGraph::new();
-        let mut map: HashMap<NodeId, NodeId> = HashMap::new();
+        let mut map: HashMap<NodeId, NodeId> = HashMap::default();
         for (i, e) in self.edges.iter().enumerate() {
             if !keep(EdgeId(i as u32), e) {
                 continue;

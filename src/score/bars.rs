@@ -6,7 +6,7 @@ use crate::graph::{GraphBuilder, SkeletonGraph};
 use crate::process::clock::CpuClock;
 use geo::{Coord, MultiLineString};
 use rayon::prelude::*;
-use std::collections::HashMap;
+use rustc_hash::FxHashMap as HashMap;
 
 /// Bars per parallel task: a polygon with fewer is scored on one thread.
 const PAR_BARS: usize = 4096;
@@ -80,7 +80,7 @@ impl SkeletonIndex {
                 }
             }
         }
-        let mut at_vertex: HashMap<(u64, u64), Vec<u32>> = HashMap::new();
+        let mut at_vertex: HashMap<(u64, u64), Vec<u32>> = HashMap::default();
         for (i, s) in segments.iter().enumerate() {
             at_vertex.entry(key(s.a)).or_default().push(i as u32);
             at_vertex.entry(key(s.b)).or_default().push(i as u32);

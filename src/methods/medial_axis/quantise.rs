@@ -21,7 +21,7 @@
 
 use geo::Coord;
 use rstar::{primitives::GeomWithData, primitives::Rectangle, RTree, AABB};
-use std::collections::HashMap;
+use rustc_hash::FxHashMap as HashMap;
 
 /// Vertices this close (grid units) to another segment's interior are put on it.
 /// Rounding moves any point by at most √2/2 units, so a touch becomes a
@@ -245,7 +245,8 @@ fn split_at_touches(segs: Vec<Seg>) -> Vec<Seg> {
 /// repeated copies of the same directed segment. Keeps the input order.
 fn cancel_opposites(segs: Vec<Seg>) -> Vec<Seg> {
     let key = |s: &Seg| if s.a <= s.b { (s.a, s.b) } else { (s.b, s.a) };
-    let mut net: HashMap<(Pt, Pt), i64> = HashMap::with_capacity(segs.len());
+    let mut net: HashMap<(Pt, Pt), i64> =
+        HashMap::with_capacity_and_hasher(segs.len(), Default::default());
     for s in &segs {
         *net.entry(key(s)).or_insert(0) += if s.a <= s.b { 1 } else { -1 };
     }
