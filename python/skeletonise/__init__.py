@@ -200,7 +200,8 @@ _DTYPES = {"int32": "Int32", "int64": "Int64", "real": "float64", "text": "strin
 def _column(kind: str, values: Any) -> Any:
     if kind in ("int32", "int64"):
         v, null = values
-        return pd.array(pd.arrays.IntegerArray(v, null), dtype=_DTYPES[kind])
+        # Already of the column's width: the masked array is the column.
+        return pd.arrays.IntegerArray(np.asarray(v, dtype=kind), np.asarray(null, dtype=bool))
     if kind == "real":
         return values
     return pd.array(values, dtype=_DTYPES[kind])
