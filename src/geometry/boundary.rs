@@ -577,20 +577,25 @@ mod tests {
         assert!(!b.crosses(Coord { x: 1.0, y: 1.0 }, Coord { x: 3.0, y: 9.0 }));
     }
 
+    /// The boundary of a ring of `n` vertices around the origin, radius 100
+    /// with two waves (amplitude, frequency) on it: a tree of several levels.
+    fn wavy_ring(n: usize, w1: [f64; 2], w2: [f64; 2]) -> Boundary {
+        let ring: Vec<(f64, f64)> = (0..n)
+            .map(|i| {
+                let t = i as f64 / n as f64 * std::f64::consts::TAU;
+                let r = 100.0 + w1[0] * (w1[1] * t).sin() + w2[0] * (w2[1] * t).cos();
+                (r * t.cos(), r * t.sin())
+            })
+            .collect();
+        Boundary::new(&geo::Polygon::new(ring.into(), vec![]))
+    }
+
     /// The bounded searches give the unbounded answers: the same nearest
     /// point within any limit at or above its distance, none below it, and
     /// `distance_within` the true distance even from a wrong bound.
     #[test]
     fn bounded_searches_agree_with_unbounded_ones() {
-        let n = 600;
-        let ring: Vec<(f64, f64)> = (0..n)
-            .map(|i| {
-                let t = i as f64 / n as f64 * std::f64::consts::TAU;
-                let r = 100.0 + 7.0 * (13.0 * t).sin() + 3.0 * (41.0 * t).cos();
-                (r * t.cos(), r * t.sin())
-            })
-            .collect();
-        let b = Boundary::new(&geo::Polygon::new(ring.into(), vec![]));
+        let b = wavy_ring(600, [7.0, 13.0], [3.0, 41.0]);
         for k in 0..200 {
             let a = k as f64 * 0.7;
             let p = Coord {
@@ -662,15 +667,7 @@ mod tests {
     /// ring whose tree has several levels, from points inside and outside.
     #[test]
     fn half_plane_and_sector_searches_match_a_scan() {
-        let n = 900;
-        let ring: Vec<(f64, f64)> = (0..n)
-            .map(|i| {
-                let t = i as f64 / n as f64 * std::f64::consts::TAU;
-                let r = 100.0 + 9.0 * (11.0 * t).sin() + 2.0 * (57.0 * t).cos();
-                (r * t.cos(), r * t.sin())
-            })
-            .collect();
-        let b = Boundary::new(&geo::Polygon::new(ring.into(), vec![]));
+        let b = wavy_ring(900, [9.0, 11.0], [2.0, 57.0]);
         type Clip<'a> = &'a dyn Fn(Coord<f64>, Coord<f64>) -> Option<(Coord<f64>, Coord<f64>)>;
         let scan = |q: Coord<f64>, clip: Clip| {
             let mut best: Option<(Coord<f64>, f64)> = None;
