@@ -13,6 +13,12 @@ mod run;
 mod table;
 mod wkb;
 
+/// mimalloc for the Rust side's own allocations, as in the command line
+/// (numpy buffers handed to Python own their memory through a capsule that
+/// frees it here, so the two allocators never meet).
+#[global_allocator]
+static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use skeletonise::config::{self, ConfigError, OnError, Steps};
