@@ -339,8 +339,9 @@ def skeletonise(
         ``reject`` (a row with the reason in ``rejected``) or ``fail`` (raise
         :class:`RejectedError` at the first rejected feature).
     threads
-        Worker threads: ``None`` one per core, ``1`` the calling thread only (on
-        a Dask worker, where Dask runs the partitions in parallel).
+        Worker threads: ``None`` one per core, ``n`` a pool of ``n`` threads for
+        this call (``1`` on a Dask worker, where Dask runs the partitions in
+        parallel: one core per task, the methods of a polygon included).
     exchange, output
         How geometries cross to Rust (``wkb``, the faster, or ``geoarrow`` ragged
         arrays of polygons) and back (``geoarrow`` buffers, the faster, or

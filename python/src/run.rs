@@ -286,7 +286,10 @@ fn work(
     })
 }
 
-/// Runs with the GIL released, in a pool of `threads` when given.
+/// Runs with the GIL released, in a pool of `threads` when given: also for
+/// one thread, since the per-feature path runs the methods and the bars in
+/// parallel and would otherwise fill rayon's global pool (a Dask worker
+/// asked for one core would take them all).
 fn detached(
     py: Python<'_>,
     input: &Input<'_>,
@@ -299,7 +302,7 @@ fn detached(
         Some(0) => Err(PyValueError::new_err(
             "threads must be ≥ 1 (or None for one per core)",
         )),
-        Some(n) if n > 1 => {
+        Some(n) => {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(n)
                 .build()

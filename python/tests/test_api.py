@@ -3,6 +3,7 @@ rejected rows, repairs, candidates, explode, exchange formats and the GIL."""
 
 from __future__ import annotations
 
+import os
 import threading
 import time
 
@@ -176,6 +177,18 @@ def test_threads_give_identical_results(islands):
     one = skeletonise.skeletonise(sample, threads=1, methods=["MA", "StSk"])
     two = skeletonise.skeletonise(sample, threads=2, methods=["MA", "StSk"])
     pd.testing.assert_frame_equal(one.drop(columns="geometry"), two.drop(columns="geometry"))
+
+
+@pytest.mark.skipif((os.cpu_count() or 1) < 2, reason="needs two cores to tell one from two")
+def test_one_thread_keeps_the_work_on_one_core(islands):
+    # A Dask worker asks for one thread per task: the methods of a polygon,
+    # run in parallel otherwise, must not spread to rayon's global pool.
+    time.sleep(0.1)  # idle pool threads from earlier tests fall asleep
+    cpu, wall = time.process_time(), time.perf_counter()
+    for _ in range(2):
+        skeletonise.skeletonise(islands.geometry, threads=1)
+    cpu, wall = time.process_time() - cpu, time.perf_counter() - wall
+    assert wall > 0.2 and cpu < 1.2 * wall, (cpu, wall)
 
 
 def test_the_gil_is_released_during_the_work(islands):
