@@ -22,7 +22,7 @@ pub struct Options {
     pub explode: bool,
     /// The `candidates` layer (every method's row) instead of `skeletons`.
     pub candidates: bool,
-    /// Worker threads: `None` rayon's global pool, 1 the calling thread.
+    /// Worker threads: `None` rayon's global pool, `n` a pool of `n` for the call.
     pub threads: Option<usize>,
     /// `on_error: fail`: the first rejected feature is an error.
     pub fail: bool,
