@@ -21,7 +21,10 @@
 //!    none is found (ρ: the reference's local radius at that end). At a
 //!    tapering tip that is the method's own leaf on the tip vertex; at a cut
 //!    end it is the node whose disc touches the end side's midpoint. For a
-//!    contact inside P (no extension) it is the nearest node.
+//!    contact inside P (no extension) it is the nearest node. A node on ∂P
+//!    serves only the contact it lies on, unless no node inside P sees c: on
+//!    a coarse polygon a CDT leaf on the next vertex would otherwise be
+//!    joined to c along the shoreline.
 //! 3. **Peel.** Leaves that are not terminals are removed until none is
 //!    left: what stays is the method's own skeleton between its terminals,
 //!    with its cycles (holes). With `trunk`, the two terminals of a
@@ -116,7 +119,13 @@ pub fn conform(
     let served: Vec<Option<(NodeId, bool)>> = structure
         .contacts
         .iter()
-        .map(|c| terminal(&g, &tree, c, polygon, tol))
+        .map(|c| {
+            // A node on ∂P away from c would join c along or across the
+            // shoreline (a coarse polygon's CDT leaf on the next vertex):
+            // such nodes serve c only when no node inside P can.
+            terminal(&g, &tree, c, polygon, tol, false)
+                .or_else(|| terminal(&g, &tree, c, polygon, tol, true))
+        })
         .collect();
     let terminals: Vec<Option<NodeId>> = served.iter().map(|t| t.map(|t| t.0)).collect();
     let mut is_terminal = vec![false; g.nodes().len()];
@@ -148,13 +157,16 @@ pub fn conform(
 /// The node of `g` that serves contact `c` (see the module documentation),
 /// and whether it sees `c`. When no node sees `c` (the reference runs into
 /// a channel too narrow for this method's skeleton), the node that sees the
-/// reference line farthest along its approach to `c` serves it.
+/// reference line farthest along its approach to `c` serves it. Nodes on
+/// ∂P (radius within `tol`) other than at `c` itself count only with
+/// `on_boundary`.
 fn terminal(
     g: &SkeletonGraph,
     tree: &NodeTree,
     c: &Contact,
     polygon: &PreparedPolygon,
     tol: f64,
+    on_boundary: bool,
 ) -> Option<(NodeId, bool)> {
     let b = polygon.boundary();
     let limit = 4.0 * polygon.extent();
@@ -168,6 +180,7 @@ fn terminal(
         tol,
         &score,
         b,
+        on_boundary,
     ) {
         return Some((n, true));
     }
@@ -187,6 +200,7 @@ fn terminal(
             tol,
             &near,
             b,
+            on_boundary,
         ) {
             return Some((n, false));
         }
@@ -199,7 +213,8 @@ type NodeTree = RTree<GeomWithData<[f64; 2], u32>>;
 
 /// The node with the smallest `score(distance, radius)` among those that see
 /// `q` (the segment to it stays in P), searched within `start` of `q` and
-/// four times farther each round up to `limit`.
+/// four times farther each round up to `limit`; without `on_boundary`,
+/// nodes on ∂P farther than `tol` from `q` are passed over.
 #[allow(clippy::too_many_arguments)]
 fn best_seeing(
     g: &SkeletonGraph,
@@ -210,6 +225,7 @@ fn best_seeing(
     tol: f64,
     score: &dyn Fn(f64, f64) -> f64,
     b: &crate::geometry::Boundary,
+    on_boundary: bool,
 ) -> Option<NodeId> {
     let mut reach = start;
     loop {
@@ -232,7 +248,7 @@ fn best_seeing(
         });
         let seen = keys.into_iter().find(|&(_, d, n)| {
             let node = g.node(NodeId(n));
-            d <= tol || b.reaches(node.pos, q)
+            d <= tol || ((on_boundary || node.radius > tol) && b.reaches(node.pos, q))
         });
         if let Some((_, _, n)) = seen {
             return Some(NodeId(n));

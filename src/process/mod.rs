@@ -590,6 +590,39 @@ mod tests {
     }
 
     #[test]
+    fn a_coarse_polygons_legs_reach_the_contacts_through_the_interior() {
+        // On the six-vertex L, CDT's leaves lie on the corners next to
+        // StSk's contacts: joined to them, they would run along the shore.
+        let c = candidates_of(vec![MethodId::STSK, MethodId::CDT], MethodId::STSK, 5);
+        let (stsk, cdt) = (c[0].result.as_ref().unwrap(), c[1].result.as_ref().unwrap());
+        assert_eq!(ends(cdt), ends(stsk));
+        let l = geo::Polygon::new(
+            vec![
+                (0., 0.),
+                (40., 0.),
+                (40., 6.),
+                (6., 6.),
+                (6., 30.),
+                (0., 30.),
+                (0., 0.),
+            ]
+            .into(),
+            vec![],
+        );
+        let boundary = crate::geometry::Boundary::new(&l);
+        for line in &cdt.geometry.0 {
+            for w in line.0.windows(2) {
+                let mid = (w[0] + w[1]) * 0.5;
+                assert!(
+                    boundary.distance(mid) > 1e-3,
+                    "{:?} runs along the shore",
+                    w
+                );
+            }
+        }
+    }
+
+    #[test]
     fn more_vertices_than_max_vertices_is_rejected_before_any_method() {
         let p = ProcessParams {
             prepare: PrepareParams {
