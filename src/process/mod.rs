@@ -520,6 +520,14 @@ mod tests {
         assert!(!o.chosen().1.geometry.0.is_empty());
     }
 
+    /// A coarse L: six vertices, arms 6 wide.
+    fn l_shape() -> geo::Polygon<f64> {
+        polygon![
+            (x: 0., y: 0.), (x: 40., y: 0.), (x: 40., y: 6.), (x: 6., y: 6.),
+            (x: 6., y: 30.), (x: 0., y: 30.)
+        ]
+    }
+
     /// Every listed method's candidates on an L-shaped polygon with every
     /// step, the reference given.
     fn candidates_of(
@@ -531,11 +539,7 @@ mod tests {
         p.skeleton.methods = methods;
         p.skeleton.reference = reference;
         p.skeleton.voronoi.max_points = max_points;
-        let l = polygon![
-            (x: 0., y: 0.), (x: 40., y: 0.), (x: 40., y: 6.), (x: 6., y: 6.),
-            (x: 6., y: 30.), (x: 0., y: 30.)
-        ];
-        let Processed::Done(o) = process(Some(&Geometry::Polygon(l)), &p) else {
+        let Processed::Done(o) = process(Some(&Geometry::Polygon(l_shape())), &p) else {
             panic!("the L-shape is skeletonised")
         };
         o.candidates
@@ -596,20 +600,7 @@ mod tests {
         let c = candidates_of(vec![MethodId::STSK, MethodId::CDT], MethodId::STSK, 5);
         let (stsk, cdt) = (c[0].result.as_ref().unwrap(), c[1].result.as_ref().unwrap());
         assert_eq!(ends(cdt), ends(stsk));
-        let l = geo::Polygon::new(
-            vec![
-                (0., 0.),
-                (40., 0.),
-                (40., 6.),
-                (6., 6.),
-                (6., 30.),
-                (0., 30.),
-                (0., 0.),
-            ]
-            .into(),
-            vec![],
-        );
-        let boundary = crate::geometry::Boundary::new(&l);
+        let boundary = crate::geometry::Boundary::new(&l_shape());
         for line in &cdt.geometry.0 {
             for w in line.0.windows(2) {
                 let mid = (w[0] + w[1]) * 0.5;
