@@ -113,7 +113,18 @@ def _options_pipeline(
         text = json.dumps(doc, default=_json_default)
     except TypeError as e:
         raise PipelineError(f"skeletonise(): {e}") from None
-    return _core.Pipeline.from_options(text, "skeletonise()")
+    # Validating the options costs as much as skeletonising a small polygon:
+    # the same options give the same (immutable) pipeline.
+    pipeline = _OPTIONS.get(text)
+    if pipeline is None:
+        pipeline = _core.Pipeline.from_options(text, "skeletonise()")
+        if len(_OPTIONS) >= 64:
+            _OPTIONS.clear()
+        _OPTIONS[text] = pipeline
+    return pipeline
+
+
+_OPTIONS: dict[str, "_core.Pipeline"] = {}
 
 
 def _geometry_array(geometries: Any) -> tuple[np.ndarray, pd.Index | None, Any]:
@@ -192,19 +203,81 @@ def _decode(geometry: tuple) -> np.ndarray:
     return out
 
 
-# Nullable integers and strings, so that an empty frame (a Dask meta) has types
-# that Arrow and GeoParquet know.
-_DTYPES = {"int32": "Int32", "int64": "Int64", "real": "float64", "text": "string"}
-
-
 def _column(kind: str, values: Any) -> Any:
+    """A column of the result: nullable integers (``Int32``, ``Int64``), floats and
+    ``string``, so that an empty frame (a Dask meta) has types that Arrow and
+    GeoParquet know."""
     if kind in ("int32", "int64"):
         v, null = values
         # Already of the column's width: the masked array is the column.
         return pd.arrays.IntegerArray(np.asarray(v, dtype=kind), np.asarray(null, dtype=bool))
     if kind == "real":
         return values
-    return pd.array(values, dtype=_DTYPES[kind])
+    return _strings(values)
+
+
+_ARROW_STRINGS: bool | None = None
+
+
+def _strings(values: list) -> Any:
+    """A ``string`` column: built from an Arrow array where pandas' ``string``
+    dtype is Arrow's (pandas ≥ 3 with pyarrow), five times faster than
+    ``pd.array(values, dtype="string")``, which gives the same array."""
+    global _ARROW_STRINGS
+    if _ARROW_STRINGS is None:
+        try:
+            import pyarrow as pa
+
+            probe = ["a", None]
+            fast = pd.arrays.ArrowStringArray(pa.array(probe, type=pa.large_string()))
+            _ARROW_STRINGS = fast.dtype == pd.array(probe, dtype="string").dtype
+        except (ImportError, AttributeError, TypeError, ValueError):
+            _ARROW_STRINGS = False
+    if _ARROW_STRINGS:
+        import pyarrow as pa
+
+        return pd.arrays.ArrowStringArray(pa.array(values, type=pa.large_string()))
+    return pd.array(values, dtype="string")
+
+
+def _geo_frame(tool: dict[str, Any], index: pd.Index) -> Any:
+    """The GeoDataFrame of ``tool``'s columns (the last one, ``geometry``, the
+    active geometry with its CRS). ``GeoDataFrame(tool, geometry=...)`` checks and
+    copies every column: 0.4 ms of a call on one small polygon, more than its
+    skeleton. The columns here are already of their final types, so the frame is
+    assembled as pandas and geopandas assemble the result of an operation on a
+    frame (``DataFrame._from_arrays``, ``GeoDataFrame._from_mgr``); where a
+    pandas or geopandas version lacks those, the public constructor
+    (tests/test_skeletonise.py checks that both give the same frame)."""
+    import geopandas as gpd
+
+    try:
+        frame = pd.DataFrame._from_arrays(
+            list(tool.values()), columns=_column_index(tuple(tool)), index=index, verify_integrity=False
+        )
+        out = gpd.GeoDataFrame._from_mgr(frame._mgr, axes=frame._mgr.axes)
+    except (AttributeError, TypeError):
+        return _public_geo_frame(tool, index)
+    out._geometry_column_name = "geometry"
+    return out
+
+
+_COLUMN_INDEXES: dict[tuple, pd.Index] = {}
+
+
+def _column_index(names: tuple) -> pd.Index:
+    """The (immutable) column index of a layer's names, made once: a string
+    index costs as much to build as the rest of a one-row frame."""
+    index = _COLUMN_INDEXES.get(names)
+    if index is None:
+        index = _COLUMN_INDEXES.setdefault(names, pd.Index(list(names)))
+    return index
+
+
+def _public_geo_frame(tool: dict[str, Any], index: pd.Index) -> Any:
+    import geopandas as gpd
+
+    return gpd.GeoDataFrame(tool, index=index, geometry="geometry")
 
 
 def _fids(index: pd.Index | None, n: int) -> np.ndarray:
@@ -250,7 +323,7 @@ def _run(
     layer = "candidates" if candidates else "skeletons"
     out_index = (index if index is not None else pd.RangeIndex(len(arr))).take(rows)
     tool: dict[str, Any] = {name: _column(kind, values) for name, kind, values in done["columns"]}
-    tool["rejected"] = pd.array(done["rejected"], dtype="string")
+    tool["rejected"] = _strings(done["rejected"])
     if attributes is not None and len(attributes.columns) and _core.columns(layer, False)[1]:
         frame = pd.DataFrame(tool, index=out_index)
         # Source fields first, renamed where they clash with the tool's (as the writer does).
@@ -268,7 +341,7 @@ def _run(
         # The geometry array with its CRS in the columns: a third of the
         # fixed cost of a GeoDataFrame made from a frame and a GeoSeries.
         tool["geometry"] = gpd.array.from_shapely(_decode(done["geometry"]), crs=crs)
-        frame = gpd.GeoDataFrame(tool, index=out_index, geometry="geometry")
+        frame = _geo_frame(tool, out_index)
     if geometry_name != "geometry":
         frame = frame.rename_geometry(geometry_name)
     t3 = time.perf_counter()

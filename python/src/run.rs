@@ -303,14 +303,41 @@ fn detached(
             "threads must be ≥ 1 (or None for one per core)",
         )),
         Some(n) => {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(n)
-                .build()
-                .map_err(|_| PyValueError::new_err(format!("cannot start {n} worker threads")))?;
+            let pool = pool_of(n)?;
             Ok(py.detach(|| pool.install(|| work(input, fids, repaired, params, opts))))
         }
         _ => Ok(py.detach(|| work(input, fids, repaired, params, opts))),
     }
+}
+
+thread_local! {
+    /// The pools of `threads=n` calls made on this (Python) thread, kept for
+    /// its next calls: starting threads costs more than a call on a small
+    /// polygon. Per calling thread, so that calls from different threads (a
+    /// Dask worker running several tasks) never share, nor wait for, a pool.
+    static POOLS: std::cell::RefCell<Vec<(usize, std::sync::Arc<rayon::ThreadPool>)>> =
+        const { std::cell::RefCell::new(Vec::new()) };
+}
+
+/// This thread's pool of `n` worker threads.
+fn pool_of(n: usize) -> PyResult<std::sync::Arc<rayon::ThreadPool>> {
+    POOLS.with(|pools| {
+        if let Some((_, p)) = pools.borrow().iter().find(|(k, _)| *k == n) {
+            return Ok(p.clone());
+        }
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .map_err(|_| PyValueError::new_err(format!("cannot start {n} worker threads")))?;
+        let pool = std::sync::Arc::new(pool);
+        let mut pools = pools.borrow_mut();
+        // A handful of sizes at most in practice; never an unbounded set of threads.
+        if pools.len() >= 4 {
+            pools.remove(0);
+        }
+        pools.push((n, pool.clone()));
+        Ok(pool)
+    })
 }
 
 /// `(type id, coords, offsets per level, null mask)` as the Python side

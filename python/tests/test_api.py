@@ -165,6 +165,25 @@ def test_geoarrow_and_wkb_exchange_give_the_same_frame(islands):
     assert shapely.equals_exact(a.geometry.values, b.geometry.values, tolerance=0).all()
 
 
+def test_the_result_frame_is_the_one_geopandas_builds(islands):
+    # The frame is assembled without GeoDataFrame's checks and copies: it must be
+    # the frame the public constructor gives, and behave as one.
+    from skeletonise import _geo_frame, _public_geo_frame, _strings
+
+    sample = islands.geometry.iloc[:50]
+    out = skeletonise.skeletonise(sample, candidates=True)
+    tool = {c: out[c].array for c in out.columns}
+    pd.testing.assert_frame_equal(_public_geo_frame(tool, out.index), out, check_exact=True)
+    assert isinstance(out, gpd.GeoDataFrame) and out.geometry.name == "geometry" and out.crs == islands.crs
+    moved = out.to_crs("EPSG:4326")
+    assert moved.crs == "EPSG:4326" and isinstance(out.iloc[:3], gpd.GeoDataFrame)
+    out["extra"] = 1
+    assert "extra" not in skeletonise.skeletonise(sample).columns
+    strings = ["CDT", None, "é"]
+    assert _strings(strings).equals(pd.array(strings, dtype="string"))
+    assert _geo_frame(tool, out.index).crs == islands.crs
+
+
 def test_wkb_in_any_byte_order_and_dimension():
     z = shapely.force_3d(RIVER, 7.0)
     for g in (z, shapely.from_wkb(shapely.to_wkb(RIVER, byte_order=0))):
