@@ -8,11 +8,10 @@ use numpy::{PyArray1, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyList, PyTuple};
-use rayon::prelude::*;
 use skeletonise::feature::Feature;
 use skeletonise::output::{CANDIDATES, SKELETONS};
 use skeletonise::process::{
-    feature_rows, FeatureRows, ProcessParams, RowOptions, Skeletons, Status,
+    feature_rows, map_in_order, FeatureRows, ProcessParams, RowOptions, Skeletons, Status,
 };
 use std::time::Instant;
 
@@ -127,19 +126,6 @@ enum Encoded {
     Wkb(Vec<Option<Vec<u8>>>),
 }
 
-/// Maps `f` over `items`, in parallel unless `par` is false.
-fn map<T: Sync, U: Send>(
-    items: &[T],
-    par: bool,
-    f: impl Fn(usize, &T) -> U + Sync + Send,
-) -> Vec<U> {
-    if par {
-        items.par_iter().enumerate().map(|(i, t)| f(i, t)).collect()
-    } else {
-        items.iter().enumerate().map(|(i, t)| f(i, t)).collect()
-    }
-}
-
 /// The features of the input (parsed, repaired parts kept as the command
 /// line keeps them).
 fn features(
@@ -149,7 +135,7 @@ fn features(
     par: bool,
 ) -> Vec<Feature> {
     let idx: Vec<usize> = (0..input.len()).collect();
-    map(&idx, par, |_, &i| {
+    map_in_order(&idx, par, |_, &i| {
         let repaired = repaired.is_some_and(|r| r[i]);
         let fid = fids.and_then(|f| u64::try_from(f[i]).ok());
         let mut f = Feature {
@@ -221,7 +207,7 @@ fn work(
         widths: false,
         measures: false,
     };
-    let results: Vec<FeatureRows> = map(&feats, par, |_, f| {
+    let results: Vec<FeatureRows> = map_in_order(&feats, par, |_, f| {
         feature_rows(f, Skeletons::Computed, params, row_opts)
     });
     let t2 = Instant::now();
@@ -263,7 +249,7 @@ fn work(
     let geometry = if opts.geoarrow_out {
         Encoded::Ragged(table::ragged(&lines))
     } else {
-        Encoded::Wkb(map(&lines, par, |_, g| {
+        Encoded::Wkb(map_in_order(&lines, par, |_, g| {
             g.as_ref().map(|m| {
                 let mut out = Vec::new();
                 wkb::write_lines(m, &mut out);

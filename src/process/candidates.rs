@@ -11,7 +11,6 @@ use crate::methods::medial_axis::medial_axis_transform;
 use crate::score::defects::graph_of;
 use crate::score::{metrics, BarRays};
 use geo::MultiLineString;
-use rayon::prelude::*;
 use std::time::Duration;
 
 /// Every method's candidate for the polygon parts `prepared`, in `methods`
@@ -21,49 +20,61 @@ pub(super) fn computed(
     params: &ProcessParams,
 ) -> Vec<super::Candidate> {
     let n = prepared.len();
+    let parallel = worth_splitting(prepared);
+    let skeletons = || -> Vec<Vec<(Result<PartSkeleton, String>, StageTimes)>> {
+        prepared
+            .iter()
+            .enumerate()
+            .map(|(i, p)| {
+                part_skeletons(p, params, parallel)
+                    .into_iter()
+                    .map(|(r, t)| (r.map_err(|e| part_reason(i, n, &e)), t))
+                    .collect()
+            })
+            .collect()
+    };
     // The bars' rays depend on the polygon alone: found while the methods
     // work (on one huge polygon they fill a core the methods leave idle).
-    let (per_part, (rays, rays_time)) = rayon::join(
-        || -> Vec<Vec<(Result<PartSkeleton, String>, StageTimes)>> {
-            prepared
-                .iter()
-                .enumerate()
-                .map(|(i, p)| {
-                    part_skeletons(p, params)
-                        .into_iter()
-                        .map(|(r, t)| (r.map_err(|e| part_reason(i, n, &e)), t))
-                        .collect()
-                })
-                .collect()
-        },
-        || bar_rays(prepared, params),
-    );
+    let (per_part, (rays, rays_time)) = if parallel {
+        rayon::join(skeletons, || bar_rays(prepared, params, true))
+    } else {
+        (skeletons(), bar_rays(prepared, params, false))
+    };
     // The shared rays, split evenly between the methods.
     let rays_share = rays_time / params.skeleton.methods.len().max(1) as u32;
-    params
-        .skeleton
-        .methods
-        .par_iter()
-        .enumerate()
-        .map(|(k, &m)| {
-            let mut time = StageTimes::default();
-            for (_, t) in per_part.iter().map(|r| &r[k]) {
-                time += *t;
-            }
-            let parts: Result<Vec<PartSkeleton>, String> =
-                per_part.iter().map(|r| r[k].0.clone()).collect();
-            let result = parts.map(|parts| finish(prepared, &rays, &parts, params));
-            let result = result.map(|(c, t)| {
-                time.score += t + rays_share;
-                c
-            });
-            super::Candidate {
-                method: m,
-                result,
-                time,
-            }
-        })
-        .collect()
+    super::map_in_order(&params.skeleton.methods, parallel, |k, &m| {
+        let mut time = StageTimes::default();
+        for (_, t) in per_part.iter().map(|r| &r[k]) {
+            time += *t;
+        }
+        let parts: Result<Vec<PartSkeleton>, String> =
+            per_part.iter().map(|r| r[k].0.clone()).collect();
+        let result = parts.map(|parts| finish(prepared, &rays, &parts, params));
+        let result = result.map(|(c, t)| {
+            time.score += t + rays_share;
+            c
+        });
+        super::Candidate {
+            method: m,
+            result,
+            time,
+        }
+    })
+}
+
+/// A feature of at most this many boundary vertices is worked on one
+/// thread: its methods take well under a millisecond each, less than
+/// handing them to other threads costs, and a layer of many such features
+/// keeps every core busy feature by feature.
+const SEQUENTIAL_VERTICES: usize = 2000;
+
+/// True when the feature's work is split between threads.
+fn worth_splitting(prepared: &[PreparedPolygon]) -> bool {
+    prepared
+        .iter()
+        .map(PreparedPolygon::vertex_count)
+        .sum::<usize>()
+        > SEQUENTIAL_VERTICES
 }
 
 /// A given skeleton (lines made by another tool) as a candidate: the same
@@ -82,7 +93,12 @@ pub(super) fn given(
             legs_raw: legs,
         })
         .collect();
-    let (mut c, _) = finish(prepared, &bar_rays(prepared, params).0, &parts, params);
+    let (mut c, _) = finish(
+        prepared,
+        &bar_rays(prepared, params, worth_splitting(prepared)).0,
+        &parts,
+        params,
+    );
     // The lines once, not once per polygon part.
     c.geometry = lines.clone();
     c.components = graph.components();
@@ -105,6 +121,7 @@ pub(super) struct PartSkeleton {
 pub(super) fn part_skeletons(
     p: &PreparedPolygon,
     params: &ProcessParams,
+    parallel: bool,
 ) -> Vec<(Result<PartSkeleton, String>, StageTimes)> {
     use crate::graph::prune::{PruneMode, Structure as Sharing};
     use crate::graph::structure::{conform, Structure};
@@ -139,35 +156,30 @@ pub(super) fn part_skeletons(
         Result<crate::graph::SkeletonGraph, String>,
         StageTimes,
         Reference,
-    )> = methods
-        .par_iter()
-        .enumerate()
-        .map(|(k, &m)| {
-            let clock = CpuClock::start();
-            let raw = params
-                .registry
-                .build(m, &params.skeleton)
-                .and_then(|method| {
-                    guarded(m, || {
-                        crate::methods::budget::with_budget(m, params.skeleton.budget(), || {
-                            method.skeletonise(p)
-                        })
-                        .map_err(|e| e.to_string())
+    )> = super::map_in_order(methods, parallel, |k, &m| {
+        let mut clock = CpuClock::start();
+        let raw = params
+            .registry
+            .build(m, &params.skeleton)
+            .and_then(|method| {
+                guarded(m, || {
+                    crate::methods::budget::with_budget(m, params.skeleton.budget(), || {
+                        method.skeletonise(p)
                     })
-                });
-            let mut time = StageTimes {
-                skeleton: clock.elapsed(),
-                ..StageTimes::default()
-            };
-            let clock = CpuClock::start();
-            let reference = match &raw {
-                Ok(g) if order.first() == Some(&k) => reference_of(k, g),
-                _ => None,
-            };
-            time.prune_extend = clock.elapsed();
-            (raw, time, reference)
-        })
-        .collect();
+                    .map_err(|e| e.to_string())
+                })
+            });
+        let mut time = StageTimes {
+            skeleton: clock.lap(),
+            ..StageTimes::default()
+        };
+        let reference = match &raw {
+            Ok(g) if order.first() == Some(&k) => reference_of(k, g),
+            _ => None,
+        };
+        time.prune_extend = clock.lap();
+        (raw, time, reference)
+    });
     let mut reference_time = vec![std::time::Duration::ZERO; methods.len()];
     let first = raws.iter().find_map(|r| r.2.as_ref());
     let fallback = match first {
@@ -180,28 +192,25 @@ pub(super) fn part_skeletons(
         }),
     };
     let structure = first.or(fallback.as_ref());
-    raws.par_iter()
-        .enumerate()
-        .map(|(k, (raw, time, _))| {
-            let clock = CpuClock::start();
-            let result = raw.as_ref().map_err(Clone::clone).and_then(|raw| {
-                let g = guarded(methods[k], || {
-                    Ok(match structure {
-                        Some((r, _, g)) if *r == k => g.clone(),
-                        Some((_, s, _)) => conform(raw, s, p),
-                        None => finish(raw),
-                    })
-                })?;
-                Ok(PartSkeleton {
-                    graph: g,
-                    legs_raw: raw.leg_count(),
+    super::map_in_order(&raws, parallel, |k, (raw, time, _)| {
+        let clock = CpuClock::start();
+        let result = raw.as_ref().map_err(Clone::clone).and_then(|raw| {
+            let g = guarded(methods[k], || {
+                Ok(match structure {
+                    Some((r, _, g)) if *r == k => g.clone(),
+                    Some((_, s, _)) => conform(raw, s, p),
+                    None => finish(raw),
                 })
-            });
-            let mut time = *time;
-            time.prune_extend += reference_time[k] + clock.elapsed();
-            (result, time)
-        })
-        .collect()
+            })?;
+            Ok(PartSkeleton {
+                graph: g,
+                legs_raw: raw.leg_count(),
+            })
+        });
+        let mut time = *time;
+        time.prune_extend += reference_time[k] + clock.elapsed();
+        (result, time)
+    })
 }
 
 /// Runs one method's work on one polygon; a panic (a bug, which must never
@@ -224,11 +233,15 @@ fn guarded<T>(
 
 /// Every part's bars when the run scores (shared by all candidates), and
 /// the CPU time they took over all threads.
-fn bar_rays(prepared: &[PreparedPolygon], params: &ProcessParams) -> (Vec<BarRays>, Duration) {
+fn bar_rays(
+    prepared: &[PreparedPolygon],
+    params: &ProcessParams,
+    parallel: bool,
+) -> (Vec<BarRays>, Duration) {
     if params.score.is_none() {
         return (Vec::new(), Duration::ZERO);
     }
-    let timed: Vec<(BarRays, Duration)> = prepared.par_iter().map(BarRays::timed).collect();
+    let timed = super::map_in_order(prepared, parallel, |_, p| BarRays::timed(p));
     let time = timed.iter().map(|(_, t)| *t).sum();
     (timed.into_iter().map(|(r, _)| r).collect(), time)
 }
@@ -259,10 +272,15 @@ fn finish(
         legs += g.leg_count();
         components += g.components();
         if params.score.is_some() {
-            let here = CpuClock::start();
+            // Cast in parallel, this thread may run other work meanwhile: the
+            // casts' own CPU time replaces this thread's; cast here, its
+            // clock counts them.
+            let here = rays[k].parallel().then(CpuClock::start);
             let (mut b, t) = rays[k].cast_timed(p, g);
-            in_casts += here.elapsed();
-            cast_time += t;
+            if let (Some(here), Some(t)) = (here, t) {
+                in_casts += here.elapsed();
+                cast_time += t;
+            }
             for bar in &mut b {
                 if let Some(h) = &mut bar.hit {
                     h.part += branch_offset;

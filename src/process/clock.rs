@@ -17,6 +17,16 @@ impl CpuClock {
     pub fn elapsed(&self) -> Duration {
         thread_cpu_time().saturating_sub(self.0)
     }
+
+    /// CPU time since the start or the last lap, and a new lap starts: one
+    /// reading of the clock per stage (a reading is a system call that takes
+    /// a lock; on a small polygon they add up to several per cent of a run).
+    pub fn lap(&mut self) -> Duration {
+        let now = thread_cpu_time();
+        let lap = now.saturating_sub(self.0);
+        self.0 = now;
+        lap
+    }
 }
 
 /// CPU time the calling thread has used (zero where the clock is missing).
@@ -52,5 +62,32 @@ mod tests {
             x = x.wrapping_add(std::hint::black_box(1));
         }
         assert!(x > 0 && c.elapsed() > Duration::from_millis(5));
+    }
+
+    #[test]
+    fn laps_add_up_to_the_elapsed_time() {
+        // Busy until this thread has used `d` of CPU time since `from`.
+        let spin = |from: CpuClock, d: Duration| {
+            let mut x = 0u64;
+            while from.elapsed() < d {
+                x = x.wrapping_add(std::hint::black_box(1));
+            }
+            x
+        };
+        let start = CpuClock::start();
+        let mut lap = start;
+        assert!(spin(start, Duration::from_millis(20)) > 0);
+        let first = lap.lap();
+        std::thread::sleep(Duration::from_millis(30));
+        let idle = lap.lap();
+        assert!(spin(lap, Duration::from_millis(10)) > 0);
+        let third = lap.lap();
+        let total = start.elapsed();
+        assert!(first >= Duration::from_millis(20) && idle < Duration::from_millis(10));
+        assert!(third >= Duration::from_millis(10));
+        assert!(
+            first + idle + third <= total
+                && total - (first + idle + third) < Duration::from_millis(5)
+        );
     }
 }

@@ -11,6 +11,23 @@ pub mod rows;
 
 pub use rows::{feature_rows, FeatureRows, RowOptions, Skeletons, Status};
 
+/// `f` over `items`, results in the items' order: in parallel, or on the
+/// calling thread when `parallel` is false (work too small to be worth
+/// splitting, or a caller that keeps to one thread). The same results
+/// either way.
+pub fn map_in_order<T: Sync, U: Send>(
+    items: &[T],
+    parallel: bool,
+    f: impl Fn(usize, &T) -> U + Sync + Send,
+) -> Vec<U> {
+    use rayon::prelude::*;
+    if parallel {
+        items.par_iter().enumerate().map(|(i, t)| f(i, t)).collect()
+    } else {
+        items.iter().enumerate().map(|(i, t)| f(i, t)).collect()
+    }
+}
+
 use crate::collapse::{collapse, CollapseParams, PartCollapse};
 use crate::geometry::PreparedPolygon;
 use crate::graph::extend::ExtendParams;

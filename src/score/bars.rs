@@ -188,20 +188,33 @@ impl BarRays {
         }
         // Where each ray leaves P: in parallel for a large polygon (one
         // huge feature must not leave the other cores idle).
+        let exits = |chunk: &mut [Ray]| {
+            for r in chunk {
+                if let Some(h) = boundary.first_hit(r.origin, r.dir, eps, f64::INFINITY) {
+                    r.exit = h.t;
+                }
+            }
+        };
+        if rays.len() <= PAR_BARS {
+            exits(&mut rays);
+            return (Self { rays }, clock.elapsed());
+        }
         let mut time = clock.elapsed();
         time += rays
             .par_chunks_mut(PAR_BARS)
             .map(|chunk| {
                 let clock = CpuClock::start();
-                for r in chunk {
-                    if let Some(h) = boundary.first_hit(r.origin, r.dir, eps, f64::INFINITY) {
-                        r.exit = h.t;
-                    }
-                }
+                exits(chunk);
                 clock.elapsed()
             })
             .sum::<std::time::Duration>();
         (Self { rays }, time)
+    }
+
+    /// True when [`BarRays::cast`] casts the bars in parallel (else on the
+    /// calling thread alone).
+    pub fn parallel(&self) -> bool {
+        self.rays.len() > PAR_BARS
     }
 
     /// Number of bars.
@@ -220,41 +233,49 @@ impl BarRays {
         self.cast_timed(polygon, skeleton).0
     }
 
-    /// [`BarRays::cast`], and the CPU time it took over all threads (a
-    /// large polygon's bars are cast in parallel).
+    /// [`BarRays::cast`], and, when the bars were cast in parallel
+    /// ([`BarRays::parallel`]), the CPU time it took over all threads; `None`
+    /// when they were cast on the calling thread alone, whose own clock then
+    /// counts them (a clock reading per small polygon saved).
     pub fn cast_timed(
         &self,
         polygon: &PreparedPolygon,
         skeleton: &SkeletonGraph,
-    ) -> (Vec<Bar>, std::time::Duration) {
-        let clock = CpuClock::start();
+    ) -> (Vec<Bar>, Option<std::time::Duration>) {
         let eps = REL_EPS * polygon.extent();
+        let cast_all = |sk: &SkeletonIndex, bars: &mut [Bar], rays: &[Ray]| {
+            let mut recent = [NOWHERE; 2];
+            for (bar, r) in bars.iter_mut().zip(rays) {
+                bar.hit = cast(polygon.boundary(), sk, r, eps, &mut recent);
+            }
+        };
+        let unhit = |r: &Ray| Bar {
+            origin: r.origin,
+            dir: r.dir,
+            hit: None,
+        };
+        if !self.parallel() {
+            let sk = SkeletonIndex::new(skeleton);
+            let mut bars: Vec<Bar> = self.rays.iter().map(unhit).collect();
+            cast_all(&sk, &mut bars, &self.rays);
+            return (bars, None);
+        }
+        let clock = CpuClock::start();
         let sk = SkeletonIndex::new(skeleton);
         let time = clock.elapsed();
         // Written in place, chunk by chunk on the threads that cast them
         // (the bars of a huge polygon are tens of megabytes: no copy).
-        let mut bars: Vec<Bar> = self
-            .rays
-            .par_iter()
-            .map(|r| Bar {
-                origin: r.origin,
-                dir: r.dir,
-                hit: None,
-            })
-            .collect();
+        let mut bars: Vec<Bar> = self.rays.par_iter().map(unhit).collect();
         let cast_time: std::time::Duration = bars
             .par_chunks_mut(PAR_BARS)
             .zip(self.rays.par_chunks(PAR_BARS))
             .map(|(bars, rays)| {
                 let clock = CpuClock::start();
-                let mut recent = [NOWHERE; 2];
-                for (bar, r) in bars.iter_mut().zip(rays) {
-                    bar.hit = cast(polygon.boundary(), &sk, r, eps, &mut recent);
-                }
+                cast_all(&sk, bars, rays);
                 clock.elapsed()
             })
             .sum();
-        (bars, time + cast_time)
+        (bars, Some(time + cast_time))
     }
 }
 
