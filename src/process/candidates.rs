@@ -2,7 +2,7 @@
 //! skeletons part by part, the reference's structure, pruning, extension,
 //! scores, bars and widths.
 
-use super::clock::CpuClock;
+use super::clock::{CpuClock, Stopwatch};
 use super::{part_reason, CandidateSkeleton, ProcessParams, StageTimes};
 use crate::geometry::PreparedPolygon;
 use crate::graph::extend::prune_and_extend;
@@ -21,6 +21,10 @@ pub(super) fn computed(
 ) -> Vec<super::Candidate> {
     let n = prepared.len();
     let parallel = worth_splitting(prepared);
+    // Worked on one thread: stages on the wall clock, scaled to this
+    // thread's CPU time over the feature at the end (two CPU clock readings
+    // per feature instead of dozens).
+    let whole = (!parallel).then(|| (CpuClock::start(), std::time::Instant::now()));
     let skeletons = || -> Vec<Vec<(Result<PartSkeleton, String>, StageTimes)>> {
         prepared
             .iter()
@@ -42,14 +46,14 @@ pub(super) fn computed(
     };
     // The shared rays, split evenly between the methods.
     let rays_share = rays_time / params.skeleton.methods.len().max(1) as u32;
-    super::map_in_order(&params.skeleton.methods, parallel, |k, &m| {
+    let mut candidates = super::map_in_order(&params.skeleton.methods, parallel, |k, &m| {
         let mut time = StageTimes::default();
         for (_, t) in per_part.iter().map(|r| &r[k]) {
             time += *t;
         }
         let parts: Result<Vec<PartSkeleton>, String> =
             per_part.iter().map(|r| r[k].0.clone()).collect();
-        let result = parts.map(|parts| finish(prepared, &rays, &parts, params));
+        let result = parts.map(|parts| finish(prepared, &rays, &parts, params, parallel));
         let result = result.map(|(c, t)| {
             time.score += t + rays_share;
             c
@@ -59,14 +63,25 @@ pub(super) fn computed(
             result,
             time,
         }
-    })
+    });
+    if let Some((cpu, wall)) = whole {
+        let k = Stopwatch::scale(cpu.elapsed(), wall.elapsed());
+        for c in &mut candidates {
+            c.time.skeleton = c.time.skeleton.mul_f64(k);
+            c.time.prune_extend = c.time.prune_extend.mul_f64(k);
+            c.time.score = c.time.score.mul_f64(k);
+        }
+    }
+    candidates
 }
 
 /// A feature of at most this many boundary vertices is worked on one
 /// thread: its methods take well under a millisecond each, less than
 /// handing them to other threads costs, and a layer of many such features
-/// keeps every core busy feature by feature.
-const SEQUENTIAL_VERTICES: usize = 2000;
+/// keeps every core busy feature by feature. Its bars are never split
+/// either (at most three per vertex).
+const SEQUENTIAL_VERTICES: usize = 1000;
+const _: () = assert!(3 * SEQUENTIAL_VERTICES <= crate::score::PAR_BARS);
 
 /// True when the feature's work is split between threads.
 fn worth_splitting(prepared: &[PreparedPolygon]) -> bool {
@@ -93,12 +108,9 @@ pub(super) fn given(
             legs_raw: legs,
         })
         .collect();
-    let (mut c, _) = finish(
-        prepared,
-        &bar_rays(prepared, params, worth_splitting(prepared)).0,
-        &parts,
-        params,
-    );
+    let parallel = worth_splitting(prepared);
+    let rays = bar_rays(prepared, params, parallel).0;
+    let (mut c, _) = finish(prepared, &rays, &parts, params, parallel);
     // The lines once, not once per polygon part.
     c.geometry = lines.clone();
     c.components = graph.components();
@@ -157,7 +169,7 @@ pub(super) fn part_skeletons(
         StageTimes,
         Reference,
     )> = super::map_in_order(methods, parallel, |k, &m| {
-        let mut clock = CpuClock::start();
+        let mut clock = Stopwatch::start(parallel);
         let raw = params
             .registry
             .build(m, &params.skeleton)
@@ -185,7 +197,7 @@ pub(super) fn part_skeletons(
     let fallback = match first {
         Some(_) => None,
         None => order.iter().skip(1).find_map(|&k| {
-            let clock = CpuClock::start();
+            let clock = Stopwatch::start(parallel);
             let found = reference_of(k, raws[k].0.as_ref().ok()?);
             reference_time[k] += clock.elapsed();
             found
@@ -193,7 +205,7 @@ pub(super) fn part_skeletons(
     };
     let structure = first.or(fallback.as_ref());
     super::map_in_order(&raws, parallel, |k, (raw, time, _)| {
-        let clock = CpuClock::start();
+        let clock = Stopwatch::start(parallel);
         let result = raw.as_ref().map_err(Clone::clone).and_then(|raw| {
             let g = guarded(methods[k], || {
                 Ok(match structure {
@@ -232,7 +244,7 @@ fn guarded<T>(
 }
 
 /// Every part's bars when the run scores (shared by all candidates), and
-/// the CPU time they took over all threads.
+/// the time they took over all threads (on the feature's [`Stopwatch`]).
 fn bar_rays(
     prepared: &[PreparedPolygon],
     params: &ProcessParams,
@@ -241,7 +253,11 @@ fn bar_rays(
     if params.score.is_none() {
         return (Vec::new(), Duration::ZERO);
     }
-    let timed = super::map_in_order(prepared, parallel, |_, p| BarRays::timed(p));
+    let timed = super::map_in_order(prepared, parallel, |_, p| {
+        let clock = Stopwatch::start(parallel);
+        let (rays, time) = BarRays::timed(p);
+        (rays, time.unwrap_or_else(|| clock.elapsed()))
+    });
     let time = timed.iter().map(|(_, t)| *t).sum();
     (timed.into_iter().map(|(r, _)| r).collect(), time)
 }
@@ -254,10 +270,11 @@ fn finish(
     rays: &[BarRays],
     parts: &[PartSkeleton],
     params: &ProcessParams,
+    parallel: bool,
 ) -> (CandidateSkeleton, Duration) {
     // CPU time: the bars' own (over every thread that cast them), plus this
     // thread's outside the casts (inside, it may run other work).
-    let clock = CpuClock::start();
+    let clock = Stopwatch::start(parallel);
     let mut cast_time = Duration::ZERO;
     let mut in_casts = Duration::ZERO;
     let mut lines = Vec::new();

@@ -9,7 +9,7 @@ use rayon::prelude::*;
 use rustc_hash::FxHashMap as HashMap;
 
 /// Bars per parallel task: a polygon with fewer is scored on one thread.
-const PAR_BARS: usize = 4096;
+pub(crate) const PAR_BARS: usize = 4096;
 
 /// Relative tolerance: hits closer than this × extent to the bar's origin are
 /// the origin itself (SPEC §6.2).
@@ -152,10 +152,14 @@ impl BarRays {
         Self::timed(polygon).0
     }
 
-    /// [`BarRays::new`], and the CPU time it took over all threads (a large
-    /// polygon's exits are found in parallel).
-    pub fn timed(polygon: &PreparedPolygon) -> (Self, std::time::Duration) {
-        let clock = CpuClock::start();
+    /// [`BarRays::new`], and, when the exits were found in parallel (a large
+    /// polygon's, [`BarRays::parallel`]), the CPU time it took over all
+    /// threads; `None` when all was done on the calling thread, whose own
+    /// clock then counts it.
+    pub fn timed(polygon: &PreparedPolygon) -> (Self, Option<std::time::Duration>) {
+        // At most three bars per vertex: no clock for a polygon that cannot
+        // have enough of them to be split.
+        let clock = (3 * polygon.vertex_count() > PAR_BARS).then(CpuClock::start);
         let boundary = polygon.boundary();
         let eps = REL_EPS * polygon.extent();
         // No ray stays inside P for longer than the bounding box's diagonal.
@@ -195,10 +199,13 @@ impl BarRays {
                 }
             }
         };
-        if rays.len() <= PAR_BARS {
-            exits(&mut rays);
-            return (Self { rays }, clock.elapsed());
-        }
+        let clock = match clock {
+            Some(c) if rays.len() > PAR_BARS => c,
+            _ => {
+                exits(&mut rays);
+                return (Self { rays }, None);
+            }
+        };
         let mut time = clock.elapsed();
         time += rays
             .par_chunks_mut(PAR_BARS)
@@ -208,7 +215,7 @@ impl BarRays {
                 clock.elapsed()
             })
             .sum::<std::time::Duration>();
-        (Self { rays }, time)
+        (Self { rays }, Some(time))
     }
 
     /// True when [`BarRays::cast`] casts the bars in parallel (else on the

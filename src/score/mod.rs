@@ -66,6 +66,7 @@ pub mod defects;
 mod metrics;
 pub mod select;
 
+pub(crate) use bars::PAR_BARS;
 pub use bars::{bars, score_skeleton, BarRays};
 pub use metrics::metrics;
 
