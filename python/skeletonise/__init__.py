@@ -248,7 +248,8 @@ def _geo_frame(tool: dict[str, Any], index: pd.Index) -> Any:
     assembled as pandas and geopandas assemble the result of an operation on a
     frame (``DataFrame._from_arrays``, ``GeoDataFrame._from_mgr``); where a
     pandas or geopandas version lacks those, the public constructor
-    (tests/test_skeletonise.py checks that both give the same frame)."""
+    (``test_the_result_frame_is_the_one_geopandas_builds`` in tests/test_api.py
+    checks that both give the same frame)."""
     import geopandas as gpd
 
     try:

@@ -33,9 +33,10 @@ impl CpuClock {
 /// ([`Stopwatch::Cpu`]) is timed by each thread's CPU clock; a feature
 /// worked on one thread ([`Stopwatch::Wall`]) by the wall clock (a vDSO
 /// read, 30 times cheaper than a CPU clock reading), its stages scaled
-/// afterwards so that they add up to the CPU time of the whole feature
-/// ([`Stopwatch::scale`]): exact in sum, and per stage exact unless the
-/// thread was preempted more in one stage than in another.
+/// afterwards by the thread's CPU time over the whole feature against its
+/// wall time ([`Stopwatch::scale`]): the stages then add up to at most that
+/// CPU time (the untimed steps between them take the rest), and each is
+/// exact unless the thread was preempted more in one stage than in another.
 #[derive(Debug, Clone, Copy)]
 pub enum Stopwatch {
     /// Thread CPU time.
