@@ -477,16 +477,25 @@ impl Boundary {
 
     /// Indices of the segments whose bounding box meets that of segment `pq`.
     pub fn segments_near(&self, p: Coord<f64>, q: Coord<f64>) -> impl Iterator<Item = usize> {
-        let env = [p.x.min(q.x), p.y.min(q.y), p.x.max(q.x), p.y.max(q.y)];
         let mut near = Vec::new();
-        self.tree.visit(
-            |b| boxes_meet(b, &env),
-            |i| {
-                near.push(i as usize);
-                ControlFlow::<()>::Continue(())
-            },
-        );
+        self.visit_segments_near(p, q, |i| {
+            near.push(i);
+            ControlFlow::<()>::Continue(())
+        });
         near.into_iter()
+    }
+
+    /// [`Boundary::segments_near`] without collecting them: `f` sees each
+    /// index (in no particular order) until it breaks, with the break value
+    /// returned.
+    pub fn visit_segments_near<B>(
+        &self,
+        p: Coord<f64>,
+        q: Coord<f64>,
+        mut f: impl FnMut(usize) -> ControlFlow<B>,
+    ) -> Option<B> {
+        let env = [p.x.min(q.x), p.y.min(q.y), p.x.max(q.x), p.y.max(q.y)];
+        self.tree.visit(|b| boxes_meet(b, &env), |i| f(i as usize))
     }
 
     /// Crossing parity of the ray from `p` towards +x against the segments of

@@ -12,6 +12,7 @@
 use super::boundary::{orient, BoundarySegment};
 use super::PreparedPolygon;
 use geo::Coord;
+use std::ops::ControlFlow;
 
 fn on_segment(a: Coord<f64>, b: Coord<f64>, p: Coord<f64>) -> bool {
     orient(a, b, p) == 0.0
@@ -105,9 +106,9 @@ pub fn problem(p: &PreparedPolygon) -> Option<String> {
         }
     };
     for (i, s) in segs.iter().enumerate() {
-        for j in b.segments_near(s.a, s.b) {
+        let found = b.visit_segments_near(s.a, s.b, |j| {
             if j <= i {
-                continue;
+                return ControlFlow::Continue(());
             }
             let t = &segs[j];
             if consecutive(s, t) {
@@ -121,16 +122,20 @@ pub fn problem(p: &PreparedPolygon) -> Option<String> {
                 let rings_of_3 = ring_len[s.ring as usize] < 3;
                 if !rings_of_3 && orient(far_s, shared, far_t) == 0.0 && u.x * v.x + u.y * v.y > 0.0
                 {
-                    return Some(format!(
+                    return ControlFlow::Break(format!(
                         "spike: the ring doubles back on itself at {}",
                         at(shared)
                     ));
                 }
-                continue;
+                return ControlFlow::Continue(());
             }
-            if let Some(m) = pair_problem(s, t) {
-                return Some(m);
+            match pair_problem(s, t) {
+                Some(m) => ControlFlow::Break(m),
+                None => ControlFlow::Continue(()),
             }
+        });
+        if found.is_some() {
+            return found;
         }
     }
     // With no crossings, a hole lies wholly inside or outside every other ring:

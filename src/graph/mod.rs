@@ -236,16 +236,37 @@ impl SkeletonGraph {
     /// Branches: maximal chains between nodes of degree ≠ 2, plus closed
     /// cycles made only of degree-2 nodes. Deterministic order (by first edge).
     pub fn branches(&self) -> Vec<Branch> {
-        let adj = self.adjacency();
-        let deg: Vec<usize> = adj.iter().map(Vec::len).collect();
-        let mut used = vec![false; self.edges.len()];
         let mut out = Vec::new();
-        let walk = |start: NodeId, first: EdgeId, used: &mut Vec<bool>| -> Branch {
-            let mut edges = vec![first];
+        self.walk_branches(|start, edges, end| {
+            let mut coords = vec![self.node(start).pos];
+            let mut cur = start;
+            for &e in edges {
+                self.push_oriented(&mut coords, e, cur);
+                cur = self.opposite(e, cur);
+            }
+            out.push(Branch {
+                start,
+                end,
+                edges: edges.to_vec(),
+                coords,
+            });
+        });
+        out
+    }
+
+    /// Walks the branches of [`SkeletonGraph::branches`] in its order,
+    /// calling `f(start, edges, end)` for each (the edges in walking order,
+    /// in a buffer reused from branch to branch).
+    fn walk_branches(&self, mut f: impl FnMut(NodeId, &[EdgeId], NodeId)) {
+        let adj = self.adjacency();
+        let mut used = vec![false; self.edges.len()];
+        let mut edges = Vec::new();
+        let mut walk = |start: NodeId, first: EdgeId, used: &mut Vec<bool>| {
+            edges.clear();
+            edges.push(first);
             used[first.0 as usize] = true;
-            let mut coords = self.oriented_coords(first, start);
             let mut cur = self.opposite(first, start);
-            while deg[cur.0 as usize] == 2 && cur != start {
+            while adj[cur.0 as usize].len() == 2 && cur != start {
                 let next = adj[cur.0 as usize]
                     .iter()
                     .copied()
@@ -253,24 +274,17 @@ impl SkeletonGraph {
                 let Some(next) = next else { break };
                 used[next.0 as usize] = true;
                 edges.push(next);
-                let c = self.oriented_coords(next, cur);
-                coords.extend_from_slice(&c[1..]);
                 cur = self.opposite(next, cur);
             }
-            Branch {
-                start,
-                end: cur,
-                edges,
-                coords,
-            }
+            f(start, &edges, cur);
         };
-        for n in 0..self.nodes.len() {
-            if deg[n] == 2 {
+        for (n, a) in adj.iter().enumerate() {
+            if a.len() == 2 {
                 continue;
             }
-            for &e in &adj[n] {
+            for &e in a {
                 if !used[e.0 as usize] {
-                    out.push(walk(NodeId(n as u32), e, &mut used));
+                    walk(NodeId(n as u32), e, &mut used);
                 }
             }
         }
@@ -278,10 +292,22 @@ impl SkeletonGraph {
         for i in 0..self.edges.len() {
             if !used[i] {
                 let start = self.edges[i].a;
-                out.push(walk(start, EdgeId(i as u32), &mut used));
+                walk(start, EdgeId(i as u32), &mut used);
             }
         }
-        out
+    }
+
+    /// Appends the polyline of edge `e`, walked from node `from`, to
+    /// `coords`, which ends at `from`'s position (so that is not repeated).
+    fn push_oriented(&self, coords: &mut Vec<Coord<f64>>, e: EdgeId, from: NodeId) {
+        let ed = self.edge(e);
+        if ed.a == from {
+            coords.extend_from_slice(&ed.interior);
+            coords.push(self.node(ed.b).pos);
+        } else {
+            coords.extend(ed.interior.iter().rev());
+            coords.push(self.node(ed.a).pos);
+        }
     }
 
     /// The polyline of edge `e` oriented to start at node `from`.
@@ -403,7 +429,15 @@ impl SkeletonGraph {
 
     /// Number of legs ([`SkeletonGraph::legs`]): the `legs` column.
     pub fn leg_count(&self) -> usize {
-        self.legs().len()
+        // The legs of `legs()`, counted without building their lines.
+        let deg = self.degrees();
+        let mut n = 0;
+        self.walk_branches(|start, _, end| {
+            n += usize::from(
+                start != end && (deg[start.0 as usize] == 1 || deg[end.0 as usize] == 1),
+            );
+        });
+        n
     }
 }
 

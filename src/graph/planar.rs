@@ -3,15 +3,16 @@
 //! Every method's raw skeleton is planar, but the segments added afterwards
 //! (end segments, bridges across necks, straight rays) can cross a line of
 //! the skeleton. [`crossings`] finds every proper crossing of two segments
-//! (an R-tree over the segments' boxes, O(n log n) on real data), and
+//! (a packed R-tree over the segments' boxes, O(n log n) on real data), and
 //! [`node_crossings`] splits both edges there, so the written skeleton is a
 //! planar graph: two lines meet only at a node.
 
 use super::{Edge, SkeletonGraph};
 use crate::geometry::boundary::{orient, properly_cross};
+use crate::geometry::packed::{Bbox, PackedTree};
 use crate::geometry::Boundary;
 use geo::Coord;
-use rstar::{primitives::GeomWithData, primitives::Rectangle, RTree, AABB};
+use std::ops::ControlFlow;
 
 /// One segment of an edge's polyline: edge index, segment index, ends.
 #[derive(Debug, Clone, Copy)]
@@ -51,33 +52,31 @@ fn intersection(p: Coord<f64>, q: Coord<f64>, a: Coord<f64>, b: Coord<f64>) -> C
 /// Every proper crossing of two segments of `g`: (segment i, segment j,
 /// point), i < j, as indices into the segments in edge order.
 fn find(segs: &[Seg]) -> Vec<(usize, usize, Coord<f64>)> {
-    let tree: RTree<GeomWithData<Rectangle<[f64; 2]>, u32>> = RTree::bulk_load(
-        segs.iter()
-            .enumerate()
-            .map(|(i, s)| {
-                GeomWithData::new(
-                    Rectangle::from_corners([s.a.x, s.a.y], [s.b.x, s.b.y]),
-                    i as u32,
-                )
-            })
-            .collect(),
-    );
+    let boxes: Vec<Bbox> = segs
+        .iter()
+        .map(|s| {
+            [
+                s.a.x.min(s.b.x),
+                s.a.y.min(s.b.y),
+                s.a.x.max(s.b.x),
+                s.a.y.max(s.b.y),
+            ]
+        })
+        .collect();
+    let tree = PackedTree::new(&boxes);
     let mut out = Vec::new();
-    for (i, s) in segs.iter().enumerate() {
-        let env = AABB::from_corners(
-            [s.a.x.min(s.b.x), s.a.y.min(s.b.y)],
-            [s.a.x.max(s.b.x), s.a.y.max(s.b.y)],
-        );
-        for item in tree.locate_in_envelope_intersecting(&env) {
-            let j = item.data as usize;
-            if j <= i {
-                continue;
+    for (i, (s, e)) in segs.iter().zip(&boxes).enumerate() {
+        let meets = |b: &Bbox| b[0] <= e[2] && e[0] <= b[2] && b[1] <= e[3] && e[1] <= b[3];
+        tree.visit(meets, |j| {
+            let j = j as usize;
+            if j > i {
+                let t = &segs[j];
+                if properly_cross(s.a, s.b, t.a, t.b) {
+                    out.push((i, j, intersection(s.a, s.b, t.a, t.b)));
+                }
             }
-            let t = &segs[j];
-            if properly_cross(s.a, s.b, t.a, t.b) {
-                out.push((i, j, intersection(s.a, s.b, t.a, t.b)));
-            }
-        }
+            ControlFlow::<()>::Continue(())
+        });
     }
     out.sort_by(|x, y| x.0.cmp(&y.0).then(x.1.cmp(&y.1)));
     out
