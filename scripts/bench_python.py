@@ -14,7 +14,8 @@
    (threads=1 in each: one core per worker).
 
 The timings of 1 and 2 are the best of REPEAT runs side by side (default 3;
-30 in 2 where one call takes less than 0.1 s, after one call of each to warm up),
+30 in 2 where one call takes less than 0.1 s, after one call of each to warm up;
+such layers also get the best of 30 calls in a row of each tool),
 those of 3 the best of 5 interleaved runs, and those of 4 the best of two runs
 each in the order 1, 2, 2, 1 workers, so that a spell of other load on the
 machine does not decide a ratio; the load average is printed at the start and
@@ -71,6 +72,17 @@ def idle_cores(seconds: float = 5.0) -> float:
     return (os.cpu_count() or 1) * (i1 - i0) / max(1, t1 - t0)
 
 
+def back_to_back(call, n: int) -> float:
+    """The best of `n` calls made one after another (the first one warms up)."""
+    call()
+    best = float("inf")
+    for _ in range(n):
+        t0 = time.perf_counter()
+        call()
+        best = min(best, time.perf_counter() - t0)
+    return best
+
+
 def row(*cells) -> None:
     print("| " + " | ".join(str(c) for c in cells) + " |")
 
@@ -106,8 +118,9 @@ def main() -> None:
     print("extended, not scored (one centreline per polygon, as pygeoops makes)\n")
     import pygeoops
 
-    row("layer", "features", "pygeoops s", "skeletonise defaults s", "speed-up", "skeletonise one method s", "speed-up")
-    row(*["---"] * 7)
+    row("layer", "features", "pygeoops s", "skeletonise defaults s", "speed-up", "skeletonise one method s", "speed-up",
+        "calls in a row: pygeoops / one method s")
+    row(*["---"] * 8)
     for layer, _ in CASES:
         geoms = pyogrio.read_dataframe(TRAIN, layer=layer, fid_as_index=True).geometry
         peer = ours = one = float("inf")
@@ -127,8 +140,21 @@ def main() -> None:
             t0 = time.perf_counter()
             skeletonise.skeletonise(geoms, methods=["CDT"], score=False, select=False)
             one = min(one, time.perf_counter() - t0)
-        row(layer, len(geoms), f"{peer:.3f}", f"{ours:.3f}", f"{peer / ours:.1f}×", f"{one:.3f}", f"{peer / one:.1f}×")
-        results["pygeoops"].append({"layer": layer, "pygeoops_s": peer, "skeletonise_s": ours, "one_method_s": one})
+        entry = {"layer": layer, "pygeoops_s": peer, "skeletonise_s": ours, "one_method_s": one}
+        warm = ""
+        if reps > repeat:
+            # A call of a millisecond after a call of another kind runs on cold
+            # caches (on this machine about twice as slow as the next call):
+            # also the best of 30 calls in a row of each, as a loop over many
+            # small GeoSeries makes them.
+            peer_warm = back_to_back(lambda: pygeoops.centerline(geoms), reps)
+            one_warm = back_to_back(
+                lambda: skeletonise.skeletonise(geoms, methods=["CDT"], score=False, select=False), reps)
+            entry |= {"pygeoops_back_to_back_s": peer_warm, "one_method_back_to_back_s": one_warm}
+            warm = f"{peer_warm:.4f} / {one_warm:.4f} = {peer_warm / one_warm:.1f}×"
+        row(layer, len(geoms), f"{peer:.3f}", f"{ours:.3f}", f"{peer / ours:.1f}×", f"{one:.3f}", f"{peer / one:.1f}×",
+            warm)
+        results["pygeoops"].append(entry)
 
     data = ROOT / "target/bench/islands-generated"
     script = [sys.executable, str(ROOT / "examples/dask_islands.py"), "--input", str(data)]

@@ -258,7 +258,7 @@ impl SkeletonGraph {
     /// calling `f(start, edges, end)` for each (the edges in walking order,
     /// in a buffer reused from branch to branch).
     fn walk_branches(&self, mut f: impl FnMut(NodeId, &[EdgeId], NodeId)) {
-        let adj = self.adjacency();
+        let adj = Incidence::of(self);
         let mut used = vec![false; self.edges.len()];
         let mut edges = Vec::new();
         let mut walk = |start: NodeId, first: EdgeId, used: &mut Vec<bool>| {
@@ -278,7 +278,8 @@ impl SkeletonGraph {
             }
             f(start, &edges, cur);
         };
-        for (n, a) in adj.iter().enumerate() {
+        for n in 0..self.nodes.len() {
+            let a = &adj[n];
             if a.len() == 2 {
                 continue;
             }
@@ -438,6 +439,46 @@ impl SkeletonGraph {
             );
         });
         n
+    }
+}
+
+/// [`SkeletonGraph::adjacency`] in two flat arrays (each node's incident
+/// edges in the same order), for the walks that run several times per
+/// skeleton: one allocation instead of one per node.
+struct Incidence {
+    /// `edges[start[n]..start[n + 1]]` are node `n`'s.
+    start: Vec<u32>,
+    edges: Vec<EdgeId>,
+}
+
+impl Incidence {
+    fn of(g: &SkeletonGraph) -> Self {
+        let mut start = vec![0u32; g.nodes.len() + 1];
+        for e in &g.edges {
+            start[e.a.0 as usize + 1] += 1;
+            start[e.b.0 as usize + 1] += 1;
+        }
+        for i in 1..start.len() {
+            start[i] += start[i - 1];
+        }
+        let mut next = start.clone();
+        let mut edges = vec![EdgeId(0); 2 * g.edges.len()];
+        for (i, e) in g.edges.iter().enumerate() {
+            for n in [e.a, e.b] {
+                let at = &mut next[n.0 as usize];
+                edges[*at as usize] = EdgeId(i as u32);
+                *at += 1;
+            }
+        }
+        Self { start, edges }
+    }
+}
+
+impl std::ops::Index<usize> for Incidence {
+    type Output = [EdgeId];
+
+    fn index(&self, n: usize) -> &[EdgeId] {
+        &self.edges[self.start[n] as usize..self.start[n + 1] as usize]
     }
 }
 

@@ -41,9 +41,10 @@ use super::ends::assemble;
 use super::line::{end_radius, point_at, ON_BOUNDARY_END as END_ON_BOUNDARY};
 use super::prune::trunk::shortest_path;
 use super::{NodeId, SkeletonGraph, UnionFind};
+use crate::geometry::packed::{box_distance_2, Bbox, PackedTree};
 use crate::geometry::PreparedPolygon;
 use geo::Coord;
-use rstar::{primitives::GeomWithData, RTree};
+use std::ops::ControlFlow;
 
 /// Where a reference line ends.
 #[derive(Debug, Clone, PartialEq)]
@@ -109,13 +110,12 @@ pub fn conform(
         return g;
     }
     let tol = END_ON_BOUNDARY * polygon.extent();
-    let tree: NodeTree = RTree::bulk_load(
-        g.nodes()
-            .iter()
-            .enumerate()
-            .map(|(i, n)| GeomWithData::new([n.pos.x, n.pos.y], i as u32))
-            .collect(),
-    );
+    let boxes: Vec<Bbox> = g
+        .nodes()
+        .iter()
+        .map(|n| [n.pos.x, n.pos.y, n.pos.x, n.pos.y])
+        .collect();
+    let tree = PackedTree::new(&boxes);
     let served: Vec<Option<(NodeId, bool)>> = structure
         .contacts
         .iter()
@@ -209,7 +209,8 @@ fn terminal(
     None
 }
 
-type NodeTree = RTree<GeomWithData<[f64; 2], u32>>;
+/// The skeleton's nodes as points, for the searches around each contact.
+type NodeTree = PackedTree;
 
 /// The node with the smallest `score(distance, radius)` among those that see
 /// `q` (the segment to it stays in P), searched within `start` of `q` and
@@ -232,15 +233,19 @@ fn best_seeing(
         // Candidates in order of (score, distance, node); the first that
         // sees q is the answer, so the costly visibility test runs only
         // until then.
-        let mut keys: Vec<(f64, f64, u32)> = tree
-            .locate_within_distance([q.x, q.y], reach * reach)
-            .map(|item| {
-                let n = item.data;
+        // Every node at most `reach` from q (a node's box is its point, so
+        // the box distance is the point's squared distance, bit for bit).
+        let r2 = reach * reach;
+        let mut keys: Vec<(f64, f64, u32)> = Vec::new();
+        tree.visit(
+            |bx| box_distance_2(bx, q.x, q.y) <= r2,
+            |n| {
                 let node = g.node(NodeId(n));
                 let d = (node.pos - q).x.hypot((node.pos - q).y);
-                (score(d, node.radius), d, n)
-            })
-            .collect();
+                keys.push((score(d, node.radius), d, n));
+                ControlFlow::<()>::Continue(())
+            },
+        );
         keys.sort_unstable_by(|a, b| {
             a.0.total_cmp(&b.0)
                 .then(a.1.total_cmp(&b.1))
