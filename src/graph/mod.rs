@@ -618,4 +618,37 @@ mod tests {
         assert_eq!(br[0].start, br[0].end);
         assert_eq!(g.leg_count(), 0);
     }
+
+    #[test]
+    fn legs_are_counted_as_listed_and_branches_keep_their_lines() {
+        // A path on its own (one leg, two leaves), a fork with a lasso (a
+        // loop edge at a junction: no leg), a cycle, and an isolated node.
+        let mut g = SkeletonGraph::new();
+        let n: Vec<NodeId> = (0..10)
+            .map(|i| g.add_node(c(i as f64, (i * i) as f64), 1.0, None))
+            .collect();
+        g.add_edge(n[0], n[1], vec![c(0.5, 0.1)]);
+        g.add_edge(n[1], n[2], vec![]);
+        g.add_edge(n[3], n[4], vec![]);
+        g.add_edge(n[5], n[4], vec![c(4.5, 20.0), c(4.6, 21.0)]);
+        g.add_edge(n[4], n[6], vec![]);
+        g.add_edge(n[6], n[6], vec![c(7.0, 40.0)]);
+        g.add_edge(n[7], n[8], vec![]);
+        g.add_edge(n[8], n[7], vec![c(7.5, 60.0)]);
+        assert_eq!(g.legs().len(), 3);
+        assert_eq!(g.leg_count(), g.legs().len());
+        // Every branch's line is its edges' lines joined end to end.
+        for b in g.branches() {
+            let mut at = b.start;
+            let mut joined = vec![g.node(at).pos];
+            for &e in &b.edges {
+                joined.extend_from_slice(&g.oriented_coords(e, at)[1..]);
+                at = g.opposite(e, at);
+            }
+            assert_eq!(at, b.end);
+            assert_eq!(joined, b.coords);
+        }
+        let lengths: f64 = g.branches().iter().map(Branch::length).sum();
+        assert!((lengths - g.total_length()).abs() < 1e-9);
+    }
 }

@@ -148,3 +148,47 @@ fn drop_empty(g: SkeletonGraph) -> SkeletonGraph {
         !(e.interior.is_empty() && e.a != e.b && g.node(e.a).pos == g.node(e.b).pos)
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::PreparedPolygon;
+    use crate::graph::NodeId;
+    use geo::polygon;
+
+    fn c(x: f64, y: f64) -> Coord<f64> {
+        Coord { x, y }
+    }
+
+    #[test]
+    fn a_crossing_is_found_and_noded_and_touches_are_not_crossings() {
+        let p = PreparedPolygon::new(&polygon![
+            (x: 0., y: 0.), (x: 10., y: 0.), (x: 10., y: 10.), (x: 0., y: 10.)
+        ])
+        .unwrap();
+        let mut g = SkeletonGraph::new();
+        let n: Vec<NodeId> = [c(1., 1.), c(9., 9.), c(1., 9.), c(9., 1.), c(6., 6.)]
+            .into_iter()
+            .map(|q| g.add_node(q, 1.0, None))
+            .collect();
+        // Two diagonals cross at (5, 5) (the second with an interior vertex
+        // at (3, 7)). A third edge starts on the first diagonal's interior
+        // and ends at the second's end: touches, not crossings.
+        g.add_edge(n[0], n[1], vec![]);
+        g.add_edge(n[2], n[3], vec![c(3., 7.)]);
+        g.add_edge(n[4], n[3], vec![]);
+        assert_eq!(crossings(&g), 1);
+        let (noded, count) = node_crossings(&g, p.boundary());
+        assert_eq!(count, 1);
+        assert_eq!(crossings(&noded), 0);
+        let centre = noded
+            .nodes()
+            .iter()
+            .position(|q| (q.pos - c(5., 5.)).x.hypot((q.pos - c(5., 5.)).y) < 1e-9)
+            .expect("a node at the crossing");
+        assert_eq!(noded.degrees()[centre], 4);
+        assert!((noded.nodes()[centre].radius - 5.0).abs() < 1e-9);
+        assert_eq!(noded.edges().len(), 5);
+        assert!((noded.total_length() - g.total_length()).abs() < 1e-9);
+    }
+}
