@@ -7,7 +7,7 @@
 //! the scoring step's sides). Queries cost O(log n) on real data instead of a
 //! scan of all edges.
 
-use super::packed::{box_distance_2, box_meets_half_plane, ray_box, Bbox, PackedTree};
+use super::packed::{box_distance_2, box_meets_half_plane, boxes_meet, ray_box, Bbox, PackedTree};
 use geo::{Coord, LineString, Polygon};
 use std::cell::Cell;
 use std::ops::ControlFlow;
@@ -112,10 +112,6 @@ fn segment_distance_2(a: Coord<f64>, b: Coord<f64>, p: Coord<f64>) -> f64 {
 }
 
 /// True when two boxes share a point.
-fn boxes_meet(a: &Bbox, b: &Bbox) -> bool {
-    a[0] <= b[2] && a[2] >= b[0] && a[1] <= b[3] && a[3] >= b[1]
-}
-
 fn cross(a: Coord<f64>, b: Coord<f64>) -> f64 {
     a.x * b.y - a.y * b.x
 }

@@ -341,6 +341,11 @@ fn union(a: Bbox, b: Bbox) -> Bbox {
     ]
 }
 
+/// Whether two boxes meet (touching counts).
+pub fn boxes_meet(a: &Bbox, b: &Bbox) -> bool {
+    a[0] <= b[2] && a[2] >= b[0] && a[1] <= b[3] && a[3] >= b[1]
+}
+
 /// Squared distance from `(x, y)` to the box (0 inside).
 pub fn box_distance_2(b: &Bbox, x: f64, y: f64) -> f64 {
     let dx = (b[0] - x).max(0.0).max(x - b[2]);

@@ -9,7 +9,7 @@
 
 use super::{Edge, SkeletonGraph};
 use crate::geometry::boundary::{orient, properly_cross};
-use crate::geometry::packed::{Bbox, PackedTree};
+use crate::geometry::packed::{boxes_meet, Bbox, PackedTree};
 use crate::geometry::Boundary;
 use geo::Coord;
 use std::ops::ControlFlow;
@@ -66,17 +66,19 @@ fn find(segs: &[Seg]) -> Vec<(usize, usize, Coord<f64>)> {
     let tree = PackedTree::new(&boxes);
     let mut out = Vec::new();
     for (i, (s, e)) in segs.iter().zip(&boxes).enumerate() {
-        let meets = |b: &Bbox| b[0] <= e[2] && e[0] <= b[2] && b[1] <= e[3] && e[1] <= b[3];
-        tree.visit(meets, |j| {
-            let j = j as usize;
-            if j > i {
-                let t = &segs[j];
-                if properly_cross(s.a, s.b, t.a, t.b) {
-                    out.push((i, j, intersection(s.a, s.b, t.a, t.b)));
+        tree.visit(
+            |b| boxes_meet(b, e),
+            |j| {
+                let j = j as usize;
+                if j > i {
+                    let t = &segs[j];
+                    if properly_cross(s.a, s.b, t.a, t.b) {
+                        out.push((i, j, intersection(s.a, s.b, t.a, t.b)));
+                    }
                 }
-            }
-            ControlFlow::<()>::Continue(())
-        });
+                ControlFlow::<()>::Continue(())
+            },
+        );
     }
     out.sort_by(|x, y| x.0.cmp(&y.0).then(x.1.cmp(&y.1)));
     out

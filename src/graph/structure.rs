@@ -162,7 +162,7 @@ pub fn conform(
 /// `on_boundary`.
 fn terminal(
     g: &SkeletonGraph,
-    tree: &NodeTree,
+    tree: &PackedTree,
     c: &Contact,
     polygon: &PreparedPolygon,
     tol: f64,
@@ -209,9 +209,6 @@ fn terminal(
     None
 }
 
-/// The skeleton's nodes as points, for the searches around each contact.
-type NodeTree = PackedTree;
-
 /// The node with the smallest `score(distance, radius)` among those that see
 /// `q` (the segment to it stays in P), searched within `start` of `q` and
 /// four times farther each round up to `limit`; without `on_boundary`,
@@ -219,7 +216,7 @@ type NodeTree = PackedTree;
 #[allow(clippy::too_many_arguments)]
 fn best_seeing(
     g: &SkeletonGraph,
-    tree: &NodeTree,
+    tree: &PackedTree,
     q: Coord<f64>,
     start: f64,
     limit: f64,
