@@ -215,9 +215,11 @@ impl PackedTree {
     }
 
     /// The traversal under [`Self::best`] and the two-sided searches:
-    /// nodes in increasing order of their bound (best first), stopping when
-    /// the next bound exceeds the cut-off (`limit` at first, then what
-    /// `item` returns; equal bounds are still visited, for the tie rule).
+    /// depth first, each node's children in increasing order of their bound,
+    /// skipping every node and item whose bound exceeds the cut-off (`limit`
+    /// at first, then what `item` returns; equal bounds are still visited,
+    /// for the tie rule). Every item that can beat or tie the answer is
+    /// scored, so the answer is the one a best-first search gives.
     pub fn branch_and_bound(
         &self,
         limit: f64,
@@ -248,88 +250,49 @@ impl PackedTree {
             }
             return;
         }
-        HEAP.with(|cell| {
-            // A query from inside a query (never done today) gets its own heap.
-            let mut own = Vec::new();
-            let mut borrowed = cell.try_borrow_mut();
-            let heap: &mut Vec<(f64, u32)> = match borrowed.as_mut() {
-                Ok(h) => h,
-                Err(_) => &mut own,
-            };
-            heap.clear();
-            let mut cut = limit;
-            push(heap, (rb, root as u32));
-            while let Some((lb, pos)) = pop(heap) {
-                if lb > cut {
-                    break;
-                }
-                let children = self.children(pos as usize);
-                if children.start < n {
-                    // Children are items: score every one that can still count.
-                    for c in children {
-                        if bound(&self.boxes[c]).is_some_and(|b| b <= cut) {
-                            cut = item(self.ids[c]);
-                        }
-                    }
-                    continue;
-                }
-                for c in children {
-                    if let Some(b) = bound(&self.boxes[c]) {
-                        if b <= cut {
-                            push(heap, (b, c as u32));
-                        }
-                    }
-                }
+        // Depth first, each node's children nearest first: the same items
+        // are scored as best first would (every item whose bound is not
+        // above the cut-off when it is reached, and the answer's never is),
+        // with a fixed stack on the call stack instead of a heap.
+        let mut stack = [MaybeUninit::<(f64, u32)>::uninit(); STACK];
+        stack[0] = MaybeUninit::new((rb, root as u32));
+        let mut top = 1;
+        let mut cut = limit;
+        while top > 0 {
+            top -= 1;
+            // SAFETY: entries below `top` were written before.
+            let (lb, pos) = unsafe { stack[top].assume_init() };
+            if lb > cut {
+                continue;
             }
-        });
-    }
-}
-
-thread_local! {
-    /// The best-first queue of the calling thread's queries, kept between
-    /// queries so that none allocates.
-    static HEAP: std::cell::RefCell<Vec<(f64, u32)>> = const { std::cell::RefCell::new(Vec::new()) };
-}
-
-/// Pushes onto a binary min-heap of (bound, position).
-fn push(heap: &mut Vec<(f64, u32)>, e: (f64, u32)) {
-    heap.push(e);
-    let mut i = heap.len() - 1;
-    while i > 0 {
-        let parent = (i - 1) / 2;
-        if heap[parent].0 <= heap[i].0 {
-            break;
+            let children = self.children(pos as usize);
+            if children.start < n {
+                // Children are items: score every one that can still count.
+                for c in children {
+                    if bound(&self.boxes[c]).is_some_and(|b| b <= cut) {
+                        cut = item(self.ids[c]);
+                    }
+                }
+                continue;
+            }
+            // The children that can still count, sorted so that the nearest
+            // is on top (insertion sort: at most NODE_SIZE of them).
+            let first = top;
+            for c in children {
+                let Some(b) = bound(&self.boxes[c]).filter(|&b| b <= cut) else {
+                    continue;
+                };
+                let mut j = top;
+                // SAFETY: entries first..top were written in this loop.
+                while j > first && unsafe { stack[j - 1].assume_init().0 } < b {
+                    stack[j] = stack[j - 1];
+                    j -= 1;
+                }
+                stack[j] = MaybeUninit::new((b, c as u32));
+                top += 1;
+            }
         }
-        heap.swap(parent, i);
-        i = parent;
     }
-}
-
-/// Pops the least bound from a binary min-heap.
-fn pop(heap: &mut Vec<(f64, u32)>) -> Option<(f64, u32)> {
-    let last = heap.pop()?;
-    if heap.is_empty() {
-        return Some(last);
-    }
-    let top = std::mem::replace(&mut heap[0], last);
-    let n = heap.len();
-    let mut i = 0;
-    loop {
-        let (l, r) = (2 * i + 1, 2 * i + 2);
-        let mut m = i;
-        if l < n && heap[l].0 < heap[m].0 {
-            m = l;
-        }
-        if r < n && heap[r].0 < heap[m].0 {
-            m = r;
-        }
-        if m == i {
-            break;
-        }
-        heap.swap(i, m);
-        i = m;
-    }
-    Some(top)
 }
 
 fn union(a: Bbox, b: Bbox) -> Bbox {

@@ -60,7 +60,19 @@ pub fn end_width_point(coords: &[Coord<f64>], polygon: &PreparedPolygon) -> (f64
     // there are skipped unevaluated (the same sample is the first at or
     // above zero, the same answer).
     let steps = 64;
-    let f = |s: f64| s - 2.0 * b.distance(point_at(coords, s));
+    // The radius is 1-Lipschitz: the last point measured bounds the next
+    // one's distance, which keeps each search short (never changing it).
+    let last: std::cell::Cell<Option<(Coord<f64>, f64)>> = std::cell::Cell::new(None);
+    let radius = |s: f64| {
+        let p = point_at(coords, s);
+        let r = match last.get() {
+            Some((q, rq)) => b.distance_within(p, rq + crate::geometry::norm(p - q)),
+            None => b.distance(p),
+        };
+        last.set(Some((p, r)));
+        r
+    };
+    let f = |s: f64| s - 2.0 * radius(s);
     let mut lo = 0.0;
     let mut negative_below = 0.0;
     for i in 1..=steps {
@@ -73,11 +85,11 @@ pub fn end_width_point(coords: &[Coord<f64>], polygon: &PreparedPolygon) -> (f64
         negative_below = s - v / 3.0 * (1.0 - 1e-9);
         if v >= 0.0 {
             let hi = first_crossing(&f, (lo, f(lo)), (s, v), total * 2f64.powi(-36));
-            return (hi, b.distance(point_at(coords, hi)));
+            return (hi, radius(hi));
         }
         lo = s;
     }
-    (total, b.distance(point_at(coords, total)))
+    (total, radius(total))
 }
 
 /// A point `hi` with `f(hi) ≥ 0` within `tol` of a sign change of `f` in the
