@@ -181,7 +181,26 @@ def test_the_result_frame_is_the_one_geopandas_builds(islands):
     assert "extra" not in skeletonise.skeletonise(sample).columns
     strings = ["CDT", None, "é"]
     assert _strings(strings).equals(pd.array(strings, dtype="string"))
+    assert _strings([None, None]).equals(pd.array([None, None], dtype="string"))
     assert _geo_frame(tool, out.index).crs == islands.crs
+    # The blocks are made directly on this pandas (not by the fallbacks), and
+    # a frame with NULLs (a rejected row) is the public constructor's too.
+    from skeletonise import _blocks, _column_index
+
+    values = {c: out[c].values for c in out.columns if c != "extra"}
+    direct = _blocks(list(values.values()), _column_index(tuple(values)), out.index)
+    assert direct.nblocks == _public_geo_frame(values, out.index)._mgr.nblocks
+    mixed = skeletonise.skeletonise([sample.iloc[0], Point(0, 0), None, sample.iloc[1]])
+    assert mixed["rejected"].notna().tolist() == [False, True, True, False]
+    assert mixed["method"].isna().tolist() == [False, True, True, False]
+    mixed_tool = {c: mixed[c].array for c in mixed.columns}
+    pd.testing.assert_frame_equal(_public_geo_frame(mixed_tool, mixed.index), mixed, check_exact=True)
+    # A frame's columns are its own: changing one result changes no other.
+    first = skeletonise.skeletonise(sample.iloc[:2])
+    first.loc[first.index[0], "bars"] = -1
+    first.loc[first.index[0], "rejected"] = "edited"
+    again = skeletonise.skeletonise(sample.iloc[:2])
+    assert again["bars"].iloc[0] > 0 and pd.isna(again["rejected"].iloc[0])
 
 
 def test_wkb_in_any_byte_order_and_dimension():
