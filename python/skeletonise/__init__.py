@@ -337,7 +337,7 @@ def _public_geo_frame(tool: dict[str, Any], index: pd.Index) -> Any:
 def _fids(index: pd.Index | None, n: int) -> np.ndarray:
     """``src_fid``: the index when it is an integer index (as pyogrio's ``fid_as_index``
     gives the source FIDs), else the 0-based position."""
-    if index is not None and pd.api.types.is_integer_dtype(index.dtype):
+    if index is not None and index.dtype.kind in "iu":
         return np.asarray(index, dtype=np.int64)
     return np.arange(n, dtype=np.int64)
 

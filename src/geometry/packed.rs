@@ -1,9 +1,9 @@
 //! A static packed R-tree of boxes (the Hilbert-packed layout of
 //! `flatbush`): items sorted along a Hilbert curve, grouped sixteen to a
 //! node, level by level, in flat arrays. Built once per polygon; queries
-//! allocate nothing (their stack lives on the call stack) and visit nodes
-//! nearest-first, so a ray stops at its first hit and a nearest-point search
-//! at its answer.
+//! allocate nothing (their stack lives on the call stack) and visit each
+//! node's children nearest first, so a ray stops soon after its first hit
+//! and a nearest-point search soon after its answer.
 //!
 //! The tree knows only boxes and item numbers: what an item is, and its
 //! exact distance or hit, is the caller's (see [`super::Boundary`]).

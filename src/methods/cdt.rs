@@ -175,21 +175,21 @@ impl SkeletonMethod for Cdt {
                 1 => {
                     // Opposite vertex of inner edge i is corner i+2.
                     let i = inner[0];
-                    b.segment(m(i), c[(i + 2) % 3], c[0]);
+                    b.segment(m(i), c[(i + 2) % 3], &c);
                 }
                 2 => {
-                    b.segment(m(inner[0]), m(inner[1]), c[0]);
+                    b.segment(m(inner[0]), m(inner[1]), &c);
                 }
                 3 => {
                     let g = centroid(&c);
                     for i in 0..3 {
-                        b.segment(g, m(i), c[0]);
+                        b.segment(g, m(i), &c);
                     }
                 }
                 _ => {
                     let g = centroid(&c);
                     for corner in c {
-                        b.segment(g, corner, c[0]);
+                        b.segment(g, corner, &c);
                     }
                 }
             }
@@ -199,9 +199,9 @@ impl SkeletonMethod for Cdt {
 }
 
 /// The graph being built, with an upper bound of every node's distance to
-/// ∂P: its distance to a corner of a triangle it lies in (the corners are
-/// vertices of ∂P). The bound keeps each radius search short and never
-/// changes the radius.
+/// ∂P: its distance to the nearest corner of a triangle it lies in (the
+/// corners are vertices of ∂P). The bound keeps each radius search short
+/// and never changes the radius.
 #[derive(Default)]
 struct Nodes {
     graph: GraphBuilder,
@@ -209,14 +209,20 @@ struct Nodes {
 }
 
 impl Nodes {
-    fn segment(&mut self, p: Coord<f64>, q: Coord<f64>, corner: Coord<f64>) {
+    fn segment(&mut self, p: Coord<f64>, q: Coord<f64>, corners: &[Coord<f64>; 3]) {
         for x in [p, q] {
             let id = self.graph.node(x).0 as usize;
             if self.bound.len() <= id {
                 self.bound.resize(id + 1, f64::INFINITY);
             }
-            let d = x - corner;
-            self.bound[id] = self.bound[id].min(d.x.hypot(d.y));
+            let d2 = corners
+                .iter()
+                .map(|&c| {
+                    let d = x - c;
+                    d.x * d.x + d.y * d.y
+                })
+                .fold(f64::INFINITY, f64::min);
+            self.bound[id] = self.bound[id].min(d2.sqrt());
         }
         self.graph.segment(p, q);
     }
