@@ -15,13 +15,16 @@
 
 The timings of 1 and 2 are the best of REPEAT runs side by side (default 3;
 30 in 2 where one call takes less than 0.1 s, after one call of each to warm up;
-such layers also get the best of 30 calls in a row of each tool, in five rounds taken in turn),
+such layers also get the best of 200 calls in a row of each tool after 50 to warm up, in three
+rounds taken in turn),
 those of 3 the best of 5 interleaved runs, and those of 4 the best of two runs
 each in the order 1, 2, 2, 1 workers, so that a spell of other load on the
 machine does not decide a ratio; the load average is printed at the start and
 the end.
 
 usage: bench_python.py SKELETONISE_BIN [N_POLYGONS [REPEAT]]
+BENCH_PYTHON_SECTIONS="cli pygeoops" runs only those sections (default: all four:
+cli pygeoops exchange dask; the last two go together).
 """
 
 from __future__ import annotations
@@ -72,9 +75,12 @@ def idle_cores(seconds: float = 5.0) -> float:
     return (os.cpu_count() or 1) * (i1 - i0) / max(1, t1 - t0)
 
 
-def back_to_back(call, n: int) -> float:
-    """The best of `n` calls made one after another (the first one warms up)."""
-    call()
+def back_to_back(call, n: int, warm_up: int = 50) -> float:
+    """The best of `n` calls made one after another, after `warm_up` calls
+    (the steady state of a loop over many small GeoSeries: Python's adaptive
+    interpreter and the caches settle within a few dozen calls)."""
+    for _ in range(warm_up):
+        call()
     best = float("inf")
     for _ in range(n):
         t0 = time.perf_counter()
@@ -95,11 +101,12 @@ def main() -> None:
           f"{idle_cores():.1f} idle over 5 s); best of {repeat} runs")
     results: dict = {"cli_vs_python": [], "pygeoops": [], "dask": {}}
 
+    only = os.environ.get("BENCH_PYTHON_SECTIONS", "cli pygeoops exchange dask").split()
     print("\n## The command line against skeletonise.apply (same pipeline, same layer)\n")
     row("layer", "features", "CLI elapsed s (incl. GPKG I/O)", "Python compute s", "ratio",
         "conversion s (to Rust + from Rust)", "parse+encode in Rust s", "Python total s")
     row(*["---"] * 8)
-    for layer, pipeline in CASES:
+    for layer, pipeline in CASES if "cli" in only else []:
         gdf = pyogrio.read_dataframe(TRAIN, layer=layer, fid_as_index=True)
         clis, runs = [], []
         for _ in range(repeat):
@@ -145,21 +152,26 @@ def main() -> None:
         if reps > repeat:
             # A call of a millisecond after a call of another kind runs on cold
             # caches (on this machine about twice as slow as the next call):
-            # also the best of 30 calls in a row of each, as a loop over many
-            # small GeoSeries makes them.
-            # Five rounds of calls in a row, the tools in turn, each tool's best
-            # over all: a slow spell of the machine then meets both tools.
+            # also the best of 200 calls in a row of each after 50 to warm up,
+            # as a loop over many small GeoSeries makes them, in three rounds
+            # with the tools in turn (each tool's best over all), so that a
+            # slow spell of the machine meets both tools.
             peer_warm = one_warm = float("inf")
-            for _ in range(5):
-                peer_warm = min(peer_warm, back_to_back(lambda: pygeoops.centerline(geoms), reps))
+            for _ in range(3):
+                peer_warm = min(peer_warm, back_to_back(lambda: pygeoops.centerline(geoms), 200))
                 one_warm = min(one_warm, back_to_back(
-                    lambda: skeletonise.skeletonise(geoms, methods=["CDT"], score=False, select=False), reps))
+                    lambda: skeletonise.skeletonise(geoms, methods=["CDT"], score=False, select=False), 200))
             entry |= {"pygeoops_back_to_back_s": peer_warm, "one_method_back_to_back_s": one_warm}
             warm = f"{peer_warm:.4f} / {one_warm:.4f} = {peer_warm / one_warm:.1f}×"
         row(layer, len(geoms), f"{peer:.3f}", f"{ours:.3f}", f"{peer / ours:.1f}×", f"{one:.3f}", f"{peer / one:.1f}×",
             warm)
         results["pygeoops"].append(entry)
 
+    if "exchange" not in only and "dask" not in only:
+        out = ROOT / "target/bench/python.json"
+        out.write_text(json.dumps(results, indent=1))
+        print(f"\n(raw figures: {out.relative_to(ROOT)})")
+        return
     data = ROOT / "target/bench/islands-generated"
     script = [sys.executable, str(ROOT / "examples/dask_islands.py"), "--input", str(data)]
     sys.path.insert(0, str(ROOT / "examples"))
