@@ -111,7 +111,6 @@ fn segment_distance_2(a: Coord<f64>, b: Coord<f64>, p: Coord<f64>) -> f64 {
     d.x * d.x + d.y * d.y
 }
 
-/// True when two boxes share a point.
 fn cross(a: Coord<f64>, b: Coord<f64>) -> f64 {
     a.x * b.y - a.y * b.x
 }
@@ -648,6 +647,39 @@ mod tests {
             )
             .unwrap();
         assert_eq!(h.t, 1.0);
+    }
+
+    /// The first hit of a ray through the tree is the one a scan of every
+    /// segment finds (least parameter, ties to the lower segment number), on
+    /// a wavy ring whose tree has several levels, from points inside and
+    /// outside, with and without a far limit.
+    #[test]
+    fn first_hits_match_a_scan() {
+        let b = wavy_ring(900, [9.0, 11.0], [2.0, 57.0]);
+        for k in 0..400 {
+            let a = k as f64 * 0.61;
+            let origin = Coord {
+                x: a.cos() * (k % 130) as f64,
+                y: a.sin() * (k % 130) as f64,
+            };
+            let dir = Coord {
+                x: (k as f64 * 2.3).cos(),
+                y: (k as f64 * 2.3).sin(),
+            };
+            let (min_t, max_t) = (1e-9, if k % 3 == 0 { 40.0 } else { f64::INFINITY });
+            let mut want: Option<(f64, usize)> = None;
+            for (i, s) in b.segments().iter().enumerate() {
+                if let Some((t, _)) = ray_segment(origin, dir, s.a, s.b) {
+                    if t > min_t && t <= max_t && want.is_none_or(|(bt, _)| t < bt) {
+                        want = Some((t, i));
+                    }
+                }
+            }
+            let got = b
+                .first_hit(origin, dir, min_t, max_t)
+                .map(|h| (h.t, h.segment));
+            assert_eq!(got, want, "{origin:?} {dir:?} {max_t}");
+        }
     }
 
     #[test]
