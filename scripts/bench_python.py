@@ -89,6 +89,12 @@ def back_to_back(call, n: int, warm_up: int = 50) -> float:
     return best
 
 
+def write_results(results: dict) -> None:
+    out = ROOT / "target/bench/python.json"
+    out.write_text(json.dumps(results, indent=1))
+    print(f"\n(raw figures: {out.relative_to(ROOT)})")
+
+
 def row(*cells) -> None:
     print("| " + " | ".join(str(c) for c in cells) + " |")
 
@@ -128,7 +134,7 @@ def main() -> None:
     row("layer", "features", "pygeoops s", "skeletonise defaults s", "speed-up", "skeletonise one method s", "speed-up",
         "calls in a row: pygeoops / one method s")
     row(*["---"] * 8)
-    for layer, _ in CASES:
+    for layer, _ in CASES if "pygeoops" in only else []:
         geoms = pyogrio.read_dataframe(TRAIN, layer=layer, fid_as_index=True).geometry
         peer = ours = one = float("inf")
         # A call on one small polygon takes a millisecond: the best of REPEAT
@@ -168,9 +174,7 @@ def main() -> None:
         results["pygeoops"].append(entry)
 
     if "exchange" not in only and "dask" not in only:
-        out = ROOT / "target/bench/python.json"
-        out.write_text(json.dumps(results, indent=1))
-        print(f"\n(raw figures: {out.relative_to(ROOT)})")
+        write_results(results)
         return
     data = ROOT / "target/bench/islands-generated"
     script = [sys.executable, str(ROOT / "examples/dask_islands.py"), "--input", str(data)]
@@ -220,9 +224,7 @@ def main() -> None:
     one, two = results["dask"][1]["elapsed_s"], results["dask"][2]["elapsed_s"]
     print(f"\n2 workers against 1: {one / two:.2f}× faster")
     print(f"\nload average at the end: {os.getloadavg()[0]:.1f}")
-    out = ROOT / "target/bench/python.json"
-    out.write_text(json.dumps(results, indent=1))
-    print(f"\n(raw figures: {out.relative_to(ROOT)})")
+    write_results(results)
 
 
 if __name__ == "__main__":
