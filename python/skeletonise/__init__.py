@@ -213,7 +213,7 @@ def _column(kind: str, values: Any) -> Any:
         return _integers(np.asarray(v, dtype=kind), np.asarray(null, dtype=bool))
     if kind == "real":
         return values
-    return _strings(values)
+    return _strings(*values)
 
 
 def _integers(values: np.ndarray, null: np.ndarray) -> Any:
@@ -226,30 +226,64 @@ def _integers(values: np.ndarray, null: np.ndarray) -> Any:
         return pd.arrays.IntegerArray(values, null)
 
 
-_ARROW_STRINGS: bool | None = None
+# How ``string`` columns are made: None until probed, then the dtype of
+# pandas' Arrow-backed strings, or False where ``string`` is not Arrow's.
+_ARROW_STRINGS: Any = None
 
 
-def _strings(values: list) -> Any:
-    """A ``string`` column: built from an Arrow array where pandas' ``string``
-    dtype is Arrow's (pandas ≥ 3 with pyarrow), five times faster than
-    ``pd.array(values, dtype="string")``, which gives the same array."""
+def _arrow_strings() -> Any:
     global _ARROW_STRINGS
     if _ARROW_STRINGS is None:
+        _ARROW_STRINGS = False
         try:
             import pyarrow as pa
 
             probe = ["a", None]
-            fast = pd.arrays.ArrowStringArray(pa.array(probe, type=pa.large_string()))
-            _ARROW_STRINGS = fast.dtype == pd.array(probe, dtype="string").dtype
+            public = pd.array(probe, dtype="string")
+            fast = _wrap_strings(pa.array(probe, type=pa.large_string()), public.dtype)
+            if type(fast) is type(public) and vars(fast).keys() == vars(public).keys() and fast.equals(public):
+                _ARROW_STRINGS = public.dtype
         except (ImportError, AttributeError, TypeError, ValueError):
-            _ARROW_STRINGS = False
-    if _ARROW_STRINGS:
+            pass
+    return _ARROW_STRINGS
+
+
+def _wrap_strings(array: Any, dtype: Any) -> Any:
+    """The ``ArrowStringArray`` of a large-string Arrow array, made as pandas
+    makes the result of an operation (the constructor's type checks and cast
+    cost five times as much as the array)."""
+    import pyarrow as pa
+
+    cls = pd.arrays.ArrowStringArray
+    out = cls.__new__(cls)
+    out._pa_array = pa.chunked_array([array])
+    out._dtype = dtype
+    out._cache = {}
+    return out
+
+
+def _strings(offsets: np.ndarray, data: bytes, null: np.ndarray | None) -> Any:
+    """A ``string`` column from Arrow large-string buffers as Rust gives them:
+    the start of every text in ``data`` (UTF-8) and the end, and which are NULL
+    (``None`` when none is). Where pandas' ``string`` is Arrow's (pandas ≥ 3
+    with pyarrow) the buffers are the column's, without a Python string per
+    row; else the texts are decoded for ``pd.array(..., dtype="string")``."""
+    n = len(offsets) - 1
+    dtype = _arrow_strings()
+    if dtype is not False:
         import pyarrow as pa
 
-        if values.count(None) == len(values):
+        if null is not None and null.all():
             # A column of NULLs (`rejected` and `note` in most calls).
-            return pd.arrays.ArrowStringArray(pa.nulls(len(values), pa.large_string()))
-        return pd.arrays.ArrowStringArray(pa.array(values, type=pa.large_string()))
+            array = pa.nulls(n, pa.large_string())
+        else:
+            valid = None if null is None else pa.py_buffer(np.packbits(~null, bitorder="little"))
+            array = pa.LargeStringArray.from_buffers(n, pa.py_buffer(offsets), pa.py_buffer(data), valid)
+        return _wrap_strings(array, dtype)
+    values = [
+        None if null is not None and null[i] else data[offsets[i] : offsets[i + 1]].decode()
+        for i in range(n)
+    ]
     return pd.array(values, dtype="string")
 
 
@@ -381,7 +415,7 @@ def _run(
     same_rows = len(rows) == len(arr) and bool((rows == np.arange(len(rows))).all())
     out_index = index if same_rows else index.take(rows)
     tool: dict[str, Any] = {name: _column(kind, values) for name, kind, values in done["columns"]}
-    tool["rejected"] = _strings(done["rejected"])
+    tool["rejected"] = _strings(*done["rejected"])
     if attributes is not None and len(attributes.columns) and _core.columns(layer, False)[1]:
         frame = pd.DataFrame(tool, index=out_index)
         # Source fields first, renamed where they clash with the tool's (as the writer does).
@@ -398,7 +432,9 @@ def _run(
     else:
         # The geometry array with its CRS in the columns: a third of the
         # fixed cost of a GeoDataFrame made from a frame and a GeoSeries.
-        tool["geometry"] = gpd.array.from_shapely(_decode(done["geometry"]), crs=crs)
+        # Shapely geometries or None from shapely itself: no need for
+        # from_shapely's check of every element.
+        tool["geometry"] = gpd.array.GeometryArray(_decode(done["geometry"]), crs=crs)
         frame = _geo_frame(tool, out_index)
     if geometry_name != "geometry":
         frame = frame.rename_geometry(geometry_name)

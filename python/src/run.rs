@@ -437,6 +437,35 @@ fn value_error(e: impl std::fmt::Display) -> PyErr {
     PyValueError::new_err(format!("arrays must be C-contiguous: {e}"))
 }
 
+/// Texts as Arrow's large-string buffers, `(offsets, data, null)`: the
+/// start of every text in `data` (UTF-8) and the end, and which are NULL
+/// (`None` when none is). Python makes the column from them without a
+/// Python string per row.
+fn text_buffers<'py>(py: Python<'py>, v: &[Option<String>]) -> PyResult<Bound<'py, PyAny>> {
+    let mut offsets = Vec::with_capacity(v.len() + 1);
+    let mut data = Vec::new();
+    offsets.push(0i64);
+    for s in v.iter().flatten().map(String::as_bytes) {
+        data.extend_from_slice(s);
+    }
+    let mut at = 0i64;
+    for s in v {
+        at += s.as_ref().map_or(0, |s| s.len() as i64);
+        offsets.push(at);
+    }
+    let null = v
+        .iter()
+        .any(Option::is_none)
+        .then(|| PyArray1::from_iter(py, v.iter().map(Option::is_none)));
+    Ok((
+        PyArray1::from_vec(py, offsets),
+        PyBytes::new(py, &data),
+        null,
+    )
+        .into_pyobject(py)?
+        .into_any())
+}
+
 fn to_python(py: Python<'_>, d: Done) -> PyResult<Bound<'_, PyAny>> {
     let out = PyDict::new(py);
     out.set_item("row", PyArray1::from_vec(py, d.rows))?;
@@ -447,12 +476,12 @@ fn to_python(py: Python<'_>, d: Done) -> PyResult<Bound<'_, PyAny>> {
                 .into_pyobject(py)?
                 .into_any(),
             Values::Real(v) => PyArray1::from_vec(py, v).into_any(),
-            Values::Text(v) => v.into_pyobject(py)?.into_any(),
+            Values::Text(v) => text_buffers(py, &v)?,
         };
         cols.append((c.name, type_name(c.ty), values))?;
     }
     out.set_item("columns", cols)?;
-    out.set_item("rejected", d.rejected)?;
+    out.set_item("rejected", text_buffers(py, &d.rejected)?)?;
     match d.geometry {
         Encoded::Ragged(r) => out.set_item(
             "geometry",

@@ -165,7 +165,7 @@ def test_geoarrow_and_wkb_exchange_give_the_same_frame(islands):
     assert shapely.equals_exact(a.geometry.values, b.geometry.values, tolerance=0).all()
 
 
-def test_the_result_frame_is_the_one_geopandas_builds(islands):
+def test_the_result_frame_is_the_one_geopandas_builds(islands, monkeypatch):
     # The frame is assembled without GeoDataFrame's checks and copies: it must be
     # the frame the public constructor gives, and behave as one.
     from skeletonise import _geo_frame, _public_geo_frame, _strings
@@ -179,9 +179,19 @@ def test_the_result_frame_is_the_one_geopandas_builds(islands):
     assert moved.crs == "EPSG:4326" and isinstance(out.iloc[:3], gpd.GeoDataFrame)
     out["extra"] = 1
     assert "extra" not in skeletonise.skeletonise(sample).columns
-    strings = ["CDT", None, "é"]
-    assert _strings(strings).equals(pd.array(strings, dtype="string"))
-    assert _strings([None, None]).equals(pd.array([None, None], dtype="string"))
+    # Text columns come from Rust as Arrow buffers: the same arrays as
+    # pandas' own, on the Arrow path and on the fallback that decodes them.
+    for strings in (["CDT", None, "é"], [None, None], ["MA", "StSk"], []):
+        encoded = [b"" if v is None else v.encode() for v in strings]
+        offsets = np.cumsum([0] + [len(e) for e in encoded], dtype=np.int64)
+        null = np.array([v is None for v in strings]) if None in strings else None
+        public = pd.array(strings, dtype="string")
+        for probed in (skeletonise._arrow_strings(), False):
+            monkeypatch.setattr(skeletonise, "_ARROW_STRINGS", probed)
+            made = _strings(offsets, b"".join(encoded), null)
+            assert type(made) is type(public) and made.dtype == public.dtype and made.equals(public)
+        monkeypatch.undo()
+    assert skeletonise._arrow_strings() is not False, "pandas' strings are Arrow's on the pandas tested with"
     assert _geo_frame(tool, out.index).crs == islands.crs
     # The blocks are made directly on this pandas (not by the fallbacks), and
     # a frame with NULLs (a rejected row) is the public constructor's too.
