@@ -179,7 +179,7 @@ pub fn prune_and_extend(
         prune_and_extend_straight(raw, polygon, pr, ex)
     };
     // Added segments may cross a line of the skeleton: node them.
-    super::planar::node_crossings(&g, boundary).0
+    super::planar::node_crossings(g, boundary).0
 }
 
 /// [`prune_and_extend`] for the straight modes (and none).

@@ -24,18 +24,21 @@ struct Seg {
 }
 
 fn segments(g: &SkeletonGraph) -> Vec<Seg> {
-    let mut out = Vec::new();
-    for i in 0..g.edges().len() {
-        let c = g.edge_coords(super::EdgeId(i as u32));
-        for (k, w) in c.windows(2).enumerate() {
-            if w[0] != w[1] {
+    let mut out = Vec::with_capacity(g.edges().len());
+    for (i, e) in g.edges().iter().enumerate() {
+        // The polyline node a, interior…, node b, without collecting it.
+        let mut a = g.node(e.a).pos;
+        let rest = e.interior.iter().copied().chain([g.node(e.b).pos]);
+        for (k, b) in rest.enumerate() {
+            if a != b {
                 out.push(Seg {
                     edge: i,
                     index: k,
-                    a: w[0],
-                    b: w[1],
+                    a,
+                    b,
                 });
             }
+            a = b;
         }
     }
     out
@@ -93,11 +96,11 @@ pub fn crossings(g: &SkeletonGraph) -> usize {
 /// `g` with a node at every proper crossing (both edges split there; the new
 /// node's radius is its distance to ∂P). Returns the graph and the number of
 /// crossings noded.
-pub fn node_crossings(g: &SkeletonGraph, boundary: &Boundary) -> (SkeletonGraph, usize) {
-    let segs = segments(g);
+pub fn node_crossings(g: SkeletonGraph, boundary: &Boundary) -> (SkeletonGraph, usize) {
+    let segs = segments(&g);
     let found = find(&segs);
     if found.is_empty() {
-        return (g.clone(), 0);
+        return (g, 0);
     }
     // Crossing points per (edge, segment), with their parameter along it.
     let mut cuts: std::collections::BTreeMap<(usize, usize), Vec<(f64, usize)>> =
@@ -180,7 +183,7 @@ mod tests {
         g.add_edge(n[2], n[3], vec![c(3., 7.)]);
         g.add_edge(n[4], n[3], vec![]);
         assert_eq!(crossings(&g), 1);
-        let (noded, count) = node_crossings(&g, p.boundary());
+        let (noded, count) = node_crossings(g.clone(), p.boundary());
         assert_eq!(count, 1);
         assert_eq!(crossings(&noded), 0);
         let centre = noded

@@ -151,7 +151,7 @@ pub fn conform(
         })
         .collect();
     let out = assemble(&g, &keep, &segments);
-    super::planar::node_crossings(&out, polygon.boundary()).0
+    super::planar::node_crossings(out, polygon.boundary()).0
 }
 
 /// The node of `g` that serves contact `c` (see the module documentation),

@@ -170,8 +170,14 @@ impl SkeletonMethod for Cdt {
         for t in &triangles {
             let c = t.corners;
             let m = |i: usize| mid(c[i], c[(i + 1) % 3]);
-            let inner: Vec<usize> = (0..3).filter(|&i| !t.on_boundary[i]).collect();
-            match inner.len() {
+            // The triangle's edges inside P (not on ∂P), in order.
+            let mut inner = [0usize; 3];
+            let mut count = 0;
+            for i in (0..3).filter(|&i| !t.on_boundary[i]) {
+                inner[count] = i;
+                count += 1;
+            }
+            match count {
                 1 => {
                     // Opposite vertex of inner edge i is corner i+2.
                     let i = inner[0];

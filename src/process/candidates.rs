@@ -151,6 +151,9 @@ pub(super) fn part_skeletons(
     // its raw skeleton is there, while the other methods' are still being
     // made (the others wait for the structure; on one huge polygon this
     // keeps both cores busy).
+    // One method has no other to share its structure with: it is finished on
+    // its own (the same skeleton as its reference path would give).
+    let shared = shared.filter(|_| methods.len() > 1);
     let order: Vec<usize> = shared.map_or_else(Vec::new, |_| {
         params
             .skeleton
