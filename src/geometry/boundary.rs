@@ -493,6 +493,15 @@ impl Boundary {
         self.tree.visit(|b| boxes_meet(b, &env), |i| f(i as usize))
     }
 
+    /// Every pair of segments whose boxes meet, once each as `(i, j)` with
+    /// `i < j`, in no particular order, until `f` breaks.
+    pub fn visit_segment_pairs<B>(
+        &self,
+        mut f: impl FnMut(usize, usize) -> ControlFlow<B>,
+    ) -> Option<B> {
+        self.tree.pairs(|i, j| f(i as usize, j as usize))
+    }
+
     /// Crossing parity of the ray from `p` towards +x against the segments of
     /// the rings for which `ring` is true: `p` is inside the region those rings bound.
     pub fn contains_with_rings(&self, p: Coord<f64>, ring: impl Fn(u32) -> bool) -> bool {

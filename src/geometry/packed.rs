@@ -175,6 +175,41 @@ impl PackedTree {
         None
     }
 
+    /// Visits every pair of items whose boxes meet, once each as `(i, j)`
+    /// with item numbers `i < j`, in no particular order, until `pair`
+    /// breaks. One descent pairs nodes with nodes (a self-join): a query per
+    /// item would descend from the root once per item and meet every pair
+    /// twice.
+    pub fn pairs<B>(&self, mut pair: impl FnMut(u32, u32) -> ControlFlow<B>) -> Option<B> {
+        let n = self.len();
+        if n < 2 {
+            return None;
+        }
+        // Node pairs of one level (every leaf is on level 0), a node with
+        // itself included: their children's pairs are still to be met.
+        let mut todo = vec![(self.boxes.len() - 1, self.boxes.len() - 1)];
+        while let Some((a, b)) = todo.pop() {
+            let (ka, kb) = (self.children(a), self.children(b));
+            for ca in ka {
+                let first = if a == b { ca } else { kb.start };
+                for cb in first..kb.end {
+                    if !boxes_meet(&self.boxes[ca], &self.boxes[cb]) {
+                        continue;
+                    }
+                    if ca >= n {
+                        todo.push((ca, cb));
+                    } else if ca != cb {
+                        let (i, j) = (self.ids[ca], self.ids[cb]);
+                        if let ControlFlow::Break(x) = pair(i.min(j), i.max(j)) {
+                            return Some(x);
+                        }
+                    }
+                }
+            }
+        }
+        None
+    }
+
     /// Branch and bound: visits items in roughly increasing `bound` order
     /// and skips every node and item whose bound is not below the best value
     /// `item` has returned so far. `bound` gives a lower bound of what any
@@ -443,6 +478,42 @@ mod tests {
                 .collect();
             assert_eq!(got, want, "n = {n}");
         }
+    }
+
+    #[test]
+    fn pairs_are_exactly_the_meeting_boxes_each_once() {
+        for n in [0, 1, 2, 15, 16, 17, 255, 256, 257, 3000] {
+            let boxes = grid(n);
+            let t = PackedTree::new(&boxes);
+            let mut got = Vec::new();
+            t.pairs(|i, j| {
+                got.push((i, j));
+                ControlFlow::<()>::Continue(())
+            });
+            got.sort_unstable();
+            let mut want = Vec::new();
+            for i in 0..n {
+                for j in i + 1..n {
+                    if boxes_meet(&boxes[i], &boxes[j]) {
+                        want.push((i as u32, j as u32));
+                    }
+                }
+            }
+            assert!(n < 17 || !want.is_empty(), "the grid's boxes overlap");
+            assert_eq!(got, want, "n = {n}");
+        }
+        // A break ends the walk with its value.
+        let t = PackedTree::new(&grid(300));
+        let mut seen = 0;
+        let stop = t.pairs(|i, j| {
+            seen += 1;
+            if seen == 5 {
+                ControlFlow::Break((i, j))
+            } else {
+                ControlFlow::Continue(())
+            }
+        });
+        assert!(stop.is_some() && seen == 5);
     }
 
     #[test]

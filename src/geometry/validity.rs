@@ -105,38 +105,38 @@ pub fn problem(p: &PreparedPolygon) -> Option<String> {
             (s.index + 1) % n == t.index || (t.index + 1) % n == s.index
         }
     };
-    for (i, s) in segs.iter().enumerate() {
-        let found = b.visit_segments_near(s.a, s.b, |j| {
-            if j <= i {
-                return ControlFlow::Continue(());
-            }
-            let t = &segs[j];
-            if consecutive(s, t) {
-                // A spike: the next edge runs straight back along this one.
-                let (shared, far_s, far_t) = if s.b == t.a {
-                    (s.b, s.a, t.b)
-                } else {
-                    (s.a, s.b, t.a)
-                };
-                let (u, v) = (far_s - shared, far_t - shared);
-                let rings_of_3 = ring_len[s.ring as usize] < 3;
-                if !rings_of_3 && orient(far_s, shared, far_t) == 0.0 && u.x * v.x + u.y * v.y > 0.0
-                {
-                    return ControlFlow::Break(format!(
-                        "spike: the ring doubles back on itself at {}",
-                        at(shared)
-                    ));
-                }
-                return ControlFlow::Continue(());
-            }
-            match pair_problem(s, t) {
-                Some(m) => ControlFlow::Break(m),
-                None => ControlFlow::Continue(()),
-            }
-        });
-        if found.is_some() {
-            return found;
+    // What is wrong with segments i < j whose boxes meet, if anything.
+    let check = |i: usize, j: usize| {
+        let (s, t) = (&segs[i], &segs[j]);
+        if consecutive(s, t) {
+            // A spike: the next edge runs straight back along this one.
+            let (shared, far_s, far_t) = if s.b == t.a {
+                (s.b, s.a, t.b)
+            } else {
+                (s.a, s.b, t.a)
+            };
+            let (u, v) = (far_s - shared, far_t - shared);
+            let rings_of_3 = ring_len[s.ring as usize] < 3;
+            return (!rings_of_3
+                && orient(far_s, shared, far_t) == 0.0
+                && u.x * v.x + u.y * v.y > 0.0)
+                .then(|| format!("spike: the ring doubles back on itself at {}", at(shared)));
         }
+        pair_problem(s, t)
+    };
+    // The first problem along the boundary: of the pair (i, j) first in
+    // segment order, so the report does not depend on the tree's layout.
+    let mut first: Option<(usize, usize, String)> = None;
+    b.visit_segment_pairs(|i, j| {
+        if first.as_ref().is_none_or(|f| (i, j) < (f.0, f.1)) {
+            if let Some(m) = check(i, j) {
+                first = Some((i, j, m));
+            }
+        }
+        ControlFlow::<()>::Continue(())
+    });
+    if let Some((_, _, m)) = first {
+        return Some(m);
     }
     // With no crossings, a hole lies wholly inside or outside every other ring:
     // test the midpoint of its first edge (never on another ring, since touching

@@ -9,7 +9,7 @@
 
 use super::{Edge, SkeletonGraph};
 use crate::geometry::boundary::{orient, properly_cross};
-use crate::geometry::packed::{boxes_meet, Bbox, PackedTree};
+use crate::geometry::packed::{Bbox, PackedTree};
 use crate::geometry::Boundary;
 use geo::Coord;
 use std::ops::ControlFlow;
@@ -66,23 +66,14 @@ fn find(segs: &[Seg]) -> Vec<(usize, usize, Coord<f64>)> {
             ]
         })
         .collect();
-    let tree = PackedTree::new(&boxes);
     let mut out = Vec::new();
-    for (i, (s, e)) in segs.iter().zip(&boxes).enumerate() {
-        tree.visit(
-            |b| boxes_meet(b, e),
-            |j| {
-                let j = j as usize;
-                if j > i {
-                    let t = &segs[j];
-                    if properly_cross(s.a, s.b, t.a, t.b) {
-                        out.push((i, j, intersection(s.a, s.b, t.a, t.b)));
-                    }
-                }
-                ControlFlow::<()>::Continue(())
-            },
-        );
-    }
+    PackedTree::new(&boxes).pairs(|i, j| {
+        let (s, t) = (&segs[i as usize], &segs[j as usize]);
+        if properly_cross(s.a, s.b, t.a, t.b) {
+            out.push((i as usize, j as usize, intersection(s.a, s.b, t.a, t.b)));
+        }
+        ControlFlow::<()>::Continue(())
+    });
     out.sort_by(|x, y| x.0.cmp(&y.0).then(x.1.cmp(&y.1)));
     out
 }
