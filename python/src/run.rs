@@ -196,7 +196,9 @@ fn work(
     params: &ProcessParams,
     opts: &Options,
 ) -> Result<Done, String> {
-    let par = opts.threads != Some(1);
+    // One feature: no hop to a worker thread (waking one costs more than
+    // a small polygon's work); a large one still splits its own work.
+    let par = opts.threads != Some(1) && input.len() > 1;
     let t0 = Instant::now();
     let feats = features(input, fids, repaired, par);
     let t1 = Instant::now();
