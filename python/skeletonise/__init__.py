@@ -411,9 +411,7 @@ def _run(
     layer = "candidates" if candidates else "skeletons"
     if index is None:
         index = pd.RangeIndex(len(arr))
-    # One row per input row, in order (no candidates, no parts): the index as it is.
-    same_rows = len(rows) == len(arr) and bool((rows == np.arange(len(rows))).all())
-    out_index = index if same_rows else index.take(rows)
+    out_index = index if done["in_order"] else index.take(rows)
     tool: dict[str, Any] = {name: _column(kind, values) for name, kind, values in done["columns"]}
     tool["rejected"] = _strings(*done["rejected"])
     if attributes is not None and len(attributes.columns) and _core.columns(layer, False)[1]:

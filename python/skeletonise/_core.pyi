@@ -54,10 +54,13 @@ class Pipeline:
     ) -> dict[str, Any]:
         """Runs the steps with the GIL released.
 
-        Returns ``row`` (the input position of every output row), ``columns``
-        (``(name, type, values)``; integers as ``(values, null mask)``),
-        ``rejected`` (reasons), ``geometry`` (``("geoarrow", coords, line_offsets,
-        geom_offsets, null)`` or ``("wkb", list)``), ``counts`` and ``timings``.
+        Returns ``row`` (the input position of every output row), ``in_order``
+        (whether ``row`` is every input position in order), ``columns``
+        (``(name, type, values)``; integers as ``(values, null mask)``, texts
+        as Arrow large-string buffers ``(offsets, data, null mask or None)``),
+        ``rejected`` (reasons, texts as the columns'), ``geometry``
+        (``("geoarrow", coords, line_offsets, geom_offsets, null)`` or
+        ``("wkb", list)``), ``counts`` and ``timings``.
         Raises RejectedError under ``on_error: fail``.
         """
 

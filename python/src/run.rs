@@ -470,6 +470,11 @@ fn text_buffers<'py>(py: Python<'py>, v: &[Option<String>]) -> PyResult<Bound<'p
 
 fn to_python(py: Python<'_>, d: Done) -> PyResult<Bound<'_, PyAny>> {
     let out = PyDict::new(py);
+    // One row per input row, in order (no candidates, no parts, no rows
+    // added): the input's index is the output's as it is.
+    let in_order = d.rows.len() as u64 == d.counts[0]
+        && d.rows.iter().enumerate().all(|(i, &r)| r == i as i64);
+    out.set_item("in_order", in_order)?;
     out.set_item("row", PyArray1::from_vec(py, d.rows))?;
     let cols = PyList::empty(py);
     for c in d.columns {
