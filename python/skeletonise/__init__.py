@@ -203,16 +203,17 @@ def _decode(geometry: tuple) -> np.ndarray:
     return out
 
 
-def _column(kind: str, values: Any) -> Any:
+def _column(kind: str, values: Any, reals: np.ndarray) -> Any:
     """A column of the result: nullable integers (``Int32``, ``Int64``), floats and
     ``string``, so that an empty frame (a Dask meta) has types that Arrow and
-    GeoParquet know."""
+    GeoParquet know. Integers come as values of the column's width and a NULL
+    mask, floats as a row of the block ``reals``, texts as Arrow buffers."""
     if kind in ("int32", "int64"):
         v, null = values
         # Already of the column's width: the masked array is the column.
-        return _integers(np.asarray(v, dtype=kind), np.asarray(null, dtype=bool))
+        return _integers(v, null)
     if kind == "real":
-        return values
+        return reals[values]
     return _strings(*values)
 
 
@@ -262,18 +263,19 @@ def _wrap_strings(array: Any, dtype: Any) -> Any:
     return out
 
 
-def _strings(offsets: np.ndarray, data: bytes, null: np.ndarray | None) -> Any:
+def _strings(offsets: np.ndarray, data: bytes, null: Any) -> Any:
     """A ``string`` column from Arrow large-string buffers as Rust gives them:
     the start of every text in ``data`` (UTF-8) and the end, and which are NULL
-    (``None`` when none is). Where pandas' ``string`` is Arrow's (pandas ≥ 3
-    with pyarrow) the buffers are the column's, without a Python string per
-    row; else the texts are decoded for ``pd.array(..., dtype="string")``."""
+    (``None`` when none is, ``True`` when all are, else a mask). Where pandas'
+    ``string`` is Arrow's (pandas ≥ 3 with pyarrow) the buffers are the
+    column's, without a Python string per row; else the texts are decoded for
+    ``pd.array(..., dtype="string")``."""
     n = len(offsets) - 1
     dtype = _arrow_strings()
     if dtype is not False:
         import pyarrow as pa
 
-        if null is not None and null.all():
+        if null is True:
             # A column of NULLs (`rejected` and `note` in most calls).
             array = pa.nulls(n, pa.large_string())
         else:
@@ -281,13 +283,13 @@ def _strings(offsets: np.ndarray, data: bytes, null: np.ndarray | None) -> Any:
             array = pa.LargeStringArray.from_buffers(n, pa.py_buffer(offsets), pa.py_buffer(data), valid)
         return _wrap_strings(array, dtype)
     values = [
-        None if null is not None and null[i] else data[offsets[i] : offsets[i + 1]].decode()
+        None if null is True or (null is not None and null[i]) else data[offsets[i] : offsets[i + 1]].decode()
         for i in range(n)
     ]
     return pd.array(values, dtype="string")
 
 
-def _geo_frame(tool: dict[str, Any], index: pd.Index) -> Any:
+def _geo_frame(tool: dict[str, Any], index: pd.Index, reals: np.ndarray | None = None) -> Any:
     """The GeoDataFrame of ``tool``'s columns (the last one, ``geometry``, the
     active geometry with its CRS). ``GeoDataFrame(tool, geometry=...)`` checks and
     copies every column: 0.4 ms of a call on one small polygon, more than its
@@ -301,7 +303,7 @@ def _geo_frame(tool: dict[str, Any], index: pd.Index) -> Any:
 
     columns = _column_index(tuple(tool))
     try:
-        mgr = _blocks(list(tool.values()), columns, index)
+        mgr = _blocks(list(tool.values()), columns, index, reals)
     except (ImportError, AttributeError, TypeError, ValueError):
         mgr = None
     try:
@@ -317,7 +319,7 @@ def _geo_frame(tool: dict[str, Any], index: pd.Index) -> Any:
     return out
 
 
-def _blocks(arrays: list, columns: pd.Index, index: pd.Index) -> Any:
+def _blocks(arrays: list, columns: pd.Index, index: pd.Index, reals: np.ndarray | None = None) -> Any:
     """The block manager ``DataFrame._from_arrays`` would make of ``arrays``
     (float64 columns in one two-dimensional block, every extension array in
     its own), made directly: a fifth of the time, as the types are known.
@@ -325,11 +327,11 @@ def _blocks(arrays: list, columns: pd.Index, index: pd.Index) -> Any:
     global _BLOCK_API
     if _BLOCK_API is None:
         from pandas._libs.internals import BlockPlacement
-        from pandas.core.internals.blocks import new_block
+        from pandas.core.internals.blocks import get_block_type, new_block
         from pandas.core.internals.managers import BlockManager
 
-        _BLOCK_API = (BlockPlacement, new_block, BlockManager, pd.api.extensions.ExtensionArray)
-    placement, new_block, manager, extension = _BLOCK_API
+        _BLOCK_API = (BlockPlacement, get_block_type, new_block, BlockManager, pd.api.extensions.ExtensionArray)
+    placement, get_block_type, new_block, manager, extension = _BLOCK_API
     floats = []
     blocks = []
     for i, a in enumerate(arrays):
@@ -338,16 +340,30 @@ def _blocks(arrays: list, columns: pd.Index, index: pd.Index) -> Any:
                 raise TypeError("a NumPy column that is not float64")
             floats.append(i)
         elif isinstance(a, extension):
-            blocks.append(new_block(a, placement(slice(i, i + 1)), ndim=2))
+            # new_block's own steps, with the block class and the (immutable)
+            # placement of each column kept from the calls before.
+            klass = _BLOCK_TYPES.get(type(a))
+            if klass is None:
+                klass = _BLOCK_TYPES.setdefault(type(a), get_block_type(a.dtype))
+            where = _PLACEMENTS.get(i)
+            if where is None:
+                where = _PLACEMENTS.setdefault(i, placement(slice(i, i + 1)))
+            blocks.append(klass(a, ndim=2, placement=where, refs=None))
         else:
             raise TypeError("a column that is not an array")
     if floats:
-        values = np.array([arrays[i] for i in floats], dtype=np.float64)
+        if reals is not None and reals.shape[0] == len(floats) and all(arrays[i].base is reals for i in floats):
+            # The rows of the block Rust made, in column order: it is the frame's.
+            values = reals
+        else:
+            values = np.array([arrays[i] for i in floats], dtype=np.float64)
         blocks.insert(0, new_block(values, placement(np.array(floats, dtype=np.intp)), ndim=2))
     return manager(tuple(blocks), [columns, index], verify_integrity=False)
 
 
 _BLOCK_API: tuple | None = None
+_BLOCK_TYPES: dict[type, Any] = {}
+_PLACEMENTS: dict[int, Any] = {}
 
 
 _COLUMN_INDEXES: dict[tuple, pd.Index] = {}
@@ -412,7 +428,8 @@ def _run(
     if index is None:
         index = pd.RangeIndex(len(arr))
     out_index = index if done["in_order"] else index.take(rows)
-    tool: dict[str, Any] = {name: _column(kind, values) for name, kind, values in done["columns"]}
+    reals = done["reals"]
+    tool: dict[str, Any] = {name: _column(kind, values, reals) for name, kind, values in done["columns"]}
     tool["rejected"] = _strings(*done["rejected"])
     if attributes is not None and len(attributes.columns) and _core.columns(layer, False)[1]:
         frame = pd.DataFrame(tool, index=out_index)
@@ -433,7 +450,7 @@ def _run(
         # Shapely geometries or None from shapely itself: no need for
         # from_shapely's check of every element.
         tool["geometry"] = gpd.array.GeometryArray(_decode(done["geometry"]), crs=crs)
-        frame = _geo_frame(tool, out_index)
+        frame = _geo_frame(tool, out_index, reals)
     if geometry_name != "geometry":
         frame = frame.rename_geometry(geometry_name)
     t3 = time.perf_counter()

@@ -4,12 +4,12 @@
 use crate::table::{self, ColumnData, Out, Values};
 use crate::{type_name, wkb, RejectedError};
 use geo::{Coord, Geometry, LineString, MultiPolygon, Polygon};
-use numpy::{PyArray1, PyReadonlyArray1, PyReadonlyArray2};
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyList, PyTuple};
 use skeletonise::feature::Feature;
-use skeletonise::output::{CANDIDATES, SKELETONS};
+use skeletonise::output::{ColumnType, CANDIDATES, SKELETONS};
 use skeletonise::process::{
     feature_rows, map_in_order, FeatureRows, ProcessParams, RowOptions, Skeletons, Status,
 };
@@ -441,7 +441,7 @@ fn value_error(e: impl std::fmt::Display) -> PyErr {
 
 /// Texts as Arrow's large-string buffers, `(offsets, data, null)`: the
 /// start of every text in `data` (UTF-8) and the end, and which are NULL
-/// (`None` when none is). Python makes the column from them without a
+/// (`None` when none is, `True` when all are, else a mask). Python makes the column from them without a
 /// Python string per row.
 fn text_buffers<'py>(py: Python<'py>, v: &[Option<String>]) -> PyResult<Bound<'py, PyAny>> {
     let mut offsets = Vec::with_capacity(v.len() + 1);
@@ -455,10 +455,14 @@ fn text_buffers<'py>(py: Python<'py>, v: &[Option<String>]) -> PyResult<Bound<'p
         at += s.as_ref().map_or(0, |s| s.len() as i64);
         offsets.push(at);
     }
-    let null = v
-        .iter()
-        .any(Option::is_none)
-        .then(|| PyArray1::from_iter(py, v.iter().map(Option::is_none)));
+    let nulls = v.iter().filter(|s| s.is_none()).count();
+    let null = if nulls == 0 {
+        py.None().into_bound(py)
+    } else if nulls == v.len() {
+        true.into_pyobject(py)?.to_owned().into_any()
+    } else {
+        PyArray1::from_iter(py, v.iter().map(Option::is_none)).into_any()
+    };
     Ok((
         PyArray1::from_vec(py, offsets),
         PyBytes::new(py, &data),
@@ -475,19 +479,38 @@ fn to_python(py: Python<'_>, d: Done) -> PyResult<Bound<'_, PyAny>> {
     let in_order = d.rows.len() as u64 == d.counts[0]
         && d.rows.iter().enumerate().all(|(i, &r)| r == i as i64);
     out.set_item("in_order", in_order)?;
+    let n = d.rows.len();
     out.set_item("row", PyArray1::from_vec(py, d.rows))?;
+    // The real columns as one block (a row each, as pandas keeps them);
+    // a real column's values are its row number in it.
+    let (mut reals, mut real_rows): (Vec<f64>, usize) = (Vec::new(), 0);
     let cols = PyList::empty(py);
     for c in d.columns {
         let values = match c.values {
+            Values::Int(v, null) if c.ty == ColumnType::Int32 => (
+                // In the column's width (the values came from 32-bit cells).
+                PyArray1::from_iter(py, v.iter().map(|&x| x as i32)),
+                PyArray1::from_vec(py, null),
+            )
+                .into_pyobject(py)?
+                .into_any(),
             Values::Int(v, null) => (PyArray1::from_vec(py, v), PyArray1::from_vec(py, null))
                 .into_pyobject(py)?
                 .into_any(),
-            Values::Real(v) => PyArray1::from_vec(py, v).into_any(),
+            Values::Real(v) => {
+                reals.extend_from_slice(&v);
+                real_rows += 1;
+                (real_rows - 1).into_pyobject(py)?.into_any()
+            }
             Values::Text(v) => text_buffers(py, &v)?,
         };
         cols.append((c.name, type_name(c.ty), values))?;
     }
     out.set_item("columns", cols)?;
+    out.set_item(
+        "reals",
+        PyArray1::from_vec(py, reals).reshape([real_rows, n])?,
+    )?;
     out.set_item("rejected", text_buffers(py, &d.rejected)?)?;
     match d.geometry {
         Encoded::Ragged(r) => out.set_item(
