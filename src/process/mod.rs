@@ -556,8 +556,9 @@ mod tests {
         p.skeleton.methods = methods;
         p.skeleton.reference = reference;
         p.skeleton.voronoi.max_points = max_points;
-        let Processed::Done(o) = process(Some(&Geometry::Polygon(l_shape())), &p) else {
-            panic!("the L-shape is skeletonised")
+        let r = process(Some(&Geometry::Polygon(l_shape())), &p);
+        let Processed::Done(o) = r else {
+            panic!("the L-shape is skeletonised: {r:?}")
         };
         o.candidates
     }
@@ -573,6 +574,31 @@ mod tests {
             .collect();
         e.sort_by(|a, b| a.partial_cmp(b).unwrap());
         e
+    }
+
+    #[test]
+    fn a_method_alone_is_the_method_as_the_reference_of_others() {
+        // Alone, a method is finished on its own (no structure to share):
+        // the skeleton it gives as the reference the others conform to. (VD
+        // of the L's six vertices alone has nothing left after pruning.)
+        let all = [
+            MethodId::MA,
+            MethodId::STSK,
+            MethodId::DVD,
+            MethodId::CDT,
+            MethodId::VD,
+        ];
+        for m in &all[..4] {
+            let m = *m;
+            let alone = candidates_of(vec![m], m, 2_000_000);
+            let with_all = candidates_of(all.to_vec(), m, 2_000_000);
+            let k = all.iter().position(|&x| x == m).unwrap();
+            let (a, b) = (alone[0].result.as_ref(), with_all[k].result.as_ref());
+            let (a, b) = (a.unwrap(), b.unwrap());
+            assert!(!a.geometry.0.is_empty(), "{m}");
+            assert_eq!(a.geometry, b.geometry, "{m}");
+            assert_eq!((a.legs, a.legs_raw), (b.legs, b.legs_raw), "{m}");
+        }
     }
 
     #[test]
