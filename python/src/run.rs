@@ -441,19 +441,15 @@ fn value_error(e: impl std::fmt::Display) -> PyErr {
 
 /// Texts as Arrow's large-string buffers, `(offsets, data, null)`: the
 /// start of every text in `data` (UTF-8) and the end, and which are NULL
-/// (`None` when none is, `True` when all are, else a mask). Python makes the column from them without a
-/// Python string per row.
+/// (`None` when none is, `True` when all are, else a mask). Python makes
+/// the column from them without a Python string per row.
 fn text_buffers<'py>(py: Python<'py>, v: &[Option<String>]) -> PyResult<Bound<'py, PyAny>> {
     let mut offsets = Vec::with_capacity(v.len() + 1);
     let mut data = Vec::new();
     offsets.push(0i64);
-    for s in v.iter().flatten().map(String::as_bytes) {
-        data.extend_from_slice(s);
-    }
-    let mut at = 0i64;
     for s in v {
-        at += s.as_ref().map_or(0, |s| s.len() as i64);
-        offsets.push(at);
+        data.extend_from_slice(s.as_deref().unwrap_or_default().as_bytes());
+        offsets.push(data.len() as i64);
     }
     let nulls = v.iter().filter(|s| s.is_none()).count();
     let null = if nulls == 0 {

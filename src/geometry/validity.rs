@@ -256,6 +256,54 @@ mod tests {
         assert_eq!(check(p), None);
     }
 
+    /// With several problems, the one reported is that of the first pair of
+    /// segments in boundary order, as a scan of every pair finds it — not
+    /// whichever the tree's self-join meets first.
+    #[test]
+    fn the_first_problem_in_boundary_order_is_reported() {
+        let n = 400;
+        let circle: Vec<Coord<f64>> = (0..n)
+            .map(|k| {
+                let t = k as f64 / n as f64 * std::f64::consts::TAU;
+                Coord {
+                    x: 100.0 * t.cos(),
+                    y: 100.0 * t.sin(),
+                }
+            })
+            .collect();
+        let places = [10, 60, 140, 220, 300, 370];
+        for (k, &a) in places.iter().enumerate() {
+            for &b in &places[k + 1..] {
+                // Two bow-ties far apart along the ring.
+                let mut ring = circle.clone();
+                ring.swap(a, a + 1);
+                ring.swap(b, b + 1);
+                let pp = PreparedPolygon::new(&geo::Polygon::new(ring.into(), vec![])).unwrap();
+                let segs = pp.boundary().segments();
+                let m = segs.len() as u32;
+                let mut scan = None;
+                'pairs: for i in 0..segs.len() {
+                    for j in i + 1..segs.len() {
+                        let (s, t) = (&segs[i], &segs[j]);
+                        if (s.index + 1) % m == t.index || (t.index + 1) % m == s.index {
+                            continue;
+                        }
+                        if let Some(found) = pair_problem(s, t) {
+                            scan = Some(found);
+                            break 'pairs;
+                        }
+                    }
+                }
+                let got = problem(&pp);
+                assert!(
+                    got.as_deref().is_some_and(|g| g.contains("cross at")),
+                    "{got:?}"
+                );
+                assert_eq!(got, scan, "bow-ties at {a} and {b}");
+            }
+        }
+    }
+
     #[test]
     fn problems_are_found_and_located() {
         let bow = polygon![(x: 0., y: 0.), (x: 4., y: 4.), (x: 4., y: 0.), (x: 0., y: 6.)];
