@@ -17,18 +17,20 @@ use crate::InputType;
 use crate::circle_event::CircleEventIndex;
 use crate::prelude::*;
 use crate::site_event as vse;
-use cpp_map::skiplist::{Index, SkipList};
-use std::cell::{Cell, RefCell};
+use ordered::{Index, OrderedList};
+use std::cell::RefCell;
 use std::rc::Rc;
 
 mod beach_line_impl;
+pub(crate) mod ordered;
 mod trait_impl;
 
 /// Type-checked placeholder for usize
 /// Hopefully rust zero cost abstractions will flatten this out.
 pub(crate) type BeachLineIndex = Index;
 
-pub type BeachLineNodeDataType = Rc<Cell<Option<BeachLineNodeData>>>;
+/// A beach line node's value, stored in the node (`None`: a temporary bisector).
+pub type BeachLineNodeDataType = Option<BeachLineNodeData>;
 
 /// Container for BeachLineNodeKey and BeachLineNodeDataType.
 /// Has a priority queue and indexed list for BeachLineNodeKey.
@@ -36,7 +38,7 @@ pub type BeachLineNodeDataType = Rc<Cell<Option<BeachLineNodeData>>>;
 /// The ordering of beach_line_vec_ is intentionally reversed, pop() will return the last element.
 /// Before this change the beach-line ordering was unpredictable.
 pub struct BeachLine<I: InputType> {
-    pub(crate) beach_line_: Rc<RefCell<SkipList<BeachLineNodeKey<I>, BeachLineNodeDataType>>>,
+    pub(crate) beach_line_: Rc<RefCell<OrderedList<BeachLineNodeKey<I>, BeachLineNodeDataType>>>,
 }
 
 /// Represents a bisector node made by two arcs that correspond to the left
@@ -71,7 +73,7 @@ pub struct BeachLineNodeData {
 #[derive(Clone)]
 pub(crate) struct BeachlineCursor<I: InputType> {
     pub(crate) current: Option<Index>,
-    pub(crate) list: Rc<RefCell<SkipList<BeachLineNodeKey<I>, BeachLineNodeDataType>>>,
+    pub(crate) list: Rc<RefCell<OrderedList<BeachLineNodeKey<I>, BeachLineNodeDataType>>>,
 }
 
 #[cfg(test)]

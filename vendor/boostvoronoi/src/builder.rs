@@ -367,13 +367,13 @@ impl<I: InputType> Builder<I> {
         &mut self,
         beachline_ptr: &BeachlineCursor<I>,
     ) -> Result<(), BvError> {
-        if let Some(mut node_cell) = beachline_ptr.get_v()?.get() {
+        if let Some(mut node_cell) = beachline_ptr.get_v()? {
             self.circle_events_
                 .deactivate(node_cell.get_circle_event_id());
 
             // make sure there are no dangling references to deactivated circle events..
             node_cell.set_circle_event_id(None);
-            beachline_ptr.get_v()?.set(Some(node_cell));
+            beachline_ptr.set_v(Some(node_cell))?;
         }
         Ok(())
     }
@@ -661,7 +661,6 @@ impl<I: InputType> Builder<I> {
         // Get the half-edge corresponding to the second bisector - (B, C).
         let bisector2 = it_first
             .get_v()?
-            .get()
             .ok_or_else(|| {
                 BvError::InternalError(format!("bisector2.is_none() {}:{}", file!(), line!()))
             })?
@@ -672,7 +671,6 @@ impl<I: InputType> Builder<I> {
 
         let bisector1 = it_first
             .get_v()?
-            .get()
             .ok_or_else(|| {
                 BvError::InternalError(format!("bisector1.is_none() {}:{}", file!(), line!()))
             })?
@@ -735,7 +733,7 @@ impl<I: InputType> Builder<I> {
             let edge = output
                 .insert_new_edge_5_(site1, site3, circle_event, bisector1, bisector2)
                 .0;
-            let data = if let Some(ref mut node) = it_first.get_v()?.get() {
+            let data = if let Some(ref mut node) = it_first.get_v()? {
                 node.set_edge_id(edge);
                 //tln!("Updated node data: {:?} new edge:{}", node, edge.0);
                 *node
@@ -743,7 +741,7 @@ impl<I: InputType> Builder<I> {
                 //tln!("Created new node data: new edge:{}", edge.0);
                 vb::BeachLineNodeData::new_1(edge)
             };
-            let _ = it_first.get_v()?.replace(Some(data));
+            it_first.set_v(Some(data))?;
         }
         #[cfg(feature = "console_debug")]
         {
@@ -802,12 +800,8 @@ impl<I: InputType> Builder<I> {
         // Check new triplets formed by the neighboring arcs
         // to the left for potential circle events.
         if !self.beach_line_.is_empty() && !it_first.is_at_head()? {
-            self.circle_events_.deactivate(
-                it_first
-                    .get_v()?
-                    .get()
-                    .and_then(|x| x.get_circle_event_id()),
-            );
+            self.circle_events_
+                .deactivate(it_first.get_v()?.and_then(|x| x.get_circle_event_id()));
             //--it_first;
             it_first.prev()?;
 
@@ -823,7 +817,7 @@ impl<I: InputType> Builder<I> {
         if it_last.is_ok()? {
             let it_last_node = it_last.get_v()?;
             self.circle_events_
-                .deactivate(it_last_node.get().and_then(|x| x.get_circle_event_id()));
+                .deactivate(it_last_node.and_then(|x| x.get_circle_event_id()));
 
             let site_r1 = *it_last.get_k()?.right_site();
             self.activate_circle_event(site1, site3, site_r1, it_last.current_must_be_valid()?)?;
@@ -947,9 +941,9 @@ impl<I: InputType> Builder<I> {
 
             let circle_event_id = self.circle_events_.associate_and_push(c_event);
             let bn = self.beach_line_.get_node(&bisector_node)?;
-            if let Some(mut bd) = bn.1.get() {
+            if let Some(mut bd) = bn.1 {
                 bd.set_circle_event_id(Some(circle_event_id));
-                bn.1.set(Some(bd));
+                self.beach_line_.get_pointer(bisector_node)?.set_v(Some(bd))?;
                 #[cfg(feature = "console_debug")]
                 {
                     t!("with bisector_node: ");

@@ -41,7 +41,6 @@
 //! This library is a port of the C++ boost voronoi implementation
 //! <https://www.boost.org/doc/libs/1_76_0/libs/polygon/doc/voronoi_main.htm>
 
-use cpp_map::CppMapError;
 use num_traits::{AsPrimitive, NumCast, PrimInt, Signed};
 use std::cell::{BorrowError, BorrowMutError};
 use std::{fmt, hash::Hash};
@@ -98,8 +97,6 @@ pub enum BvError {
     IndexError(String),
     #[error(transparent)]
     BorrowError(#[from] BorrowError),
-    #[error(transparent)]
-    CppMapError(#[from] CppMapError),
     #[error(transparent)]
     BorrowMutError(#[from] BorrowMutError),
     #[error("error: Some error with object id")]

@@ -18,9 +18,8 @@ use super::{
 use crate::{BvError, InputType};
 #[cfg(feature = "console_debug")]
 use crate::{t, tln};
-use cpp_map::skiplist::{Index, SkipList};
-use std::cell::{Cell, RefCell};
-use std::ops::Deref;
+use super::ordered::{Index, OrderedList};
+use std::cell::RefCell;
 use std::rc::Rc;
 
 impl<I: InputType> BeachLine<I> {
@@ -67,13 +66,12 @@ impl<I: InputType> BeachLine<I> {
         key: BeachLineNodeKey<I>,
         data: Option<BeachLineNodeData>,
     ) -> Result<(BeachLineNodeKey<I>, BeachLineIndex), BvError> {
-        let node = Rc::new(Cell::new(data));
         let node_index = if let Some(position) = position {
             self.beach_line_
                 .borrow_mut()
-                .insert_with_hint(key, node, position)?
+                .insert_with_hint(key, data, position)
         } else {
-            self.beach_line_.borrow_mut().insert(key, node)?
+            self.beach_line_.borrow_mut().insert(key, data)
         };
         Ok((key, node_index))
     }
@@ -88,21 +86,19 @@ impl<I: InputType> BeachLine<I> {
         data: BeachLineNodeData,
         _ce: &crate::circle_event::CircleEventQueue,
     ) -> Result<(BeachLineNodeKey<I>, BeachLineIndex), BvError> {
-        let node = Rc::from(Cell::from(Some(data)));
-        let node_clone = node.clone();
         let node_index = if let Some(position) = position {
             let rv = self
                 .beach_line_
                 .borrow_mut()
-                .insert_with_hint(key, node, position)?;
+                .insert_with_hint(key, Some(data), position);
             t!("inserted beach_line_1:");
             rv
         } else {
-            let rv = self.beach_line_.borrow_mut().insert(key, node)?;
+            let rv = self.beach_line_.borrow_mut().insert(key, Some(data));
             t!("inserted beach_line_2:");
             rv
         };
-        self.dbgpa_compat_node_(&key, &node_clone, _ce)?;
+        self.dbgpa_compat_node_(&key, &Some(data), _ce)?;
         Ok((key, node_index))
     }
 
@@ -113,8 +109,7 @@ impl<I: InputType> BeachLine<I> {
         &mut self,
         key: BeachLineNodeKey<I>,
     ) -> Result<(BeachLineNodeKey<I>, BeachLineIndex), BvError> {
-        let node = Rc::new(Cell::new(None));
-        let node_index = self.beach_line_.borrow_mut().insert(key, node)?;
+        let node_index = self.beach_line_.borrow_mut().insert(key, None);
         Ok((key, node_index))
     }
 
@@ -126,8 +121,7 @@ impl<I: InputType> BeachLine<I> {
         key: BeachLineNodeKey<I>,
         _ce: &crate::circle_event::CircleEventQueue,
     ) -> Result<(BeachLineNodeKey<I>, BeachLineIndex), BvError> {
-        let data_node = Rc::from(Cell::from(None));
-        let node_index = self.beach_line_.borrow_mut().insert(key, data_node)?;
+        let node_index = self.beach_line_.borrow_mut().insert(key, None);
         t!("inserted beach_line_2:");
         let _ = self.dbgpa_compat_node_(
             &key,
@@ -161,7 +155,7 @@ impl<I: InputType> BeachLine<I> {
             )));
         }
         let node = node.unwrap();
-        Ok((*node.0, Rc::clone(node.1)))
+        Ok((*node.0, *node.1))
     }
 
     #[inline(always)]
@@ -198,7 +192,7 @@ impl<I: InputType> BeachLine<I> {
                 &node_key.right_site()
             );
 
-            if let Some(data) = node_data.get() {
+            if let Some(data) = node_data {
                 if let Some(circle_event) = data.circle_event_ {
                     t!(" -> CircleEvent:{}", circle_event);
                 } else {
@@ -263,7 +257,7 @@ impl<I: InputType> BeachLine<I> {
             &node_key.left_site(),
             &node_key.right_site(),
         );
-        if let Some(data) = node_data.get() {
+        if let Some(data) = node_data {
             if let Some(_circle_event) = data.circle_event_ {
                 if ce.is_active(_circle_event) {
                     t!(" -> CircleEvent: ");
@@ -362,7 +356,7 @@ impl<I: InputType> BeachlineCursor<I> {
     /// Initiates the pointer with a list, set current to the head of the list.
     #[allow(dead_code)]
     pub(crate) fn new_1(
-        list: Rc<RefCell<SkipList<BeachLineNodeKey<I>, BeachLineNodeDataType>>>,
+        list: Rc<RefCell<OrderedList<BeachLineNodeKey<I>, BeachLineNodeDataType>>>,
     ) -> Result<Self, BvError> {
         let head = list.try_borrow()?.first();
         Ok(Self {
@@ -372,7 +366,7 @@ impl<I: InputType> BeachlineCursor<I> {
     }
 
     pub(crate) fn new_2(
-        list: Rc<RefCell<SkipList<BeachLineNodeKey<I>, BeachLineNodeDataType>>>,
+        list: Rc<RefCell<OrderedList<BeachLineNodeKey<I>, BeachLineNodeDataType>>>,
         pos: Index,
     ) -> Result<Self, BvError> {
         Ok(Self {
@@ -404,7 +398,7 @@ impl<I: InputType> BeachlineCursor<I> {
 
     /// Initiates the pointer with a list, set index.
     pub fn new_from_index(
-        list: Rc<RefCell<SkipList<BeachLineNodeKey<I>, BeachLineNodeDataType>>>,
+        list: Rc<RefCell<OrderedList<BeachLineNodeKey<I>, BeachLineNodeDataType>>>,
         current: Option<BeachLineIndex>,
     ) -> Result<Self, BvError> {
         if current.is_some() {
@@ -450,7 +444,7 @@ impl<I: InputType> BeachlineCursor<I> {
         let list = self.list.try_borrow()?;
         if let Some(current) = self.current {
             if let Some(v) = list.get_v_at(current) {
-                return Ok(v.clone());
+                return Ok(*v);
             }
         }
         Err(BvError::IndexError(
@@ -522,47 +516,37 @@ impl<I: InputType> BeachlineCursor<I> {
     }
 
     #[inline(always)]
-    /// Replace current key with the new one (re-order the list accordingly)
-    pub fn replace_key(&mut self, new_key: BeachLineNodeKey<I>) -> Result<Index, BvError> {
-        let result = {
-            let mut list = self.list.try_borrow_mut()?;
-            list.change_key_of_node(self.current.unwrap(), new_key)
-        };
-        match result {
-            Ok(v) => Ok(v),
-            Err(e) => {
-                println!("Error: {e:?} when trying to change key");
-                let list = self.list.try_borrow()?;
-                println!(
-                    "     new key:{:?} existing value:{:?}",
-                    new_key,
-                    list.get_v_at(self.current.unwrap())
-                );
-                let existing_kv = list.deref().get_kv(&new_key).unwrap();
-                println!(
-                    "existing key:{:?} existing value:{:?}",
-                    existing_kv.0,
-                    existing_kv.1.get()
-                );
-                println!(
-                    "existing key .eq() new key == {:?}",
-                    existing_kv.0.eq(&new_key)
-                );
-                println!(
-                    "existing key .cmp() new key == {:?}",
-                    existing_kv.0.cmp(&new_key)
-                );
-                println!(
-                    "existing key .lt() new key == {:?}",
-                    existing_kv.0.lt(&new_key)
-                );
-                println!(
-                    "existing key .gt() new key == {:?}",
-                    existing_kv.0.gt(&new_key)
-                );
-                Err(e)?
+    /// Replaces the value at the current position.
+    pub fn set_v(&self, value: BeachLineNodeDataType) -> Result<(), BvError> {
+        let mut list = self.list.try_borrow_mut()?;
+        if let Some(current) = self.current {
+            if list.set_v_at(current, value) {
+                return Ok(());
             }
         }
+        Err(BvError::IndexError(format!(
+            "set_v: no node at {:?} {} {}",
+            self.current,
+            file!(),
+            line!()
+        )))
+    }
+
+    #[inline(always)]
+    /// Replace current key with the new one, in place: the caller keeps the
+    /// order (see `Builder::process_circle_event`).
+    pub fn replace_key(&mut self, new_key: BeachLineNodeKey<I>) -> Result<Index, BvError> {
+        let current = self.current_must_be_valid()?;
+        self.list
+            .try_borrow_mut()?
+            .change_key_of_node(current, new_key)
+            .ok_or_else(|| {
+                BvError::IndexError(format!(
+                    "replace_key: no node at {current} {} {}",
+                    file!(),
+                    line!()
+                ))
+            })
     }
 
     #[inline(always)]
@@ -593,12 +577,12 @@ impl<I: InputType> BeachlineCursor<I> {
     /// before position (i.e., either it is equivalent or goes after).
     /// Returns a Pointer where is_ok() returns false if no data is found
     pub fn lower_bound(
-        list: Rc<RefCell<SkipList<BeachLineNodeKey<I>, BeachLineNodeDataType>>>,
+        list: Rc<RefCell<OrderedList<BeachLineNodeKey<I>, BeachLineNodeDataType>>>,
         key: BeachLineNodeKey<I>,
     ) -> Result<Self, BvError> {
         let position = {
             let bt_list = list.try_borrow()?;
-            bt_list.deref().lower_bound(&key)
+            bt_list.lower_bound(&key)
         };
         Ok(Self {
             list,

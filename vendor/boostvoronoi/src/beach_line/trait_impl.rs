@@ -13,7 +13,7 @@
 
 use crate::InputType;
 use crate::beach_line::{BeachLine, BeachLineNodeData, BeachLineNodeKey, BeachlineCursor};
-use cpp_map::prelude::*;
+use crate::beach_line::ordered::{IsLessThan, OrderedList};
 use std::cell::RefCell;
 use std::cmp::Ordering;
 use std::fmt;
@@ -35,7 +35,7 @@ impl fmt::Debug for BeachLineNodeData {
 impl<I: InputType> Default for BeachLine<I> {
     fn default() -> Self {
         Self {
-            beach_line_: Rc::from(RefCell::from(SkipList::default())),
+            beach_line_: Rc::from(RefCell::from(OrderedList::default())),
         }
     }
 }
