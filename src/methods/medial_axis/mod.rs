@@ -14,8 +14,10 @@
 //!
 //! 1. **Grid.** The diagram is built by [`boostvoronoi`] (Boost.Polygon's
 //!    robust sweep; the workspace patches it with closed-form circle events
-//!    for a vertex and its own edge and for three consecutive edges, which
-//!    the general formulas sent to the exact big-integer evaluation —
+//!    for a vertex and its own edge, a vertex and two consecutive edges, an
+//!    edge with one of its vertices and another vertex, and three
+//!    consecutive edges, which the general formulas sent to the exact
+//!    big-integer evaluation, and with a treap under its beach line —
 //!    `vendor/boostvoronoi/PATCHES.md`), which takes integer input. Coordinates are quantised
 //!    relative to the polygon's bounding-box corner on a grid of spacing
 //!    `2^-k < extent / 2^26` (**resolution < 1.5e-8 × extent**,

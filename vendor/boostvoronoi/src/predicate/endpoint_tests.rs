@@ -1,9 +1,11 @@
 //! The closed-form circle events (`pss_at_endpoint`: a polygon vertex and its
-//! own edge; `sss_chain`: three consecutive edges) against the general
-//! lazy/exact evaluation: the diagrams of many polygons, built both ways,
-//! have the same vertices and the same edges.
+//! own edge; `pss_shared_vertex`: a vertex and two consecutive edges;
+//! `pps_at_endpoint`: an edge, one of its vertices and another vertex;
+//! `sss_chain`: three consecutive edges) against the general lazy/exact
+//! evaluation: the diagrams of many polygons, built both ways, have the same
+//! vertices and the same edges, and every closed form is exercised.
 
-use super::lazy_circle_formation::ENDPOINT_FAST_PATH;
+use super::lazy_circle_formation::{CLOSED_FORM_USES, ENDPOINT_FAST_PATH};
 use crate::builder::Builder;
 use crate::diagram::Diagram;
 
@@ -122,4 +124,8 @@ fn endpoint_circles_give_the_same_diagrams() {
         checked += 1;
     }
     assert!(checked > 350);
+    // Each closed form decided many events on its own (without the exact
+    // evaluation), so the comparison above covers all four.
+    let uses = CLOSED_FORM_USES.with(|c| c.get());
+    assert!(uses.iter().all(|&n| n > 100), "closed-form uses {uses:?}");
 }

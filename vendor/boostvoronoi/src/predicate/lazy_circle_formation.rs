@@ -113,6 +113,30 @@ pub(crate) fn pps<I: InputType>(
         segment_index
     );
 
+    if let Some((c_x, c_y, lower_x)) =
+        pps_at_endpoint(point1, point2, site3).filter(|_| endpoint_fast_path())
+    {
+        let ulps = ULPSX2 as f64;
+        let (rx, ry, rl) = (c_x.ulp() > ulps, c_y.ulp() > ulps, lower_x.ulp() > ulps);
+        c_event.set_3(c_x.fpv(), c_y.fpv(), lower_x.fpv());
+        count_closed_form(2, rx || ry || rl);
+        if rx || ry || rl {
+            exact_circle_formation::pps::<I>(
+                point1,
+                point2,
+                site3,
+                segment_index,
+                &mut c_event,
+                rx,
+                ry,
+                rl,
+            );
+        }
+        // A point is an end point of the segment: the general path's check
+        // of where the circle touches the segment does not apply either.
+        return Some(c_event);
+    }
+
     // (line_a,line_b) it the perpendicular vector of site3-point0 -> site3-point1
     let line_a = cast::<I, f64>(site3.y1()) - cast::<I, f64>(site3.y0());
     let line_b = cast::<I, f64>(site3.x0()) - cast::<I, f64>(site3.x1());
@@ -478,6 +502,16 @@ pub(crate) fn pss<I: InputType>(
         recompute_c_x = c_x.ulp() > ulps;
         recompute_c_y = c_y.ulp() > ulps;
         recompute_lower_x = lower_x.ulp() > ulps;
+        count_closed_form(0, recompute_c_x || recompute_c_y || recompute_lower_x);
+        c_event.set_3(c_x.fpv(), c_y.fpv(), lower_x.fpv());
+    } else if let Some((c_x, c_y, lower_x)) =
+        pss_shared_vertex(point1, site2, site3, point_index).filter(|_| endpoint_fast_path())
+    {
+        let ulps = ULPSX2 as f64;
+        recompute_c_x = c_x.ulp() > ulps;
+        recompute_c_y = c_y.ulp() > ulps;
+        recompute_lower_x = lower_x.ulp() > ulps;
+        count_closed_form(1, recompute_c_x || recompute_c_y || recompute_lower_x);
         c_event.set_3(c_x.fpv(), c_y.fpv(), lower_x.fpv());
     } else {
         tln!("  LazyCircleFormationFunctor::pss !collinear");
@@ -659,8 +693,25 @@ pub(crate) fn pss<I: InputType>(
 
 #[cfg(test)]
 thread_local! {
-    /// Tests turn the closed forms ([`pss_at_endpoint`], [`sss_chain`]) off to compare with the general path.
+    /// Tests turn the closed forms ([`pss_at_endpoint`], [`pss_shared_vertex`],
+    /// [`pps_at_endpoint`], [`sss_chain`]) off to compare with the general path.
     pub(crate) static ENDPOINT_FAST_PATH: std::cell::Cell<bool> = const { std::cell::Cell::new(true) };
+    /// How often each closed form's circle was taken without the exact
+    /// evaluation, in the order above (tests: every form must be exercised).
+    pub(crate) static CLOSED_FORM_USES: std::cell::Cell<[u64; 4]> = const { std::cell::Cell::new([0; 4]) };
+}
+
+/// Counts a use of closed form `k` whose bounds were accepted (tests only).
+#[inline(always)]
+fn count_closed_form(_k: usize, _exact: bool) {
+    #[cfg(test)]
+    if !_exact {
+        CLOSED_FORM_USES.with(|c| {
+            let mut v = c.get();
+            v[_k] += 1;
+            c.set(v);
+        });
+    }
 }
 
 #[inline(always)]
@@ -763,6 +814,146 @@ fn pss_at_endpoint<I: InputType>(
     Some((c_x.dif(), c_y.dif(), lower_x))
 }
 
+/// The circle of [`pps`] when one of the two points is an end point `e` of
+/// the segment (in a polygon: a vertex of the edge, and another vertex). The
+/// circle passes through `e` and is tangent to the segment's line, so it
+/// touches the line at `e`: its centre is on the line's normal there,
+/// `c = e + g·n` with `n` the normal of length `|d|` toward the other point
+/// `q` and `g = |q − e|² / (2·|d × (q − e)|)`; the radius is `g·|d|`. The
+/// general formula's discriminant is zero here and its error bound then
+/// sends every such event to the exact evaluation. Returns `c_x`, `c_y`,
+/// `lower_x` with their error bounds, or `None` when the case does not apply.
+fn pps_at_endpoint<I: InputType>(
+    point1: Point<I>,
+    point2: Point<I>,
+    site3: &vse::SiteEvent<I>,
+) -> Option<(rf::RobustFpt, rf::RobustFpt, rf::RobustFpt)> {
+    let ends = [site3.point0(), site3.point1()];
+    let (e, q) = match (ends.contains(&point1), ends.contains(&point2)) {
+        (true, false) => (point1, point2),
+        (false, true) => (point2, point1),
+        _ => return None,
+    };
+    let i = |v: I| cast::<I, i64>(v);
+    let d = [
+        i(site3.point1().x) - i(site3.point0().x),
+        i(site3.point1().y) - i(site3.point0().y),
+    ];
+    let eq = [i(q.x) - i(e.x), i(q.y) - i(e.y)];
+    // Twice the signed area of q against the segment's line.
+    let w = robust_cross_product::<i64>(d[0], d[1], eq[0], eq[1]);
+    if w == 0.0 {
+        return None;
+    }
+    let f = |v: i64| v as f64;
+    // |q − e|², exact in i128 and rounded once.
+    let sq = (eq[0] as i128 * eq[0] as i128 + eq[1] as i128 * eq[1] as i128) as f64;
+    let g = rf::RobustFpt::new(sq, 1_f64) / rf::RobustFpt::new(2.0 * w.abs(), 1_f64);
+    // n = L(d) when q is left of d, else R(d): n·(q − e) = |w|.
+    let n = if w > 0.0 { [-d[1], d[0]] } else { [d[1], -d[0]] };
+    let len = rf::RobustFpt::new((f(d[0]) * f(d[0]) + f(d[1]) * f(d[1])).sqrt(), 2_f64);
+    let (ex, ey) = (rf::RobustFpt::from(f(i(e.x))), rf::RobustFpt::from(f(i(e.y))));
+    let c_x = ex + g * rf::RobustFpt::from(f(n[0]));
+    let c_y = ey + g * rf::RobustFpt::from(f(n[1]));
+    // lower_x = c_x + g·|d| = e.x + g·(n.x + |d|), the bracket without
+    // cancellation: |d| + n.x = n.y² / (|d| − n.x) when n.x < 0.
+    let nx = f(n[0]);
+    let bracket = if nx < 0.0 {
+        rf::RobustFpt::new(f(n[1]) * f(n[1]), 1_f64) / (len - rf::RobustFpt::from(nx))
+    } else {
+        len + rf::RobustFpt::from(nx)
+    };
+    let lower_x = ex + g * bracket;
+    Some((c_x, c_y, lower_x))
+}
+
+/// The circle of [`pss`] when the two segments share an end point `v` (two
+/// consecutive edges of a polygon) and the point is on neither. The general
+/// formula measures from the lines' intersection, which it computes with
+/// cancellation when the lines are nearly parallel; here that intersection
+/// is `v` itself, exact. In the frame at `v` the general formula reads
+/// `c = v + t·B`, `B = |d2|·d1 + |d1|·d2`, `t = (p·B ± √det) / a²`, radius
+/// `|t|·|d1 × d2|` (`d1`, `d2`, `a`, `det`, the sign and the root as in the
+/// general path). `B` itself cancels when the segments turn back on each
+/// other (`d1·d2 < 0`, the two directions nearly opposite); it is then
+/// computed as `a / (d1 × d2) · R(|d1|·d2 − |d2|·d1)` (`R` the right normal),
+/// which does not. Returns `c_x`, `c_y`, `lower_x` with their error bounds,
+/// or `None` when the case does not apply.
+fn pss_shared_vertex<I: InputType>(
+    point1: Point<I>,
+    site2: &vse::SiteEvent<I>,
+    site3: &vse::SiteEvent<I>,
+    point_index: SiteIndex,
+) -> Option<(rf::RobustFpt, rf::RobustFpt, rf::RobustFpt)> {
+    let on = |s: &vse::SiteEvent<I>| point1 == s.point0() || point1 == s.point1();
+    if on(site2) || on(site3) {
+        return None;
+    }
+    let v = [site2.point0(), site2.point1()]
+        .into_iter()
+        .find(|&q| q == site3.point0() || q == site3.point1())?;
+    let i = |x: I| cast::<I, i64>(x);
+    let f = |x: i64| x as f64;
+    // As in the general path: d1 runs along site 2 reversed, d2 along site 3.
+    let (s1, e1) = (site2.point1(), site2.point0());
+    let (s2, e2) = (site3.point0(), site3.point1());
+    let (a1, b1) = (i(e1.x) - i(s1.x), i(e1.y) - i(s1.y));
+    let (a2, b2) = (i(e2.x) - i(s2.x), i(e2.y) - i(s2.y));
+    let orientation = rf::RobustFpt::new(robust_cross_product::<i64>(b1, a1, b2, a2), 1_f64);
+    if orientation.fpv() == 0.0 {
+        return None;
+    }
+    let l1 = rf::RobustFpt::new((f(a1) * f(a1) + f(b1) * f(b1)).sqrt(), 2_f64);
+    let l2 = rf::RobustFpt::new((f(a2) * f(a2) + f(b2) * f(b2)).sqrt(), 2_f64);
+    let dot = rf::RobustFpt::new(robust_cross_product::<i64>(a1, b1, -b2, a2), 1_f64);
+    let a = if !dot.is_neg() {
+        dot + l1 * l2
+    } else {
+        (orientation * orientation) / (l1 * l2 - dot)
+    };
+    let or1 = rf::RobustFpt::new(
+        robust_cross_product::<i64>(b1, a1, i(e1.y) - i(point1.y), i(e1.x) - i(point1.x)),
+        1_f64,
+    );
+    let or2 = rf::RobustFpt::new(
+        robust_cross_product::<i64>(a2, b2, i(e2.x) - i(point1.x), i(e2.y) - i(point1.y)),
+        1_f64,
+    );
+    let det = rf::RobustFpt::from(2_f64) * a * or1 * or2;
+    if det.fpv() < 0.0 || !a.is_pos() {
+        return None;
+    }
+    let r = |x: i64| rf::RobustFpt::from(f(x));
+    let (bx, by) = if !dot.is_neg() {
+        (r(a1) * l2 + r(a2) * l1, r(b1) * l2 + r(b2) * l1)
+    } else {
+        // a / (d1 × d2), with d1 × d2 = −orientation.
+        let k = -(a / orientation);
+        (k * (r(b2) * l1 - r(b1) * l2), k * (r(a1) * l2 - r(a2) * l1))
+    };
+    let (px, py) = (i(point1.x) - i(v.x), i(point1.y) - i(v.y));
+    let p_b = r(px) * bx + r(py) * by;
+    // The roots of a²t² − 2(p·B)t + |p|² = 0 (|c − p| = radius); their
+    // product is |p|²/a², which gives the root whose sum would cancel.
+    let pp = rf::RobustFpt::new(
+        (px as i128 * px as i128 + py as i128 * py as i128) as f64,
+        1_f64,
+    );
+    let s = det.sqrt();
+    let t = match (point_index == SiteIndex::Two, p_b.is_neg()) {
+        (true, false) => (p_b + s) / (a * a),
+        (true, true) => pp / (p_b - s),
+        (false, true) => (p_b - s) / (a * a),
+        (false, false) => pp / (p_b + s),
+    };
+    let (vx, vy) = (r(i(v.x)), r(i(v.y)));
+    let c_x = vx + t * bx;
+    let c_y = vy + t * by;
+    let abs = |x: rf::RobustFpt| if x.is_neg() { -x } else { x };
+    let lower_x = c_x + abs(t) * abs(orientation);
+    Some((c_x, c_y, lower_x))
+}
+
 /// The circle of [`sss`] when one segment (`m`) shares an end point with
 /// each of the two others, which share none — three consecutive edges of a
 /// polygon, the common case. With `v`, `w` the shared end points, `g = w − v`,
@@ -856,6 +1047,7 @@ pub(crate) fn sss<I: InputType>(
         let ulps = ULPSX2 as f64;
         let (rx, ry, rl) = (c_x.ulp() > ulps, c_y.ulp() > ulps, lower_x.ulp() > ulps);
         c_event.set_3(c_x.fpv(), c_y.fpv(), lower_x.fpv());
+        count_closed_form(3, rx || ry || rl);
         if rx || ry || rl {
             exact_circle_formation::sss(site1, site2, site3, &mut c_event, rx, ry, rl);
         }
