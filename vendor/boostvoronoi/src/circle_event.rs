@@ -18,9 +18,9 @@ use crate::tln;
 use crate::{BvError, GrowingVob, VobU32};
 use ordered_float::OrderedFloat;
 use std::cmp::Ordering;
-use std::collections::BTreeSet;
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
 use std::fmt;
-use std::rc::Rc;
 
 /// Type-checked placeholder for usize
 /// Hopefully rust zero cost abstractions will flatten this out.
@@ -123,7 +123,7 @@ impl Ord for CircleEvent {
                     // self_lower_x_ == other_lower_x_ and self_center_y_ == other_center_y_
                     // Sort by reverse order of circle event id (highest value==youngest first)
                     // This implementation differ from C++, because i can only keep one
-                    // unique circle-event in the circle-event BTreeSet
+                    // unique circle-event in the circle-event queue
                     if let (Some(self_index), Some(other_index)) = (self.index_, other.index_) {
                         #[cfg(feature = "console_debug")]
                         println!(
@@ -270,19 +270,16 @@ impl CircleEvent {
 
 /// Event queue data structure, holds circle events.
 /// During algorithm run, some of the circle events disappear (become
-/// inactive). Priority queue data structure doesn't support
-/// iterators (there is no direct ability to modify its elements).
-/// Instead, the list is used to store all the circle events and priority queue
-/// of the iterators to the list elements is used to keep the correct circle
-/// events ordering.
-// todo: this comment text is from c++, convert to rust
+/// inactive): they stay in the queue, marked in `inactive_circle_ids_`, and
+/// are dropped when they reach the top.
+///
+/// A binary heap in the events' order (`lower_x`, then `y`, then the newer
+/// event first: a strict total order, since indices are unique), so events
+/// leave it in exactly the order the `BTreeSet` of boostvoronoi 0.12.1 gave
+/// them, without an allocation per event and without the id map that only
+/// debug output read.
 pub(crate) struct CircleEventQueue {
-    /// circle events sorted by order
-    /// Note that the `CircleEvent`s must be identical clones of the ones in `ce_by_id_`
-    ce_by_order_: BTreeSet<Rc<CircleEvent>>,
-    /// circle events sorted by id
-    /// Note that the `CircleEvent`s must be identical clones of the ones in `ce_by_order_`
-    ce_by_id_: rustc_hash::FxHashMap<u32, Rc<CircleEvent>>,
+    ce_by_order_: BinaryHeap<Reverse<CircleEvent>>,
     c_list_next_free_index_: CircleEventIndex,
     inactive_circle_ids_: VobU32, // Circle events turned inactive
 }
@@ -290,8 +287,7 @@ pub(crate) struct CircleEventQueue {
 impl Default for CircleEventQueue {
     fn default() -> CircleEventQueue {
         Self {
-            ce_by_order_: BTreeSet::new(),
-            ce_by_id_: rustc_hash::FxHashMap::default(),
+            ce_by_order_: BinaryHeap::new(),
             c_list_next_free_index_: CircleEventIndex(0),
             inactive_circle_ids_: VobU32::fill(128),
         }
@@ -305,16 +301,16 @@ impl CircleEventQueue {
     }
 
     #[inline(always)]
-    pub(crate) fn peek(&self) -> Option<&Rc<CircleEvent>> {
-        self.ce_by_order_.first()
+    pub(crate) fn peek(&self) -> Option<&CircleEvent> {
+        self.ce_by_order_.peek().map(|Reverse(c)| c)
     }
 
     #[cfg(feature = "ce_corruption_check")]
     pub(crate) fn ce_corruption_check(&self) {
         if self.ce_by_order_.len() >= 2 {
-            let mut iter = self.ce_by_order_.iter();
-            let first_ce = iter.next().unwrap();
-            let second_ce = iter.next().unwrap();
+            let mut sorted: Vec<&CircleEvent> = self.ce_by_order_.iter().map(|Reverse(c)| c).collect();
+            sorted.sort();
+            let (first_ce, second_ce) = (sorted[0], sorted[1]);
 
             if first_ce.cmp(second_ce) != Ordering::Less {
                 println!("*************************************************");
@@ -326,8 +322,8 @@ impl CircleEventQueue {
     }
 
     #[inline(always)]
-    fn pop_first(&mut self) -> Option<Rc<CircleEvent>> {
-        self.ce_by_order_.pop_first()
+    fn pop_first(&mut self) -> Option<CircleEvent> {
+        self.ce_by_order_.pop().map(|Reverse(c)| c)
     }
 
     pub(crate) fn pop_inactive_at_top(&mut self) -> Result<(), BvError> {
@@ -349,17 +345,6 @@ impl CircleEventQueue {
             }
             break;
         }
-        debug_assert!({
-            // todo: remove this when stable
-            if self.ce_by_id_.len() != self.ce_by_order_.len() {
-                return Err(BvError::InternalError(format!(
-                    "The two circle event lists should always be of the same size. {}:{}",
-                    file!(),
-                    line!()
-                )));
-            };
-            true
-        });
         Ok(())
     }
 
@@ -367,7 +352,6 @@ impl CircleEventQueue {
     pub(crate) fn pop_and_destroy(&mut self) -> Result<(), BvError> {
         if let Some(circle) = self.pop_first() {
             if let Some(circle_id) = circle.index_ {
-                let _ = self.ce_by_id_.remove(&circle_id.0);
                 self.inactive_circle_ids_.set_grow(circle_id.usize(), true);
             } else {
                 return Err(BvError::InternalError(format!(
@@ -378,24 +362,12 @@ impl CircleEventQueue {
                 )));
             }
         }
-        debug_assert!({
-            // todo: remove this when stable
-            if self.ce_by_id_.len() != self.ce_by_order_.len() {
-                return Err(BvError::InternalError(format!(
-                    "The two circle event lists should always be of the same size. {}:{}",
-                    file!(),
-                    line!()
-                )));
-            };
-            true
-        });
         Ok(())
     }
 
     #[allow(dead_code)]
     pub(crate) fn clear(&mut self) {
         self.ce_by_order_.clear();
-        self.ce_by_id_.clear();
         self.inactive_circle_ids_ = {
             let mut cids = VobU32::fill(512);
             cids.resize(512, false);
@@ -410,10 +382,7 @@ impl CircleEventQueue {
         let circle_event_id = self.c_list_next_free_index_;
         // set the correct index on the circle event
         ce.set_index(circle_event_id);
-        let rc_ce = Rc::new(ce);
-        let _ = self.ce_by_id_.insert(circle_event_id.0, Rc::clone(&rc_ce));
-
-        let _ = self.ce_by_order_.insert(rc_ce);
+        self.ce_by_order_.push(Reverse(ce));
         self.c_list_next_free_index_.increment();
         circle_event_id
     }
@@ -432,18 +401,14 @@ impl CircleEventQueue {
         #[cfg(feature = "console_debug")]
         if let Some(circle_event_id) = circle_event_id {
             if !self.inactive_circle_ids_.get_f(circle_event_id.usize()) {
-                if self.ce_by_id_.contains_key(&circle_event_id.0) {
-                    tln!("deactivate {:?}", self.ce_by_id_[&circle_event_id.0]);
-                } else {
-                    tln!("circle {} not present", circle_event_id);
-                }
+                tln!("deactivate circle {}", circle_event_id);
                 self.inactive_circle_ids_
                     .set_grow(circle_event_id.usize(), true);
             }
         }
     }
 
-    pub(crate) fn top(&self) -> Result<Option<&Rc<CircleEvent>>, BvError> {
+    pub(crate) fn top(&self) -> Result<Option<&CircleEvent>, BvError> {
         let c = self.peek();
         if let Some(cc) = c {
             let id = cc.index_.unwrap();
@@ -461,10 +426,14 @@ impl CircleEventQueue {
 
     #[cfg(feature = "console_debug")]
     pub(crate) fn dbg_ce(&self, cei: CircleEventIndex) {
-        if let Some(ce) = self.ce_by_id_.get(&cei.0) {
-            print!("{:?}", ce);
-        } else {
-            print!("{}: not found", cei);
+        match self
+            .ce_by_order_
+            .iter()
+            .map(|Reverse(c)| c)
+            .find(|c| c.index_.map(|i| i.0) == Some(cei.0))
+        {
+            Some(ce) => print!("{:?}", ce),
+            None => print!("{}: not found", cei),
         }
     }
 
