@@ -7,7 +7,13 @@
 //! and a nearest-point search soon after its answer.
 //!
 //! The tree knows only boxes and item numbers: what an item is, and its
-//! exact distance or hit, is the caller's (see [`super::Boundary`]).
+//! exact distance or hit, is the caller's (see [`super::Boundary`]). A tree
+//! of more than 64 segments ([`PackedTree::of_segments`]) also keeps an
+//! oriented box ([`Obb`]) around each node, which the nearest-point and
+//! half-plane searches bound with: seen from inside a round polygon, the
+//! axis-aligned box of a diagonal or curved stretch of shore reaches far
+//! towards the query point, and the side searches of a 200 000-vertex noisy
+//! circle's bars scored 446 boxes each with them, 140 with oriented ones.
 
 use std::mem::MaybeUninit;
 use std::ops::ControlFlow;
@@ -36,6 +42,117 @@ pub struct PackedTree {
     ids: Vec<u32>,
     /// End position of each level in `boxes` (level 0 = the items).
     level_ends: Vec<usize>,
+    /// An oriented box around each node (position − number of items), when
+    /// the tree was built from segments and is large enough to gain from
+    /// them ([`PackedTree::of_segments`]); empty otherwise.
+    oriented: Vec<Obb>,
+}
+
+/// An oriented box: centre `c`, unit axis `u`, half-length `hl` along `u`
+/// and half-width `hw` across it. Around the segments under a node of a
+/// large tree: a chunk of shore is long and thin in its own direction, and
+/// its axis-aligned box is not when the shore runs diagonally or curves —
+/// from inside a round polygon such boxes reach far towards the query point
+/// and can rarely be ruled out. Its bounds are lower bounds under rounding
+/// (the extents are widened by a relative 10⁻¹² of the coordinates at
+/// construction and every bound is shrunk by a relative 10⁻⁹), so a search
+/// gives the same answer with them as with axis-aligned boxes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Obb {
+    c: [f64; 2],
+    u: [f64; 2],
+    hl: f64,
+    hw: f64,
+}
+
+/// Trees of at most this many items get no oriented boxes: two levels at
+/// most, whose few boxes are cheaper to test axis-aligned.
+const ORIENTED_MIN: usize = NODE_SIZE * NODE_SIZE;
+
+impl Obb {
+    /// Around `points` (at least one), its axis along their principal
+    /// direction.
+    fn around(points: &[[f64; 2]]) -> Self {
+        let k = points.len() as f64;
+        let (mut mx, mut my) = (0.0, 0.0);
+        for p in points {
+            mx += p[0];
+            my += p[1];
+        }
+        let (mx, my) = (mx / k, my / k);
+        let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
+        for p in points {
+            let (dx, dy) = (p[0] - mx, p[1] - my);
+            sxx += dx * dx;
+            sxy += dx * dy;
+            syy += dy * dy;
+        }
+        let angle = 0.5 * (2.0 * sxy).atan2(sxx - syy);
+        let u = [angle.cos(), angle.sin()];
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for p in points {
+            let (dx, dy) = (p[0] - mx, p[1] - my);
+            let l = [dx * u[0] + dy * u[1], -dx * u[1] + dy * u[0]];
+            for a in 0..2 {
+                lo[a] = lo[a].min(l[a]);
+                hi[a] = hi[a].max(l[a]);
+            }
+        }
+        let (ca, cb) = (0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]));
+        let c = [mx + ca * u[0] - cb * u[1], my + ca * u[1] + cb * u[0]];
+        let (hl, hw) = (0.5 * (hi[0] - lo[0]), 0.5 * (hi[1] - lo[1]));
+        // Rounding in the projections above and in a query's: a relative
+        // 10⁻¹² of the magnitudes involved is far beyond it.
+        let slack = 1e-12 * (c[0].abs() + c[1].abs() + hl + hw) + f64::MIN_POSITIVE;
+        Self {
+            c,
+            u,
+            hl: hl + slack,
+            hw: hw + slack,
+        }
+    }
+
+    /// `p − c` along and across the axis.
+    fn local(&self, p: [f64; 2]) -> [f64; 2] {
+        let (dx, dy) = (p[0] - self.c[0], p[1] - self.c[1]);
+        [
+            dx * self.u[0] + dy * self.u[1],
+            -dx * self.u[1] + dy * self.u[0],
+        ]
+    }
+
+    /// A lower bound of the squared distance from `p` to anything in the box.
+    pub fn distance_2(&self, p: [f64; 2]) -> f64 {
+        let l = self.local(p);
+        let a = (l[0].abs() - self.hl).max(0.0);
+        let b = (l[1].abs() - self.hw).max(0.0);
+        (a * a + b * b) * (1.0 - 2e-9)
+    }
+
+    /// A lower bound of the distance from `q` to the part of the box in the
+    /// closed half-planes `(x − q) · n ≥ 0` of every `n` in `normals`, or
+    /// `None` when the box is out of one of them (never when a point of it
+    /// is in all).
+    pub fn clipped_distance(&self, q: [f64; 2], normals: &[[f64; 2]]) -> Option<f64> {
+        let l = self.local(q);
+        for n in normals {
+            let nl = [
+                n[0] * self.u[0] + n[1] * self.u[1],
+                -n[0] * self.u[1] + n[1] * self.u[0],
+            ];
+            // The farthest reach of the box along n, from q.
+            let reach =
+                -(l[0] * nl[0] + l[1] * nl[1]) + self.hl * nl[0].abs() + self.hw * nl[1].abs();
+            let room =
+                1e-9 * (l[0].abs() + l[1].abs() + self.hl + self.hw) * (nl[0].abs() + nl[1].abs());
+            if reach < -room {
+                return None;
+            }
+        }
+        let a = (l[0].abs() - self.hl).max(0.0);
+        let b = (l[1].abs() - self.hw).max(0.0);
+        Some(((a * a + b * b) * (1.0 - 2e-9)).sqrt())
+    }
 }
 
 /// What a node or item is to a query: its lower bound (a distance, a ray
@@ -111,7 +228,51 @@ impl PackedTree {
             boxes: tree_boxes,
             ids,
             level_ends,
+            oriented: Vec::new(),
         }
+    }
+
+    /// Packs segments (item `i` runs from `ends[i][0]` to `ends[i][1]`),
+    /// with an oriented box around every node when there are more than
+    /// [`ORIENTED_MIN`] of them.
+    pub fn of_segments(ends: &[[[f64; 2]; 2]]) -> Self {
+        let boxes: Vec<Bbox> = ends
+            .iter()
+            .map(|[a, b]| {
+                [
+                    a[0].min(b[0]),
+                    a[1].min(b[1]),
+                    a[0].max(b[0]),
+                    a[1].max(b[1]),
+                ]
+            })
+            .collect();
+        let mut tree = Self::new(&boxes);
+        let n = tree.len();
+        if n <= ORIENTED_MIN {
+            return tree;
+        }
+        // Each node covers a run of item positions: its first child's first
+        // item to its last child's last one.
+        let mut points: Vec<[f64; 2]> = Vec::with_capacity(2 * n);
+        for &i in &tree.ids[..n] {
+            points.extend_from_slice(&ends[i as usize]);
+        }
+        let nodes = tree.boxes.len() - n;
+        let mut runs: Vec<(usize, usize)> = Vec::with_capacity(nodes);
+        let mut oriented = Vec::with_capacity(nodes);
+        for pos in n..tree.boxes.len() {
+            let kids = tree.children(pos);
+            let run = if kids.start < n {
+                (kids.start, kids.end)
+            } else {
+                (runs[kids.start - n].0, runs[kids.end - 1 - n].1)
+            };
+            runs.push(run);
+            oriented.push(Obb::around(&points[2 * run.0..2 * run.1]));
+        }
+        tree.oriented = oriented;
+        tree
     }
 
     /// Number of items.
@@ -225,9 +386,10 @@ impl PackedTree {
     pub fn best(
         &self,
         bound: impl Fn(&Bbox) -> Bound,
+        oriented: Option<impl Fn(&Obb) -> Bound>,
         item: impl FnMut(u32, f64) -> Bound,
     ) -> Option<(f64, u32)> {
-        self.best_within(f64::INFINITY, bound, item)
+        self.best_within(f64::INFINITY, bound, oriented, item)
     }
 
     /// [`Self::best`] among the items scoring at most `limit`.
@@ -235,12 +397,14 @@ impl PackedTree {
         &self,
         limit: f64,
         bound: impl Fn(&Bbox) -> Bound,
+        oriented: Option<impl Fn(&Obb) -> Bound>,
         mut item: impl FnMut(u32, f64) -> Bound,
     ) -> Option<(f64, u32)> {
         let mut best: Option<(f64, u32)> = None;
         self.branch_and_bound(
             limit,
             |b| bound(b),
+            oriented,
             |id| {
                 let cut = best.map_or(limit, |(v, _)| v);
                 if let Some(v) = item(id, cut).filter(|&v| v <= limit) {
@@ -264,14 +428,22 @@ impl PackedTree {
         &self,
         limit: f64,
         bound: impl Fn(&Bbox) -> Bound,
+        oriented: Option<impl Fn(&Obb) -> Bound>,
         mut item: impl FnMut(u32) -> f64,
     ) {
         let n = self.len();
         if n == 0 {
             return;
         }
+        // A node's bound: from its oriented box when the tree has them and
+        // the query can use them.
+        let oriented = oriented.filter(|_| !self.oriented.is_empty());
+        let node_bound = |pos: usize| match &oriented {
+            Some(f) if pos >= n => f(&self.oriented[pos - n]),
+            _ => bound(&self.boxes[pos]),
+        };
         let root = self.boxes.len() - 1;
-        let Some(rb) = bound(&self.boxes[root]).filter(|&b| b <= limit) else {
+        let Some(rb) = node_bound(root).filter(|&b| b <= limit) else {
             return;
         };
         if root < n {
@@ -316,20 +488,35 @@ impl PackedTree {
                 continue;
             }
             // The children that can still count, sorted so that the nearest
-            // is on top (insertion sort: at most NODE_SIZE of them).
+            // is on top (insertion sort: at most NODE_SIZE of them); their
+            // bounds from their oriented or their axis-aligned boxes, each
+            // kind in its own loop.
             let first = top;
-            for c in children {
-                let Some(b) = bound(&self.boxes[c]).filter(|&b| b <= cut) else {
-                    continue;
-                };
-                let mut j = top;
+            let mut push = |b: f64, c: usize, top: &mut usize| {
+                let mut j = *top;
                 // SAFETY: entries first..top were written in this loop.
                 while j > first && unsafe { stack[j - 1].assume_init().0 } < b {
                     stack[j] = stack[j - 1];
                     j -= 1;
                 }
                 stack[j] = MaybeUninit::new((b, c as u32));
-                top += 1;
+                *top += 1;
+            };
+            match &oriented {
+                Some(f) => {
+                    for c in children {
+                        if let Some(b) = f(&self.oriented[c - n]).filter(|&b| b <= cut) {
+                            push(b, c, &mut top);
+                        }
+                    }
+                }
+                None => {
+                    for c in children {
+                        if let Some(b) = bound(&self.boxes[c]).filter(|&b| b <= cut) {
+                            push(b, c, &mut top);
+                        }
+                    }
+                }
             }
         }
     }
@@ -455,6 +642,7 @@ fn hilbert(x: u32, y: u32) -> u32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use geo::Coord;
 
     fn grid(n: usize) -> Vec<Bbox> {
         (0..n)
@@ -534,6 +722,7 @@ mod tests {
         ] {
             let got = t.best(
                 |b| Some(box_distance_2(b, x, y)),
+                Some(|o: &Obb| Some(o.distance_2([x, y]))),
                 |i, _| Some(box_distance_2(&boxes[i as usize], x, y)),
             );
             let want = (0..boxes.len())
@@ -541,6 +730,93 @@ mod tests {
                 .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
             assert_eq!(got, want, "at ({x}, {y})");
         }
+    }
+
+    /// A noisy ring of `n` segments and a spray of segments inside it.
+    fn segment_soup(n: usize) -> Vec<[[f64; 2]; 2]> {
+        let mut s = 17u64;
+        let mut rnd = || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let at = |k: usize, r: f64| {
+            let t = std::f64::consts::TAU * k as f64 / n as f64;
+            [5.0e5 + r * t.cos(), 6.0e6 + r * t.sin()]
+        };
+        let mut out = Vec::new();
+        let radii: Vec<f64> = (0..n)
+            .map(|k| 1e4 * (1.0 + 0.05 * (7.0 * k as f64).sin()) + rnd())
+            .collect();
+        for k in 0..n {
+            out.push([at(k, radii[k]), at((k + 1) % n, radii[(k + 1) % n])]);
+        }
+        for _ in 0..n / 4 {
+            let p = [5.0e5 + 8e3 * (rnd() - 0.5), 6.0e6 + 8e3 * (rnd() - 0.5)];
+            out.push([
+                p,
+                [p[0] + 300.0 * (rnd() - 0.5), p[1] + 300.0 * (rnd() - 0.5)],
+            ]);
+        }
+        out
+    }
+
+    #[test]
+    fn oriented_boxes_bound_every_segment_under_their_node() {
+        let segs = segment_soup(3000);
+        let t = PackedTree::of_segments(&segs);
+        let n = t.len();
+        assert_eq!(
+            t.oriented.len(),
+            t.boxes.len() - n,
+            "a large tree has oriented boxes"
+        );
+        assert!(PackedTree::of_segments(&segs[..ORIENTED_MIN])
+            .oriented
+            .is_empty());
+        // The items under each node, by walking down from it.
+        fn under(t: &PackedTree, pos: usize, out: &mut Vec<u32>) {
+            if pos < t.len() {
+                out.push(t.ids[pos]);
+            } else {
+                for c in t.children(pos) {
+                    under(t, c, out);
+                }
+            }
+        }
+        let queries: Vec<[f64; 2]> = (0..40)
+            .map(|k| {
+                let a = k as f64 * 0.7;
+                let r = 2e3 * (k % 7) as f64;
+                [5.0e5 + r * a.cos(), 6.0e6 + r * a.sin()]
+            })
+            .collect();
+        let mut checked = 0;
+        for pos in n..t.boxes.len() {
+            let o = &t.oriented[pos - n];
+            let mut items = Vec::new();
+            under(&t, pos, &mut items);
+            for q in &queries {
+                let normal = [q[1] - 6.0e6, 5.0e5 - q[0]];
+                let hp = o.clipped_distance(*q, &[normal]);
+                for &i in &items {
+                    let [a, b] = segs[i as usize];
+                    let (ca, cb) = (Coord { x: a[0], y: a[1] }, Coord { x: b[0], y: b[1] });
+                    let qc = Coord { x: q[0], y: q[1] };
+                    let c = crate::geometry::boundary::closest_on_segment(ca, cb, qc).0;
+                    let d2 = (c.x - q[0]).hypot(c.y - q[1]);
+                    assert!(o.distance_2(*q) <= d2 * d2, "node {pos}, item {i}");
+                    let side = |p: [f64; 2]| (p[0] - q[0]) * normal[0] + (p[1] - q[1]) * normal[1];
+                    if side(a) >= 0.0 || side(b) >= 0.0 {
+                        let d = hp.expect("a segment in the half-plane keeps its node");
+                        assert!(d <= d2, "node {pos}, item {i}: {d} > {d2}");
+                    }
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked > 100_000);
     }
 
     #[test]
