@@ -19,9 +19,10 @@
 //! * any remaining intersection is an error naming the place, instead of a
 //!   diagram built on invalid input.
 
+use crate::geometry::packed::{Bbox, PackedTree};
 use geo::Coord;
-use rstar::{primitives::GeomWithData, primitives::Rectangle, RTree, AABB};
 use rustc_hash::FxHashMap as HashMap;
+use std::ops::ControlFlow;
 
 /// Vertices this close (grid units) to another segment's interior are put on it.
 /// Rounding moves any point by at most √2/2 units, so a touch becomes a
@@ -129,25 +130,18 @@ fn len2(a: Pt, b: Pt) -> i128 {
     dot(a, b, b)
 }
 
-type Indexed = GeomWithData<Rectangle<[f64; 2]>, usize>;
-
-fn index(segs: &[Seg], pad: f64) -> RTree<Indexed> {
-    RTree::bulk_load(
-        segs.iter()
-            .enumerate()
-            .map(|(i, s)| {
-                let lo = [
-                    s.a[0].min(s.b[0]) as f64 - pad,
-                    s.a[1].min(s.b[1]) as f64 - pad,
-                ];
-                let hi = [
-                    s.a[0].max(s.b[0]) as f64 + pad,
-                    s.a[1].max(s.b[1]) as f64 + pad,
-                ];
-                GeomWithData::new(Rectangle::from_corners(lo, hi), i)
-            })
-            .collect(),
-    )
+/// The segments' boxes on the grid, widened by `pad` grid units.
+fn boxes(segs: &[Seg], pad: f64) -> Vec<Bbox> {
+    segs.iter()
+        .map(|s| {
+            [
+                s.a[0].min(s.b[0]) as f64 - pad,
+                s.a[1].min(s.b[1]) as f64 - pad,
+                s.a[0].max(s.b[0]) as f64 + pad,
+                s.a[1].max(s.b[1]) as f64 + pad,
+            ]
+        })
+        .collect()
 }
 
 /// The segments of every ring (each closed, first == last), cleaned on the grid.
@@ -184,7 +178,7 @@ pub(super) fn segments<'a>(
 
 /// Splits every segment whose interior passes within [`SNAP`] of a vertex.
 fn split_at_touches(segs: Vec<Seg>) -> Vec<Seg> {
-    let tree = index(&segs, SNAP as f64);
+    let tree = PackedTree::new(&boxes(&segs, SNAP as f64));
     let mut vertices: Vec<(Pt, Coord<f64>)> = segs.iter().map(|s| (s.a, s.wa)).collect();
     vertices.sort_unstable_by_key(|v| v.0);
     vertices.dedup_by_key(|v| v.0);
@@ -192,21 +186,24 @@ fn split_at_touches(segs: Vec<Seg>) -> Vec<Seg> {
     let mut splits: Vec<(usize, i128, Pt, Coord<f64>)> = Vec::new();
     for &(v, wv) in &vertices {
         let p = [v[0] as f64, v[1] as f64];
-        for item in tree.locate_all_at_point(&p) {
-            let s = segs[item.data];
+        let holds = |b: &Bbox| b[0] <= p[0] && p[0] <= b[2] && b[1] <= p[1] && p[1] <= b[3];
+        tree.visit(holds, |i| {
+            let i = i as usize;
+            let s = segs[i];
             if v == s.a || v == s.b {
-                continue;
+                return ControlFlow::<()>::Continue(());
             }
             let l2 = len2(s.a, s.b);
             let t = dot(s.a, s.b, v);
             if t <= 0 || t >= l2 {
-                continue;
+                return ControlFlow::Continue(());
             }
             let o = orient(s.a, s.b, v);
             if o * o <= (SNAP as i128 * SNAP as i128) * l2 {
-                splits.push((item.data, t, v, wv));
+                splits.push((i, t, v, wv));
             }
-        }
+            ControlFlow::Continue(())
+        });
     }
     if splits.is_empty() {
         return segs;
@@ -311,21 +308,22 @@ fn bad_pair(s: Seg, t: Seg) -> bool {
         || on_segment(t.a, t.b, s.b)
 }
 
+/// The first segment (in order) that meets another one anywhere but at one
+/// shared endpoint is reported, at its start.
 fn check_no_crossing(segs: &[Seg]) -> Result<(), Crossing> {
-    let tree = index(segs, 0.0);
-    for (i, s) in segs.iter().enumerate() {
-        let env = AABB::from_corners(
-            [s.a[0].min(s.b[0]) as f64, s.a[1].min(s.b[1]) as f64],
-            [s.a[0].max(s.b[0]) as f64, s.a[1].max(s.b[1]) as f64],
-        );
-        for item in tree.locate_in_envelope_intersecting(&env) {
-            let j = item.data;
-            if j > i && bad_pair(*s, segs[j]) {
-                return Err(Crossing { at: s.a });
-            }
+    let mut first: Option<u32> = None;
+    PackedTree::new(&boxes(segs, 0.0)).pairs(|i, j| {
+        if first.is_none_or(|f| i < f) && bad_pair(segs[i as usize], segs[j as usize]) {
+            first = Some(i);
         }
+        ControlFlow::<()>::Continue(())
+    });
+    match first {
+        Some(i) => Err(Crossing {
+            at: segs[i as usize].a,
+        }),
+        None => Ok(()),
     }
-    Ok(())
 }
 
 #[cfg(test)]
