@@ -296,7 +296,7 @@ fn finish(
             // casts' own CPU time replaces this thread's; cast here, its
             // clock counts them.
             let here = rays[k].parallel().then(CpuClock::start);
-            let (mut b, t) = rays[k].cast_timed(p, g);
+            let (mut b, t, parts) = rays[k].cast_timed(p, g);
             if let (Some(here), Some(t)) = (here, t) {
                 in_casts += here.elapsed();
                 cast_time += t;
@@ -306,7 +306,7 @@ fn finish(
                     h.part += branch_offset;
                 }
             }
-            branch_offset += g.branches().len();
+            branch_offset += parts;
             all_bars.extend(b);
         }
         if params.keep_widths {

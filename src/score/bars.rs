@@ -6,7 +6,6 @@ use crate::graph::{GraphBuilder, SkeletonGraph};
 use crate::process::clock::CpuClock;
 use geo::{Coord, MultiLineString};
 use rayon::prelude::*;
-use rustc_hash::FxHashMap as HashMap;
 
 /// Bars per parallel task: a polygon with fewer is scored on one thread.
 pub(crate) const PAR_BARS: usize = 4096;
@@ -57,18 +56,20 @@ const RIGHT_ANGLE_TOLERANCE: f64 = 1e-9;
 /// it indexes the skeleton: `ring` holds the part (branch) index.
 struct SkeletonIndex {
     index: Boundary,
-    /// Segments incident to each segment end point (keyed by coordinate bits).
-    at_vertex: HashMap<(u64, u64), Vec<u32>>,
+    /// Number of parts (branches).
+    parts: usize,
 }
 
-fn key(p: Coord<f64>) -> (u64, u64) {
-    ((p.x + 0.0).to_bits(), (p.y + 0.0).to_bits())
+/// The same point, bit for bit (−0 and +0 alike).
+fn same_point(a: Coord<f64>, b: Coord<f64>) -> bool {
+    a.x == b.x && a.y == b.y
 }
 
 impl SkeletonIndex {
     fn new(skeleton: &SkeletonGraph) -> Self {
+        let branches = skeleton.branches();
         let mut segments = Vec::new();
-        for (k, branch) in skeleton.branches().iter().enumerate() {
+        for (k, branch) in branches.iter().enumerate() {
             for w in branch.coords.windows(2) {
                 if w[0] != w[1] {
                     segments.push(BoundarySegment {
@@ -80,15 +81,26 @@ impl SkeletonIndex {
                 }
             }
         }
-        let mut at_vertex: HashMap<(u64, u64), Vec<u32>> = HashMap::default();
-        for (i, s) in segments.iter().enumerate() {
-            at_vertex.entry(key(s.a)).or_default().push(i as u32);
-            at_vertex.entry(key(s.b)).or_default().push(i as u32);
-        }
         Self {
             index: Boundary::from_segments(segments),
-            at_vertex,
+            parts: branches.len(),
         }
+    }
+
+    /// The segments with an end point at `v`, in index order (found in the
+    /// tree when a bar hits a vertex, which few do).
+    fn at_vertex(&self, v: Coord<f64>) -> Vec<u32> {
+        let segs = self.index.segments();
+        let mut incident: Vec<u32> = Vec::new();
+        self.index.visit_segments_near(v, v, |i| {
+            let s = &segs[i];
+            if same_point(s.a, v) || same_point(s.b, v) {
+                incident.push(i as u32);
+            }
+            std::ops::ControlFlow::<()>::Continue(())
+        });
+        incident.sort_unstable();
+        incident
     }
 
     /// The first skeleton point on `origin + t·u`, `eps < t ≤ max_t`, and the
@@ -106,8 +118,9 @@ impl SkeletonIndex {
         // At a skeleton vertex, the incident segment most nearly
         // perpendicular to the bar (largest angle to u).
         let vertex = [s.a, s.b].into_iter().find(|&v| norm(v - h.point) <= eps);
-        let sigma = match vertex.and_then(|v| self.at_vertex.get(&key(v))) {
-            Some(incident) => incident
+        let sigma = match vertex {
+            Some(v) => self
+                .at_vertex(v)
                 .iter()
                 .map(|&i| &segs[i as usize])
                 .min_by(|x, y| {
@@ -243,12 +256,14 @@ impl BarRays {
     /// [`BarRays::cast`], and, when the bars were cast in parallel
     /// ([`BarRays::parallel`]), the CPU time it took over all threads; `None`
     /// when they were cast on the calling thread alone, whose own clock then
-    /// counts them (a clock reading per small polygon saved).
+    /// counts them (a clock reading per small polygon saved). Also the
+    /// number of the skeleton's branches (`skeleton.branches().len()`, which
+    /// [`BarHit::part`] indexes).
     pub fn cast_timed(
         &self,
         polygon: &PreparedPolygon,
         skeleton: &SkeletonGraph,
-    ) -> (Vec<Bar>, Option<std::time::Duration>) {
+    ) -> (Vec<Bar>, Option<std::time::Duration>, usize) {
         let eps = REL_EPS * polygon.extent();
         let cast_all = |sk: &SkeletonIndex, bars: &mut [Bar], rays: &[Ray]| {
             let mut recent = [NOWHERE; 2];
@@ -265,7 +280,7 @@ impl BarRays {
             let sk = SkeletonIndex::new(skeleton);
             let mut bars: Vec<Bar> = self.rays.iter().map(unhit).collect();
             cast_all(&sk, &mut bars, &self.rays);
-            return (bars, None);
+            return (bars, None, sk.parts);
         }
         let clock = CpuClock::start();
         let sk = SkeletonIndex::new(skeleton);
@@ -282,7 +297,7 @@ impl BarRays {
                 clock.elapsed()
             })
             .sum();
-        (bars, Some(time + cast_time))
+        (bars, Some(time + cast_time), sk.parts)
     }
 }
 
