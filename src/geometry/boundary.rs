@@ -88,6 +88,9 @@ fn pt(c: Coord<f64>) -> [f64; 2] {
 /// A candidate answer of a nearest-point search: point, distance, segment.
 type Found = (Coord<f64>, f64, u32);
 
+/// [`Boundary::few_segments`]: one leaf of the tree, or two.
+const FEW_SEGMENTS: usize = 16;
+
 /// Squared distance from `p` to segment `ab` (the nearest point computed as
 /// the projection parameter strictly inside (0, 1), else an end).
 fn segment_distance_2(a: Coord<f64>, b: Coord<f64>, p: Coord<f64>) -> f64 {
@@ -338,6 +341,51 @@ impl Boundary {
             |o| o.clipped_distance(pt(q), &[n]),
             |a, b| clip_to_half_plane(a, b, q, normal),
         )
+    }
+
+    /// [`Boundary::nearest_in_half_plane`] on both sides of the line through
+    /// `q` across `normal` at once — `(normal side, opposite side)` — by one
+    /// pass over every segment: the same answers, for a boundary of few
+    /// segments, where two tree searches cost more than the pass
+    /// ([`Boundary::few_segments`]).
+    pub fn nearest_on_both_sides(
+        &self,
+        q: Coord<f64>,
+        normal: Coord<f64>,
+    ) -> [Option<(Coord<f64>, f64)>; 2] {
+        let mut best: [Option<(Coord<f64>, f64)>; 2] = [None, None];
+        if !finite(q) {
+            return best;
+        }
+        let side = |c: Coord<f64>| (c - q).x * normal.x + (c - q).y * normal.y;
+        for s in &self.segments {
+            let (fa, fb) = (side(s.a), side(s.b));
+            // The segment clipped to each closed half-plane, as
+            // `clip_to_half_plane` clips it (the opposite side's values are
+            // the negated ones, exactly).
+            let cut = |f_a: f64, f_b: f64| match (f_a >= 0.0, f_b >= 0.0) {
+                (true, true) => Some((s.a, s.b)),
+                (false, false) => None,
+                (true, false) => Some((s.a, s.a + (s.b - s.a) * (f_a / (f_a - f_b)))),
+                (false, true) => Some((s.a + (s.b - s.a) * (f_a / (f_a - f_b)), s.b)),
+            };
+            for (k, part) in [cut(fa, fb), cut(-fa, -fb)].into_iter().enumerate() {
+                let Some((a, b)) = part else { continue };
+                let c = closest_on_segment(a, b, q).0;
+                let d = super::norm(c - q);
+                // Segments in index order: the first of equal distances stays.
+                if best[k].is_none_or(|(_, bd)| d < bd) {
+                    best[k] = Some((c, d));
+                }
+            }
+        }
+        best
+    }
+
+    /// True when the boundary has so few segments that a pass over all of
+    /// them is cheaper than a tree search ([`Boundary::nearest_on_both_sides`]).
+    pub fn few_segments(&self) -> bool {
+        self.segments.len() <= FEW_SEGMENTS
     }
 
     /// Nearest boundary point to `q` within the closed sector swept
@@ -715,6 +763,34 @@ mod tests {
     /// The tree searches in half-planes and sectors find what a scan of
     /// every segment finds (ties to the lower segment number), on a wavy
     /// ring whose tree has several levels, from points inside and outside.
+    /// The one-pass search of both sides gives exactly the two half-plane
+    /// searches' answers, on small rings (its use) and on a large one.
+    #[test]
+    fn both_sides_at_once_match_the_two_searches() {
+        let dir = |a: f64| Coord {
+            x: a.cos(),
+            y: a.sin(),
+        };
+        let mut compared = 0;
+        for (n, b) in [
+            (5, wavy_ring(5, [1.0, 0.0], [0.0, 0.0])),
+            (9, wavy_ring(9, [9.0, 3.0], [2.0, 7.0])),
+            (16, wavy_ring(16, [9.0, 11.0], [2.0, 57.0])),
+            (300, wavy_ring(300, [9.0, 11.0], [2.0, 57.0])),
+        ] {
+            assert_eq!(b.few_segments(), n <= FEW_SEGMENTS);
+            for k in 0..300 {
+                let q = dir(k as f64 * 0.61) * ((k % 130) as f64);
+                let nu = dir(k as f64 * 2.3);
+                let [left, right] = b.nearest_on_both_sides(q, nu);
+                assert_eq!(left, b.nearest_in_half_plane(q, nu), "{n}: {q:?} {nu:?}");
+                assert_eq!(right, b.nearest_in_half_plane(q, -nu), "{n}: {q:?} {nu:?}");
+                compared += usize::from(left.is_some()) + usize::from(right.is_some());
+            }
+        }
+        assert!(compared > 1500);
+    }
+
     #[test]
     fn half_plane_and_sector_searches_match_a_scan() {
         let b = wavy_ring(900, [9.0, 11.0], [2.0, 57.0]);

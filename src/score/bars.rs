@@ -337,8 +337,13 @@ fn cast(
                 .nearest_in_half_plane_within(q, n, seed)
                 .or_else(|| boundary.nearest_in_half_plane(q, n))
         };
-        let (p_left, d_left) = side(nu)?;
-        let (p_right, d_right) = side(-nu)?;
+        let [left, right] = if boundary.few_segments() {
+            boundary.nearest_on_both_sides(q, nu)
+        } else {
+            [side(nu), side(-nu)]
+        };
+        let (p_left, d_left) = left?;
+        let (p_right, d_right) = right?;
         *recent = [p_left, p_right];
         // A hit on ∂P itself (a leaf at a corner reached along the boundary)
         // has no sides to compare: it is a miss.
