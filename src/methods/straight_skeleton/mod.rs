@@ -92,7 +92,8 @@ use crate::geometry::{Boundary, PreparedPolygon};
 use crate::graph::{GraphBuilder, SkeletonGraph};
 use events::{edge_collapse_time, split_candidates, EventKind, EventQueue, SplitCandidate};
 use geo::Coord;
-use rstar::{primitives::GeomWithData, primitives::Line as RLine, RTree, AABB};
+use crate::geometry::packed::{boxes_meet, Bbox, PackedTree};
+use std::ops::ControlFlow;
 use wavefront::{dot, Line, LineId, VertexId, Wavefront};
 
 /// The straight-skeleton method.
@@ -152,7 +153,10 @@ const PREDICTION_SAMPLE: usize = 64;
 /// the budget by the deadline.
 const SECONDS_PER_TRY: f64 = 5e-8;
 
-type EdgeTree = RTree<GeomWithData<RLine<[f64; 2]>, u32>>;
+/// The box of the segment `ab`.
+fn segment_box(a: Coord<f64>, b: Coord<f64>) -> Bbox {
+    [a.x.min(b.x), a.y.min(b.y), a.x.max(b.x), a.y.max(b.y)]
+}
 
 /// Which original edges a reflex vertex's split candidates are taken from.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -173,7 +177,8 @@ const SEARCH_PASSES: [Search; 3] = [Search::Near(2.0), Search::Near(16.0), Searc
 struct Propagation<'a> {
     w: Wavefront,
     q: EventQueue,
-    tree: EdgeTree,
+    /// The original edges, item `i` being `LineId(i)`.
+    tree: PackedTree,
     search: Search,
     boundary: &'a Boundary,
     origin: Coord<f64>,
@@ -208,10 +213,7 @@ impl<'a> Propagation<'a> {
                 let (a, b) = (pts[i], pts[(i + 1) % m]);
                 w.lines.push(Line::new(a, b));
                 w.pieces.push(Vec::new());
-                entries.push(GeomWithData::new(
-                    RLine::new([a.x, a.y], [b.x, b.y]),
-                    (base + i) as u32,
-                ));
+                entries.push(segment_box(a, b));
             }
             let first = w.vertices.len();
             for i in 0..m {
@@ -231,7 +233,7 @@ impl<'a> Propagation<'a> {
             candidates: vec![Vec::new(); w.vertices.len()],
             w,
             q: EventQueue::default(),
-            tree: RTree::bulk_load(entries),
+            tree: PackedTree::new(&entries),
             search,
             boundary: polygon.boundary(),
             origin,
@@ -797,14 +799,22 @@ impl<'a> Propagation<'a> {
                 // edge: search a margin proportional to the reach.
                 let end = vx.start + dir * reach;
                 let m = factor * reach + self.tol;
-                let env = AABB::from_corners(
-                    [vx.start.x.min(end.x) - m, vx.start.y.min(end.y) - m],
-                    [vx.start.x.max(end.x) + m, vx.start.y.max(end.y) + m],
+                let env = [
+                    vx.start.x.min(end.x) - m,
+                    vx.start.y.min(end.y) - m,
+                    vx.start.x.max(end.x) + m,
+                    vx.start.y.max(end.y) + m,
+                ];
+                // In any order: the candidates are sorted.
+                let mut lines = Vec::new();
+                self.tree.visit(
+                    |b| boxes_meet(b, &env),
+                    |i| {
+                        lines.push(LineId(i));
+                        ControlFlow::<()>::Continue(())
+                    },
                 );
-                self.tree
-                    .locate_in_envelope_intersecting(&env)
-                    .map(|g| LineId(g.data))
-                    .collect()
+                lines
             }
             Search::All => (0..self.w.lines.len() as u32).map(LineId).collect(),
         };
@@ -934,31 +944,29 @@ fn verify(polygon: &PreparedPolygon, arcs: &[Arc]) -> Result<(), MethodError> {
             a.to.x, a.to.y
         )));
     }
-    let tree: EdgeTree = RTree::bulk_load(
-        arcs.iter()
-            .enumerate()
-            .filter(|(_, a)| a.from != a.to)
-            .map(|(i, a)| {
-                GeomWithData::new(RLine::new([a.from.x, a.from.y], [a.to.x, a.to.y]), i as u32)
-            })
-            .collect(),
-    );
-    for (i, a) in arcs.iter().enumerate() {
-        let env = AABB::from_corners(
-            [a.from.x.min(a.to.x), a.from.y.min(a.to.y)],
-            [a.from.x.max(a.to.x), a.from.y.max(a.to.y)],
-        );
-        for g in tree.locate_in_envelope_intersecting(&env) {
-            let b = &arcs[g.data as usize];
-            if (g.data as usize) > i {
-                if let Some(x) = crossing(a.from, a.to, b.from, b.to, tol) {
-                    return Err(fail(format!(
-                        "straight skeleton traces cross near ({}, {}) (a missed split event)",
-                        x.x, x.y
-                    )));
-                }
+    // Every pair of traces whose boxes meet; the first crossing in trace
+    // order is reported.
+    let traces: Vec<usize> = (0..arcs.len()).filter(|&i| arcs[i].from != arcs[i].to).collect();
+    let boxes: Vec<Bbox> = traces
+        .iter()
+        .map(|&i| segment_box(arcs[i].from, arcs[i].to))
+        .collect();
+    let mut first: Option<(usize, usize, Coord<f64>)> = None;
+    PackedTree::new(&boxes).pairs(|i, j| {
+        let (i, j) = (traces[i as usize], traces[j as usize]);
+        if first.is_none_or(|(fi, fj, _)| (i, j) < (fi, fj)) {
+            let (a, b) = (&arcs[i], &arcs[j]);
+            if let Some(x) = crossing(a.from, a.to, b.from, b.to, tol) {
+                first = Some((i, j, x));
             }
         }
+        ControlFlow::<()>::Continue(())
+    });
+    if let Some((_, _, x)) = first {
+        return Err(fail(format!(
+            "straight skeleton traces cross near ({}, {}) (a missed split event)",
+            x.x, x.y
+        )));
     }
     Ok(())
 }
