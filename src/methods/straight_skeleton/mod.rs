@@ -88,11 +88,11 @@ pub mod events;
 pub mod wavefront;
 
 use super::{MethodError, MethodId, SkeletonMethod};
+use crate::geometry::packed::{boxes_meet, Bbox, PackedTree};
 use crate::geometry::{Boundary, PreparedPolygon};
 use crate::graph::{GraphBuilder, SkeletonGraph};
 use events::{edge_collapse_time, split_candidates, EventKind, EventQueue, SplitCandidate};
 use geo::Coord;
-use crate::geometry::packed::{boxes_meet, Bbox, PackedTree};
 use std::ops::ControlFlow;
 use wavefront::{dot, Line, LineId, VertexId, Wavefront};
 
@@ -946,7 +946,9 @@ fn verify(polygon: &PreparedPolygon, arcs: &[Arc]) -> Result<(), MethodError> {
     }
     // Every pair of traces whose boxes meet; the first crossing in trace
     // order is reported.
-    let traces: Vec<usize> = (0..arcs.len()).filter(|&i| arcs[i].from != arcs[i].to).collect();
+    let traces: Vec<usize> = (0..arcs.len())
+        .filter(|&i| arcs[i].from != arcs[i].to)
+        .collect();
     let boxes: Vec<Bbox> = traces
         .iter()
         .map(|&i| segment_box(arcs[i].from, arcs[i].to))
