@@ -522,13 +522,15 @@ impl Boundary {
         self.contains_with_rings(p, |_| true)
     }
 
-    /// Indices of the segments whose bounding box meets that of segment `pq`.
+    /// Indices of the segments whose bounding box meets that of segment `pq`,
+    /// in increasing order (whatever the tree's layout).
     pub fn segments_near(&self, p: Coord<f64>, q: Coord<f64>) -> impl Iterator<Item = usize> {
         let mut near = Vec::new();
         self.visit_segments_near(p, q, |i| {
             near.push(i);
             ControlFlow::<()>::Continue(())
         });
+        near.sort_unstable();
         near.into_iter()
     }
 

@@ -166,6 +166,25 @@ impl PackedTree {
         if n == 0 {
             return Self::default();
         }
+        if n <= NODE_SIZE {
+            // One node holds every item (or the item is the root): no order
+            // to find along the curve.
+            let mut tree_boxes = Vec::with_capacity(n + 1);
+            tree_boxes.extend_from_slice(boxes);
+            let mut ids: Vec<u32> = (0..n as u32).collect();
+            let mut level_ends = vec![n];
+            if n > 1 {
+                tree_boxes.push(boxes[1..].iter().fold(boxes[0], |acc, b| union(acc, *b)));
+                ids.push(0);
+                level_ends.push(n + 1);
+            }
+            return Self {
+                boxes: tree_boxes,
+                ids,
+                level_ends,
+                oriented: Vec::new(),
+            };
+        }
         let mut all = [
             f64::INFINITY,
             f64::INFINITY,
