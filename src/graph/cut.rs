@@ -33,7 +33,7 @@
 //! cut, where j's disc touches it (the middle of a rectangle's end side).
 
 use super::line::point_at;
-use super::{EdgeId, NodeId, SkeletonGraph};
+use super::{Adjacency, EdgeId, NodeId, SkeletonGraph};
 use crate::geometry::boundary::closest_on_segment;
 use crate::geometry::Boundary;
 use geo::Coord;
@@ -73,7 +73,7 @@ pub struct CutEnd {
 /// ∂P); `tol` is the distance within which a leaf lies on ∂P.
 pub fn cut_ends(m: &SkeletonGraph, boundary: &Boundary, tol: f64) -> Vec<CutEnd> {
     let adj = m.adjacency();
-    let deg: Vec<usize> = adj.iter().map(Vec::len).collect();
+    let deg: Vec<usize> = adj.iter().map(<[EdgeId]>::len).collect();
     let rings = RingIndex::new(boundary);
     let mut out = Vec::new();
     for (j, edges) in adj.iter().enumerate() {
@@ -147,7 +147,7 @@ pub fn cut_ends(m: &SkeletonGraph, boundary: &Boundary, tol: f64) -> Vec<CutEnd>
 /// the rest of the skeleton, or the node `length` along it).
 fn course_line(
     m: &SkeletonGraph,
-    adj: &[Vec<EdgeId>],
+    adj: &Adjacency,
     deg: &[usize],
     j: NodeId,
     first: EdgeId,

@@ -56,7 +56,7 @@
 
 use super::cut::{cut_ends, CutEnd};
 use super::line::{end_turn, point_at, HOOK_DEG};
-use super::{EdgeId, NodeId, SkeletonGraph};
+use super::{Adjacency, EdgeId, NodeId, SkeletonGraph};
 use crate::geometry::{Boundary, PreparedPolygon};
 use geo::Coord;
 
@@ -227,7 +227,7 @@ struct Extender<'a> {
     boundary: &'a Boundary,
     /// Every cut end, by junction.
     cuts: std::collections::HashMap<NodeId, CutEnd>,
-    adj: Vec<Vec<EdgeId>>,
+    adj: Adjacency,
     len: Vec<f64>,
     tol: f64,
     max_t: f64,

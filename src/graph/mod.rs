@@ -183,13 +183,8 @@ impl SkeletonGraph {
     }
 
     /// Incident edges of every node (a loop edge appears twice).
-    pub fn adjacency(&self) -> Vec<Vec<EdgeId>> {
-        let mut adj = vec![Vec::new(); self.nodes.len()];
-        for (i, e) in self.edges.iter().enumerate() {
-            adj[e.a.0 as usize].push(EdgeId(i as u32));
-            adj[e.b.0 as usize].push(EdgeId(i as u32));
-        }
-        adj
+    pub fn adjacency(&self) -> Adjacency {
+        Adjacency::of(self, |_| true)
     }
 
     /// Degree of every node.
@@ -258,7 +253,7 @@ impl SkeletonGraph {
     /// calling `f(start, edges, end)` for each (the edges in walking order,
     /// in a buffer reused from branch to branch).
     fn walk_branches(&self, mut f: impl FnMut(NodeId, &[EdgeId], NodeId)) {
-        let adj = Incidence::of(self);
+        let adj = Adjacency::of(self, |_| true);
         let mut used = vec![false; self.edges.len()];
         let mut edges = Vec::new();
         let mut walk = |start: NodeId, first: EdgeId, used: &mut Vec<bool>| {
@@ -381,7 +376,7 @@ impl SkeletonGraph {
     /// The polyline from node `n` along its first edge to the first node of
     /// degree ≠ 2 (for a leaf: its whole branch, starting at the leaf);
     /// `adj` is [`SkeletonGraph::adjacency`].
-    pub fn line_from(&self, n: NodeId, adj: &[Vec<EdgeId>]) -> Vec<Coord<f64>> {
+    pub fn line_from(&self, n: NodeId, adj: &Adjacency) -> Vec<Coord<f64>> {
         let deg = |m: NodeId| adj[m.0 as usize].len();
         let mut coords = vec![self.node(n).pos];
         let Some(&first) = adj[n.0 as usize].first() else {
@@ -442,28 +437,39 @@ impl SkeletonGraph {
     }
 }
 
-/// [`SkeletonGraph::adjacency`] in two flat arrays (each node's incident
-/// edges in the same order), for the walks that run several times per
-/// skeleton: one allocation instead of one per node.
-struct Incidence {
+/// The incident edges of every node of a [`SkeletonGraph`] in two flat
+/// arrays: `adj[n]` is node `n`'s, in edge order (a loop twice). One
+/// allocation for the whole graph instead of one per node — the walks over
+/// a skeleton build it several times per polygon.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Adjacency {
     /// `edges[start[n]..start[n + 1]]` are node `n`'s.
     start: Vec<u32>,
     edges: Vec<EdgeId>,
 }
 
-impl Incidence {
-    fn of(g: &SkeletonGraph) -> Self {
+impl Adjacency {
+    /// The edges of `g` for which `keep` is true, per node in edge order (a
+    /// loop twice at its node).
+    pub fn of(g: &SkeletonGraph, keep: impl Fn(EdgeId) -> bool) -> Self {
         let mut start = vec![0u32; g.nodes.len() + 1];
-        for e in &g.edges {
-            start[e.a.0 as usize + 1] += 1;
-            start[e.b.0 as usize + 1] += 1;
+        let mut kept = 0;
+        for (i, e) in g.edges.iter().enumerate() {
+            if keep(EdgeId(i as u32)) {
+                start[e.a.0 as usize + 1] += 1;
+                start[e.b.0 as usize + 1] += 1;
+                kept += 2;
+            }
         }
         for i in 1..start.len() {
             start[i] += start[i - 1];
         }
         let mut next = start.clone();
-        let mut edges = vec![EdgeId(0); 2 * g.edges.len()];
+        let mut edges = vec![EdgeId(0); kept];
         for (i, e) in g.edges.iter().enumerate() {
+            if !keep(EdgeId(i as u32)) {
+                continue;
+            }
             for n in [e.a, e.b] {
                 let at = &mut next[n.0 as usize];
                 edges[*at as usize] = EdgeId(i as u32);
@@ -472,9 +478,24 @@ impl Incidence {
         }
         Self { start, edges }
     }
+
+    /// Number of nodes.
+    pub fn len(&self) -> usize {
+        self.start.len() - 1
+    }
+
+    /// True for a graph without nodes.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Each node's edges, in node order.
+    pub fn iter(&self) -> impl ExactSizeIterator<Item = &[EdgeId]> + '_ {
+        (0..self.len()).map(|n| &self[n])
+    }
 }
 
-impl std::ops::Index<usize> for Incidence {
+impl std::ops::Index<usize> for Adjacency {
     type Output = [EdgeId];
 
     fn index(&self, n: usize) -> &[EdgeId] {

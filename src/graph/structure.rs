@@ -40,7 +40,7 @@ use super::bridge::bridge;
 use super::ends::assemble;
 use super::line::{end_radius, point_at, ON_BOUNDARY_END as END_ON_BOUNDARY};
 use super::prune::trunk::shortest_path;
-use super::{NodeId, SkeletonGraph, UnionFind};
+use super::{EdgeId, NodeId, SkeletonGraph, UnionFind};
 use crate::geometry::packed::{box_distance_2, Bbox, PackedTree};
 use crate::geometry::PreparedPolygon;
 use geo::Coord;
@@ -266,7 +266,7 @@ fn best_seeing(
 fn peel(g: &SkeletonGraph, is_terminal: &[bool]) -> Vec<bool> {
     let adj = g.adjacency();
     let mut keep = vec![true; g.edges().len()];
-    let mut deg: Vec<usize> = adj.iter().map(Vec::len).collect();
+    let mut deg: Vec<usize> = adj.iter().map(<[EdgeId]>::len).collect();
     // Loops count twice in `adj` and never make a leaf.
     let mut stack: Vec<usize> = (0..deg.len())
         .filter(|&n| deg[n] == 1 && !is_terminal[n])

@@ -8,7 +8,7 @@
 //! to end. A component with one leaf keeps its cycles without the leg; a
 //! component without leaves (a ring) is kept.
 
-use crate::graph::{EdgeId, NodeId, SkeletonGraph};
+use crate::graph::{Adjacency, EdgeId, NodeId, SkeletonGraph};
 use std::cmp::{Ordering, Reverse};
 use std::collections::BinaryHeap;
 
@@ -33,7 +33,7 @@ impl Sweep {
     fn run(
         &mut self,
         g: &SkeletonGraph,
-        adj: &[Vec<EdgeId>],
+        adj: &Adjacency,
         len: &[f64],
         deg: &[usize],
         s: NodeId,
@@ -167,15 +167,11 @@ pub(crate) fn shortest_path(
     from: NodeId,
     to: NodeId,
 ) -> Option<Vec<EdgeId>> {
-    let adj: Vec<Vec<EdgeId>> = g
-        .adjacency()
-        .into_iter()
-        .map(|es| es.into_iter().filter(|e| usable[e.0 as usize]).collect())
-        .collect();
+    let adj = Adjacency::of(g, |e| usable[e.0 as usize]);
     let len: Vec<f64> = (0..g.edges().len())
         .map(|i| g.edge_length(EdgeId(i as u32)))
         .collect();
-    let deg: Vec<usize> = adj.iter().map(Vec::len).collect();
+    let deg: Vec<usize> = adj.iter().map(<[EdgeId]>::len).collect();
     let mut sweep = Sweep::new(g.nodes().len());
     sweep.run(g, &adj, &len, &deg, from);
     if from != to && sweep.pred[to.0 as usize].is_none() {
