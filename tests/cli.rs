@@ -87,6 +87,17 @@ fn demo_pipeline_runs_and_writes_every_layer() {
     assert!(reals(&ds, "skeletons", "distortion")
         .iter()
         .all(|z| z.is_some_and(|z| (0.0..=1.0).contains(&z))));
+    // Every spatial layer has its R-tree, holding every feature (a GIS
+    // draws and filters the layers through it).
+    for layer in ["skeletons", "candidates", "widths", "rejected"] {
+        let sql = format!("SELECT count(*) FROM \"rtree_{layer}_geom\"");
+        let mut rs = ds
+            .execute_sql(&sql, None, gdal::vector::sql::Dialect::DEFAULT)
+            .unwrap()
+            .unwrap_or_else(|| panic!("no R-tree for {layer}"));
+        let n = rs.features().next().unwrap().field_as_integer64(0).unwrap();
+        assert_eq!(n, Some(count(&ds, layer) as i64), "{layer}");
+    }
 }
 
 #[test]

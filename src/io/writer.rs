@@ -348,12 +348,18 @@ impl Writer {
         } else {
             ogr_geometry(def.geometry)
         };
+        // The spatial index is made now, while the layer is empty, so every
+        // batch's rows enter it as they are written (on the writer thread,
+        // alongside the workers) rather than all at once when the file is
+        // closed (GDAL's deferred index: a serial tail after the last batch,
+        // 0.8 s for 100 000 skeletons).
+        let spatial = def.geometry != GeometryKind::None;
         let l = ds
             .create_layer(LayerOptions {
                 name,
                 srs,
                 ty,
-                options: None,
+                options: spatial.then_some(&["SPATIAL_INDEX=NO"][..]),
             })
             .map_err(|e| IoError::gdal(format!("creating layer `{name}`"), e))?;
         if def.attributes.is_some() {
@@ -368,6 +374,21 @@ impl Writer {
         }
         for c in self.columns(def) {
             field(&l, c.name, ogr_type(c.ty))?;
+        }
+        if spatial {
+            let column = l
+                .defn()
+                .geom_fields()
+                .next()
+                .map_or_else(|| "geom".to_string(), |g| g.name());
+            let quote = |s: &str| s.replace('\'', "''");
+            let sql = format!(
+                "SELECT CreateSpatialIndex('{}', '{}')",
+                quote(name),
+                quote(&column)
+            );
+            ds.execute_sql(&sql, None, gdal::vector::sql::Dialect::DEFAULT)
+                .map_err(|e| IoError::gdal(format!("indexing layer `{name}`"), e))?;
         }
         Ok(())
     }
