@@ -13,6 +13,7 @@ use super::packed::{
 use geo::{Coord, LineString, Polygon};
 use std::cell::Cell;
 use std::ops::ControlFlow;
+use std::sync::OnceLock;
 
 /// One boundary edge, oriented as its ring (interior on the left).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -69,7 +70,10 @@ pub struct RayHit {
 #[derive(Debug, Clone)]
 pub struct Boundary {
     segments: Vec<BoundarySegment>,
-    tree: PackedTree,
+    /// Built on the first query that needs it: a small boundary answers its
+    /// ray queries by a pass over the segments, so a skeleton scored by
+    /// bars that hit no vertex never builds one.
+    tree: OnceLock<PackedTree>,
     min: Coord<f64>,
     max: Coord<f64>,
 }
@@ -210,7 +214,6 @@ impl Boundary {
 
     /// Indexes an explicit list of segments.
     pub fn from_segments(segments: Vec<BoundarySegment>) -> Self {
-        let ends: Vec<[[f64; 2]; 2]> = segments.iter().map(|s| [pt(s.a), pt(s.b)]).collect();
         let mut min = Coord {
             x: f64::INFINITY,
             y: f64::INFINITY,
@@ -229,10 +232,19 @@ impl Boundary {
         }
         Self {
             segments,
-            tree: PackedTree::of_segments(&ends),
+            tree: OnceLock::new(),
             min,
             max,
         }
+    }
+
+    /// The packed R-tree of the segments, built on first use.
+    fn tree(&self) -> &PackedTree {
+        self.tree.get_or_init(|| {
+            let ends: Vec<[[f64; 2]; 2]> =
+                self.segments.iter().map(|s| [pt(s.a), pt(s.b)]).collect();
+            PackedTree::of_segments(&ends)
+        })
     }
 
     /// All boundary segments (ring order).
@@ -265,7 +277,7 @@ impl Boundary {
     /// The nearest segment among those within squared distance `limit2`.
     fn nearest_segment_within(&self, p: Coord<f64>, limit2: f64) -> Option<(f64, u32)> {
         let (x, y) = (p.x, p.y);
-        self.tree.best_within(
+        self.tree().best_within(
             limit2,
             |b| Some(box_distance_2(b, x, y)),
             Some(|o: &Obb| Some(o.distance_2([x, y]))),
@@ -439,7 +451,7 @@ impl Boundary {
             return None;
         }
         let best: Cell<Option<Found>> = Cell::new(None);
-        self.tree
+        self.tree()
             .branch_and_bound(limit, bound, Some(oriented), |i| {
                 let s = &self.segments[i as usize];
                 if let Some((a, b)) = clip(s.a, s.b) {
@@ -470,12 +482,43 @@ impl Boundary {
         if !(finite(origin) && finite(dir)) {
             return None;
         }
+        if self.few_segments() {
+            // Every segment in index order: the tree's answer (lowest t,
+            // ties to the lower index) without building or walking it.
+            let mut best: Option<(f64, usize)> = None;
+            for (i, s) in self.segments.iter().enumerate() {
+                let hit = ray_segment(origin, dir, s.a, s.b)
+                    .map(|(t, _)| t)
+                    .filter(|&t| t > min_t && t <= max_t);
+                if let Some(t) = hit {
+                    if best.is_none_or(|(bt, _)| t < bt) {
+                        best = Some((t, i));
+                    }
+                }
+            }
+            return best.map(|(t, segment)| RayHit {
+                t,
+                point: origin + dir * t,
+                segment,
+            });
+        }
+        self.first_hit_in_tree(origin, dir, min_t, max_t)
+    }
+
+    /// [`Boundary::first_hit`] through the tree, whatever the size.
+    fn first_hit_in_tree(
+        &self,
+        origin: Coord<f64>,
+        dir: Coord<f64>,
+        min_t: f64,
+        max_t: f64,
+    ) -> Option<RayHit> {
         let slab = RaySlab::new(pt(origin), pt(dir), max_t);
         // Axis-aligned boxes only: a ray crossing the polygon passes as many
         // oriented boxes as axis-aligned ones, and their test costs more
         // (callgrind, a noisy circle of 50 000 vertices: the exits 2.3 G
         // instructions with axis-aligned boxes, 3.1 G with oriented ones).
-        let (t, i) = self.tree.best(
+        let (t, i) = self.tree().best(
             |b| slab.enter(b),
             None::<fn(&Obb) -> Option<f64>>,
             |i, _| {
@@ -495,7 +538,7 @@ impl Boundary {
     /// True when the open segment `pq` properly crosses a boundary segment.
     pub fn crosses(&self, p: Coord<f64>, q: Coord<f64>) -> bool {
         let env = [p.x.min(q.x), p.y.min(q.y), p.x.max(q.x), p.y.max(q.y)];
-        self.tree
+        self.tree()
             .visit(
                 |b| boxes_meet(b, &env),
                 |i| {
@@ -547,7 +590,8 @@ impl Boundary {
         mut f: impl FnMut(usize) -> ControlFlow<B>,
     ) -> Option<B> {
         let env = [p.x.min(q.x), p.y.min(q.y), p.x.max(q.x), p.y.max(q.y)];
-        self.tree.visit(|b| boxes_meet(b, &env), |i| f(i as usize))
+        self.tree()
+            .visit(|b| boxes_meet(b, &env), |i| f(i as usize))
     }
 
     /// Every pair of segments whose boxes meet, once each as `(i, j)` with
@@ -556,7 +600,7 @@ impl Boundary {
         &self,
         mut f: impl FnMut(usize, usize) -> ControlFlow<B>,
     ) -> Option<B> {
-        self.tree.pairs(|i, j| f(i as usize, j as usize))
+        self.tree().pairs(|i, j| f(i as usize, j as usize))
     }
 
     /// Crossing parity of the ray from `p` towards +x against the segments of
@@ -564,7 +608,7 @@ impl Boundary {
     pub fn contains_with_rings(&self, p: Coord<f64>, ring: impl Fn(u32) -> bool) -> bool {
         let max_t = (self.max.x - p.x).max(0.0) + 1.0;
         let mut inside = false;
-        self.tree.visit(
+        self.tree().visit(
             |b| ray_box(b, pt(p), [1.0, 0.0], max_t).is_some(),
             |i| {
                 let s = &self.segments[i as usize];
@@ -770,6 +814,44 @@ mod tests {
     /// ring whose tree has several levels, from points inside and outside.
     /// The one-pass search of both sides gives exactly the two half-plane
     /// searches' answers, on small rings (its use) and on a large one.
+    #[test]
+    fn small_boundaries_answer_rays_as_the_tree_does() {
+        // A wavy ring of 60 segments (the pass) and rays from inside and
+        // outside, through vertices among them; the tree must agree.
+        let ring: Vec<(f64, f64)> = (0..60)
+            .map(|i| {
+                let a = i as f64 * std::f64::consts::TAU / 60.0;
+                let r = 10.0 + if i % 2 == 0 { 1.0 } else { -1.0 };
+                (
+                    (r * a.cos() * 8.0).round() / 8.0,
+                    (r * a.sin() * 8.0).round() / 8.0,
+                )
+            })
+            .collect();
+        let b = Boundary::new(&Polygon::new(LineString::from(ring.clone()), vec![]));
+        assert!(b.few_segments());
+        let mut hits = 0;
+        for (k, &(vx, vy)) in ring.iter().enumerate() {
+            for (ox, oy) in [(0.0, 0.0), (0.5, -1.25), (30.0, 2.0), (-3.0, 20.0)] {
+                let origin = Coord { x: ox, y: oy };
+                let v = Coord { x: vx, y: vy };
+                let dirs = [
+                    v - origin,
+                    Coord {
+                        x: 1.0,
+                        y: k as f64 * 0.1,
+                    },
+                ];
+                for dir in dirs {
+                    let pass = b.first_hit(origin, dir, 1e-9, 1e3);
+                    assert_eq!(pass, b.first_hit_in_tree(origin, dir, 1e-9, 1e3));
+                    hits += usize::from(pass.is_some());
+                }
+            }
+        }
+        assert!(hits > 300, "{hits}");
+    }
+
     #[test]
     fn both_sides_at_once_match_the_two_searches() {
         let dir = |a: f64| Coord {
