@@ -179,13 +179,14 @@ pub fn ray_segment(
         };
         return Some((0.0, s0.clamp(0.0, 1.0)));
     }
-    let t = cross(w, e) / den;
+    // The segment parameter first: most segments a ray is tested against
+    // miss it, and then the second division is not needed.
     let s = cross(w, d) / den;
-    if t >= 0.0 && (0.0..=1.0).contains(&s) {
-        Some((t, s))
-    } else {
-        None
+    if !(0.0..=1.0).contains(&s) {
+        return None;
     }
+    let t = cross(w, e) / den;
+    (t >= 0.0).then_some((t, s))
 }
 
 impl Boundary {
@@ -276,6 +277,24 @@ impl Boundary {
 
     /// The nearest segment among those within squared distance `limit2`.
     fn nearest_segment_within(&self, p: Coord<f64>, limit2: f64) -> Option<(f64, u32)> {
+        if self.few_segments() {
+            // Every segment in index order: the tree's answer (least squared
+            // distance within the limit, ties to the lower index).
+            let mut best: Option<(f64, u32)> = None;
+            for (i, s) in self.segments.iter().enumerate() {
+                let d2 = segment_distance_2(s.a, s.b, p);
+                if d2 <= limit2 && best.is_none_or(|(bd, _)| d2 < bd) {
+                    best = Some((d2, i as u32));
+                }
+            }
+            return best;
+        }
+        self.nearest_segment_in_tree(p, limit2)
+    }
+
+    /// [`Boundary::nearest_segment_within`] through the tree, whatever the
+    /// size.
+    fn nearest_segment_in_tree(&self, p: Coord<f64>, limit2: f64) -> Option<(f64, u32)> {
         let (x, y) = (p.x, p.y);
         self.tree().best_within(
             limit2,
@@ -815,7 +834,7 @@ mod tests {
     /// The one-pass search of both sides gives exactly the two half-plane
     /// searches' answers, on small rings (its use) and on a large one.
     #[test]
-    fn small_boundaries_answer_rays_as_the_tree_does() {
+    fn small_boundaries_answer_as_the_tree_does() {
         // A wavy ring of 60 segments (the pass) and rays from inside and
         // outside, through vertices among them; the tree must agree.
         let ring: Vec<(f64, f64)> = (0..60)
@@ -846,6 +865,17 @@ mod tests {
                     let pass = b.first_hit(origin, dir, 1e-9, 1e3);
                     assert_eq!(pass, b.first_hit_in_tree(origin, dir, 1e-9, 1e3));
                     hits += usize::from(pass.is_some());
+                    // Nearest segments too, from points along the ray (on
+                    // the ring's vertices and edges among them).
+                    for t in [0.25, 0.5, 1.0, 1.5] {
+                        let p = origin + dir * t;
+                        for limit2 in [f64::INFINITY, 4.0] {
+                            assert_eq!(
+                                b.nearest_segment_within(p, limit2),
+                                b.nearest_segment_in_tree(p, limit2)
+                            );
+                        }
+                    }
                 }
             }
         }
