@@ -253,7 +253,7 @@ impl PackedTree {
 
     /// Packs segments (item `i` runs from `ends[i][0]` to `ends[i][1]`),
     /// with an oriented box around every node when there are more than
-    /// [`ORIENTED_MIN`] of them.
+    /// `ORIENTED_MIN` (64) of them.
     pub fn of_segments(ends: &[[[f64; 2]; 2]]) -> Self {
         let boxes: Vec<Bbox> = ends
             .iter()

@@ -2,10 +2,13 @@
 //!
 //! Coordinates are taken relative to the polygon's bounding-box corner and
 //! multiplied by `scale = 2^k`, the largest power of two with
-//! `extent · scale ≤ 2^27` (≈ 1.3e8), then rounded. The grid spacing (the
+//! `extent · scale ≤ 2^27` (≈ 1.3e8), rounded, and shifted by [`OFFSET`]
+//! (2^27) away from zero, where boostvoronoi's error bounds are relative
+//! and fail for circle events near an axis. The grid spacing (the
 //! method's coordinate resolution) is therefore `1 / scale < extent / 2^26
 //! ≈ 1.5e-8 × extent`, whatever the position of the polygon on Earth. Powers
-//! of two make the way back (`origin + q / scale`) exact up to one rounding.
+//! of two make the way back (`origin + (q − OFFSET) / scale`) exact up to one
+//! rounding (`q − OFFSET` is exact for a point near the polygon).
 //!
 //! Rounding can break what boostvoronoi requires of its input (segments meet
 //! only at shared endpoints), so the segments are cleaned on the grid:
@@ -55,6 +58,12 @@ pub(super) struct Grid {
 /// predicates on the training rivers for no visible gain.
 const GRID_MAX: f64 = (1u64 << 27) as f64;
 
+/// Added to every grid coordinate: the polygon lies in
+/// `[OFFSET, OFFSET + GRID_MAX]` on both axes, so no circle event's centre is
+/// near zero, where a relative error bound fails on a small absolute error
+/// and boostvoronoi falls back to its exact (extended-integer) evaluation.
+const OFFSET: i64 = 1 << 27;
+
 impl Grid {
     /// The grid for a polygon with bounding-box corner `origin` and larger
     /// bounding-box side `extent` (> 0).
@@ -87,16 +96,17 @@ impl Grid {
     /// The grid point nearest to `c`.
     pub fn quantise(&self, c: Coord<f64>) -> Pt {
         [
-            ((c.x - self.origin.x) * self.scale).round() as i64,
-            ((c.y - self.origin.y) * self.scale).round() as i64,
+            ((c.x - self.origin.x) * self.scale).round() as i64 + OFFSET,
+            ((c.y - self.origin.y) * self.scale).round() as i64 + OFFSET,
         ]
     }
 
     /// World coordinates of a grid-frame position.
     pub fn world(&self, x: f64, y: f64) -> Coord<f64> {
+        let k = OFFSET as f64;
         Coord {
-            x: self.origin.x + x / self.scale,
-            y: self.origin.y + y / self.scale,
+            x: self.origin.x + (x - k) / self.scale,
+            y: self.origin.y + (y - k) / self.scale,
         }
     }
 
