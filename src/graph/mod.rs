@@ -172,7 +172,17 @@ impl SkeletonGraph {
 
     /// Length of an edge's polyline.
     pub fn edge_length(&self, e: EdgeId) -> f64 {
-        polyline_length(&self.edge_coords(e))
+        // polyline_length of edge_coords, term by term in the same order,
+        // without building the polyline.
+        let ed = self.edge(e);
+        let points = std::iter::once(self.node(ed.a).pos)
+            .chain(ed.interior.iter().copied())
+            .chain(std::iter::once(self.node(ed.b).pos));
+        points
+            .clone()
+            .zip(points.skip(1))
+            .map(|(p, q)| crate::geometry::norm(q - p))
+            .sum()
     }
 
     /// Total length of all edges.
@@ -233,7 +243,12 @@ impl SkeletonGraph {
     pub fn branches(&self) -> Vec<Branch> {
         let mut out = Vec::new();
         self.walk_branches(|start, edges, end| {
-            let mut coords = vec![self.node(start).pos];
+            let len = 1 + edges
+                .iter()
+                .map(|&e| self.edge(e).interior.len() + 1)
+                .sum::<usize>();
+            let mut coords = Vec::with_capacity(len);
+            coords.push(self.node(start).pos);
             let mut cur = start;
             for &e in edges {
                 self.push_oriented(&mut coords, e, cur);
