@@ -397,13 +397,11 @@ impl Boundary {
             // The segment clipped to each closed half-plane, as
             // `clip_to_half_plane` clips it (the opposite side's values are
             // the negated ones, exactly).
-            let cut = |f_a: f64, f_b: f64| match (f_a >= 0.0, f_b >= 0.0) {
-                (true, true) => Some((s.a, s.b)),
-                (false, false) => None,
-                (true, false) => Some((s.a, s.a + (s.b - s.a) * (f_a / (f_a - f_b)))),
-                (false, true) => Some((s.a + (s.b - s.a) * (f_a / (f_a - f_b)), s.b)),
-            };
-            for (k, part) in [cut(fa, fb), cut(-fa, -fb)].into_iter().enumerate() {
+            let parts = [
+                clip_by_sides(s.a, s.b, fa, fb),
+                clip_by_sides(s.a, s.b, -fa, -fb),
+            ];
+            for (k, part) in parts.into_iter().enumerate() {
                 let Some((a, b)) = part else { continue };
                 let c = closest_on_segment(a, b, q).0;
                 let d = super::norm(c - q);
@@ -678,6 +676,17 @@ fn clip_to_half_plane(
 ) -> Option<(Coord<f64>, Coord<f64>)> {
     let fa = (a - q).x * n.x + (a - q).y * n.y;
     let fb = (b - q).x * n.x + (b - q).y * n.y;
+    clip_by_sides(a, b, fa, fb)
+}
+
+/// Segment `ab` cut down to where a linear function with values `fa` at `a`
+/// and `fb` at `b` is ≥ 0, or `None` when it is negative at both ends.
+fn clip_by_sides(
+    a: Coord<f64>,
+    b: Coord<f64>,
+    fa: f64,
+    fb: f64,
+) -> Option<(Coord<f64>, Coord<f64>)> {
     match (fa >= 0.0, fb >= 0.0) {
         (true, true) => Some((a, b)),
         (false, false) => None,
@@ -828,11 +837,8 @@ mod tests {
         assert_eq!(c, Coord { x: 4.0, y: 4.0 });
     }
 
-    /// The tree searches in half-planes and sectors find what a scan of
-    /// every segment finds (ties to the lower segment number), on a wavy
-    /// ring whose tree has several levels, from points inside and outside.
-    /// The one-pass search of both sides gives exactly the two half-plane
-    /// searches' answers, on small rings (its use) and on a large one.
+    /// A boundary of few segments answers ray and nearest-segment queries
+    /// by a pass over them: exactly the tree's answers, ties included.
     #[test]
     fn small_boundaries_answer_as_the_tree_does() {
         // A wavy ring of 60 segments (the pass) and rays from inside and
@@ -882,6 +888,8 @@ mod tests {
         assert!(hits > 300, "{hits}");
     }
 
+    /// The one-pass search of both sides gives exactly the two half-plane
+    /// searches' answers, on small rings (its use) and on a large one.
     #[test]
     fn both_sides_at_once_match_the_two_searches() {
         let dir = |a: f64| Coord {
@@ -908,6 +916,9 @@ mod tests {
         assert!(compared > 1500);
     }
 
+    /// The tree searches in half-planes and sectors find what a scan of
+    /// every segment finds (ties to the lower segment number), on a wavy
+    /// ring whose tree has several levels, from points inside and outside.
     #[test]
     fn half_plane_and_sector_searches_match_a_scan() {
         let b = wavy_ring(900, [9.0, 11.0], [2.0, 57.0]);
