@@ -51,6 +51,22 @@ pub fn closest_on_segment(a: Coord<f64>, b: Coord<f64>, p: Coord<f64>) -> (Coord
     (a + d * t, t)
 }
 
+/// [`closest_on_segment`]'s point without its parameter, dividing only when
+/// the foot is interior (see [`segment_distance_2`]: the same point, but
+/// for the sign of a zero coordinate).
+fn closest_point(a: Coord<f64>, b: Coord<f64>, p: Coord<f64>) -> Coord<f64> {
+    let d = b - a;
+    let dot = (p - a).x * d.x + (p - a).y * d.y;
+    let l2 = d.x * d.x + d.y * d.y;
+    if dot <= 0.0 || l2 == 0.0 {
+        a
+    } else if dot < l2 {
+        a + d * (dot / l2)
+    } else {
+        a + d
+    }
+}
+
 /// The first boundary point met by a ray.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RayHit {
@@ -100,13 +116,23 @@ const FEW_SEGMENTS: usize = 64;
 
 /// Squared distance from `p` to segment `ab` (the nearest point computed as
 /// the projection parameter strictly inside (0, 1), else an end).
+///
+/// The parameter is `dot / l2` (`dot` = (p − a)·(b − a), `l2` = |b − a|²),
+/// but the division is made only when the foot is interior: `0 < dot/l2`
+/// exactly when `0 < dot` (a quotient that underflows to zero gives the
+/// same point `a`), and a quotient of floating-point numbers `dot < l2` is
+/// below one after rounding (the gap below 1 is 2⁻⁵³, and `dot/l2` is at
+/// most 1 − 2⁻⁵³), so `dot/l2 < 1` exactly when `dot < l2`. The same
+/// distance, bit for bit, as dividing first; most segments of a pass have
+/// their nearest point at an end.
 fn segment_distance_2(a: Coord<f64>, b: Coord<f64>, p: Coord<f64>) -> f64 {
     let dir = b - a;
-    let s = ((p - a).x * dir.x + (p - a).y * dir.y) / (dir.x * dir.x + dir.y * dir.y);
-    let n = if 0.0 < s && s < 1.0 {
-        a + dir * s
-    } else if s <= 0.0 {
+    let dot = (p - a).x * dir.x + (p - a).y * dir.y;
+    let l2 = dir.x * dir.x + dir.y * dir.y;
+    let n = if dot <= 0.0 {
         a
+    } else if dot < l2 {
+        a + dir * (dot / l2)
     } else {
         b
     };
@@ -142,6 +168,7 @@ pub fn properly_cross(p: Coord<f64>, q: Coord<f64>, a: Coord<f64>, b: Coord<f64>
 /// Intersection parameter of ray `o + t d` with segment `ab`: `(t, s)` where
 /// `s` ∈ [0, 1] is the segment parameter. For a collinear overlap the nearest
 /// overlapping point is returned.
+#[inline]
 pub fn ray_segment(
     o: Coord<f64>,
     d: Coord<f64>,
@@ -179,12 +206,25 @@ pub fn ray_segment(
         };
         return Some((0.0, s0.clamp(0.0, 1.0)));
     }
-    // The segment parameter first: most segments a ray is tested against
-    // miss it, and then the second division is not needed.
-    let s = cross(w, d) / den;
-    if !(0.0..=1.0).contains(&s) {
+    // Whether the segment parameter `s = num / den` is in [0, 1], decided
+    // without dividing (most segments a ray is tested against miss it): the
+    // quotient's sign is that of its operands, and a quotient of
+    // floating-point numbers exceeds one after rounding exactly when the
+    // numerator's magnitude exceeds the denominator's (the gap above 1 is
+    // 2⁻⁵², and the quotient is then above 1 + 2⁻⁵³, which rounds up; see
+    // `segment_distance_2` for the gap below). The same decisions as
+    // dividing first, but for a negative quotient below 2⁻¹⁰⁷⁴ in magnitude,
+    // which would have rounded to −0 and counted as 0.
+    let num = cross(w, d);
+    let inside = if den > 0.0 {
+        0.0 <= num && num <= den
+    } else {
+        den <= num && num <= 0.0
+    };
+    if !inside {
         return None;
     }
+    let s = num / den;
     let t = cross(w, e) / den;
     (t >= 0.0).then_some((t, s))
 }
@@ -388,6 +428,7 @@ impl Boundary {
         normal: Coord<f64>,
     ) -> [Option<(Coord<f64>, f64)>; 2] {
         let mut best: [Option<(Coord<f64>, f64)>; 2] = [None, None];
+        let mut best_d2 = [f64::INFINITY; 2];
         if !finite(q) {
             return best;
         }
@@ -403,11 +444,18 @@ impl Boundary {
             ];
             for (k, part) in parts.into_iter().enumerate() {
                 let Some((a, b)) = part else { continue };
-                let c = closest_on_segment(a, b, q).0;
-                let d = super::norm(c - q);
-                // Segments in index order: the first of equal distances stays.
-                if best[k].is_none_or(|(_, bd)| d < bd) {
-                    best[k] = Some((c, d));
+                let c = closest_point(a, b, q);
+                let d2 = (c - q).x * (c - q).x + (c - q).y * (c - q).y;
+                // Segments in index order: the first of equal distances
+                // stays. The root is taken only for a squared distance
+                // below the best one's (a root is never smaller when its
+                // square is not), and compared as before: the same answer.
+                if d2 < best_d2[k] || best[k].is_none() {
+                    let d = d2.sqrt();
+                    if best[k].is_none_or(|(_, bd)| d < bd) {
+                        best[k] = Some((c, d));
+                        best_d2[k] = d2;
+                    }
                 }
             }
         }
