@@ -24,6 +24,17 @@ pub fn norm(d: Coord<f64>) -> f64 {
     (d.x * d.x + d.y * d.y).sqrt()
 }
 
+/// `d.x.hypot(d.y) <= tol`, the same answer bit for bit, with `hypot` only
+/// when both components are within `tol`: `hypot` is never below the larger
+/// component (a faithfully rounded `√(x² + y²) ≥ max(|x|, |y|)` cannot
+/// round below that floating-point number), so a larger component decides
+/// alone — as it does for nearly every pair of points compared with a
+/// tolerance.
+#[inline]
+pub fn within_hypot(d: Coord<f64>, tol: f64) -> bool {
+    d.x.abs() <= tol && d.y.abs() <= tol && d.x.hypot(d.y) <= tol
+}
+
 /// Why a polygon cannot be prepared for skeletonisation.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum GeometryError {

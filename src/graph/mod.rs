@@ -559,6 +559,15 @@ impl GraphBuilder {
         Some(self.graph.add_edge(a, b, Vec::new()))
     }
 
+    /// [`GraphBuilder::segment`] between two nodes it made, without looking
+    /// their positions up again (ignored when they are at one position).
+    pub fn segment_between(&mut self, a: NodeId, b: NodeId) -> Option<EdgeId> {
+        if self.graph.node(a).pos == self.graph.node(b).pos {
+            return None;
+        }
+        Some(self.graph.add_edge(a, b, Vec::new()))
+    }
+
     /// Adds a polyline as one edge (ignored when shorter than two distinct points).
     pub fn polyline(&mut self, pts: &[Coord<f64>]) -> Option<EdgeId> {
         let mut v: Vec<Coord<f64>> = Vec::with_capacity(pts.len());

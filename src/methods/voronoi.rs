@@ -256,6 +256,9 @@ impl SkeletonMethod for Voronoi {
         // the R-tree a second time for every node.
         let mut b = GraphBuilder::new();
         let mut radii = Vec::new();
+        // Each Voronoi vertex's node, looked up by position once (vertices
+        // at the same position share a node, as the builder decides).
+        let mut node_of: Vec<Option<crate::graph::NodeId>> = vec![None; pos.len()];
         for &[u, v] in &vd.edges {
             let (u, v) = (u as usize, v as usize);
             let (Some(ru), Some(rv)) = (radius[u], radius[v]) else {
@@ -264,12 +267,18 @@ impl SkeletonMethod for Voronoi {
             if boundary.crosses(pos[u], pos[v]) {
                 continue;
             }
-            for (p, r) in [(pos[u], ru), (pos[v], rv)] {
-                if b.node(p).0 as usize == radii.len() {
-                    radii.push(r);
+            for (k, r) in [(u, ru), (v, rv)] {
+                if node_of[k].is_none() {
+                    let n = b.node(pos[k]);
+                    if n.0 as usize == radii.len() {
+                        radii.push(r);
+                    }
+                    node_of[k] = Some(n);
                 }
             }
-            b.segment(pos[u], pos[v]);
+            if let (Some(a), Some(c)) = (node_of[u], node_of[v]) {
+                b.segment_between(a, c);
+            }
         }
         let mut g = b.finish_raw();
         for (n, r) in g.nodes_mut().iter_mut().zip(radii) {
@@ -362,7 +371,7 @@ impl VoronoiDiagram {
             }
             let (f, g) = (f.fix().index(), g.fix().index());
             let (cf, cg) = (centre[f], centre[g]);
-            if (cf.x - cg.x).hypot(cf.y - cg.y) <= merge_tolerance {
+            if crate::geometry::within_hypot(cf - cg, merge_tolerance) {
                 uf.union(f, g);
             } else {
                 dual.push((f, g));
@@ -384,8 +393,9 @@ impl VoronoiDiagram {
             if id[r] == u32::MAX {
                 id[r] = vertices.len() as u32;
                 vertices.push(centre[r]);
-                let d = centre[r] - corner[r];
-                site_distance.push(d.x.hypot(d.y));
+                // A bound of the search for the nearest boundary point,
+                // which never changes its answer: no need for `hypot`.
+                site_distance.push(crate::geometry::norm(centre[r] - corner[r]));
             }
             id[f] = id[r];
         }

@@ -364,7 +364,7 @@ impl<'a> Propagation<'a> {
     fn at(&self, v: VertexId, p: Coord<f64>) -> bool {
         let speed = self.w.v(v).vel.map_or(0.0, |s| s.x.hypot(s.y));
         let d = self.w.pos(v, self.now) - p;
-        d.x.hypot(d.y) <= self.tol * (1.0 + speed)
+        crate::geometry::within_hypot(d, self.tol * (1.0 + speed))
     }
 
     /// Handles the valid event `ev` (popped at time `now`) together with
@@ -741,8 +741,8 @@ impl<'a> Propagation<'a> {
             }
             let (px, py) = (w.pos(x, t), w.pos(y, t));
             let (sx, sy) = (dot(l.dir, px), dot(l.dir, py));
-            let at_x = (px - p).x.hypot((px - p).y) <= tol;
-            let at_y = (py - p).x.hypot((py - p).y) <= tol;
+            let at_x = crate::geometry::within_hypot(px - p, tol);
+            let at_y = crate::geometry::within_hypot(py - p, tol);
             // Touching a zero-length piece, or a piece end that already
             // carries one of v's own lines, changes nothing: not a split.
             // A vertex made by an event touching a piece end at once: the
@@ -994,7 +994,11 @@ fn crossing(
     }
     let s = wavefront::cross(a - p, e) / den;
     let x = p + d * s;
-    let far = |c: Coord<f64>| (c - x).x.hypot((c - x).y) > tol;
+    let far = |c: Coord<f64>| {
+        // `hypot > tol`, the hypot only when no component alone decides.
+        let d = c - x;
+        d.x.abs() > tol || d.y.abs() > tol || d.x.hypot(d.y) > tol
+    };
     let off = |u: Coord<f64>, v: Coord<f64>, c: Coord<f64>| {
         let w = v - u;
         wavefront::cross(w, c - u).abs() / w.x.hypot(w.y)
