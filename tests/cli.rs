@@ -97,7 +97,65 @@ fn demo_pipeline_runs_and_writes_every_layer() {
             .unwrap_or_else(|| panic!("no R-tree for {layer}"));
         let n = rs.features().next().unwrap().field_as_integer64(0).unwrap();
         assert_eq!(n, Some(count(&ds, layer) as i64), "{layer}");
+        // The tree is sound by SQLite's own check, and each row is under
+        // its own id in a box around its geometry.
+        let check = format!("SELECT rtreecheck('rtree_{layer}_geom')");
+        assert_eq!(first_text(&ds, &check).as_deref(), Some("ok"), "{layer}");
+        let covered = format!(
+            "SELECT count(*) FROM \"{layer}\" t JOIN \"rtree_{layer}_geom\" r ON r.id = t.fid \
+             WHERE r.minx <= ST_MinX(t.geom) AND r.maxx >= ST_MaxX(t.geom) \
+             AND r.miny <= ST_MinY(t.geom) AND r.maxy >= ST_MaxY(t.geom)"
+        );
+        assert_eq!(
+            first_text(&ds, &covered),
+            Some(count(&ds, layer).to_string()),
+            "{layer}"
+        );
     }
+    // The widths layer is large enough for a tree of several nodes.
+    let nodes = first_text(&ds, "SELECT count(*) FROM rtree_widths_geom_node");
+    assert!(
+        nodes
+            .as_deref()
+            .is_some_and(|n| n.parse::<i32>().unwrap() > 1),
+        "widths tree nodes: {nodes:?}"
+    );
+    drop(ds);
+    // A row added later by any GIS is indexed as in any GeoPackage.
+    let ds = gdal::Dataset::open_ex(
+        &out,
+        gdal::DatasetOptions {
+            open_flags: gdal::GdalOpenFlags::GDAL_OF_UPDATE | gdal::GdalOpenFlags::GDAL_OF_VECTOR,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let before = count(&ds, "skeletons");
+    {
+        let l = ds.layer_by_name("skeletons").unwrap();
+        let g = gdal::vector::Geometry::from_wkt("MULTILINESTRING ((1 2, 3 4))").unwrap();
+        let mut f = gdal::vector::Feature::new(l.defn()).unwrap();
+        f.set_geometry(g).unwrap();
+        f.create(&l).unwrap();
+    }
+    let indexed = first_text(
+        &ds,
+        "SELECT count(*) FROM rtree_skeletons_geom WHERE minx <= 1 AND maxx >= 3 AND miny <= 2 AND maxy >= 4",
+    );
+    assert_eq!(indexed.as_deref(), Some("1"));
+    assert_eq!(
+        first_text(&ds, "SELECT count(*) FROM rtree_skeletons_geom"),
+        Some((before + 1).to_string())
+    );
+}
+
+/// The first column of the first row of `sql`, as text.
+fn first_text(ds: &gdal::Dataset, sql: &str) -> Option<String> {
+    let mut rs = ds
+        .execute_sql(sql, None, gdal::vector::sql::Dialect::SQLITE)
+        .unwrap()?;
+    let f = rs.features().next()?;
+    f.field_as_string(0).unwrap()
 }
 
 #[test]
