@@ -427,8 +427,8 @@ impl Boundary {
         q: Coord<f64>,
         normal: Coord<f64>,
     ) -> [Option<(Coord<f64>, f64)>; 2] {
+        // The nearest point on each side so far and its squared distance.
         let mut best: [Option<(Coord<f64>, f64)>; 2] = [None, None];
-        let mut best_d2 = [f64::INFINITY; 2];
         if !finite(q) {
             return best;
         }
@@ -447,19 +447,21 @@ impl Boundary {
                 let c = closest_point(a, b, q);
                 let d2 = (c - q).x * (c - q).x + (c - q).y * (c - q).y;
                 // Segments in index order: the first of equal distances
-                // stays. The root is taken only for a squared distance
-                // below the best one's (a root is never smaller when its
-                // square is not), and compared as before: the same answer.
-                if d2 < best_d2[k] || best[k].is_none() {
-                    let d = d2.sqrt();
-                    if best[k].is_none_or(|(_, bd)| d < bd) {
-                        best[k] = Some((c, d));
-                        best_d2[k] = d2;
-                    }
+                // stays, distances compared as roots (as the tree search
+                // compares them). A root is never smaller when its square
+                // is not, and is smaller when its square is smaller by more
+                // than the roots' rounding (a relative 2⁻⁵³ each): only
+                // squares closer than that need their roots. The root of
+                // the winner is taken at the end: the same answer.
+                let nearer = best[k].is_none_or(|(_, bd2)| {
+                    d2 < bd2 && (d2 < bd2 * (1.0 - 1e-15) || d2.sqrt() < bd2.sqrt())
+                });
+                if nearer {
+                    best[k] = Some((c, d2));
                 }
             }
         }
-        best
+        best.map(|b| b.map(|(c, d2)| (c, d2.sqrt())))
     }
 
     /// True when the boundary has so few segments that a pass over all of
