@@ -110,12 +110,7 @@ pub fn conform(
         return g;
     }
     let tol = END_ON_BOUNDARY * polygon.extent();
-    let boxes: Vec<Bbox> = g
-        .nodes()
-        .iter()
-        .map(|n| [n.pos.x, n.pos.y, n.pos.x, n.pos.y])
-        .collect();
-    let tree = PackedTree::new(&boxes);
+    let tree = NodeIndex::new(&g);
     let served: Vec<Option<(NodeId, bool)>> = structure
         .contacts
         .iter()
@@ -154,6 +149,53 @@ pub fn conform(
     super::planar::node_crossings(out, polygon.boundary()).0
 }
 
+/// The nodes of a graph by position, for the searches around each contact.
+struct NodeIndex {
+    /// Each node's point as a box, in node order.
+    boxes: Vec<Bbox>,
+    /// A tree over them when there are many.
+    tree: Option<PackedTree>,
+}
+
+/// At most this many nodes are scanned instead of searched in a tree: a
+/// handful of searches per contact cost less than building one (most
+/// islands' skeletons).
+const FEW_NODES: usize = 128;
+
+impl NodeIndex {
+    fn new(g: &SkeletonGraph) -> Self {
+        let boxes: Vec<Bbox> = g
+            .nodes()
+            .iter()
+            .map(|n| [n.pos.x, n.pos.y, n.pos.x, n.pos.y])
+            .collect();
+        let tree = (boxes.len() > FEW_NODES).then(|| PackedTree::new(&boxes));
+        Self { boxes, tree }
+    }
+
+    /// Every node within squared distance `r2` of `q` (a node's box is its
+    /// point, so the box distance is the point's squared distance, bit for
+    /// bit), in no particular order.
+    fn within(&self, q: Coord<f64>, r2: f64, mut f: impl FnMut(u32)) {
+        let near = |bx: &Bbox| box_distance_2(bx, q.x, q.y) <= r2;
+        match &self.tree {
+            Some(tree) => {
+                tree.visit(near, |n| {
+                    f(n);
+                    ControlFlow::<()>::Continue(())
+                });
+            }
+            None => {
+                for (n, bx) in self.boxes.iter().enumerate() {
+                    if near(bx) {
+                        f(n as u32);
+                    }
+                }
+            }
+        }
+    }
+}
+
 /// The node of `g` that serves contact `c` (see the module documentation),
 /// and whether it sees `c`. When no node sees `c` (the reference runs into
 /// a channel too narrow for this method's skeleton), the node that sees the
@@ -162,7 +204,7 @@ pub fn conform(
 /// `on_boundary`.
 fn terminal(
     g: &SkeletonGraph,
-    tree: &PackedTree,
+    tree: &NodeIndex,
     c: &Contact,
     polygon: &PreparedPolygon,
     tol: f64,
@@ -216,7 +258,7 @@ fn terminal(
 #[allow(clippy::too_many_arguments)]
 fn best_seeing(
     g: &SkeletonGraph,
-    tree: &PackedTree,
+    tree: &NodeIndex,
     q: Coord<f64>,
     start: f64,
     limit: f64,
@@ -230,19 +272,14 @@ fn best_seeing(
         // Candidates in order of (score, distance, node); the first that
         // sees q is the answer, so the costly visibility test runs only
         // until then.
-        // Every node at most `reach` from q (a node's box is its point, so
-        // the box distance is the point's squared distance, bit for bit).
+        // Every node at most `reach` from q.
         let r2 = reach * reach;
         let mut keys: Vec<(f64, f64, u32)> = Vec::new();
-        tree.visit(
-            |bx| box_distance_2(bx, q.x, q.y) <= r2,
-            |n| {
-                let node = g.node(NodeId(n));
-                let d = (node.pos - q).x.hypot((node.pos - q).y);
-                keys.push((score(d, node.radius), d, n));
-                ControlFlow::<()>::Continue(())
-            },
-        );
+        tree.within(q, r2, |n| {
+            let node = g.node(NodeId(n));
+            let d = (node.pos - q).x.hypot((node.pos - q).y);
+            keys.push((score(d, node.radius), d, n));
+        });
         keys.sort_unstable_by(|a, b| {
             a.0.total_cmp(&b.0)
                 .then(a.1.total_cmp(&b.1))
