@@ -25,6 +25,10 @@ use std::ops::ControlFlow;
 /// less CPU, small polygons the same (`BENCHMARKS.md`).
 const NODE_SIZE: usize = 8;
 
+/// At most this many boxes are paired one by one ([`PackedTree::pairs_of`]):
+/// the skeletons and rings of most islands.
+const FEW_PAIRED: usize = 48;
+
 /// Depth-first stack entries a query can need: one node's children per
 /// level, and a tree over 2^32 items has 11 levels.
 const STACK: usize = NODE_SIZE * 12;
@@ -354,6 +358,28 @@ impl PackedTree {
                 } else {
                     stack[top] = MaybeUninit::new(c);
                     top += 1;
+                }
+            }
+        }
+        None
+    }
+
+    /// [`PackedTree::pairs`] of the tree over `boxes`, without building one
+    /// for a few boxes: every pair is tested in turn (in order: `(0, 1)`,
+    /// `(0, 2)`, …), which costs less than packing them.
+    pub fn pairs_of<B>(
+        boxes: &[Bbox],
+        mut pair: impl FnMut(u32, u32) -> ControlFlow<B>,
+    ) -> Option<B> {
+        if boxes.len() > FEW_PAIRED {
+            return Self::new(boxes).pairs(pair);
+        }
+        for (i, a) in boxes.iter().enumerate() {
+            for (j, b) in boxes.iter().enumerate().skip(i + 1) {
+                if boxes_meet(a, b) {
+                    if let ControlFlow::Break(x) = pair(i as u32, j as u32) {
+                        return Some(x);
+                    }
                 }
             }
         }

@@ -67,7 +67,7 @@ fn find(segs: &[Seg]) -> Vec<(usize, usize, Coord<f64>)> {
         })
         .collect();
     let mut out = Vec::new();
-    PackedTree::new(&boxes).pairs(|i, j| {
+    PackedTree::pairs_of(&boxes, |i, j| {
         let (s, t) = (&segs[i as usize], &segs[j as usize]);
         if properly_cross(s.a, s.b, t.a, t.b) {
             out.push((i as usize, j as usize, intersection(s.a, s.b, t.a, t.b)));

@@ -322,7 +322,7 @@ fn bad_pair(s: Seg, t: Seg) -> bool {
 /// shared endpoint is reported, at its start.
 fn check_no_crossing(segs: &[Seg]) -> Result<(), Crossing> {
     let mut first: Option<u32> = None;
-    PackedTree::new(&boxes(segs, 0.0)).pairs(|i, j| {
+    PackedTree::pairs_of(&boxes(segs, 0.0), |i, j| {
         if first.is_none_or(|f| i < f) && bad_pair(segs[i as usize], segs[j as usize]) {
             first = Some(i);
         }

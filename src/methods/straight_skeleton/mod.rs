@@ -954,7 +954,7 @@ fn verify(polygon: &PreparedPolygon, arcs: &[Arc]) -> Result<(), MethodError> {
         .map(|&i| segment_box(arcs[i].from, arcs[i].to))
         .collect();
     let mut first: Option<(usize, usize, Coord<f64>)> = None;
-    PackedTree::new(&boxes).pairs(|i, j| {
+    PackedTree::pairs_of(&boxes, |i, j| {
         let (i, j) = (traces[i as usize], traces[j as usize]);
         if first.is_none_or(|(fi, fj, _)| (i, j) < (fi, fj)) {
             let (a, b) = (&arcs[i], &arcs[j]);
