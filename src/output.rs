@@ -634,6 +634,22 @@ impl Rows {
         self.connections.append(&mut other.connections);
         self.rejected.append(&mut other.rejected);
     }
+
+    /// Rows in every layer together.
+    pub fn len(&self) -> usize {
+        self.skeletons.len()
+            + self.candidates.len()
+            + self.bars.len()
+            + self.widths.len()
+            + self.areas.len()
+            + self.connections.len()
+            + self.rejected.len()
+    }
+
+    /// True when there is no row in any layer.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
 }
 
 #[cfg(test)]

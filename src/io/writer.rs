@@ -38,7 +38,16 @@ pub struct Writer {
     /// `input.merge_adjacent`: the `members` column.
     merge: bool,
     source_fields: Vec<(String, FieldInfo)>,
+    /// Rows written in the open transaction (`None`: none open).
+    in_transaction: Option<usize>,
 }
+
+/// Rows written between two commits. A commit costs about as much as
+/// writing a thousand rows; the file is a temporary one until the run has
+/// finished (a failed run leaves nothing), so a long transaction risks
+/// nothing, and SQLite spills what its page cache cannot hold to the file,
+/// so memory stays bounded.
+const ROWS_PER_COMMIT: usize = 65_536;
 
 /// Checks that `spec.path` can be written without harm, creating nothing
 /// that stays: a `.gpkg` path, not an existing device, FIFO or directory,
@@ -300,6 +309,7 @@ impl Writer {
             collapse,
             merge,
             source_fields,
+            in_transaction: None,
         };
         let r = (|| -> Result<(), IoError> {
             let srs = srs.as_ref();
@@ -445,30 +455,53 @@ impl Writer {
         Ok(())
     }
 
-    /// Writes one batch of rows in one transaction.
+    /// Writes one batch of rows, in the transaction open since the last
+    /// commit (one commit every [`ROWS_PER_COMMIT`] rows and at the end).
     pub fn write_batch(&mut self, rows: &Rows) -> Result<(), IoError> {
-        let mut ds = self.ds.take().expect("open until finish/abort");
+        let ds = self.ds.take().expect("open until finish/abort");
         let r = (|| {
-            let txn = ds
-                .start_transaction()
-                .map_err(|e| IoError::gdal("starting a transaction", e))?;
-            self.write_rows(&txn, &SKELETONS, &self.spec.layer, &rows.skeletons)?;
-            self.write_rows(&txn, &CANDIDATES, CANDIDATES.name, &rows.candidates)?;
-            self.write_rows(&txn, &BARS, BARS.name, &rows.bars)?;
-            self.write_rows(&txn, &WIDTHS, WIDTHS.name, &rows.widths)?;
-            self.write_rows(&txn, &AREAS, AREAS.name, &rows.areas)?;
-            self.write_rows(&txn, &CONNECTIONS, CONNECTIONS.name, &rows.connections)?;
-            self.write_rows(&txn, &REJECTED, REJECTED.name, &rows.rejected)?;
-            txn.commit()
-                .map_err(|e| IoError::gdal("committing a batch", e))
+            let written = match self.in_transaction {
+                Some(n) => n,
+                None => {
+                    transaction(&ds, "starting a transaction", |h| unsafe {
+                        gdal_sys::GDALDatasetStartTransaction(h, 0)
+                    })?;
+                    0
+                }
+            };
+            self.in_transaction = Some(written);
+            self.write_rows(&ds, &SKELETONS, &self.spec.layer, &rows.skeletons)?;
+            self.write_rows(&ds, &CANDIDATES, CANDIDATES.name, &rows.candidates)?;
+            self.write_rows(&ds, &BARS, BARS.name, &rows.bars)?;
+            self.write_rows(&ds, &WIDTHS, WIDTHS.name, &rows.widths)?;
+            self.write_rows(&ds, &AREAS, AREAS.name, &rows.areas)?;
+            self.write_rows(&ds, &CONNECTIONS, CONNECTIONS.name, &rows.connections)?;
+            self.write_rows(&ds, &REJECTED, REJECTED.name, &rows.rejected)?;
+            let written = written + rows.len();
+            self.in_transaction = Some(written);
+            if written >= ROWS_PER_COMMIT {
+                self.commit(&ds)?;
+            }
+            Ok(())
         })();
         self.ds = Some(ds);
         r
     }
 
+    /// Commits the open transaction, if any.
+    fn commit(&mut self, ds: &Dataset) -> Result<(), IoError> {
+        if self.in_transaction.take().is_some() {
+            transaction(ds, "committing the rows written", |h| unsafe {
+                gdal_sys::GDALDatasetCommitTransaction(h)
+            })?;
+        }
+        Ok(())
+    }
+
     /// Writes the run record, closes the file and renames it over the output.
     pub fn finish(mut self, run: &RunRecord) -> Result<PathBuf, IoError> {
         let ds = self.ds.take().expect("open until finish/abort");
+        self.commit(&ds)?;
         self.write_rows(&ds, &RUNS, RUNS.name, std::slice::from_ref(run))?;
         // Closing flushes the file before it is renamed into place.
         drop(ds);
@@ -492,6 +525,19 @@ impl Writer {
         drop(self.ds.take());
         let _ = std::fs::remove_file(&self.tmp);
         signals::unregister(&self.tmp);
+    }
+}
+
+/// Starts or commits a transaction on `ds` by `call` (a GDAL dataset
+/// transaction function), with GDAL's reason when it fails.
+fn transaction(
+    ds: &Dataset,
+    context: &str,
+    call: impl FnOnce(gdal_sys::GDALDatasetH) -> gdal_sys::OGRErr::Type,
+) -> Result<(), IoError> {
+    match call(ds.c_dataset()) {
+        gdal_sys::OGRErr::OGRERR_NONE => Ok(()),
+        code => Err(IoError::gdal(context, format!("OGR error {code}"))),
     }
 }
 
