@@ -811,6 +811,34 @@ mod tests {
         assert!(stop.is_some() && seen == 5);
     }
 
+    /// Pairing without a tree (few boxes) or through one (many) finds the
+    /// same pairs as the tree, the few in order, and stops at a break.
+    #[test]
+    fn pairs_of_few_or_many_boxes_are_the_trees_pairs() {
+        for n in [0, 1, 2, 17, FEW_PAIRED, FEW_PAIRED + 1, 300] {
+            let boxes = grid(n);
+            let mut got = Vec::new();
+            PackedTree::pairs_of(&boxes, |i, j| {
+                got.push((i, j));
+                ControlFlow::<()>::Continue(())
+            });
+            if n <= FEW_PAIRED {
+                assert!(got.windows(2).all(|w| w[0] < w[1]), "n = {n}: in order");
+            }
+            got.sort_unstable();
+            let mut want = Vec::new();
+            PackedTree::new(&boxes).pairs(|i, j| {
+                want.push((i, j));
+                ControlFlow::<()>::Continue(())
+            });
+            want.sort_unstable();
+            assert!(n < 17 || !want.is_empty(), "the grid's boxes overlap");
+            assert_eq!(got, want, "n = {n}");
+            let stop = PackedTree::pairs_of(&boxes, |i, j| ControlFlow::Break((i, j)));
+            assert_eq!(stop.is_some(), !want.is_empty(), "n = {n}");
+        }
+    }
+
     #[test]
     fn best_is_the_brute_force_nearest_with_ties_to_the_lower_number() {
         let boxes = grid(3000);

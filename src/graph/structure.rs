@@ -367,3 +367,44 @@ fn trunk_paths(
     }
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The nodes around a point are the same whether scanned (a small
+    /// graph) or found through the tree (a large one).
+    #[test]
+    fn nodes_within_a_distance_by_scan_or_tree() {
+        for n in [1, 7, FEW_NODES, FEW_NODES + 1, 700] {
+            let mut g = SkeletonGraph::new();
+            for i in 0..n {
+                let a = i as f64 * 0.37;
+                let pos = Coord {
+                    x: a.cos() * (i % 19) as f64,
+                    y: a.sin() * (i % 23) as f64,
+                };
+                g.add_node(pos, 1.0, None);
+            }
+            let index = NodeIndex::new(&g);
+            assert_eq!(index.tree.is_some(), n > FEW_NODES);
+            for k in 0..40 {
+                let q = Coord {
+                    x: (k % 9) as f64 * 2.0 - 8.0,
+                    y: (k % 7) as f64 * 2.5 - 7.0,
+                };
+                let r2 = (k % 5) as f64 * 6.0;
+                let mut got = Vec::new();
+                index.within(q, r2, |i| got.push(i));
+                got.sort_unstable();
+                let want: Vec<u32> = (0..n as u32)
+                    .filter(|&i| {
+                        let p = g.node(NodeId(i)).pos;
+                        (p.x - q.x).powi(2) + (p.y - q.y).powi(2) <= r2
+                    })
+                    .collect();
+                assert_eq!(got, want, "{n} nodes, around {q:?}");
+            }
+        }
+    }
+}
