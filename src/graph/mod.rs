@@ -450,6 +450,17 @@ impl SkeletonGraph {
         });
         n
     }
+
+    /// [`SkeletonGraph::leg_count`] from the graph's branches
+    /// ([`SkeletonGraph::branches`]) when they are at hand: no second walk.
+    pub fn leg_count_in(&self, branches: &[Branch]) -> usize {
+        let deg = self.degrees();
+        let leaf = |n: NodeId| deg[n.0 as usize] == 1;
+        branches
+            .iter()
+            .filter(|b| b.start != b.end && (leaf(b.start) || leaf(b.end)))
+            .count()
+    }
 }
 
 /// The incident edges of every node of a [`SkeletonGraph`] in two flat
@@ -682,6 +693,7 @@ mod tests {
         g.add_edge(n[8], n[7], vec![c(7.5, 60.0)]);
         assert_eq!(g.legs().len(), 3);
         assert_eq!(g.leg_count(), g.legs().len());
+        assert_eq!(g.leg_count_in(&g.branches()), g.legs().len());
         // Every branch's line is its edges' lines joined end to end.
         for b in g.branches() {
             let mut at = b.start;

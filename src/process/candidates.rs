@@ -10,7 +10,7 @@ use crate::graph::SkeletonGraph;
 use crate::methods::medial_axis::medial_axis_transform;
 use crate::score::defects::graph_of;
 use crate::score::{metrics, BarRays};
-use geo::MultiLineString;
+use geo::{LineString, MultiLineString};
 use std::time::Duration;
 
 /// Every method's candidate for the polygon parts `prepared`, in `methods`
@@ -289,14 +289,15 @@ fn finish(
     for (k, (p, part)) in prepared.iter().zip(parts).enumerate() {
         let g: &SkeletonGraph = &part.graph;
         legs_raw += part.legs_raw;
-        legs += g.leg_count();
+        let branches = g.branches();
+        legs += g.leg_count_in(&branches);
         components += g.components();
         if params.score.is_some() {
             // Cast in parallel, this thread may run other work meanwhile: the
             // casts' own CPU time replaces this thread's; cast here, its
             // clock counts them.
             let here = rays[k].parallel().then(CpuClock::start);
-            let (mut b, t, parts) = rays[k].cast_timed(p, g);
+            let (mut b, t, parts) = rays[k].cast_on_branches(p, &branches);
             if let (Some(here), Some(t)) = (here, t) {
                 in_casts += here.elapsed();
                 cast_time += t;
@@ -315,7 +316,8 @@ fn finish(
         if params.collapse.is_some() || params.connect.is_some() {
             graphs.push(g.clone());
         }
-        lines.extend(g.to_multilinestring().0);
+        // The branches as lines (`SkeletonGraph::to_multilinestring`).
+        lines.extend(branches.into_iter().map(|b| LineString(b.coords)));
     }
     let scores = params.score.map(|_| metrics(&all_bars));
     if !params.keep_bars {

@@ -2,7 +2,7 @@
 
 use super::{metrics, Bar, BarHit, Scores};
 use crate::geometry::{boundary::orient, Boundary, BoundarySegment, PreparedPolygon};
-use crate::graph::{GraphBuilder, SkeletonGraph};
+use crate::graph::{Branch, GraphBuilder, SkeletonGraph};
 use crate::process::clock::CpuClock;
 use geo::{Coord, MultiLineString};
 use rayon::prelude::*;
@@ -66,8 +66,8 @@ fn same_point(a: Coord<f64>, b: Coord<f64>) -> bool {
 }
 
 impl SkeletonIndex {
-    fn new(skeleton: &SkeletonGraph) -> Self {
-        let branches = skeleton.branches();
+    /// The segments of `branches` (a skeleton's, [`SkeletonGraph::branches`]).
+    fn new(branches: &[Branch]) -> Self {
         let mut segments = Vec::new();
         for (k, branch) in branches.iter().enumerate() {
             for w in branch.coords.windows(2) {
@@ -264,6 +264,16 @@ impl BarRays {
         polygon: &PreparedPolygon,
         skeleton: &SkeletonGraph,
     ) -> (Vec<Bar>, Option<std::time::Duration>, usize) {
+        self.cast_on_branches(polygon, &skeleton.branches())
+    }
+
+    /// [`BarRays::cast_timed`] on a skeleton's branches
+    /// ([`SkeletonGraph::branches`], which the caller may need as well).
+    pub fn cast_on_branches(
+        &self,
+        polygon: &PreparedPolygon,
+        branches: &[Branch],
+    ) -> (Vec<Bar>, Option<std::time::Duration>, usize) {
         let eps = REL_EPS * polygon.extent();
         let cast_all = |sk: &SkeletonIndex, bars: &mut [Bar], rays: &[Ray]| {
             let mut recent = [NOWHERE; 2];
@@ -277,13 +287,13 @@ impl BarRays {
             hit: None,
         };
         if !self.parallel() {
-            let sk = SkeletonIndex::new(skeleton);
+            let sk = SkeletonIndex::new(branches);
             let mut bars: Vec<Bar> = self.rays.iter().map(unhit).collect();
             cast_all(&sk, &mut bars, &self.rays);
             return (bars, None, sk.parts);
         }
         let clock = CpuClock::start();
-        let sk = SkeletonIndex::new(skeleton);
+        let sk = SkeletonIndex::new(branches);
         let time = clock.elapsed();
         // Written in place, chunk by chunk on the threads that cast them
         // (the bars of a huge polygon are tens of megabytes: no copy).
