@@ -333,18 +333,16 @@ impl SkeletonGraph {
     /// A new graph in which every chain through degree-2 nodes is one edge.
     /// Unused nodes are dropped.
     pub fn merged(&self) -> SkeletonGraph {
+        let branches = self.branches();
         let mut g = SkeletonGraph::new();
-        let mut map: HashMap<NodeId, NodeId> = HashMap::default();
-        let mut id = |g: &mut SkeletonGraph, n: NodeId| -> NodeId {
-            *map.entry(n).or_insert_with(|| {
-                let nd = self.node(n);
-                g.add_node(nd.pos, nd.radius, nd.time)
-            })
-        };
-        for b in self.branches() {
-            let s = id(&mut g, b.start);
-            let t = id(&mut g, b.end);
-            let interior = b.coords[1..b.coords.len() - 1].to_vec();
+        g.edges.reserve_exact(branches.len());
+        let mut ids = NodeMap::new(self);
+        for b in branches {
+            let s = ids.id(&mut g, b.start);
+            let t = ids.id(&mut g, b.end);
+            let mut interior = b.coords;
+            interior.pop();
+            interior.remove(0);
             g.add_edge(s, t, interior);
         }
         g
@@ -353,19 +351,13 @@ impl SkeletonGraph {
     /// A copy keeping only the edges for which `keep` is true; unused nodes dropped.
     pub fn filter_edges(&self, mut keep: impl FnMut(EdgeId, &Edge) -> bool) -> SkeletonGraph {
         let mut g = SkeletonGraph::new();
-        let mut map: HashMap<NodeId, NodeId> = HashMap::default();
+        let mut ids = NodeMap::new(self);
         for (i, e) in self.edges.iter().enumerate() {
             if !keep(EdgeId(i as u32), e) {
                 continue;
             }
-            let mut id = |n: NodeId| -> NodeId {
-                *map.entry(n).or_insert_with(|| {
-                    let nd = self.node(n);
-                    g.add_node(nd.pos, nd.radius, nd.time)
-                })
-            };
-            let a = id(e.a);
-            let b = id(e.b);
+            let a = ids.id(&mut g, e.a);
+            let b = ids.id(&mut g, e.b);
             g.add_edge(a, b, e.interior.clone());
         }
         g
@@ -463,6 +455,33 @@ impl SkeletonGraph {
     }
 }
 
+/// The nodes of a graph copied into a new one, numbered in the order they
+/// are first met.
+struct NodeMap<'a> {
+    from: &'a SkeletonGraph,
+    /// New number of every node of `from` (`u32::MAX`: not copied yet).
+    ids: Vec<u32>,
+}
+
+impl<'a> NodeMap<'a> {
+    fn new(from: &'a SkeletonGraph) -> Self {
+        Self {
+            from,
+            ids: vec![u32::MAX; from.nodes.len()],
+        }
+    }
+
+    /// Node `n`'s number in `g`, copied there the first time.
+    fn id(&mut self, g: &mut SkeletonGraph, n: NodeId) -> NodeId {
+        let id = &mut self.ids[n.0 as usize];
+        if *id == u32::MAX {
+            let nd = self.from.node(n);
+            *id = g.add_node(nd.pos, nd.radius, nd.time).0;
+        }
+        NodeId(*id)
+    }
+}
+
 /// The incident edges of every node of a [`SkeletonGraph`] in two flat
 /// arrays: `adj[n]` is node `n`'s, in edge order (a loop twice). One
 /// allocation for the whole graph instead of one per node — the walks over
@@ -542,6 +561,15 @@ impl GraphBuilder {
     /// An empty builder.
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// An empty builder with room for `nodes` nodes and `edges` edges.
+    pub fn with_capacity(nodes: usize, edges: usize) -> Self {
+        let mut b = Self::default();
+        b.graph.nodes.reserve(nodes);
+        b.graph.edges.reserve(edges);
+        b.index.reserve(nodes);
+        b
     }
 
     /// The node at `p`, created when absent (radius set by [`GraphBuilder::finish`]).

@@ -254,8 +254,9 @@ impl SkeletonMethod for Voronoi {
             .collect();
         // The radii are the distances just found, so `finish` need not query
         // the R-tree a second time for every node.
-        let mut b = GraphBuilder::new();
-        let mut radii = Vec::new();
+        let inside = radius.iter().filter(|r| r.is_some()).count();
+        let mut b = GraphBuilder::with_capacity(inside, vd.edges.len());
+        let mut radii = Vec::with_capacity(inside);
         // Each Voronoi vertex's node, looked up by position once (vertices
         // at the same position share a node, as the builder decides).
         let mut node_of: Vec<Option<crate::graph::NodeId>> = vec![None; pos.len()];
