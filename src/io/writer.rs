@@ -42,11 +42,12 @@ pub struct Writer {
     in_transaction: Option<usize>,
 }
 
-/// Rows written between two commits. A commit costs about as much as
-/// writing a thousand rows; the file is a temporary one until the run has
-/// finished (a failed run leaves nothing), so a long transaction risks
-/// nothing, and SQLite spills what its page cache cannot hold to the file,
-/// so memory stays bounded.
+/// Rows written between two commits. Each commit has a fixed cost on top of
+/// the rows (callgrind, 2 000 islands: 1 % fewer instructions for the whole
+/// run with one commit than with one per 256-feature batch). The file is a
+/// temporary one until the run has finished (a failed run leaves nothing),
+/// so a long transaction risks nothing, and SQLite spills what its page
+/// cache cannot hold to the file, so memory stays bounded.
 const ROWS_PER_COMMIT: usize = 65_536;
 
 /// Checks that `spec.path` can be written without harm, creating nothing
