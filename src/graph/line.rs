@@ -2,7 +2,7 @@
 //! shape the ends and by the defect counts: arc-length positions, the local
 //! width at an end, and how much an end turns.
 
-use super::{polyline_length, NodeId, SkeletonGraph};
+use super::{NodeId, SkeletonGraph};
 use crate::geometry::PreparedPolygon;
 use geo::Coord;
 
@@ -29,6 +29,43 @@ pub fn point_at(line: &[Coord<f64>], s: f64) -> Coord<f64> {
     *line.last().expect("a polyline has at least one point")
 }
 
+/// A polyline with the lengths of its segments, for many [`point_at`]
+/// queries on one line: the same points, bit for bit, without measuring
+/// every segment walked again.
+struct Measured<'a> {
+    line: &'a [Coord<f64>],
+    lengths: Vec<f64>,
+    /// [`super::polyline_length`] of the line (the same sum).
+    total: f64,
+}
+
+impl<'a> Measured<'a> {
+    fn new(line: &'a [Coord<f64>]) -> Self {
+        let lengths: Vec<f64> = line
+            .windows(2)
+            .map(|w| crate::geometry::norm(w[1] - w[0]))
+            .collect();
+        let total = lengths.iter().sum();
+        Self {
+            line,
+            lengths,
+            total,
+        }
+    }
+
+    /// [`point_at`].
+    fn point_at(&self, s: f64) -> Coord<f64> {
+        let mut left = s;
+        for (w, &l) in self.line.windows(2).zip(&self.lengths) {
+            if l >= left && l > 0.0 {
+                return w[0] + (w[1] - w[0]) * (left / l);
+            }
+            left -= l;
+        }
+        *self.line.last().expect("a polyline has at least one point")
+    }
+}
+
 /// The angle between two directions, in degrees (`None` for a zero vector).
 pub fn angle_deg(a: Coord<f64>, b: Coord<f64>) -> Option<f64> {
     let (la, lb) = (a.x.hypot(a.y), b.x.hypot(b.y));
@@ -50,8 +87,13 @@ pub fn end_radius(coords: &[Coord<f64>], polygon: &PreparedPolygon) -> f64 {
 /// Arc length from the end and distance to ∂P of the point one local width
 /// back along `coords` (see [`end_radius`]).
 pub fn end_width_point(coords: &[Coord<f64>], polygon: &PreparedPolygon) -> (f64, f64) {
+    measured_end_width_point(&Measured::new(coords), polygon)
+}
+
+/// [`end_width_point`] on a measured line.
+fn measured_end_width_point(line: &Measured, polygon: &PreparedPolygon) -> (f64, f64) {
     let b = polygon.boundary();
-    let total = polyline_length(coords);
+    let total = line.total;
     // Arc length s grows with slope 1 and the radius at most with slope 1,
     // so s − 2 r(s) changes sign once on a medial line; sample it finely
     // enough and find the first sign change (regula falsi).
@@ -64,7 +106,7 @@ pub fn end_width_point(coords: &[Coord<f64>], polygon: &PreparedPolygon) -> (f64
     // one's distance, which keeps each search short (never changing it).
     let last: std::cell::Cell<Option<(Coord<f64>, f64)>> = std::cell::Cell::new(None);
     let radius = |s: f64| {
-        let p = point_at(coords, s);
+        let p = line.point_at(s);
         let r = match last.get() {
             Some((q, rq)) => b.distance_within(p, rq + crate::geometry::norm(p - q)),
             None => b.distance(p),
@@ -158,15 +200,16 @@ pub fn end_turns(g: &SkeletonGraph, polygon: &PreparedPolygon) -> Vec<f64> {
 
 /// The turn of the line `coords` at its first point (see the module docs).
 pub fn end_turn(coords: &[Coord<f64>], polygon: &PreparedPolygon) -> Option<f64> {
-    let total = polyline_length(coords);
+    let line = Measured::new(coords);
+    let total = line.total;
     if total <= 0.0 {
         return None;
     }
-    let (w, _) = end_width_point(coords, polygon);
+    let (w, _) = measured_end_width_point(&line, polygon);
     let e = coords[0];
     let last = coords.iter().copied().find(|&c| c != e)?;
-    let before = point_at(coords, w.min(total));
-    let start = point_at(coords, (1.5 * w).min(total));
+    let before = line.point_at(w.min(total));
+    let start = line.point_at((1.5 * w).min(total));
     if before == start {
         return Some(0.0);
     }
