@@ -149,13 +149,6 @@ fn demo_pipeline_runs_and_writes_every_layer() {
 }
 
 /// The first column of the first row of `sql`, as text.
-fn first_text(ds: &gdal::Dataset, sql: &str) -> Option<String> {
-    let mut rs = ds
-        .execute_sql(sql, None, gdal::vector::sql::Dialect::SQLITE)
-        .unwrap()?;
-    let f = rs.features().next()?;
-    f.field_as_string(0).unwrap()
-}
 
 #[test]
 fn invalid_pipeline_files_exit_78_with_line_and_column_and_write_nothing() {

@@ -500,3 +500,32 @@ fn progress_lines_appear_in_logs_without_a_terminal() {
     );
     let _ = std::fs::remove_file("/tmp/skeletonise-progress.gpkg");
 }
+
+#[test]
+fn a_run_longer_than_one_commit_writes_and_indexes_every_row() {
+    // 1 192 islands with candidates: skeleton and candidate rows together
+    // span several of the writer's commits (every 1 024 rows) and the last
+    // one after the last batch; none may be lost or left out of an R-tree.
+    let d = tmp();
+    let out = d.path().join("o.gpkg");
+    let o = skeletonise(&[
+        "run",
+        "pipelines/islands.yaml",
+        "--set",
+        "steps.skeleton.methods=[CDT,VD]",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", out_err(&o));
+    let ds = open(&out);
+    assert_eq!(count(&ds, "skeletons") + count(&ds, "rejected"), 1192);
+    assert_eq!(count(&ds, "candidates"), 2 * 1192);
+    for layer in ["skeletons", "candidates"] {
+        let entries = format!("SELECT count(*) FROM \"rtree_{layer}_geom\"");
+        assert_eq!(
+            first_text(&ds, &entries),
+            Some(count(&ds, layer).to_string()),
+            "R-tree of {layer}"
+        );
+    }
+}

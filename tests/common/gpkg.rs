@@ -119,3 +119,12 @@ pub fn canonical(path: &Path) -> String {
     }
     out
 }
+
+/// The first column of the first row of `sql` (SQLite dialect) as text.
+pub fn first_text(ds: &Dataset, sql: &str) -> Option<String> {
+    let mut rs = ds
+        .execute_sql(sql, None, gdal::vector::sql::Dialect::SQLITE)
+        .unwrap()?;
+    let f = rs.features().next()?;
+    f.field_as_string(0).unwrap()
+}
