@@ -17,12 +17,20 @@ pub const HOOK_DEG: f64 = 60.0;
 
 /// The point at arc length `s` along `line` (its end when `s` ≥ its length).
 pub fn point_at(line: &[Coord<f64>], s: f64) -> Coord<f64> {
+    walk_to(
+        line,
+        line.windows(2).map(|w| crate::geometry::norm(w[1] - w[0])),
+        s,
+    )
+}
+
+/// [`point_at`] with the segments' lengths given in order (measured as
+/// [`point_at`] measures them).
+fn walk_to(line: &[Coord<f64>], lengths: impl Iterator<Item = f64>, s: f64) -> Coord<f64> {
     let mut left = s;
-    for w in line.windows(2) {
-        let d = w[1] - w[0];
-        let l = crate::geometry::norm(d);
+    for (w, l) in line.windows(2).zip(lengths) {
         if l >= left && l > 0.0 {
-            return w[0] + d * (left / l);
+            return w[0] + (w[1] - w[0]) * (left / l);
         }
         left -= l;
     }
@@ -55,14 +63,7 @@ impl<'a> Measured<'a> {
 
     /// [`point_at`].
     fn point_at(&self, s: f64) -> Coord<f64> {
-        let mut left = s;
-        for (w, &l) in self.line.windows(2).zip(&self.lengths) {
-            if l >= left && l > 0.0 {
-                return w[0] + (w[1] - w[0]) * (left / l);
-            }
-            left -= l;
-        }
-        *self.line.last().expect("a polyline has at least one point")
+        walk_to(self.line, self.lengths.iter().copied(), s)
     }
 }
 
