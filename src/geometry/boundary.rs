@@ -7,6 +7,7 @@
 //! the scoring step's sides). Queries cost O(log n) on real data instead of a
 //! scan of all edges.
 
+use super::lanes::{self, Columns};
 use super::packed::{
     box_distance_2, box_meets_half_plane, boxes_meet, ray_box, Bbox, Obb, PackedTree, RaySlab,
 };
@@ -90,6 +91,10 @@ pub struct Boundary {
     /// ray queries by a pass over the segments, so a skeleton scored by
     /// bars that hit no vertex never builds one.
     tree: OnceLock<PackedTree>,
+    /// The segments in columns for the small-boundary passes
+    /// ([`super::lanes`]); `None` for a large boundary, or one with a
+    /// coordinate beyond [`super::lanes::TAME`] (the scalar passes then).
+    columns: Option<Columns>,
     min: Coord<f64>,
     max: Coord<f64>,
 }
@@ -271,11 +276,27 @@ impl Boundary {
                 max.y = max.y.max(c.y);
             }
         }
+        let columns = if segments.len() <= FEW_SEGMENTS {
+            Columns::new(segments.iter().map(|s| (s.a, s.b)))
+        } else {
+            None
+        };
         Self {
             segments,
             tree: OnceLock::new(),
+            columns,
             min,
             max,
+        }
+    }
+
+    /// The same boundary answering by the scalar passes alone (no columns):
+    /// what the lane passes must agree with.
+    #[cfg(test)]
+    fn scalar(&self) -> Self {
+        Self {
+            columns: None,
+            ..self.clone()
         }
     }
 
@@ -317,6 +338,10 @@ impl Boundary {
 
     /// The nearest segment among those within squared distance `limit2`.
     fn nearest_segment_within(&self, p: Coord<f64>, limit2: f64) -> Option<(f64, u32)> {
+        if let Some(c) = self.columns.as_ref().filter(|_| lanes::tame(p)) {
+            // The same pass, several segments at a time.
+            return c.nearest_2(p, limit2);
+        }
         if self.few_segments() {
             // Every segment in index order: the tree's answer (least squared
             // distance within the limit, ties to the lower index).
@@ -432,6 +457,16 @@ impl Boundary {
         if !finite(q) {
             return best;
         }
+        if let Some(c) = self
+            .columns
+            .as_ref()
+            .filter(|_| lanes::tame(q) && lanes::tame(normal))
+        {
+            // The same pass, several segments at a time.
+            return c
+                .both_sides(q, normal)
+                .map(|b| b.map(|(c, d2)| (c, d2.sqrt())));
+        }
         let side = |c: Coord<f64>| (c - q).x * normal.x + (c - q).y * normal.y;
         for s in &self.segments {
             let (fa, fb) = (side(s.a), side(s.b));
@@ -453,10 +488,7 @@ impl Boundary {
                 // than the roots' rounding (a relative 2⁻⁵³ each): only
                 // squares closer than that need their roots. The root of
                 // the winner is taken at the end: the same answer.
-                let nearer = best[k].is_none_or(|(_, bd2)| {
-                    d2 < bd2 && (d2 < bd2 * (1.0 - 1e-15) || d2.sqrt() < bd2.sqrt())
-                });
-                if nearer {
+                if best[k].is_none_or(|(_, bd2)| nearer_2(d2, bd2)) {
                     best[k] = Some((c, d2));
                 }
             }
@@ -548,6 +580,20 @@ impl Boundary {
     ) -> Option<RayHit> {
         if !(finite(origin) && finite(dir)) {
             return None;
+        }
+        if let Some(c) = self
+            .columns
+            .as_ref()
+            .filter(|_| lanes::tame(origin) && lanes::tame(dir))
+        {
+            // The same pass, several segments at a time.
+            return c
+                .first_param(origin, dir, min_t, max_t)
+                .map(|(t, segment)| RayHit {
+                    t,
+                    point: origin + dir * t,
+                    segment,
+                });
         }
         if self.few_segments() {
             // Every segment in index order: the tree's answer (lowest t,
@@ -729,6 +775,16 @@ fn clip_to_half_plane(
     clip_by_sides(a, b, fa, fb)
 }
 
+/// True when the distance whose square is `d2` is smaller than the one
+/// whose square is `best2`, compared as roots (as the tree search compares
+/// them): a root is never smaller when its square is not, and is smaller
+/// when its square is smaller by more than the roots' rounding (a relative
+/// 2⁻⁵³ each), so only squares closer than that need their roots.
+#[inline]
+pub(super) fn nearer_2(d2: f64, best2: f64) -> bool {
+    d2 < best2 && (d2 < best2 * (1.0 - 1e-15) || d2.sqrt() < best2.sqrt())
+}
+
 /// Segment `ab` cut down to where a linear function with values `fa` at `a`
 /// and `fb` at `b` is ≥ 0, or `None` when it is negative at both ends.
 fn clip_by_sides(
@@ -889,6 +945,124 @@ mod tests {
 
     /// A boundary of few segments answers ray and nearest-segment queries
     /// by a pass over them: exactly the tree's answers, ties included.
+    /// The lane passes ([`super::lanes`]) give the scalar passes' answers
+    /// bit for bit: on random small boundaries (1 to 64 segments, some of
+    /// zero length, some collinear) and on a grid where rays run along
+    /// segments, through vertices and points sit on segment lines, with
+    /// ties of equal distances.
+    #[test]
+    fn lane_passes_answer_as_the_scalar_passes_do() {
+        let bits = |x: f64| x.to_bits();
+        let pt_bits = |c: Coord<f64>| (bits(c.x), bits(c.y));
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut boundaries = Vec::new();
+        for n in 1..=64 {
+            // Random segments, with grid-snapped coordinates now and then
+            // (exact collinearity, shared ends, zero lengths).
+            let mut segs = Vec::new();
+            for i in 0..n {
+                let snap = i % 3 == 0;
+                let mut c = || {
+                    let v = next() * 20.0 - 10.0;
+                    if snap {
+                        v.round()
+                    } else {
+                        v
+                    }
+                };
+                let a = Coord { x: c(), y: c() };
+                let b = if i % 7 == 3 {
+                    a
+                } else {
+                    Coord { x: c(), y: c() }
+                };
+                segs.push(BoundarySegment {
+                    a,
+                    b,
+                    ring: 0,
+                    index: i as u32,
+                });
+            }
+            boundaries.push(Boundary::from_segments(segs));
+        }
+        // A square grid of unit segments: rays along them, ties everywhere.
+        let mut grid = Vec::new();
+        for i in 0..4 {
+            for j in 0..4 {
+                let (x, y) = (i as f64, j as f64);
+                for (a, b) in [((x, y), (x + 1.0, y)), ((x, y), (x, y + 1.0))] {
+                    grid.push(BoundarySegment {
+                        a: a.into(),
+                        b: b.into(),
+                        ring: 0,
+                        index: grid.len() as u32,
+                    });
+                }
+            }
+        }
+        boundaries.push(Boundary::from_segments(grid));
+        let mut queries = vec![];
+        for k in 0..40 {
+            let p = Coord {
+                x: (next() * 24.0 - 12.0),
+                y: (next() * 24.0 - 12.0),
+            };
+            let p = if k % 4 == 0 {
+                Coord {
+                    x: p.x.round() * 0.5,
+                    y: p.y.round() * 0.5,
+                }
+            } else {
+                p
+            };
+            let a = next() * std::f64::consts::TAU;
+            let dir = match k % 5 {
+                0 => Coord { x: 1.0, y: 0.0 },
+                1 => Coord { x: 0.0, y: -1.0 },
+                _ => Coord {
+                    x: a.cos(),
+                    y: a.sin(),
+                },
+            };
+            queries.push((p, dir));
+        }
+        let mut answered = [0usize; 3];
+        for b in &boundaries {
+            assert_eq!(b.columns.is_some(), lanes::available());
+            let s = b.scalar();
+            for &(p, dir) in &queries {
+                for limit2 in [f64::INFINITY, 9.0, 0.0] {
+                    let (x, y) = (
+                        b.nearest_segment_within(p, limit2),
+                        s.nearest_segment_within(p, limit2),
+                    );
+                    assert_eq!(x.map(|(d, i)| (bits(d), i)), y.map(|(d, i)| (bits(d), i)));
+                    answered[0] += usize::from(x.is_some());
+                }
+                for (min_t, max_t) in [(0.0, f64::INFINITY), (1e-9, 5.0)] {
+                    let key =
+                        |h: Option<RayHit>| h.map(|h| (bits(h.t), pt_bits(h.point), h.segment));
+                    let x = b.first_hit(p, dir, min_t, max_t);
+                    assert_eq!(key(x), key(s.first_hit(p, dir, min_t, max_t)));
+                    answered[1] += usize::from(x.is_some());
+                }
+                let key = |r: [Option<(Coord<f64>, f64)>; 2]| {
+                    r.map(|o| o.map(|(c, d)| (pt_bits(c), bits(d))))
+                };
+                let x = b.nearest_on_both_sides(p, dir);
+                assert_eq!(key(x), key(s.nearest_on_both_sides(p, dir)));
+                answered[2] += x.iter().filter(|o| o.is_some()).count();
+            }
+        }
+        assert!(answered.iter().all(|&n| n > 1000), "{answered:?}");
+    }
+
     #[test]
     fn small_boundaries_answer_as_the_tree_does() {
         // A wavy ring of 60 segments (the pass) and rays from inside and

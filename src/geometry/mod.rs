@@ -7,6 +7,7 @@
 
 pub mod boundary;
 pub mod densify;
+pub mod lanes;
 pub mod packed;
 pub mod ring;
 pub mod validity;
