@@ -193,16 +193,13 @@ mod avx2 {
         out
     }
 
-    /// The lanes set in mask `m` among the first `live`, as bits.
+    /// The lanes set in mask `m`, as bits. Pad lanes (copies of the first
+    /// segment) may be set: they never win, since every scan keeps the
+    /// first of equal values.
     #[inline]
     #[target_feature(enable = "avx2")]
-    fn bits(m: __m256d, live: usize) -> u32 {
-        let all = if live >= W {
-            (1 << W) - 1
-        } else {
-            (1 << live) - 1
-        };
-        _mm256_movemask_pd(m) as u32 & all
+    fn bits(m: __m256d) -> u32 {
+        _mm256_movemask_pd(m) as u32
     }
 
     /// Takes the lowest set bit of `bits` off and returns its lane.
@@ -223,8 +220,8 @@ mod avx2 {
     #[target_feature(enable = "avx2")]
     pub fn nearest_2(c: &Columns, p: Coord<f64>, limit2: f64) -> Option<(f64, u32)> {
         let (px, py) = (_mm256_set1_pd(p.x), _mm256_set1_pd(p.y));
-        let zero = _mm256_setzero_pd();
-        let mut best: Option<(f64, u32)> = None;
+        let (zero, limit) = (_mm256_setzero_pd(), _mm256_set1_pd(limit2));
+        let (mut best_d2, mut best) = (f64::INFINITY, usize::MAX);
         let mut base = 0;
         while base < c.n {
             let (ax, ay) = (load(&c.ax, base), load(&c.ay, base));
@@ -251,26 +248,25 @@ mod avx2 {
             );
             let (ex, ey) = (_mm256_sub_pd(nx, px), _mm256_sub_pd(ny, py));
             let d2 = _mm256_add_pd(_mm256_mul_pd(ex, ex), _mm256_mul_pd(ey, ey));
-            // Only lanes below the limit and the best so far can win (the
-            // best only falls within a step): the scalar comparisons then
-            // decide among them in index order.
-            let bound = _mm256_set1_pd(best.map_or(limit2, |(bd, _)| bd));
+            // Only lanes within the limit and below the best so far can win
+            // (the best only falls within a step): in index order, each
+            // that is still below the best becomes it. The squares of tame
+            // coordinates are finite, so an infinite best stands for none.
             let maybe = _mm256_and_pd(
-                _mm256_cmp_pd::<_CMP_LE_OQ>(d2, _mm256_set1_pd(limit2)),
-                _mm256_cmp_pd::<_CMP_LE_OQ>(d2, bound),
+                _mm256_cmp_pd::<_CMP_LE_OQ>(d2, limit),
+                _mm256_cmp_pd::<_CMP_LT_OQ>(d2, _mm256_set1_pd(best_d2)),
             );
             let d2s = store(d2);
-            let mut set = bits(maybe, c.n - base);
+            let mut set = bits(maybe);
             while set != 0 {
                 let l = next_lane(&mut set);
-                let d2 = d2s[l];
-                if d2 <= limit2 && best.is_none_or(|(bd, _)| d2 < bd) {
-                    best = Some((d2, (base + l) as u32));
+                if d2s[l] < best_d2 {
+                    (best_d2, best) = (d2s[l], base + l);
                 }
             }
             base += W;
         }
-        best
+        (best < c.n).then_some((best_d2, best as u32))
     }
 
     #[target_feature(enable = "avx2")]
@@ -321,7 +317,7 @@ mod avx2 {
             );
             let ts = store(pick(hit, t, nan));
             let dens = store(den);
-            let mut set = bits(maybe, c.n - base);
+            let mut set = bits(maybe);
             while set != 0 {
                 let l = next_lane(&mut set);
                 let t = if dens[l] == 0.0 {
@@ -388,7 +384,7 @@ mod avx2 {
                 // Four segments wholly on the other side (as neighbours
                 // along a bank often are) have nothing here.
                 let part = _mm256_or_pd(ia, ib);
-                if bits(part, c.n - base) == 0 {
+                if bits(part) == 0 {
                     continue;
                 }
                 let r = _mm256_div_pd(fa, _mm256_sub_pd(fa, fb));
@@ -439,7 +435,7 @@ mod avx2 {
                 };
                 let d2 = store(pick(part, d2, nan));
                 let (xs, ys) = (store(x), store(y));
-                let mut set = bits(maybe, c.n - base);
+                let mut set = bits(maybe);
                 while set != 0 {
                     let l = next_lane(&mut set);
                     let d2 = d2[l];
