@@ -438,7 +438,11 @@ struct Workers<'a> {
 
 impl Workers<'_> {
     /// The workers' loop: every batch computed on the pool in parallel,
-    /// counted, and handed to the writer in the order read.
+    /// counted, and handed to the writer in the order read. Up to
+    /// [`IN_FLIGHT`] batches are computed at once, so a worker that has
+    /// finished its share of one batch starts on the next instead of
+    /// waiting for the batch's last feature; results are put back in input
+    /// order before they are counted and written.
     fn compute(
         &self,
         batches: &mpsc::Receiver<Batch>,
@@ -447,27 +451,93 @@ impl Workers<'_> {
         progress: &mut Progress,
     ) -> Result<(), RunError> {
         let (job, params, row_opts) = (self.job, self.params, self.row_opts);
-        for features in batches.iter() {
-            let features = features?;
-            let done: Vec<FeatureRows> = self.pool.install(|| {
-                features
-                    .par_iter()
-                    .map(|f| feature_rows(f, job.skeletons(f), params, row_opts))
-                    .collect()
-            });
-            counts.read += features.iter().map(Feature::source_count).sum::<u64>();
-            let mut rows = Rows::default();
-            for (f, r) in features.iter().zip(done) {
-                counts.add(f, &r, job.on_error)?;
-                rows.append(r.rows);
+        let (done_tx, done_rx) = mpsc::channel::<(usize, Computed)>();
+        // Runs on this thread (not a worker), so blocking on the reader or
+        // on the results never takes a worker away from the features.
+        self.pool.in_place_scope(|scope| {
+            let mut order = InOrder::default();
+            let mut read_all = false;
+            loop {
+                while !read_all && order.in_flight() < IN_FLIGHT {
+                    match batches.recv() {
+                        Ok(features) => {
+                            let features = features?;
+                            let (i, done_tx) = (order.start(), done_tx.clone());
+                            scope.spawn(move |_| {
+                                let done = features
+                                    .par_iter()
+                                    .map(|f| feature_rows(f, job.skeletons(f), params, row_opts))
+                                    .collect();
+                                // The receiver outlives the scope.
+                                let _ = done_tx.send((i, (features, done)));
+                            });
+                        }
+                        Err(_) => read_all = true,
+                    }
+                }
+                if order.in_flight() == 0 {
+                    return Ok(());
+                }
+                let (i, computed) = done_rx.recv().expect("a sender lives in every task");
+                for (features, done) in order.finish(i, computed) {
+                    counts.read += features.iter().map(Feature::source_count).sum::<u64>();
+                    let mut rows = Rows::default();
+                    for (f, r) in features.iter().zip(done) {
+                        counts.add(f, &r, job.on_error)?;
+                        rows.append(r.rows);
+                    }
+                    if rows_tx.send(rows).is_err() {
+                        // The writer stopped on an error; it says which below.
+                        return Ok(());
+                    }
+                    progress.add(features.len() as u64);
+                }
             }
-            if rows_tx.send(rows).is_err() {
-                // The writer stopped on an error; it says which below.
-                break;
-            }
-            progress.add(features.len() as u64);
+        })
+    }
+}
+
+/// Batches computed at once: two, so the workers always have the next
+/// batch's features to take while the last features of one are finishing
+/// (and memory stays bounded by a few batches).
+const IN_FLIGHT: usize = 2;
+
+/// A batch's features and their computed rows.
+type Computed = (Vec<Feature>, Vec<FeatureRows>);
+
+/// Puts batches finished in any order back in the order they were started.
+#[derive(Default)]
+struct InOrder<T> {
+    /// Batches started so far (the next one's number).
+    started: usize,
+    /// The number of the next batch to hand on.
+    next: usize,
+    /// Finished batches waiting for an earlier one.
+    waiting: std::collections::BTreeMap<usize, T>,
+}
+
+impl<T> InOrder<T> {
+    /// Numbers a new batch.
+    fn start(&mut self) -> usize {
+        self.started += 1;
+        self.started - 1
+    }
+
+    /// Batches started and not yet handed on.
+    fn in_flight(&self) -> usize {
+        self.started - self.next
+    }
+
+    /// Records batch `i` as finished; returns the batches that can now be
+    /// handed on, in order.
+    fn finish(&mut self, i: usize, batch: T) -> Vec<T> {
+        self.waiting.insert(i, batch);
+        let mut ready = Vec::new();
+        while let Some(b) = self.waiting.remove(&self.next) {
+            ready.push(b);
+            self.next += 1;
         }
-        Ok(())
+        ready
     }
 }
 
