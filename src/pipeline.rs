@@ -754,3 +754,25 @@ fn stage_json(stages: &[(MethodId, StageTimes)]) -> String {
 fn round_ms(d: std::time::Duration) -> f64 {
     (d.as_secs_f64() * 1000.0).round() / 1000.0
 }
+
+#[cfg(test)]
+mod tests {
+    use super::InOrder;
+
+    /// Batches finished out of order are held back until every earlier one
+    /// has finished, then handed on in the order they were started.
+    #[test]
+    fn batches_finished_out_of_order_are_handed_on_in_order() {
+        let mut order = InOrder::default();
+        let ids: Vec<usize> = (0..4).map(|_| order.start()).collect();
+        assert_eq!(ids, [0, 1, 2, 3]);
+        assert_eq!(order.in_flight(), 4);
+        assert!(order.finish(2, "c").is_empty());
+        assert!(order.finish(1, "b").is_empty());
+        assert_eq!(order.in_flight(), 4, "held batches still count");
+        assert_eq!(order.finish(0, "a"), ["a", "b", "c"]);
+        assert_eq!(order.in_flight(), 1);
+        assert_eq!(order.finish(3, "d"), ["d"]);
+        assert_eq!(order.in_flight(), 0);
+    }
+}
