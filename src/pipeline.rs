@@ -451,50 +451,79 @@ impl Workers<'_> {
         progress: &mut Progress,
     ) -> Result<(), RunError> {
         let (job, params, row_opts) = (self.job, self.params, self.row_opts);
-        let (done_tx, done_rx) = mpsc::channel::<(usize, Computed)>();
-        // Runs on this thread (not a worker), so blocking on the reader or
-        // on the results never takes a worker away from the features.
-        self.pool.in_place_scope(|scope| {
-            let mut order = InOrder::default();
-            let mut read_all = false;
-            loop {
-                while !read_all && order.in_flight() < IN_FLIGHT {
-                    match batches.recv() {
-                        Ok(features) => {
-                            let features = features?;
-                            let (i, done_tx) = (order.start(), done_tx.clone());
-                            scope.spawn(move |_| {
-                                let done = features
-                                    .par_iter()
-                                    .map(|f| feature_rows(f, job.skeletons(f), params, row_opts))
-                                    .collect();
-                                // The receiver outlives the scope.
-                                let _ = done_tx.send((i, (features, done)));
-                            });
-                        }
-                        Err(_) => read_all = true,
-                    }
-                }
-                if order.in_flight() == 0 {
-                    return Ok(());
-                }
-                let (i, computed) = done_rx.recv().expect("a sender lives in every task");
-                for (features, done) in order.finish(i, computed) {
-                    counts.read += features.iter().map(Feature::source_count).sum::<u64>();
-                    let mut rows = Rows::default();
-                    for (f, r) in features.iter().zip(done) {
-                        counts.add(f, &r, job.on_error)?;
-                        rows.append(r.rows);
-                    }
-                    if rows_tx.send(rows).is_err() {
-                        // The writer stopped on an error; it says which below.
-                        return Ok(());
-                    }
-                    progress.add(features.len() as u64);
-                }
+        let next = || batches.recv().ok().map(|b| b.map_err(RunError::from));
+        let work = |features: &Vec<Feature>| -> Vec<FeatureRows> {
+            features
+                .par_iter()
+                .map(|f| feature_rows(f, job.skeletons(f), params, row_opts))
+                .collect()
+        };
+        in_order(self.pool, next, work, |features, done| {
+            counts.read += features.iter().map(Feature::source_count).sum::<u64>();
+            let mut rows = Rows::default();
+            for (f, r) in features.iter().zip(done) {
+                counts.add(f, &r, job.on_error)?;
+                rows.append(r.rows);
             }
+            // A closed channel: the writer stopped on an error; it says
+            // which after the workers.
+            let more = rows_tx.send(rows).is_ok();
+            progress.add(features.len() as u64);
+            Ok(more)
         })
     }
+}
+
+/// Computes `work` on every batch `next` yields, up to [`IN_FLIGHT`] batches
+/// at once on `pool`, and gives each batch with its result to `take` in the
+/// order `next` yielded them, on the calling thread. Stops at the first
+/// error (from `next` or `take`) or when `take` returns false. A panic in
+/// `work` is raised again on the calling thread, as `pool.install` would.
+fn in_order<T: Send, U: Send>(
+    pool: &rayon::ThreadPool,
+    mut next: impl FnMut() -> Option<Result<T, RunError>>,
+    work: impl Fn(&T) -> U + Sync,
+    mut take: impl FnMut(T, U) -> Result<bool, RunError>,
+) -> Result<(), RunError> {
+    type Done<T, U> = (usize, T, std::thread::Result<U>);
+    let (done_tx, done_rx) = mpsc::channel::<Done<T, U>>();
+    let work = &work;
+    // Runs on this thread (not a worker), so blocking on `next` or on the
+    // results never takes a worker away from the batches.
+    pool.in_place_scope(|scope| {
+        let mut order = InOrder::new();
+        let mut ended = false;
+        loop {
+            while !ended && order.in_flight() < IN_FLIGHT {
+                match next() {
+                    Some(batch) => {
+                        let batch = batch?;
+                        let (i, done_tx) = (order.start(), done_tx.clone());
+                        scope.spawn(move |_| {
+                            let done =
+                                std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                                    work(&batch)
+                                }));
+                            // The receiver outlives the scope.
+                            let _ = done_tx.send((i, batch, done));
+                        });
+                    }
+                    None => ended = true,
+                }
+            }
+            if order.in_flight() == 0 {
+                return Ok(());
+            }
+            // Every task sends before it ends, panic or not.
+            let (i, batch, done) = done_rx.recv().expect("the sender is held here");
+            let done = done.unwrap_or_else(|p| std::panic::resume_unwind(p));
+            for (batch, done) in order.finish(i, (batch, done)) {
+                if !take(batch, done)? {
+                    return Ok(());
+                }
+            }
+        }
+    })
 }
 
 /// Batches computed at once: two, so the workers always have the next
@@ -502,11 +531,7 @@ impl Workers<'_> {
 /// (and memory stays bounded by a few batches).
 const IN_FLIGHT: usize = 2;
 
-/// A batch's features and their computed rows.
-type Computed = (Vec<Feature>, Vec<FeatureRows>);
-
 /// Puts batches finished in any order back in the order they were started.
-#[derive(Default)]
 struct InOrder<T> {
     /// Batches started so far (the next one's number).
     started: usize,
@@ -517,6 +542,15 @@ struct InOrder<T> {
 }
 
 impl<T> InOrder<T> {
+    /// None started yet.
+    fn new() -> Self {
+        Self {
+            started: 0,
+            next: 0,
+            waiting: std::collections::BTreeMap::new(),
+        }
+    }
+
     /// Numbers a new batch.
     fn start(&mut self) -> usize {
         self.started += 1;
@@ -757,13 +791,13 @@ fn round_ms(d: std::time::Duration) -> f64 {
 
 #[cfg(test)]
 mod tests {
-    use super::InOrder;
+    use super::{in_order, InOrder, RunError};
 
     /// Batches finished out of order are held back until every earlier one
     /// has finished, then handed on in the order they were started.
     #[test]
     fn batches_finished_out_of_order_are_handed_on_in_order() {
-        let mut order = InOrder::default();
+        let mut order = InOrder::new();
         let ids: Vec<usize> = (0..4).map(|_| order.start()).collect();
         assert_eq!(ids, [0, 1, 2, 3]);
         assert_eq!(order.in_flight(), 4);
@@ -774,5 +808,48 @@ mod tests {
         assert_eq!(order.in_flight(), 1);
         assert_eq!(order.finish(3, "d"), ["d"]);
         assert_eq!(order.in_flight(), 0);
+    }
+
+    /// Batches come out in input order whatever order they finish in, and a
+    /// panic in the work is raised on the calling thread instead of leaving
+    /// it waiting for a result that never comes.
+    #[test]
+    fn in_order_keeps_the_order_and_raises_a_panic() {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
+        let mut items = (0..20u64).map(Ok::<u64, RunError>);
+        let mut seen = Vec::new();
+        let slow_first = |&i: &u64| {
+            // Earlier batches finish later.
+            std::thread::sleep(std::time::Duration::from_millis(20 - i));
+            i * 10
+        };
+        in_order(
+            &pool,
+            || items.next(),
+            slow_first,
+            |i, r| {
+                seen.push((i, r));
+                Ok(true)
+            },
+        )
+        .unwrap();
+        assert_eq!(seen, (0..20).map(|i| (i, i * 10)).collect::<Vec<_>>());
+
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                let mut items = (0..5u64).map(Ok::<u64, RunError>);
+                let boom = |&i: &u64| if i == 3 { panic!("boom") } else { i };
+                in_order(&pool, || items.next(), boom, |_, _| Ok(true))
+            }));
+            let _ = tx.send(r.is_err());
+        });
+        let panicked = rx
+            .recv_timeout(std::time::Duration::from_secs(60))
+            .expect("a panic in the work must not hang the run");
+        assert!(panicked, "the panic is raised again");
     }
 }
