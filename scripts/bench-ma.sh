@@ -2,7 +2,7 @@
 # Side-by-side benchmark of method MA (this crate, boostvoronoi) against
 # PostGIS ST_ApproximateMedialAxis (SFCGAL), in one run, on the same layers.
 #
-#   scripts/bench-ma.sh [layer ...]        (default: river_lena river_st_lawrence islands_hebrides)
+#   scripts/bench-ma.sh [layer ...]        (default: river_lena river_st_lawrence river_danube islands_hebrides)
 #
 # Environment:
 #   DATA=tests/data/gshhg-train.gpkg   input GeoPackage
@@ -30,7 +30,7 @@ RUNS=${RUNS:-3}
 PG_TIMEOUT=${PG_TIMEOUT:-3600}
 PG_PORT=${PG_PORT:-54329}
 OUT=${OUT:-target/bench-ma}
-if [ $# -gt 0 ]; then LAYERS=("$@"); else LAYERS=(river_lena river_st_lawrence islands_hebrides); fi
+if [ $# -gt 0 ]; then LAYERS=("$@"); else LAYERS=(river_lena river_st_lawrence river_danube islands_hebrides); fi
 DATA=$(realpath "$DATA")
 mkdir -p "$OUT"
 OUT=$(realpath "$OUT")

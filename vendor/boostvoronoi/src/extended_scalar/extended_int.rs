@@ -314,7 +314,22 @@ impl ExtendedInt {
     /// when it is not zero — without a bounds-checked `SmallVec` access per
     /// partial product (patched for skeletonise, see PATCHES.md).
     fn mul_slice(&mut self, c1: &[Wrapping<u32>], sz1: usize, c2: &[Wrapping<u32>], sz2: usize) {
-        const MAX: usize = 128;
+        // Most products are of a few chunks: a small buffer to clear.
+        if sz1 + sz2 <= 16 {
+            self.mul_on::<16>(c1, sz1, c2, sz2);
+        } else {
+            self.mul_on::<128>(c1, sz1, c2, sz2);
+        }
+    }
+
+    /// [`Self::mul_slice`] on a stack buffer of `MAX` chunks.
+    fn mul_on<const MAX: usize>(
+        &mut self,
+        c1: &[Wrapping<u32>],
+        sz1: usize,
+        c2: &[Wrapping<u32>],
+        sz2: usize,
+    ) {
         let n = sz1 + sz2;
         assert!(n <= MAX, "ExtendedInt product of {n} chunks");
         let mut r = [0_u32; MAX];

@@ -694,11 +694,13 @@ pub(crate) fn pss<I: InputType>(
 #[cfg(test)]
 thread_local! {
     /// Tests turn the closed forms ([`pss_at_endpoint`], [`pss_shared_vertex`],
-    /// [`pps_at_endpoint`], [`sss_chain`]) off to compare with the general path.
+    /// [`pps_at_endpoint`], [`sss_chain`]) and the local frame of [`sss`]'s
+    /// general path off to compare with the general path as published.
     pub(crate) static ENDPOINT_FAST_PATH: std::cell::Cell<bool> = const { std::cell::Cell::new(true) };
     /// How often each closed form's circle was taken without the exact
-    /// evaluation, in the order above (tests: every form must be exercised).
-    pub(crate) static CLOSED_FORM_USES: std::cell::Cell<[u64; 4]> = const { std::cell::Cell::new([0; 4]) };
+    /// evaluation, in the order above, then the general `sss` in the local
+    /// frame (tests: every form must be exercised).
+    pub(crate) static CLOSED_FORM_USES: std::cell::Cell<[u64; 5]> = const { std::cell::Cell::new([0; 5]) };
 }
 
 /// Counts a use of closed form `k` whose bounds were accepted (tests only).
@@ -1053,41 +1055,37 @@ pub(crate) fn sss<I: InputType>(
         }
         return Some(c_event);
     }
+    // The lines' offsets c_k are taken in the frame at site 1's start `o`
+    // (patched for skeletonise, see PATCHES.md): in the grid's own frame
+    // they are products of coordinates far larger than the event, whose
+    // cancellation sent most of these events to the exact evaluation.
+    let (ox, oy) = if endpoint_fast_path() {
+        (cast::<I, i64>(site1.x0()), cast::<I, i64>(site1.y0()))
+    } else {
+        (0, 0)
+    };
+    let local_cross = |s: &vse::SiteEvent<I>| {
+        rf::RobustFpt::new(
+            robust_cross_product::<i64>(
+                cast::<I, i64>(s.x0()) - ox,
+                cast::<I, i64>(s.y0()) - oy,
+                cast::<I, i64>(s.x1()) - ox,
+                cast::<I, i64>(s.y1()) - oy,
+            ),
+            1_f64,
+        )
+    };
     let a1 = rf::RobustFpt::from(cast::<I, f64>(site1.x1()) - cast::<I, f64>(site1.x0()));
     let b1 = rf::RobustFpt::from(cast::<I, f64>(site1.y1()) - cast::<I, f64>(site1.y0()));
-    let c1 = rf::RobustFpt::new(
-        robust_cross_product::<i64>(
-            cast::<I, i64>(site1.x0()),
-            cast::<I, i64>(site1.y0()),
-            cast::<I, i64>(site1.x1()),
-            cast::<I, i64>(site1.y1()),
-        ),
-        1_f64,
-    );
+    let c1 = local_cross(site1);
 
     let a2 = rf::RobustFpt::from(cast::<I, f64>(site2.x1()) - cast::<I, f64>(site2.x0()));
     let b2 = rf::RobustFpt::from(cast::<I, f64>(site2.y1()) - cast::<I, f64>(site2.y0()));
-    let c2 = rf::RobustFpt::new(
-        robust_cross_product::<i64>(
-            cast::<I, i64>(site2.x0()),
-            cast::<I, i64>(site2.y0()),
-            cast::<I, i64>(site2.x1()),
-            cast::<I, i64>(site2.y1()),
-        ),
-        1_f64,
-    );
+    let c2 = local_cross(site2);
 
     let a3 = rf::RobustFpt::from(cast::<I, f64>(site3.x1()) - cast::<I, f64>(site3.x0()));
     let b3 = rf::RobustFpt::from(cast::<I, f64>(site3.y1()) - cast::<I, f64>(site3.y0()));
-    let c3 = rf::RobustFpt::new(
-        robust_cross_product::<i64>(
-            cast::<I, i64>(site3.x0()),
-            cast::<I, i64>(site3.y0()),
-            cast::<I, i64>(site3.x1()),
-            cast::<I, i64>(site3.y1()),
-        ),
-        1_f64,
-    );
+    let c3 = local_cross(site3);
 
     let len1 = (a1 * a1 + b1 * b1).sqrt();
     let len2 = (a2 * a2 + b2 * b2).sqrt();
@@ -1152,14 +1150,15 @@ pub(crate) fn sss<I: InputType>(
 
     let denom_dif = denom.dif();
     //tln!("  denom_dif:{:?}", denom_dif);
-    let c_x_dif = c_x.dif() / denom_dif;
-    let c_y_dif = c_y.dif() / denom_dif;
-    let lower_x_dif = lower_x.dif() / denom_dif;
+    let c_x_dif = shifted(ox, c_x.dif() / denom_dif);
+    let c_y_dif = shifted(oy, c_y.dif() / denom_dif);
+    let lower_x_dif = shifted(ox, lower_x.dif() / denom_dif);
 
     let ulps = ULPSX2 as f64;
     let recompute_c_x = c_x_dif.ulp() > ulps;
     let recompute_c_y = c_y_dif.ulp() > ulps;
     let recompute_lower_x = lower_x_dif.ulp() > ulps;
+    count_closed_form(4, recompute_c_x || recompute_c_y || recompute_lower_x);
 
     t!(" c_x_dif.ulp():{:.12}", c_x_dif.ulp());
     t!("  c_y_dif.ulp() :{:.12}", c_y_dif.ulp());
@@ -1193,4 +1192,24 @@ pub(crate) fn sss<I: InputType>(
     tln!("  c_event:{:?}", c_event);
 
     Some(c_event)
+}
+
+/// `o + x` for an exact integer `o` (|o| < 2⁵³) and a value `x` with its
+/// relative error bound: the absolute error is `x`'s alone, so the bound
+/// relative to the sum is `|x|·re(x) / |o + x|` plus the sum's rounding
+/// (tighter than `RobustFpt`'s addition, which keeps the larger relative
+/// error of two summands of one sign). Patched for skeletonise.
+fn shifted(o: i64, x: rf::RobustFpt) -> rf::RobustFpt {
+    let fpv = o as f64 + x.fpv();
+    let err = x.fpv().abs() * x.re();
+    let re = if err.is_nan() {
+        f64::INFINITY
+    } else if err == 0.0 {
+        rf::ROUNDING_ERROR
+    } else if fpv == 0.0 {
+        f64::INFINITY
+    } else {
+        err / fpv.abs() + rf::ROUNDING_ERROR
+    };
+    rf::RobustFpt::new(fpv, re)
 }
