@@ -6,7 +6,7 @@
 //! the diagrams of many polygons, built both ways, have the same vertices and
 //! the same edges, and every closed form is exercised.
 
-use super::lazy_circle_formation::{CLOSED_FORM_USES, ENDPOINT_FAST_PATH};
+use super::lazy_circle_formation::{CLOSED_FORM_USES, ENDPOINT_FAST_PATH, GENERAL_SSS_EXACT};
 use crate::builder::Builder;
 use crate::diagram::Diagram;
 
@@ -139,13 +139,6 @@ fn same(a: &Diagram, b: &Diagram) -> Result<(), String> {
 fn endpoint_circles_give_the_same_diagrams() {
     let mut rng = Lcg(0x5eed);
     let mut checked = 0;
-    // Shapes far from the origin, as skeletonise's grid puts them (offset
-    // 2^27): there the general sss formula's line offsets cancel most.
-    let far = |pts: Vec<[i32; 2]>| -> Vec<[i32; 2]> {
-        pts.into_iter()
-            .map(|[x, y]| [x + (1 << 27), y + (1 << 27)])
-            .collect()
-    };
     for case in 0..600 {
         let pts = match case % 6 {
             0 => ring(&mut rng, 8 + case % 40, 1.0e3, 0.5),
@@ -170,4 +163,28 @@ fn endpoint_circles_give_the_same_diagrams() {
     // evaluation), so the comparison above covers all five.
     let uses = CLOSED_FORM_USES.with(|c| c.get());
     assert!(uses.iter().all(|&n| n > 100), "closed-form uses {uses:?}");
+}
+
+/// Shapes far from the origin, as skeletonise's grid puts them (offset
+/// 2^27): there the general sss formula's line offsets cancel most.
+fn far(pts: Vec<[i32; 2]>) -> Vec<[i32; 2]> {
+    pts.into_iter()
+        .map(|[x, y]| [x + (1 << 27), y + (1 << 27)])
+        .collect()
+}
+
+#[test]
+fn local_frame_keeps_far_sss_events_out_of_the_exact_evaluation() {
+    let mut rng = Lcg(0xba2d);
+    let bands: Vec<Vec<[i32; 2]>> = (0..20).map(|_| far(band(&mut rng, 60, 2.0e6, 4.0e4))).collect();
+    let exact = |fast: bool| {
+        GENERAL_SSS_EXACT.with(|c| c.set(0));
+        for pts in &bands {
+            let _ = diagram(pts, fast);
+        }
+        GENERAL_SSS_EXACT.with(|c| c.get())
+    };
+    let (published, local) = (exact(false), exact(true));
+    assert!(published > 100, "the general path as published: {published} exact evaluations");
+    assert!(local * 4 < published, "local frame: {local} exact evaluations against {published}");
 }

@@ -701,6 +701,9 @@ thread_local! {
     /// evaluation, in the order above, then the general `sss` in the local
     /// frame (tests: every form must be exercised).
     pub(crate) static CLOSED_FORM_USES: std::cell::Cell<[u64; 5]> = const { std::cell::Cell::new([0; 5]) };
+    /// How often the general `sss` path went on to the exact evaluation
+    /// (tests: the local frame must send far fewer there).
+    pub(crate) static GENERAL_SSS_EXACT: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
 }
 
 /// Counts a use of closed form `k` whose bounds were accepted (tests only).
@@ -1159,6 +1162,10 @@ pub(crate) fn sss<I: InputType>(
     let recompute_c_y = c_y_dif.ulp() > ulps;
     let recompute_lower_x = lower_x_dif.ulp() > ulps;
     count_closed_form(4, recompute_c_x || recompute_c_y || recompute_lower_x);
+    #[cfg(test)]
+    if recompute_c_x || recompute_c_y || recompute_lower_x {
+        GENERAL_SSS_EXACT.with(|c| c.set(c.get() + 1));
+    }
 
     t!(" c_x_dif.ulp():{:.12}", c_x_dif.ulp());
     t!("  c_y_dif.ulp() :{:.12}", c_y_dif.ulp());
