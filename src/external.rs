@@ -13,6 +13,7 @@
 use crate::config::{InputSpec, OnError, OutputSpec};
 use crate::feature::Feature;
 use crate::geometry::PreparedPolygon;
+use crate::io::guard::Protected;
 use crate::io::reader::Reader;
 use crate::pipeline::{run_job, Given, Job, RunError, RunOptions, RunSummary};
 use crate::process::{polygon_parts, PrepareParams, ProcessParams};
@@ -96,7 +97,13 @@ fn read_all(r: &mut Reader) -> Result<Vec<Feature>, RunError> {
 /// the methods' skeletons.
 pub fn score_external(job: &ScoreJob, keep_bars: bool) -> Result<RunSummary, RunError> {
     // Before reading anything: the output must not be one of the inputs.
-    crate::io::writer::check_output(&job.output, &[&job.polygons.source, &job.skeletons.source])?;
+    crate::io::writer::check_output(
+        &job.output,
+        &[
+            Protected::new("the polygons source", &job.polygons.source),
+            Protected::new("the skeletons source", &job.skeletons.source),
+        ],
+    )?;
     let given = Given {
         label: job.label.clone(),
         lines: join(job)?,
@@ -125,7 +132,7 @@ pub fn score_external(job: &ScoreJob, keep_bars: bool) -> Result<RunSummary, Run
         params,
         on_error: OnError::Reject,
         given: Some(&given),
-        other_inputs: vec![job.skeletons.source.clone()],
+        other_inputs: vec![("the skeletons source", job.skeletons.source.clone())],
     };
     run_job(&run, &RunOptions::default())
 }

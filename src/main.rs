@@ -231,6 +231,9 @@ struct ReportArgs {
     /// Reproject the polygons (default: as the run did).
     #[arg(long, value_name = "CRS", requires = "polygons")]
     reproject: Option<String>,
+    /// Replace an existing report.
+    #[arg(long)]
+    overwrite: bool,
 }
 
 impl ReportArgs {
@@ -275,6 +278,7 @@ impl ReportArgs {
             gpkg: self.gpkg.clone(),
             selection,
             polygons,
+            overwrite: self.overwrite,
         })
     }
 }

@@ -7,6 +7,7 @@
 
 use crate::config::{InputSpec, OnError, OutputSpec, Pipeline};
 use crate::feature::Feature;
+use crate::io::guard::Protected;
 use crate::io::reader::Reader;
 use crate::io::writer::{check_output, Writer};
 use crate::io::{IoError, SourceInfo};
@@ -103,15 +104,12 @@ pub fn validate(p: &Pipeline) -> Result<crate::io::SourceInfo, RunError> {
     if let Some(reason) = merge_field(input, reader.info()).err() {
         return Err(RunError::Io(reason));
     }
-    let mut sources = vec![input.source.as_str()];
     if let Some(c) = &input.connect {
         Reader::open(&c.input(input))?.probe()?;
-        sources.push(c.source.as_str());
     }
-    check_output(&p.file.output, &sources)?;
-    if let Some(html) = p.file.output.report_path() {
-        check_path(&html)?;
-    }
+    let job = Job::of(p);
+    check_output(&p.file.output, &job.protected())?;
+    check_report_path(&job)?;
     Ok(reader.info().clone())
 }
 
@@ -142,8 +140,9 @@ pub struct Job<'a> {
     pub on_error: OnError,
     /// The skeletons when another tool made them.
     pub given: Option<&'a Given>,
-    /// Other data sources the job reads (never to be written over).
-    pub other_inputs: Vec<String>,
+    /// Other data sources the job reads (never to be written over), each
+    /// with what it is to the job (e.g. "the skeletons source").
+    pub other_inputs: Vec<(&'static str, String)>,
 }
 
 impl<'a> Job<'a> {
@@ -161,6 +160,21 @@ impl<'a> Job<'a> {
         }
     }
 
+    /// Every data source the job reads: no file it writes may be one of
+    /// them.
+    pub fn protected(&self) -> Vec<Protected<'_>> {
+        let mut p = vec![Protected::new("the input", &self.input.source)];
+        if let Some(c) = &self.input.connect {
+            p.push(Protected::new("the connect source", &c.source));
+        }
+        p.extend(
+            self.other_inputs
+                .iter()
+                .map(|(role, s)| Protected::new(role, s)),
+        );
+        p
+    }
+
     fn skeletons(&self, f: &Feature) -> Skeletons<'_> {
         match self.given {
             None => Skeletons::Computed,
@@ -175,25 +189,33 @@ impl<'a> Job<'a> {
 /// Runs the pipeline end to end, then writes its report when the output
 /// asks for one (`output.report`).
 pub fn run(p: &Pipeline, opts: &RunOptions) -> Result<RunSummary, RunError> {
-    let report = p
-        .file
-        .output
-        .report
-        .as_ref()
-        .zip(p.file.output.report_path());
-    if let Some((_, html)) = &report {
-        check_path(html)?;
-    }
-    let mut summary = run_job(&Job::of(p), opts)?;
+    let job = Job::of(p);
+    check_report_path(&job)?;
+    let mut summary = run_job(&job, opts)?;
+    let report = job.output.report.as_ref().zip(job.output.report_path());
     if let Some((spec, html)) = report {
         summary.report = Some(write_report(&ReportJob {
             gpkg: summary.output.clone().into(),
             html,
             selection: spec.features.clone(),
             polygons: None,
+            overwrite: job.output.overwrite,
         })?);
     }
     Ok(summary)
+}
+
+/// Checks the path of the report a job writes after its run (if any):
+/// never one of the job's sources or its output GeoPackage, an existing
+/// file only with `output.overwrite`.
+fn check_report_path(job: &Job<'_>) -> Result<(), RunError> {
+    let Some(html) = job.output.report_path() else {
+        return Ok(());
+    };
+    let mut protected = job.protected();
+    protected.push(Protected::new("the output GeoPackage", &job.output.path));
+    check_path(&html, job.output.overwrite, &protected)?;
+    Ok(())
 }
 
 /// Counts of a run so far.
@@ -368,15 +390,10 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
             Ok(Err(e)) => return Err(e.into()),
             Err(_) => return Err(reader_gone(reader)),
         };
-        let mut inputs = vec![job.input.source.as_str()];
-        if let Some(c) = &job.input.connect {
-            inputs.push(c.source.as_str());
-        }
-        inputs.extend(job.other_inputs.iter().map(String::as_str));
         let writer = Writer::create(
             job.output,
             &info,
-            &inputs,
+            &job.protected(),
             job.params.collapse.is_some(),
             job.input.merge_adjacent,
             job.input.connect.is_some(),

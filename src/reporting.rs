@@ -7,6 +7,7 @@
 
 use crate::config::{InputSpec, LayerRef};
 use crate::feature::{Feature, Value};
+use crate::io::guard::{Kind, Protected, Target};
 use crate::io::readback::OutputFile;
 use crate::io::{IoError, Reader};
 use crate::output::{BarRow, CandidateRow, SkeletonRow};
@@ -44,6 +45,8 @@ pub struct ReportJob {
     pub selection: Selection,
     /// Where the polygons are, when not where `skeletonise_runs` says.
     pub polygons: Option<InputSpec>,
+    /// Replace an existing report.
+    pub overwrite: bool,
 }
 
 /// What a report holds.
@@ -83,36 +86,38 @@ pub enum ReportError {
     },
 }
 
-/// Checks that `html` can be written (its directory exists, it is not a
-/// directory) without creating anything.
-pub fn check_path(html: &Path) -> Result<(), IoError> {
-    let fail = |reason: String| IoError::Output {
-        path: html.display().to_string(),
-        reason,
-    };
-    if html.is_dir() {
-        return Err(fail(
-            "it is a directory; give a file name ending in .html".into(),
-        ));
+/// Checks that the report `html` can be written ([`crate::io::guard`]): an
+/// `.html` path, no directory, device or FIFO, none of the `protected`
+/// sources (the GeoPackage reported on, the polygons read, the run's
+/// input), an existing file only with `overwrite`. Creates nothing.
+pub fn check_path(
+    html: &Path,
+    overwrite: bool,
+    protected: &[Protected<'_>],
+) -> Result<(), IoError> {
+    Target {
+        path: html,
+        kind: Kind::Report,
+        overwrite,
+        protected,
     }
-    let parent = html
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    if !parent.is_dir() {
-        return Err(fail(format!(
-            "directory `{}` does not exist; create it first",
-            parent.display()
-        )));
-    }
-    Ok(())
+    .check()
 }
 
 /// Makes the report of `job.gpkg` and writes it to `job.html`.
 pub fn write_report(job: &ReportJob) -> Result<ReportSummary, ReportError> {
     let clock = Instant::now();
-    check_path(&job.html)?;
+    let gpkg = job.gpkg.display().to_string();
+    let mut protected = vec![Protected::new("the GeoPackage reported on", &gpkg)];
+    if let Some(p) = &job.polygons {
+        protected.push(Protected::new("the polygons source", &p.source));
+    }
+    check_path(&job.html, job.overwrite, &protected)?;
     let file = OutputFile::open(&job.gpkg)?;
+    if let Some(run) = file.run() {
+        protected.push(Protected::new("the run's input", &run.input_source));
+        check_path(&job.html, job.overwrite, &protected)?;
+    }
     let mut notes = Vec::new();
     let has_candidates = file.has_layer(crate::output::CANDIDATES.name);
     if !has_candidates {
@@ -144,7 +149,7 @@ pub fn write_report(job: &ReportJob) -> Result<ReportSummary, ReportError> {
         notes,
     };
     let html = render(&report);
-    write_atomically(&job.html, &html)?;
+    write_atomically(&job.html, job.overwrite, &html)?;
     Ok(ReportSummary {
         path: job.html.clone(),
         sections: report.sections.len(),
@@ -153,21 +158,30 @@ pub fn write_report(job: &ReportJob) -> Result<ReportSummary, ReportError> {
     })
 }
 
-fn write_atomically(path: &Path, text: &str) -> Result<(), ReportError> {
+/// Writes `text` under a new temporary name (never through a link or over
+/// a file) and renames it into place; the temporary file is removed on
+/// every failure.
+fn write_atomically(path: &Path, overwrite: bool, text: &str) -> Result<(), ReportError> {
     let fail = |e: std::io::Error| ReportError::Write {
         path: path.display().to_string(),
         reason: e.to_string(),
     };
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().to_string())
-        .unwrap_or_else(|| "report.html".into());
-    let tmp = path.with_file_name(format!(".{name}.{}.tmp", std::process::id()));
-    std::fs::write(&tmp, text).map_err(fail)?;
-    std::fs::rename(&tmp, path).map_err(|e| {
+    let target = Target {
+        path,
+        kind: Kind::Report,
+        overwrite,
+        protected: &[],
+    };
+    crate::io::signals::remove_stale(path);
+    let tmp = target.temporary(std::process::id())?;
+    crate::io::signals::register(&tmp);
+    let r = crate::io::guard::create_new(&tmp, text.as_bytes())
+        .and_then(|_| std::fs::rename(&tmp, path));
+    if r.is_err() {
         let _ = std::fs::remove_file(&tmp);
-        fail(e)
-    })
+    }
+    crate::io::signals::unregister(&tmp);
+    r.map_err(fail)
 }
 
 /// Every candidate row passing `filter`, or without a candidates layer the

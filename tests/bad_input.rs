@@ -397,3 +397,321 @@ fn outputs_that_must_not_be_written() {
     }
     assert_eq!(std::fs::read(&existing).unwrap(), b"keep me");
 }
+
+// Reliability round 3: every path the tool writes goes through one guard.
+
+/// A finished demo run in `dir` (its GeoPackage and a copy of its input),
+/// with candidates so that a report has something to show.
+fn demo_output(dir: &Path) -> (std::path::PathBuf, std::path::PathBuf) {
+    let input = dir.join("src.gpkg");
+    std::fs::copy(root(DEMO), &input).unwrap();
+    let out = dir.join("x.gpkg");
+    let o = skeletonise(&[
+        "run",
+        "pipelines/demo.yaml",
+        "-i",
+        input.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--set",
+        "output.report=null",
+        "-q",
+    ]);
+    let (code, err) = code_and_err(&o);
+    assert_eq!(code, 0, "{err}");
+    (input, out)
+}
+
+/// Runs `args` and checks that it fails with exit 1 and `message`, and that
+/// every file in `kept` still has the bytes it had.
+fn refused(name: &str, args: &[&str], message: &str, kept: &[&Path]) {
+    refused_with(1, name, args, message, kept);
+}
+
+/// [`refused`] with the exit code `want`.
+fn refused_with(want: i32, name: &str, args: &[&str], message: &str, kept: &[&Path]) {
+    let before: Vec<Vec<u8>> = kept.iter().map(|p| std::fs::read(p).unwrap()).collect();
+    let o = skeletonise(args);
+    let (code, err) = code_and_err(&o);
+    assert_eq!(code, want, "{name}: {err}");
+    assert!(err.contains(message), "{name}: `{message}` not in {err}");
+    for (p, b) in kept.iter().zip(&before) {
+        assert_eq!(
+            &std::fs::read(p).unwrap(),
+            b,
+            "{name}: {} changed",
+            p.display()
+        );
+    }
+}
+
+#[test]
+fn the_report_never_replaces_the_output_or_a_source() {
+    let d = tmp();
+    let (input, out) = demo_output(d.path());
+    let (i, o) = (input.to_str().unwrap(), out.to_str().unwrap());
+    refused(
+        "report over its own GeoPackage",
+        &["report", o, "-o", o],
+        "give a path ending in `.html`",
+        &[&out],
+    );
+    refused(
+        "report over the polygons source",
+        &["report", o, "--polygons", i, "-o", i],
+        "give a path ending in `.html`",
+        &[&out, &input],
+    );
+    // The same files under an .html name (hard links): refused as files, not
+    // by their names.
+    let gpkg_link = d.path().join("x-link.html");
+    std::fs::hard_link(&out, &gpkg_link).unwrap();
+    refused(
+        "report over a link to its GeoPackage",
+        &[
+            "report",
+            o,
+            "-o",
+            gpkg_link.to_str().unwrap(),
+            "--overwrite",
+        ],
+        "it is the GeoPackage reported on",
+        &[&out],
+    );
+    let src_link = d.path().join("src-link.html");
+    std::fs::hard_link(&input, &src_link).unwrap();
+    refused(
+        "report over a link to the polygons",
+        &[
+            "report",
+            o,
+            "--polygons",
+            i,
+            "-o",
+            src_link.to_str().unwrap(),
+            "--overwrite",
+        ],
+        "it is the polygons source",
+        &[&input],
+    );
+    refused(
+        "report over a link to the run's recorded input",
+        &["report", o, "-o", src_link.to_str().unwrap(), "--overwrite"],
+        "it is the run's input",
+        &[&input],
+    );
+}
+
+#[test]
+fn the_report_path_of_a_run_is_checked_before_any_work_by_run_and_validate() {
+    let d = tmp();
+    let input = d.path().join("src.gpkg");
+    std::fs::copy(root(DEMO), &input).unwrap();
+    let link = d.path().join("in.html");
+    std::fs::hard_link(&input, &link).unwrap();
+    let out = d.path().join("o.gpkg");
+    for (name, report, code, message) in [
+        ("the input", input.to_str().unwrap(), 1, "`.html`"),
+        (
+            "a link to the input",
+            link.to_str().unwrap(),
+            1,
+            "it is the input",
+        ),
+        (
+            "the output",
+            out.to_str().unwrap(),
+            78,
+            "would overwrite the GeoPackage",
+        ),
+    ] {
+        let set = format!("output.report.path={report}");
+        for cmd in ["run", "validate"] {
+            refused_with(
+                code,
+                &format!("{cmd}: report over {name}"),
+                &[
+                    cmd,
+                    "pipelines/demo.yaml",
+                    "-i",
+                    input.to_str().unwrap(),
+                    "-o",
+                    out.to_str().unwrap(),
+                    "--set",
+                    &set,
+                ],
+                message,
+                &[&input],
+            );
+            assert!(!out.exists(), "{cmd} {name}: the run went on");
+        }
+    }
+}
+
+#[test]
+fn a_report_never_replaces_a_device_a_fifo_or_an_existing_file_without_overwrite() {
+    let d = tmp();
+    let (_, out) = demo_output(d.path());
+    let o = out.to_str().unwrap();
+    refused(
+        "report to /dev/null",
+        &["report", o, "-o", "/dev/null", "--overwrite"],
+        "",
+        &[],
+    );
+    use std::os::unix::fs::FileTypeExt;
+    assert!(std::fs::metadata("/dev/null")
+        .unwrap()
+        .file_type()
+        .is_char_device());
+    let null_link = d.path().join("null.html");
+    std::os::unix::fs::symlink("/dev/null", &null_link).unwrap();
+    refused(
+        "report to a link to /dev/null",
+        &[
+            "report",
+            o,
+            "-o",
+            null_link.to_str().unwrap(),
+            "--overwrite",
+        ],
+        "not a regular file",
+        &[],
+    );
+    let fifo = d.path().join("fifo.html");
+    let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o644) }, 0);
+    refused(
+        "report to a FIFO",
+        &["report", o, "-o", fifo.to_str().unwrap(), "--overwrite"],
+        "not a regular file",
+        &[],
+    );
+    assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo());
+    let html = d.path().join("r.html");
+    std::fs::write(&html, b"my notes").unwrap();
+    refused(
+        "report over an existing file",
+        &["report", o, "-o", html.to_str().unwrap()],
+        "already exists",
+        &[&html],
+    );
+    let ok = skeletonise(&[
+        "report",
+        o,
+        "-o",
+        html.to_str().unwrap(),
+        "--overwrite",
+        "-q",
+    ]);
+    assert_eq!(code_and_err(&ok).0, 0, "{}", code_and_err(&ok).1);
+    assert!(std::fs::read_to_string(&html)
+        .unwrap()
+        .starts_with("<!DOCTYPE html>"));
+    // A run's report follows `output.overwrite`.
+    let input = d.path().join("src.gpkg");
+    refused(
+        "run over an existing report",
+        &[
+            "run",
+            "pipelines/demo.yaml",
+            "-i",
+            input.to_str().unwrap(),
+            "-o",
+            d.path().join("new.gpkg").to_str().unwrap(),
+            "--set",
+            "output.overwrite=false",
+            "--set",
+            &format!("output.report.path={}", html.display()),
+        ],
+        "already exists",
+        &[&html],
+    );
+    let leftovers: Vec<String> = std::fs::read_dir(d.path())
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().to_string())
+        .filter(|n| n.contains(".tmp."))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+}
+
+/// Runs the binary with the size of any file it writes limited to `bytes`
+/// (RLIMIT_FSIZE, with SIGXFSZ ignored so that the write fails with EFBIG
+/// as on a full disk).
+fn skeletonise_with_file_limit(args: &[&str], bytes: u64) -> std::process::Output {
+    use std::os::unix::process::CommandExt;
+    let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_skeletonise"));
+    cmd.args(args).current_dir(env!("CARGO_MANIFEST_DIR"));
+    unsafe {
+        cmd.pre_exec(move || {
+            libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
+            let lim = libc::rlimit {
+                rlim_cur: bytes,
+                rlim_max: bytes,
+            };
+            if libc::setrlimit(libc::RLIMIT_FSIZE, &lim) != 0 {
+                return Err(std::io::Error::last_os_error());
+            }
+            Ok(())
+        });
+    }
+    cmd.output().expect("the binary runs")
+}
+
+#[test]
+fn a_run_that_fails_on_a_full_disk_leaves_no_temporary_file() {
+    let d = tmp();
+    let out = d.path().join("dated-2026-12-04.gpkg");
+    let mut failed = 0;
+    // From a file too small for the empty layers to one that fails only at
+    // the last commit (few rows: the final commit is the first) or in a
+    // batch (many rows): every way of failing cleans up.
+    let few = ["output.widths=false", "output.candidates=false"];
+    let many = ["output.bars=true", "output.widths=true"];
+    for (rows, kbs) in [
+        (few, &[100u64, 130, 160, 190][..]),
+        (many, &[96, 256, 512, 1024][..]),
+    ] {
+        for &kb in kbs {
+            let args = [
+                "run",
+                "pipelines/demo.yaml",
+                "-o",
+                out.to_str().unwrap(),
+                "--set",
+                "output.overwrite=true",
+                "--set",
+                "output.report=null",
+                "--set",
+                rows[0],
+                "--set",
+                rows[1],
+                "-q",
+            ];
+            let before = std::fs::read(&out).ok();
+            let o = skeletonise_with_file_limit(&args, kb * 1024);
+            let (code, err) = code_and_err(&o);
+            let left: Vec<String> = std::fs::read_dir(d.path())
+                .unwrap()
+                .flatten()
+                .map(|e| e.file_name().to_string_lossy().to_string())
+                .filter(|n| n.contains(".tmp."))
+                .collect();
+            assert!(
+                left.is_empty(),
+                "{kb} KB, {rows:?} (exit {code}): left {left:?}\n{err}"
+            );
+            if code != 0 {
+                assert_eq!(code, 1, "{kb} KB: {err}");
+                assert_eq!(
+                    std::fs::read(&out).ok(),
+                    before,
+                    "{kb} KB: a failed run changed the output"
+                );
+                failed += 1;
+            }
+        }
+    }
+    assert!(failed >= 6, "the limits must make runs fail: {failed}");
+}

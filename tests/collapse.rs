@@ -857,6 +857,7 @@ fn the_report_of_a_collapse_run_draws_each_feature_once_with_all_its_lines() {
             out.to_str().unwrap(),
             "-o",
             html.to_str().unwrap(),
+            "--overwrite",
             "-q",
         ]);
         assert!(o.status.success(), "{}", code_and_err(&o).1);

@@ -4,6 +4,7 @@
 //! report. No GDAL type leaves this module.
 
 pub mod gdal_errors;
+pub mod guard;
 pub mod readback;
 pub mod reader;
 pub mod signals;

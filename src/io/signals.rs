@@ -17,7 +17,8 @@ static TEMPORARY: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 /// Files SQLite may keep beside a GeoPackage while it is written.
 const COMPANIONS: [&str; 4] = ["", "-journal", "-wal", "-shm"];
 
-fn remove_with_companions(p: &Path) {
+/// Removes `p` and the files SQLite may have kept beside it.
+pub(crate) fn remove_with_companions(p: &Path) {
     for suffix in COMPANIONS {
         let mut f = p.as_os_str().to_owned();
         f.push(suffix);
@@ -64,16 +65,6 @@ pub fn unregister(p: &Path) {
     }
 }
 
-/// The temporary name of output `path` for process `pid`:
-/// `.NAME.PID.tmp.gpkg` beside it.
-pub fn temporary_name(path: &Path, pid: u32) -> PathBuf {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().to_string())
-        .unwrap_or_else(|| "out.gpkg".into());
-    path.with_file_name(format!(".{name}.{pid}.tmp.gpkg"))
-}
-
 /// Removes the temporary files of earlier runs on output `path` whose
 /// process no longer runs (killed with SIGKILL, or a crashed machine).
 pub fn remove_stale(path: &Path) {
@@ -92,7 +83,10 @@ pub fn remove_stale(path: &Path) {
         let file = e.file_name().to_string_lossy().to_string();
         let Some(pid) = file
             .strip_prefix(&prefix)
-            .and_then(|r| r.strip_suffix(".tmp.gpkg"))
+            .and_then(|r| {
+                r.strip_suffix(".tmp.gpkg")
+                    .or_else(|| r.strip_suffix(".tmp.html"))
+            })
             .and_then(|p| p.parse::<u32>().ok())
         else {
             continue;
@@ -112,6 +106,12 @@ fn alive(pid: u32) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    use crate::io::guard::Kind;
+
+    fn temporary_name(path: &Path, pid: u32) -> PathBuf {
+        crate::io::guard::temporary_name(path, pid, Kind::GeoPackage)
+    }
 
     #[test]
     fn stale_temporary_files_of_dead_processes_are_removed() {

@@ -10,6 +10,7 @@
 //! output only when the run succeeds: a killed run never leaves a half-written
 //! output.
 
+use super::guard::{Kind, Protected, Target};
 use super::reader::{FieldInfo, SourceInfo};
 use super::{signals, IoError};
 use crate::feature::Value;
@@ -52,113 +53,22 @@ pub struct Writer {
 /// temporary one until the run has finished (a failed run leaves nothing).
 const ROWS_PER_COMMIT: usize = 1_024;
 
-/// Checks that `spec.path` can be written without harm, creating nothing
-/// that stays: a `.gpkg` path, not an existing device, FIFO or directory,
-/// not one of the `inputs` (data source strings; compared after resolving
-/// links, `/vsizip/`-style prefixes stripped), no file in the way without
-/// `overwrite`, and a directory the process may write to (probed by
-/// creating and removing a temporary file).
-pub fn check_output(spec: &OutputSpec, inputs: &[&str]) -> Result<(), IoError> {
-    let path = Path::new(&spec.path);
-    let bad = |reason: String| IoError::Output {
-        path: spec.path.clone(),
-        reason,
-    };
-    let is_gpkg = path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("gpkg"));
-    if !is_gpkg {
-        return Err(bad(
-            "the output is always a GeoPackage: give a path ending in `.gpkg` (`output.path` or `-o`)"
-                .into(),
-        ));
-    }
-    if let Ok(meta) = std::fs::metadata(path) {
-        if !meta.is_file() {
-            let what = if meta.is_dir() {
-                "a directory"
-            } else {
-                "not a regular file (a device, FIFO or socket)"
-            };
-            return Err(bad(format!(
-                "it is {what}; choose the path of a GeoPackage file"
-            )));
-        }
-    }
-    let target = resolved(path);
-    for input in inputs {
-        if let Some(src) = local_path(input) {
-            if resolved(&src) == target {
-                return Err(bad(format!(
-                    "it is the input `{input}`; writing it would destroy the data being read: choose another output path"
-                )));
-            }
-        }
-    }
-    if path.exists() && !spec.overwrite {
-        return Err(IoError::OutputExists {
-            path: spec.path.clone(),
-        });
-    }
-    let parent = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    if !parent.is_dir() {
-        return Err(bad(format!(
-            "directory `{}` does not exist; create it first",
-            parent.display()
-        )));
-    }
-    probe_writable(parent).map_err(|e| {
-        bad(format!(
-            "directory `{}` cannot be written ({e}); choose a directory you may write to",
-            parent.display()
-        ))
-    })
+/// Checks that `spec.path` can be written without harm ([`super::guard`]):
+/// a `.gpkg` path, not an existing device, FIFO or directory, none of the
+/// `protected` sources, no file in the way without `overwrite`, and a
+/// directory the process may write to. Creates nothing that stays.
+pub fn check_output(spec: &OutputSpec, protected: &[Protected<'_>]) -> Result<(), IoError> {
+    output_target(spec, protected).check()
 }
 
-/// `path` with links resolved (its parent's when it does not exist yet).
-fn resolved(path: &Path) -> PathBuf {
-    if let Ok(p) = std::fs::canonicalize(path) {
-        return p;
+/// The output GeoPackage as a guarded target.
+fn output_target<'a>(spec: &'a OutputSpec, protected: &'a [Protected<'a>]) -> Target<'a> {
+    Target {
+        path: Path::new(&spec.path),
+        kind: Kind::GeoPackage,
+        overwrite: spec.overwrite,
+        protected,
     }
-    let parent = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    match (std::fs::canonicalize(parent), path.file_name()) {
-        (Ok(p), Some(n)) => p.join(n),
-        _ => path.to_path_buf(),
-    }
-}
-
-/// The file behind an OGR data source string, when it is a local file
-/// (`PG:` and other connection strings are not).
-fn local_path(source: &str) -> Option<PathBuf> {
-    let s = source
-        .trim_start_matches("/vsizip/")
-        .trim_start_matches("/vsigzip/")
-        .trim_start_matches("/vsitar/");
-    if s.starts_with("/vsi")
-        || s.contains("://")
-        || s.split_once(':')
-            .is_some_and(|(a, _)| a.len() > 1 && !a.contains('/'))
-    {
-        return None;
-    }
-    // A path inside an archive: the archive is the file.
-    let archive = [".zip/", ".gz/", ".tar/"]
-        .iter()
-        .find_map(|ext| s.find(ext).map(|i| &s[..i + ext.len() - 1]));
-    Some(PathBuf::from(archive.unwrap_or(s)))
-}
-
-/// Creates and removes a file in `dir`.
-fn probe_writable(dir: &Path) -> std::io::Result<()> {
-    let probe = dir.join(format!(".skeletonise-probe-{}", std::process::id()));
-    std::fs::File::create(&probe)?;
-    std::fs::remove_file(&probe)
 }
 
 fn field(layer: &gdal::vector::Layer<'_>, name: &str, ty: u32) -> Result<(), IoError> {
@@ -255,7 +165,7 @@ fn to_gdal<G: ToGdal>(g: &G) -> Result<Geometry, IoError> {
 
 impl Writer {
     /// Creates the temporary GeoPackage and its layers. Fails, touching
-    /// nothing, when the output is refused by [`check_output`] (`inputs` are
+    /// nothing, when the output is refused by [`check_output`] (`protected`:
     /// the data sources the run reads). `collapse`: the pipeline has a
     /// `collapse` step (the `areas` layer, the `collapsed` column); `merge`:
     /// the input merges adjacent polygons (the `members` column); `connect`:
@@ -263,21 +173,21 @@ impl Writer {
     pub fn create(
         spec: &OutputSpec,
         source: &SourceInfo,
-        inputs: &[&str],
+        protected: &[Protected<'_>],
         collapse: bool,
         merge: bool,
         connect: bool,
     ) -> Result<Self, IoError> {
-        check_output(spec, inputs)?;
+        let target = output_target(spec, protected);
+        target.check()?;
         let path = PathBuf::from(&spec.path);
         signals::remove_stale(&path);
-        let tmp = signals::temporary_name(&path, std::process::id());
+        let tmp = target.temporary(std::process::id())?;
         let out_err = |e: gdal::errors::GdalError| IoError::Output {
             path: spec.path.clone(),
             reason: e.to_string(),
         };
         let driver = DriverManager::get_driver_by_name("GPKG").map_err(out_err)?;
-        let _ = std::fs::remove_file(&tmp);
         signals::register(&tmp);
         let mut ds = driver.create_vector_only(&tmp).map_err(out_err)?;
         let srs = source
@@ -502,32 +412,55 @@ impl Writer {
     }
 
     /// Writes the run record, closes the file and renames it over the output.
+    /// On any failure (a full disk at the last commit, a rename refused) the
+    /// temporary file is removed and the previous output, if any, stays.
     pub fn finish(mut self, run: &RunRecord) -> Result<PathBuf, IoError> {
         let ds = self.ds.take().expect("open until finish/abort");
+        let r = self.close(ds, run);
+        if r.is_err() {
+            signals::remove_with_companions(&self.tmp);
+        }
+        signals::unregister(&self.tmp);
+        r
+    }
+
+    /// The last commit, the run record, closing and the rename.
+    fn close(&mut self, ds: Dataset, run: &RunRecord) -> Result<PathBuf, IoError> {
         self.commit(&ds)?;
         self.write_rows(&ds, &RUNS, RUNS.name, std::slice::from_ref(run))?;
         // Closing flushes the file before it is renamed into place.
-        drop(ds);
+        close_dataset(ds).map_err(|reason| IoError::Output {
+            path: self.spec.path.clone(),
+            reason: format!("closing the finished file failed: {reason}"),
+        })?;
         if self.path.exists() && !self.spec.overwrite {
-            let _ = std::fs::remove_file(&self.tmp);
             return Err(IoError::OutputExists {
                 path: self.spec.path.clone(),
             });
         }
-        let renamed = std::fs::rename(&self.tmp, &self.path);
-        signals::unregister(&self.tmp);
-        renamed.map_err(|e| IoError::Output {
+        std::fs::rename(&self.tmp, &self.path).map_err(|e| IoError::Output {
             path: self.spec.path.clone(),
             reason: format!("renaming the finished file into place failed: {e}"),
         })?;
         Ok(self.path.clone())
     }
 
-    /// Discards the temporary file.
+    /// Discards the temporary file (and what SQLite kept beside it).
     pub fn abort(&mut self) {
         drop(self.ds.take());
-        let _ = std::fs::remove_file(&self.tmp);
+        signals::remove_with_companions(&self.tmp);
         signals::unregister(&self.tmp);
+    }
+}
+
+/// Closes a dataset, with GDAL's reason when closing fails (the last
+/// write of a file on a full disk fails here).
+fn close_dataset(ds: Dataset) -> Result<(), String> {
+    super::gdal_errors::clear();
+    ds.close().map_err(|e| e.to_string())?;
+    match super::gdal_errors::take_failures().first() {
+        Some(m) => Err(m.clone()),
+        None => Ok(()),
     }
 }
 
