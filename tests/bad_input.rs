@@ -715,3 +715,73 @@ fn a_run_that_fails_on_a_full_disk_leaves_no_temporary_file() {
     }
     assert!(failed >= 6, "the limits must make runs fail: {failed}");
 }
+
+/// Runs the binary with the environment variables `env` set.
+fn skeletonise_env(args: &[&str], env: &[(&str, &str)]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_skeletonise"))
+        .args(args)
+        .envs(env.iter().copied())
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("the binary runs")
+}
+
+#[test]
+fn a_variable_that_is_set_but_empty_is_an_error_naming_it_for_every_key() {
+    let d = tmp();
+    let src = d.path().join("in.gpkg");
+    make_layer(&src, "first", 3035, &[Some(SQUARE)]);
+    make_layer(&src, "3", 3035, &[Some(SQUARE), Some(SQUARE)]);
+    let out = d.path().join("o.gpkg");
+    let body = |input: &str| {
+        format!(
+            "input:\n  source: {}\n{input}steps:\n  - skeleton: {{ methods: [MA] }}\noutput:\n  path: {}\n  overwrite: true\n",
+            src.display(),
+            out.display()
+        )
+    };
+    for (name, input, var) in [
+        ("layer", "  layer: \"${LAYER}\"\n", "LAYER"),
+        (
+            "connect.layer",
+            "  connect: { source: \"SRC\", layer: \"${NET}\" }\n",
+            "NET",
+        ),
+        (
+            "merge_by",
+            "  merge_adjacent: true\n  merge_by: \"${RIVER_ID}\"\n",
+            "RIVER_ID",
+        ),
+    ] {
+        let text = body(&input.replace("SRC", src.to_str().unwrap()));
+        let p = pipeline(d.path(), "env.yaml", &text);
+        for cmd in ["validate", "run"] {
+            let o = skeletonise_env(&[cmd, p.to_str().unwrap()], &[(var, "")]);
+            let (code, err) = code_and_err(&o);
+            assert_eq!(code, 78, "{cmd} {name}: {err}");
+            assert!(
+                err.contains(&format!("`{var}` is set but empty")),
+                "{cmd} {name}: {err}"
+            );
+            assert!(!out.exists(), "{cmd} {name}: something was written");
+        }
+    }
+    // `:-` gives the default for an empty variable too, as in the shell.
+    let p = pipeline(d.path(), "default.yaml", &body("  layer: \"${LAYER:-first}\"\n"));
+    let o = skeletonise_env(&["run", p.to_str().unwrap(), "-q"], &[("LAYER", "")]);
+    assert_eq!(code_and_err(&o).0, 0, "{}", code_and_err(&o).1);
+    assert_eq!(ints(&open(&out), "skeletonise_runs", "features_read"), [Some(1)]);
+    // A substituted layer stays a name: `3` is the layer called "3", not the
+    // fourth layer; a numeric key still gets its number.
+    let text = body("  layer: \"${LAYER}\"\n").replace(
+        "  - skeleton: { methods: [MA] }\n",
+        "  - skeleton: { methods: [MA] }\n  - prune: { ratio: \"${RATIO}\" }\n",
+    );
+    let p = pipeline(d.path(), "typed.yaml", &text);
+    let o = skeletonise_env(&["run", p.to_str().unwrap(), "-q"], &[("LAYER", "3"), ("RATIO", "2")]);
+    assert_eq!(code_and_err(&o).0, 0, "{}", code_and_err(&o).1);
+    let ds = open(&out);
+    assert_eq!(ints(&ds, "skeletonise_runs", "features_read"), [Some(2)]);
+    let recorded = strings(&ds, "skeletonise_runs", "input_layer");
+    assert_eq!(recorded, [Some("3".to_string())]);
+}

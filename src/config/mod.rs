@@ -330,14 +330,26 @@ fn parse<T: serde::de::DeserializeOwned>(
             message: m,
         })?;
     }
-    substitute_env(&mut value, "").map_err(|(k, m)| err(locs.value(&k), &k, m))?;
+    let mut typed = Typed::new();
+    substitute_env(&mut value, "", &mut typed).map_err(|(k, m)| err(locs.value(&k), &k, m))?;
     unknown_skeleton_keys(&value).map_err(|(k, m)| err(locs.key(&k), &k, m))?;
-    // Enums are written as single-key maps (`prune: {...}`, `densify: {factor: 4}`).
-    let mut track = serde_path_to_error::Track::new();
-    let de = serde_path_to_error::Deserializer::new(value, &mut track);
-    let parsed: Result<T, _> = serde_yaml_ng::with::singleton_map_recursive::deserialize(de);
-    let file: T = parsed.map_err(|e| {
+    let file: T = loop {
+        // Enums are written as single-key maps (`prune: {...}`, `densify: {factor: 4}`).
+        let mut track = serde_path_to_error::Track::new();
+        let de = serde_path_to_error::Deserializer::new(value.clone(), &mut track);
+        let parsed: Result<T, _> = serde_yaml_ng::with::singleton_map_recursive::deserialize(de);
+        let e = match parsed {
+            Ok(file) => break file,
+            Err(e) => e,
+        };
         let key = path_string(&track.path());
+        // A substituted number or boolean where a string does not do.
+        if let Some(t) = typed.remove(&key) {
+            if let Some(slot) = value_at(&mut value, &key) {
+                *slot = t;
+                continue;
+            }
+        }
         let inner = e.to_string();
         // Point unknown keys at the key itself.
         let pos = match unknown_field(&inner) {
@@ -345,8 +357,8 @@ fn parse<T: serde::de::DeserializeOwned>(
             Some(f) => locs.key(&locate::join(&key, &f)),
             None => locs.value(&key),
         };
-        err(pos, &key, hint(&inner))
-    })?;
+        return Err(err(pos, &key, hint(&inner)));
+    };
     check(&file).map_err(|(k, m)| err(locs.key(&k), &k, m))?;
     Ok(file)
 }
@@ -612,32 +624,37 @@ fn step_index(seq: &mut Vec<Value>, name: &str) -> Result<usize, String> {
     Ok(at)
 }
 
-/// Replaces `${NAME}` and `${NAME:-default}` in every string.
-fn substitute_env(v: &mut Value, path: &str) -> Result<(), (String, String)> {
+/// A value that was one `${…}` as a whole, by key path, with the value its
+/// text has in YAML: it stays a string unless the key needs a number or a
+/// boolean ([`parse`] retries with the typed value where the string fails).
+type Typed = std::collections::HashMap<String, Value>;
+
+/// Replaces `${NAME}` and `${NAME:-default}` in every string; records the
+/// values that were one `${…}` as a whole in `typed`.
+fn substitute_env(v: &mut Value, path: &str, typed: &mut Typed) -> Result<(), (String, String)> {
     match v {
         Value::String(s) if s.contains("${") => {
             let whole = s.starts_with("${") && s.ends_with('}') && s.matches("${").count() == 1;
             let text = expand(s).map_err(|m| (path.to_string(), m))?;
-            // A value that is one `${…}` takes the type its text has in YAML
-            // (`ratio: ${RATIO}` is a number); one with text around it is
-            // a string.
-            let typed = whole
-                .then(|| serde_yaml_ng::from_str::<Value>(&text).ok())
-                .flatten()
-                .filter(|t| {
-                    !matches!(t, Value::Mapping(_) | Value::Sequence(_) | Value::Tagged(_))
+            if whole {
+                let t = serde_yaml_ng::from_str::<Value>(&text).ok().filter(|t| {
+                    matches!(t, Value::Number(_) | Value::Bool(_))
                 });
-            *v = typed.unwrap_or(Value::String(text));
+                if let Some(t) = t {
+                    typed.insert(path.to_string(), t);
+                }
+            }
+            *v = Value::String(text);
         }
         Value::Mapping(m) => {
             for (k, val) in m.iter_mut() {
                 let key = k.as_str().map(str::to_string).unwrap_or_default();
-                substitute_env(val, &locate::join(path, &key))?;
+                substitute_env(val, &locate::join(path, &key), typed)?;
             }
         }
         Value::Sequence(s) => {
             for (i, val) in s.iter_mut().enumerate() {
-                substitute_env(val, &format!("{path}[{i}]"))?;
+                substitute_env(val, &format!("{path}[{i}]"), typed)?;
             }
         }
         _ => {}
@@ -645,6 +662,30 @@ fn substitute_env(v: &mut Value, path: &str) -> Result<(), (String, String)> {
     Ok(())
 }
 
+/// The value at key path `path` (`a.b[2].c`, as [`substitute_env`] names
+/// them).
+fn value_at<'v>(v: &'v mut Value, path: &str) -> Option<&'v mut Value> {
+    let mut cur = v;
+    for seg in path.split('.') {
+        let (key, indices) = match seg.find('[') {
+            Some(i) => (&seg[..i], &seg[i..]),
+            None => (seg, ""),
+        };
+        if !key.is_empty() {
+            cur = cur.as_mapping_mut()?.get_mut(key)?;
+        }
+        for idx in indices.split('[').filter(|x| !x.is_empty()) {
+            let i: usize = idx.trim_end_matches(']').parse().ok()?;
+            cur = cur.as_sequence_mut()?.get_mut(i)?;
+        }
+    }
+    Some(cur)
+}
+
+/// `${NAME}` and `${NAME:-default}` in `s` replaced by the environment. A
+/// variable that is not set, or set but empty, is an error naming it,
+/// unless the expression gives a default (`:-`, as in the shell: used when
+/// the variable is unset or empty).
 fn expand(s: &str) -> Result<String, String> {
     let mut out = String::new();
     let mut rest = s;
@@ -660,8 +701,13 @@ fn expand(s: &str) -> Result<String, String> {
             None => (expr, None),
         };
         match (std::env::var(name), default) {
-            (Ok(v), _) => out.push_str(&v),
-            (Err(_), Some(d)) => out.push_str(d),
+            (Ok(v), _) if !v.is_empty() => out.push_str(&v),
+            (_, Some(d)) => out.push_str(d),
+            (Ok(_), None) => {
+                return Err(format!(
+                    "environment variable `{name}` is set but empty; give it a value, or write `${{{name}:-default}}` for a default"
+                ))
+            }
             (Err(_), None) => {
                 return Err(format!(
                     "environment variable `{name}` is not set; export it or write `${{{name}:-default}}`"
@@ -829,6 +875,37 @@ mod tests {
         let e = load_str(&OK.replace("in.gpkg", "${SKELETONISE_NOPE}"), "p.yaml", &[]).unwrap_err();
         assert_eq!(e.key, "input.source");
         assert_eq!(e.position, Some((2, 11)));
+    }
+
+    #[test]
+    fn substituted_values_stay_strings_unless_the_key_needs_a_number_or_boolean() {
+        std::env::set_var("SKELETONISE_TEST_LAYER", "7");
+        std::env::set_var("SKELETONISE_TEST_RATIO", "2.5");
+        std::env::set_var("SKELETONISE_TEST_OW", "true");
+        std::env::set_var("SKELETONISE_TEST_EMPTY", "");
+        let t = OK
+            .replace(
+                "source: in.gpkg",
+                "source: in.gpkg\n  layer: \"${SKELETONISE_TEST_LAYER}\"",
+            )
+            .replace("ratio: 1.5", "ratio: \"${SKELETONISE_TEST_RATIO}\"")
+            .replace(
+                "path: out.gpkg",
+                "path: out.gpkg\n  overwrite: ${SKELETONISE_TEST_OW}\n  layer: ${SKELETONISE_TEST_EMPTY:-lines}",
+            );
+        let p = load_str(&t, "p.yaml", &[]).unwrap();
+        assert_eq!(p.file.input.layer, Some(LayerRef::Name("7".into())));
+        assert_eq!(p.process_params().prune.unwrap().ratio, 2.5);
+        assert!(p.file.output.overwrite);
+        assert_eq!(p.file.output.layer, "lines");
+        let e = load_str(
+            &OK.replace("ratio: 1.5", "ratio: \"${SKELETONISE_TEST_EMPTY}\""),
+            "p.yaml",
+            &[],
+        )
+        .unwrap_err();
+        assert_eq!(e.key, "steps[2].prune.ratio");
+        assert!(e.message.contains("`SKELETONISE_TEST_EMPTY` is set but empty"), "{e}");
     }
 
     #[test]
