@@ -375,6 +375,20 @@ fn log_summary(s: &pipeline::RunSummary) {
         "done: {} read, {} written, {} rejected, {} filtered in {:.2} s → {}",
         s.read, s.written, s.rejected, s.filtered, s.elapsed_s, s.output
     );
+    if let Some(c) = &s.connect {
+        tracing::info!(
+            connections = c.connections,
+            lines_used = c.lines_used,
+            lines = c.lines,
+            "connect: {} connections made, {} of the network's {} lines used",
+            c.connections,
+            c.lines_used,
+            c.lines
+        );
+        if c.connections == 0 {
+            tracing::warn!("connect: no line of the network touches, crosses or comes within `snap` of a polygon; check that the network is the right layer and covers the polygons");
+        }
+    }
     for (m, t) in &s.stages {
         tracing::debug!(
             method = %m,

@@ -62,6 +62,20 @@ pub struct RunSummary {
     pub stages: Vec<(MethodId, StageTimes)>,
     /// The report written after the run (`output.report`).
     pub report: Option<ReportSummary>,
+    /// With `input.connect`: the legs added to skeletons, and the lines of
+    /// the network that got at least one.
+    pub connect: Option<ConnectCounts>,
+}
+
+/// What `input.connect` did in a run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct ConnectCounts {
+    /// Lines in the network.
+    pub lines: u64,
+    /// Lines that got at least one leg.
+    pub lines_used: u64,
+    /// Legs added (connection points served).
+    pub connections: u64,
 }
 
 /// Why a run failed.
@@ -105,7 +119,12 @@ pub fn validate(p: &Pipeline) -> Result<crate::io::SourceInfo, RunError> {
         return Err(RunError::Io(reason));
     }
     if let Some(c) = &input.connect {
-        Reader::open(&c.input(input))?.probe()?;
+        let mut lines = Reader::open(&c.input(reader.info().srs_wkt.as_deref()))
+            .map_err(|e| connect_error(c, e))?;
+        lines.probe()?;
+        if lines.info().selected == Some(0) {
+            return Err(no_lines(c, lines.info(), 0));
+        }
     }
     let job = Job::of(p);
     check_output(&p.file.output, &job.protected())?;
@@ -228,6 +247,10 @@ struct Counts {
     rows: u64,
     methods: std::collections::BTreeMap<String, u64>,
     stages: Vec<(MethodId, StageTimes)>,
+    connections: u64,
+    lines_used: std::collections::BTreeSet<Option<u64>>,
+    /// Lines of `input.connect`, when the run has a network.
+    network: Option<u64>,
 }
 
 impl Counts {
@@ -253,6 +276,9 @@ impl Counts {
             }
         }
         self.rows += r.rows.skeletons.len() as u64;
+        self.connections += r.rows.connections.len() as u64;
+        self.lines_used
+            .extend(r.rows.connections.iter().map(|c| c.line_fid));
         for (m, t) in &r.times {
             match self.stages.iter_mut().find(|(x, _)| x == m) {
                 Some((_, total)) => *total += *t,
@@ -373,11 +399,6 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
         .map_err(|_| RunError::Threads(threads))?;
     let batch = opts.batch_size.unwrap_or(256).max(1);
     let make_valid = job.params.prepare.make_valid;
-    let mut params = job.params.clone();
-    if let Some(c) = &job.input.connect {
-        params.connect = Some(std::sync::Arc::new(read_network(c, job.input)?));
-    }
-    let params = &params;
     std::thread::scope(|scope| {
         // The reader opens the source on its own thread (GDAL handles stay on
         // the thread that made them) and reports what it found first.
@@ -390,6 +411,11 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
             Ok(Err(e)) => return Err(e.into()),
             Err(_) => return Err(reader_gone(reader)),
         };
+        let mut params = job.params.clone();
+        if let Some(c) = &job.input.connect {
+            params.connect = Some(std::sync::Arc::new(read_network(c, &info)?));
+        }
+        let params = &params;
         let writer = Writer::create(
             job.output,
             &info,
@@ -441,6 +467,7 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
             (Ok(()), Err(e)) => return Err(e.into()),
             (Ok(()), Ok(w)) => w,
         };
+        counts.network = params.connect.as_ref().map(|n| n.len() as u64);
         finish_run(job, &info, counts, threads, started, clock, writer)
     })
 }
@@ -646,15 +673,19 @@ fn merge_field(input: &InputSpec, info: &SourceInfo) -> Result<Option<usize>, Io
         })
 }
 
-/// The lines of `input.connect`.
+/// The lines of `input.connect`, reprojected to the CRS the polygons are
+/// handed out in (`polygons`); a layer without lines is an error.
 fn read_network(
     c: &crate::config::ConnectSpec,
-    input: &InputSpec,
+    polygons: &SourceInfo,
 ) -> Result<crate::process::connect::Network, RunError> {
-    let mut reader = Reader::open(&c.input(input))?;
+    let mut reader =
+        Reader::open(&c.input(polygons.srs_wkt.as_deref())).map_err(|e| connect_error(c, e))?;
     let mut lines = Vec::new();
-    reader.read::<IoError>(1024, false, |features| {
-        for f in features {
+    let mut features = 0;
+    reader.read::<IoError>(1024, false, |batch| {
+        features += batch.len();
+        for f in batch {
             let mut ls = Vec::new();
             if let Some(g) = &f.geometry {
                 crate::process::connect::lines_of(g, &mut ls);
@@ -663,8 +694,30 @@ fn read_network(
         }
         Ok(())
     })?;
-    tracing::info!(source = %c.source, lines = lines.len(), "connect: line network read");
+    if lines.is_empty() {
+        return Err(no_lines(c, reader.info(), features));
+    }
+    tracing::info!(source = %c.source, layer = %reader.info().layer, crs = %reader.info().crs_name, lines = lines.len(), "connect: line network read");
     Ok(crate::process::connect::Network::new(lines, c.snap))
+}
+
+/// An error opening `input.connect`, said to be about it.
+fn connect_error(c: &crate::config::ConnectSpec, e: IoError) -> RunError {
+    RunError::Io(IoError::Read {
+        source_name: c.source.clone(),
+        reason: format!("`input.connect`: {e}"),
+    })
+}
+
+/// The error of a connect layer without lines.
+fn no_lines(c: &crate::config::ConnectSpec, info: &SourceInfo, features: usize) -> RunError {
+    RunError::Io(IoError::Read {
+        source_name: c.source.clone(),
+        reason: format!(
+            "`input.connect`: layer `{}` has no lines ({features} features read, none a LINESTRING or MULTILINESTRING); give the layer of the line network (`input.connect.layer`)",
+            info.layer
+        ),
+    })
 }
 
 /// `input.merge_adjacent`: every feature read first, the adjacent ones
@@ -779,6 +832,11 @@ fn finish_run(
         methods: counts.methods.into_iter().collect(),
         stages: counts.stages,
         report: None,
+        connect: counts.network.map(|lines| ConnectCounts {
+            lines,
+            lines_used: counts.lines_used.len() as u64,
+            connections: counts.connections,
+        }),
     })
 }
 

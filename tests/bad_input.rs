@@ -767,10 +767,17 @@ fn a_variable_that_is_set_but_empty_is_an_error_naming_it_for_every_key() {
         }
     }
     // `:-` gives the default for an empty variable too, as in the shell.
-    let p = pipeline(d.path(), "default.yaml", &body("  layer: \"${LAYER:-first}\"\n"));
+    let p = pipeline(
+        d.path(),
+        "default.yaml",
+        &body("  layer: \"${LAYER:-first}\"\n"),
+    );
     let o = skeletonise_env(&["run", p.to_str().unwrap(), "-q"], &[("LAYER", "")]);
     assert_eq!(code_and_err(&o).0, 0, "{}", code_and_err(&o).1);
-    assert_eq!(ints(&open(&out), "skeletonise_runs", "features_read"), [Some(1)]);
+    assert_eq!(
+        ints(&open(&out), "skeletonise_runs", "features_read"),
+        [Some(1)]
+    );
     // A substituted layer stays a name: `3` is the layer called "3", not the
     // fourth layer; a numeric key still gets its number.
     let text = body("  layer: \"${LAYER}\"\n").replace(
@@ -778,10 +785,103 @@ fn a_variable_that_is_set_but_empty_is_an_error_naming_it_for_every_key() {
         "  - skeleton: { methods: [MA] }\n  - prune: { ratio: \"${RATIO}\" }\n",
     );
     let p = pipeline(d.path(), "typed.yaml", &text);
-    let o = skeletonise_env(&["run", p.to_str().unwrap(), "-q"], &[("LAYER", "3"), ("RATIO", "2")]);
+    let o = skeletonise_env(
+        &["run", p.to_str().unwrap(), "-q"],
+        &[("LAYER", "3"), ("RATIO", "2")],
+    );
     assert_eq!(code_and_err(&o).0, 0, "{}", code_and_err(&o).1);
     let ds = open(&out);
     assert_eq!(ints(&ds, "skeletonise_runs", "features_read"), [Some(2)]);
     let recorded = strings(&ds, "skeletonise_runs", "input_layer");
     assert_eq!(recorded, [Some("3".to_string())]);
+}
+
+/// Lines across the Danube reach (UTM 34N, the training layer's CRS).
+fn danube_network(dir: &Path) -> std::path::PathBuf {
+    let net = dir.join("net.gpkg");
+    let lines: Vec<String> = [5_855_000, 5_857_000, 5_859_000, 5_861_000, 5_863_000]
+        .iter()
+        .map(|y| format!("LINESTRING(-627000 {y},-612000 {y})"))
+        .collect();
+    let wkts: Vec<Option<&str>> = lines.iter().map(|l| Some(l.as_str())).collect();
+    make_layer(&net, "lines", 32634, &wkts);
+    net
+}
+
+/// Runs the Danube with `connect` (a flow mapping's inside) and returns the
+/// exit code, stderr and the number of connection rows.
+fn danube_connected(dir: &Path, connect: &str) -> (i32, String, u64) {
+    let out = dir.join("c.gpkg");
+    let text = format!(
+        "input:\n  source: {}\n  layer: river_danube\n  connect: {{ {connect} }}\nsteps:\n  - skeleton: {{ methods: [MA] }}\n  - prune: {{}}\n  - extend: {{}}\noutput:\n  path: {}\n  overwrite: true\n",
+        root(TRAIN),
+        out.display()
+    );
+    let p = pipeline(dir, "connect.yaml", &text);
+    let o = skeletonise(&["run", p.to_str().unwrap()]);
+    let (code, err) = code_and_err(&o);
+    let n = if code == 0 {
+        count(&open(&out), "connections")
+    } else {
+        0
+    };
+    let _ = std::fs::remove_file(&out);
+    (code, err, n)
+}
+
+#[test]
+fn a_connect_layer_in_another_crs_is_reprojected_and_one_without_lines_is_an_error() {
+    let d = tmp();
+    let net = danube_network(d.path());
+    let (code, err, same) = danube_connected(
+        d.path(),
+        &format!("source: {}, layer: lines", net.display()),
+    );
+    assert_eq!(code, 0, "{err}");
+    assert!(same >= 10, "the lines cross the river: {same}");
+    assert!(
+        err.contains(&format!(
+            "connect: {same} connections made, 5 of the network's 5 lines used"
+        )),
+        "{err}"
+    );
+    // The same lines in ETRS89-LAEA.
+    let laea = d.path().join("laea.gpkg");
+    let o = std::process::Command::new("ogr2ogr")
+        .args(["-t_srs", "EPSG:3035", "-nln", "lines"])
+        .arg(&laea)
+        .arg(&net)
+        .arg("lines")
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (code, err, other) = danube_connected(
+        d.path(),
+        &format!("source: {}, layer: lines", laea.display()),
+    );
+    assert_eq!((code, other), (0, same), "{err}");
+    // A layer of points, and an empty layer.
+    make_layer(&net, "points", 32634, &[Some("POINT(-620000 5858000)")]);
+    make_layer(&net, "empty", 32634, &[]);
+    for layer in ["points", "empty"] {
+        let c = format!("source: {}, layer: {layer}", net.display());
+        let (code, err, _) = danube_connected(d.path(), &c);
+        assert_eq!(code, 1, "{layer}: {err}");
+        assert!(err.contains("has no lines"), "{layer}: {err}");
+        assert!(err.contains("input.connect"), "{layer}: {err}");
+    }
+}
+
+#[test]
+fn every_crossing_gets_its_leg_whatever_the_snap() {
+    let d = tmp();
+    let net = danube_network(d.path());
+    let c = |snap: &str| format!("source: {}, layer: lines, snap: {snap}", net.display());
+    let (_, err, exact) = danube_connected(d.path(), &c("0"));
+    for snap in ["300", "1000", "100000"] {
+        let (code, err, n) = danube_connected(d.path(), &c(snap));
+        assert_eq!(code, 0, "{err}");
+        assert_eq!(n, exact, "snap {snap}: crossings dropped or added\n{err}");
+    }
+    assert!(exact >= 10, "{err}");
 }

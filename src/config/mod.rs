@@ -637,9 +637,9 @@ fn substitute_env(v: &mut Value, path: &str, typed: &mut Typed) -> Result<(), (S
             let whole = s.starts_with("${") && s.ends_with('}') && s.matches("${").count() == 1;
             let text = expand(s).map_err(|m| (path.to_string(), m))?;
             if whole {
-                let t = serde_yaml_ng::from_str::<Value>(&text).ok().filter(|t| {
-                    matches!(t, Value::Number(_) | Value::Bool(_))
-                });
+                let t = serde_yaml_ng::from_str::<Value>(&text)
+                    .ok()
+                    .filter(|t| matches!(t, Value::Number(_) | Value::Bool(_)));
                 if let Some(t) = t {
                     typed.insert(path.to_string(), t);
                 }
@@ -905,7 +905,11 @@ mod tests {
         )
         .unwrap_err();
         assert_eq!(e.key, "steps[2].prune.ratio");
-        assert!(e.message.contains("`SKELETONISE_TEST_EMPTY` is set but empty"), "{e}");
+        assert!(
+            e.message
+                .contains("`SKELETONISE_TEST_EMPTY` is set but empty"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -57,7 +57,7 @@ pub struct InputSpec {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ConnectSpec {
-    /// Any OGR data source string of lines, in the input's CRS (reprojected with it).
+    /// Any OGR data source string of lines, in any CRS: reprojected to the CRS the polygons are processed in.
     pub source: String,
     /// Layer name or zero-based index; default the first layer.
     #[serde(default)]
@@ -68,15 +68,16 @@ pub struct ConnectSpec {
 }
 
 impl ConnectSpec {
-    /// The network's lines as an input of their own (same reprojection as
-    /// the polygons).
-    pub fn input(&self, polygons: &InputSpec) -> InputSpec {
+    /// The network's lines as an input of their own, reprojected to `crs`
+    /// (a definition GDAL reads: the CRS the polygons are handed out in,
+    /// as WKT; `None` when they have none).
+    pub fn input(&self, crs: Option<&str>) -> InputSpec {
         InputSpec {
             source: self.source.clone(),
             layer: self.layer.clone(),
             where_: None,
             bbox: None,
-            reproject: polygons.reproject.clone(),
+            reproject: crs.map(str::to_string),
             merge_adjacent: false,
             merge_by: None,
             connect: None,

@@ -91,12 +91,14 @@ fn target_srs(
                 .into(),
         ));
     }
-    if source_srs.is_none() {
-        return Err(bad(format!(
+    match source_srs {
+        None => Err(bad(format!(
             "layer `{layer_name}` has no CRS to reproject from; assign one to the source first"
-        )));
+        ))),
+        // Already there: no transformation, not even an identity one.
+        Some(s) if *s == srs => Ok(None),
+        Some(_) => Ok(Some(traditional(srs))),
     }
-    Ok(Some(traditional(srs)))
 }
 
 /// Whether two sources hand out geometries in the same CRS (`None` when

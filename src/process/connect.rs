@@ -72,39 +72,52 @@ impl Network {
         self.lines.is_empty()
     }
 
-    /// The connection points of polygon part `p`: (line FID, point on ∂P),
-    /// each line's points at least `snap` apart (a line that runs along the
-    /// boundary connects once per stretch).
+    /// The connection points of polygon part `p`: (line FID, point on ∂P).
+    /// Every point where a line touches or crosses ∂P connects (points of
+    /// one line closer than `1e-9 × extent` count once: a line through a
+    /// vertex meets two edges there). `snap` only adds near-misses: a line
+    /// end outside P within `snap` of ∂P connects at its nearest boundary
+    /// point unless a touch or crossing of the same line lies within `snap`
+    /// of that point (it already serves the end). An end inside P never
+    /// snaps: the line entered P where it crossed ∂P.
     pub fn points(&self, p: &PreparedPolygon) -> Vec<(Option<u64>, Coord<f64>)> {
         let b = p.boundary();
         let (lo, hi) = (b.bbox_min(), b.bbox_max());
-        let tol = self.snap.max(1e-9 * p.extent());
+        let eps = 1e-9 * p.extent();
+        let snap = self.snap.max(eps);
         let mut out: Vec<(Option<u64>, Coord<f64>)> = Vec::new();
         for l in &self.lines {
             let (a, z) = (l.bbox.min(), l.bbox.max());
-            if a.x > hi.x + tol || z.x < lo.x - tol || a.y > hi.y + tol || z.y < lo.y - tol {
+            if a.x > hi.x + snap || z.x < lo.x - snap || a.y > hi.y + snap || z.y < lo.y - snap {
                 continue;
             }
             let mut found: Vec<Coord<f64>> = Vec::new();
-            let mut add = |c: Coord<f64>| {
+            let add = |found: &mut Vec<Coord<f64>>, c: Coord<f64>, tol: f64| {
                 if found.iter().all(|f| crate::geometry::norm(*f - c) > tol) {
                     found.push(c);
                 }
             };
-            // Ends that touch ∂P, or come within snap of it.
-            for end in [l.line.0.first(), l.line.0.last()].into_iter().flatten() {
-                if let Some((c, _, d)) = b.nearest(*end) {
-                    if d <= tol {
-                        add(c);
-                    }
-                }
-            }
-            // Crossings.
+            // Touches and crossings: each its own connection.
             for w in l.line.0.windows(2) {
                 for i in b.segments_near(w[0], w[1]) {
                     let s = &b.segments()[i];
                     if let Some(c) = intersection(w[0], w[1], s.a, s.b) {
-                        add(c);
+                        add(&mut found, c, eps);
+                    }
+                }
+            }
+            // Near-misses: ends outside P within snap of ∂P.
+            let crossings = found.len();
+            for end in [l.line.0.first(), l.line.0.last()].into_iter().flatten() {
+                if b.contains(*end) {
+                    continue;
+                }
+                if let Some((c, _, d)) = b.nearest(*end) {
+                    let served = found[..crossings]
+                        .iter()
+                        .any(|f| crate::geometry::norm(*f - c) <= snap);
+                    if d <= snap && !served {
+                        add(&mut found, c, eps);
                     }
                 }
             }
