@@ -885,3 +885,98 @@ fn every_crossing_gets_its_leg_whatever_the_snap() {
     }
     assert!(exact >= 10, "{err}");
 }
+
+#[test]
+fn a_report_filter_that_fails_only_when_it_runs_is_an_error() {
+    let d = tmp();
+    let (_, out) = demo_output(d.path());
+    let html = d.path().join("r.html");
+    for w in [
+        "abs(-9223372036854775808) > 0",
+        "json_extract(method, '$.a') = 1",
+    ] {
+        refused(
+            w,
+            &[
+                "report",
+                out.to_str().unwrap(),
+                "-o",
+                html.to_str().unwrap(),
+                "--where",
+                w,
+            ],
+            "invalid filter",
+            &[&out],
+        );
+        assert!(!html.exists(), "{w}: a report was written");
+        // The same filter in a pipeline's report: the run says so.
+        let o = skeletonise(&[
+            "run",
+            "pipelines/demo.yaml",
+            "-o",
+            d.path().join("run.gpkg").to_str().unwrap(),
+            "--set",
+            "output.overwrite=true",
+            "--set",
+            &format!(
+                "output.report={{path: {}, features: {{where: \"{w}\"}}}}",
+                html.display()
+            ),
+            "-q",
+        ]);
+        let (code, err) = code_and_err(&o);
+        assert_eq!(code, 1, "{w}: {err}");
+        assert!(err.contains("invalid filter"), "{w}: {err}");
+        let i = skeletonise(&[
+            "run",
+            "pipelines/demo.yaml",
+            "-o",
+            d.path().join("where.gpkg").to_str().unwrap(),
+            "--set",
+            &format!("input.where={w}"),
+            "-q",
+        ]);
+        let (code, err) = code_and_err(&i);
+        assert_eq!(code, 1, "input.where {w}: {err}");
+        assert!(err.contains("invalid `input.where`"), "{w}: {err}");
+    }
+}
+
+#[test]
+fn a_timeout_too_large_for_a_deadline_is_an_invalid_pipeline() {
+    let d = tmp();
+    let out = d.path().join("o.gpkg");
+    for t in ["1.8e19", "1e300", "-1", ".inf"] {
+        for cmd in ["validate", "run"] {
+            let o = skeletonise(&[
+                cmd,
+                "pipelines/demo.yaml",
+                "-o",
+                out.to_str().unwrap(),
+                "--set",
+                &format!("steps.skeleton.timeout_s={t}"),
+            ]);
+            let (code, err) = code_and_err(&o);
+            assert_eq!(code, 78, "{cmd} {t}: {err}");
+            assert!(
+                err.contains("timeout_s is a number of seconds between 0 and"),
+                "{err}"
+            );
+            assert!(!out.exists());
+        }
+    }
+    // The largest allowed is no limit in practice: every feature written.
+    let o = skeletonise(&[
+        "run",
+        "pipelines/demo.yaml",
+        "-o",
+        out.to_str().unwrap(),
+        "--set",
+        "steps.skeleton.timeout_s=1e9",
+        "--set",
+        "output.report=null",
+        "-q",
+    ]);
+    assert_eq!(code_and_err(&o).0, 0, "{}", code_and_err(&o).1);
+    assert_eq!(count(&open(&out), "rejected"), 0);
+}

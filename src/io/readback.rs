@@ -220,7 +220,28 @@ impl OutputFile {
             })?;
         }
         let fields = Fields::of(&layer);
-        Ok(layer.features().map(|f| row(&fields, &f)).collect())
+        super::gdal_errors::clear();
+        let rows = layer.features().map(|f| row(&fields, &f)).collect();
+        // A filter that fails only on some rows (an integer overflow,
+        // malformed JSON) ends the loop early with GDAL's report: an error,
+        // not fewer rows.
+        let failures = super::gdal_errors::take_failures();
+        if failures.is_empty() {
+            return Ok(rows);
+        }
+        let reason = failures.join("; ");
+        Err(match filter {
+            Some(w) => IoError::BadFilter {
+                path: self.path.clone(),
+                layer: name.to_string(),
+                filter: w.to_string(),
+                reason,
+            },
+            None => IoError::NotAnOutput {
+                path: self.path.clone(),
+                reason: format!("reading layer `{name}` failed: {reason}"),
+            },
+        })
     }
 
     fn read_run(&self) -> Result<Option<RunRecord>, IoError> {

@@ -201,6 +201,10 @@ pub struct SkeletonParams {
     pub max_memory_mb: f64,
 }
 
+/// The largest `timeout_s` (about 31 years; 0 is the way to no limit):
+/// larger ones are not representable as a deadline.
+pub const MAX_TIMEOUT_S: f64 = 1e9;
+
 fn default_timeout_s() -> f64 {
     120.0
 }
@@ -233,10 +237,10 @@ impl SkeletonParams {
         if let Some(d) = self.methods.iter().find(|m| !seen.insert(**m)) {
             return Err(("methods".into(), format!("method {d} is listed twice")));
         }
-        if !(self.timeout_s >= 0.0 && self.timeout_s.is_finite()) {
+        if !(0.0..=MAX_TIMEOUT_S).contains(&self.timeout_s) {
             return Err((
                 "timeout_s".into(),
-                "timeout_s is a number of seconds ≥ 0 (0: no limit)".into(),
+                format!("timeout_s is a number of seconds between 0 and {MAX_TIMEOUT_S:e} (0: no limit)"),
             ));
         }
         if !(self.max_memory_mb >= 0.0 && self.max_memory_mb.is_finite()) {
