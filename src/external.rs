@@ -104,9 +104,14 @@ pub fn score_external(job: &ScoreJob, keep_bars: bool) -> Result<RunSummary, Run
             Protected::new("the skeletons source", &job.skeletons.source),
         ],
     )?;
+    let (lines, unjoined) = join(job)?;
+    unjoined.report(
+        &job.skeletons.source,
+        lines.values().any(|l| !l.0.is_empty()),
+    )?;
     let given = Given {
         label: job.label.clone(),
-        lines: join(job)?,
+        lines,
     };
     let output = OutputSpec {
         bars: keep_bars,
@@ -137,10 +142,68 @@ pub fn score_external(job: &ScoreJob, keep_bars: bool) -> Result<RunSummary, Run
     run_job(&run, &RunOptions::default())
 }
 
-/// The skeleton lines of `job`, by the FID of the polygon they are joined to.
-fn join(job: &ScoreJob) -> Result<HashMap<u64, MultiLineString<f64>>, RunError> {
-    let mut pr = Reader::open(&job.polygons)?;
-    let mut sr = Reader::open(&job.skeletons)?;
+/// Skeleton rows that were joined to no polygon, by why.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Unjoined {
+    /// Rows whose key is NULL.
+    pub null_key: usize,
+    /// Rows whose key no polygon has, with the first such key.
+    pub unknown_key: (usize, Option<String>),
+    /// Rows without a geometry, or whose geometry has no line (points,
+    /// polygons).
+    pub not_lines: usize,
+    /// Lines (joined by location) that lie in no polygon.
+    pub outside: usize,
+}
+
+impl Unjoined {
+    /// Logs what was left out; with nothing joined at all, the error
+    /// saying why.
+    fn report(&self, source: &str, any_joined: bool) -> Result<(), RunError> {
+        let mut why = Vec::new();
+        if self.null_key > 0 {
+            why.push(format!("{} with a NULL key", self.null_key));
+        }
+        if let (n, Some(k)) = &self.unknown_key {
+            why.push(format!("{n} with a key no polygon has (e.g. `{k}`)"));
+        }
+        if self.not_lines > 0 {
+            why.push(format!(
+                "{} without a line geometry (points, polygons or NULL)",
+                self.not_lines
+            ));
+        }
+        if self.outside > 0 {
+            why.push(format!("{} lines inside no polygon", self.outside));
+        }
+        if !any_joined {
+            return Err(RunError::Io(crate::io::IoError::Read {
+                source_name: source.to_string(),
+                reason: format!(
+                    "no skeleton line could be joined to a polygon ({}); check `--skeleton-key`/`--polygon-key` (or, joining by location, that the lines lie in the polygons) and that both layers are the ones meant",
+                    if why.is_empty() { "the layer has no rows".to_string() } else { why.join(", ") }
+                ),
+            }));
+        }
+        if !why.is_empty() {
+            tracing::warn!(
+                null_key = self.null_key,
+                unknown_key = self.unknown_key.0,
+                not_lines = self.not_lines,
+                outside = self.outside,
+                "skeleton rows joined to no polygon and left out: {}",
+                why.join(", ")
+            );
+        }
+        Ok(())
+    }
+}
+
+/// The skeleton lines of `job`, by the FID of the polygon they are joined
+/// to, and the rows that joined none.
+fn join(job: &ScoreJob) -> Result<(HashMap<u64, MultiLineString<f64>>, Unjoined), RunError> {
+    let mut pr = Reader::open(&job.polygons).map_err(for_score)?;
+    let mut sr = Reader::open(&job.skeletons).map_err(for_score)?;
     if crate::io::reader::same_crs(pr.info(), sr.info()) == Some(false) {
         return Err(RunError::Io(crate::io::IoError::Gdal {
             context: format!(
@@ -155,34 +218,49 @@ fn join(job: &ScoreJob) -> Result<HashMap<u64, MultiLineString<f64>>, RunError> 
     }
     let polygons = read_all(&mut pr)?;
     let skeletons = read_all(&mut sr)?;
+    let mut unjoined = Unjoined::default();
     let assigned = match &job.join {
         Join::Key {
             polygon_field,
             skeleton_field,
         } => join_by_key(
-            &pr,
-            &sr,
-            &polygons,
-            &skeletons,
+            (&pr, &sr),
+            (&polygons, &skeletons),
             polygon_field,
             skeleton_field,
+            &mut unjoined,
         )?,
-        Join::Location => join_by_location(&polygons, &skeletons),
+        Join::Location => join_by_location(&polygons, &skeletons, &mut unjoined),
     };
-    Ok(polygons
+    let lines = polygons
         .iter()
         .zip(assigned)
         .filter_map(|(f, lines)| Some((f.fid?, MultiLineString(lines))))
-        .collect())
+        .collect();
+    Ok((lines, unjoined))
+}
+
+/// A reader's error with `score`'s own words: a geographic CRS is
+/// reprojected with `--reproject`.
+fn for_score(e: crate::io::IoError) -> RunError {
+    match e {
+        crate::io::IoError::Geographic { layer, crs, .. } => {
+            RunError::Io(crate::io::IoError::Geographic {
+                layer,
+                crs,
+                fix: "give `--reproject EPSG:<code>` (e.g. the layers' UTM zone)",
+            })
+        }
+        e => RunError::Io(e),
+    }
 }
 
 fn join_by_key(
-    pr: &Reader,
-    sr: &Reader,
-    polygons: &[Feature],
-    skeletons: &[Feature],
+    (pr, sr): (&Reader, &Reader),
+    (polygons, skeletons): (&[Feature], &[Feature]),
     polygon_field: &Option<String>,
     skeleton_field: &str,
+    unjoined: &mut Unjoined,
 ) -> Result<Vec<Vec<LineString<f64>>>, RunError> {
     let mut assigned = vec![Vec::new(); polygons.len()];
     let pf = polygon_field
@@ -196,16 +274,34 @@ fn join_by_key(
         .filter_map(|(i, f)| key_text(f, pf).map(|k| (k, i)))
         .collect();
     for s in skeletons {
-        if let (Some(k), Some(g)) = (key_text(s, Some(sf)), &s.geometry) {
-            if let Some(&i) = by_key.get(&k) {
-                lines_of(g, &mut assigned[i]);
+        let mut ls = Vec::new();
+        if let Some(g) = &s.geometry {
+            lines_of(g, &mut ls);
+        }
+        if ls.is_empty() {
+            unjoined.not_lines += 1;
+            continue;
+        }
+        let Some(k) = key_text(s, Some(sf)) else {
+            unjoined.null_key += 1;
+            continue;
+        };
+        match by_key.get(&k) {
+            Some(&i) => assigned[i].extend(ls),
+            None => {
+                unjoined.unknown_key.0 += 1;
+                unjoined.unknown_key.1.get_or_insert(k);
             }
         }
     }
     Ok(assigned)
 }
 
-fn join_by_location(polygons: &[Feature], skeletons: &[Feature]) -> Vec<Vec<LineString<f64>>> {
+fn join_by_location(
+    polygons: &[Feature],
+    skeletons: &[Feature],
+    unjoined: &mut Unjoined,
+) -> Vec<Vec<LineString<f64>>> {
     let mut assigned = vec![Vec::new(); polygons.len()];
     let prepared: Vec<Vec<PreparedPolygon>> = polygons
         .iter()
@@ -232,9 +328,13 @@ fn join_by_location(polygons: &[Feature], skeletons: &[Feature]) -> Vec<Vec<Line
         .collect();
     let tree = RTree::bulk_load(boxes);
     for s in skeletons {
-        let Some(g) = &s.geometry else { continue };
         let mut ls = Vec::new();
-        lines_of(g, &mut ls);
+        if let Some(g) = &s.geometry {
+            lines_of(g, &mut ls);
+        }
+        if ls.is_empty() {
+            unjoined.not_lines += 1;
+        }
         for l in ls {
             let Some(w) = l.0.windows(2).find(|w| w[0] != w[1]) else {
                 continue;
@@ -249,8 +349,9 @@ fn join_by_location(polygons: &[Feature], skeletons: &[Feature]) -> Vec<Vec<Line
                         .any(|p| p.boundary().contains_with_tolerance(m, 1e-9 * p.extent()))
                 })
                 .min();
-            if let Some(i) = hit {
-                assigned[i].push(l);
+            match hit {
+                Some(i) => assigned[i].push(l),
+                None => unjoined.outside += 1,
             }
         }
     }

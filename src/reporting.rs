@@ -300,7 +300,15 @@ fn polygons(
     let spec = polygon_spec(file, job)?;
     let reader = Reader::open(&spec).map_err(|e| ReportError::Polygons {
         gpkg: file.path().to_string(),
-        reason: e.to_string(),
+        reason: match e {
+            IoError::Geographic { layer, crs, .. } => IoError::Geographic {
+                layer,
+                crs,
+                fix: "give `--reproject EPSG:<code>`",
+            },
+            e => e,
+        }
+        .to_string(),
     })?;
     let mut fids: Vec<u64> = keys.iter().filter_map(|(k, _)| k.0).collect();
     fids.sort_unstable();

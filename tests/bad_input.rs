@@ -980,3 +980,169 @@ fn a_timeout_too_large_for_a_deadline_is_an_invalid_pipeline() {
     assert_eq!(code_and_err(&o).0, 0, "{}", code_and_err(&o).1);
     assert_eq!(count(&open(&out), "rejected"), 0);
 }
+
+/// Runs `score` of the square layer `bad` in `src` against the lines `wkts`
+/// (with `id` the row number, `key` joined to the polygon FID as given).
+fn score_case(
+    dir: &Path,
+    lines: &[(Option<&str>, Option<&str>)],
+    extra: &[&str],
+) -> (i32, String, std::path::PathBuf) {
+    let src = dir.join("polys.gpkg");
+    if !src.exists() {
+        make_layer(
+            &src,
+            "bad",
+            3035,
+            &[
+                Some(SQUARE),
+                Some("POLYGON((200 0,300 0,300 10,200 10,200 0))"),
+            ],
+        );
+    }
+    let sk = dir.join("lines.gpkg");
+    let _ = std::fs::remove_file(&sk);
+    let wkts: Vec<Option<&str>> = lines.iter().map(|l| l.0).collect();
+    make_layer(&sk, "l", 3035, &wkts);
+    // A text key column: the polygon FID, or NULL.
+    let ds = gdal::Dataset::open_ex(
+        &sk,
+        gdal::DatasetOptions {
+            open_flags: gdal::GdalOpenFlags::GDAL_OF_UPDATE | gdal::GdalOpenFlags::GDAL_OF_VECTOR,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    ds.execute_sql(
+        "ALTER TABLE l ADD COLUMN pkey TEXT",
+        None,
+        gdal::vector::sql::Dialect::SQLITE,
+    )
+    .unwrap();
+    for (i, (_, k)) in lines.iter().enumerate() {
+        let v = k.map_or("NULL".to_string(), |k| format!("'{k}'"));
+        ds.execute_sql(
+            &format!("UPDATE l SET pkey = {v} WHERE id = {i}"),
+            None,
+            gdal::vector::sql::Dialect::SQLITE,
+        )
+        .unwrap();
+    }
+    drop(ds);
+    let out = dir.join("scored.gpkg");
+    let mut argv = vec![
+        "score",
+        "--polygons",
+        src.to_str().unwrap(),
+        "--skeletons",
+        sk.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--overwrite",
+    ];
+    argv.extend_from_slice(extra);
+    let o = skeletonise(&argv);
+    let (code, err) = code_and_err(&o);
+    (code, err, out)
+}
+
+#[test]
+fn score_explains_lines_outside_and_counts_what_it_leaves_out() {
+    let d = tmp();
+    let key = ["--skeleton-key", "pkey"];
+    // The square's skeleton drawn 1 km away: not "too thin to score".
+    let (code, err, out) = score_case(
+        d.path(),
+        &[
+            (Some("LINESTRING(1000 50,1100 50)"), Some("1")),
+            (Some("LINESTRING(200 5,300 5)"), Some("2")),
+        ],
+        &key,
+    );
+    assert_eq!(code, 0, "{err}");
+    let reasons = strings(&open(&out), "rejected", "reason");
+    assert_eq!(reasons.len(), 1, "{reasons:?}");
+    let r = reasons[0].clone().unwrap();
+    assert!(
+        r.contains("lies outside its polygon") && !r.contains("too thin"),
+        "{r}"
+    );
+    // Partly outside: scored, with a note saying so.
+    let (code, err, out) = score_case(
+        d.path(),
+        &[
+            (Some("LINESTRING(0 50,150 50)"), Some("1")),
+            (Some("LINESTRING(200 5,300 5)"), Some("2")),
+        ],
+        &key,
+    );
+    assert_eq!(code, 0, "{err}");
+    let notes = strings(&open(&out), "skeletons", "note");
+    assert!(
+        notes[0]
+            .as_deref()
+            .unwrap_or("")
+            .contains("33.33 % of the skeleton's length"),
+        "{notes:?}"
+    );
+    assert_eq!(notes[1], None);
+    // Unknown keys, NULL keys and non-line rows are counted in a warning.
+    let (code, err, _) = score_case(
+        d.path(),
+        &[
+            (Some("LINESTRING(0 50,100 50)"), Some("1")),
+            (Some("LINESTRING(0 50,100 50)"), Some("77")),
+            (Some("LINESTRING(0 50,100 50)"), None),
+            (Some("POINT(5 5)"), Some("2")),
+            (Some("POLYGON((0 0,1 0,1 1,0 0))"), Some("2")),
+        ],
+        &key,
+    );
+    assert_eq!(code, 0, "{err}");
+    for part in [
+        "1 with a NULL key",
+        "1 with a key no polygon has (e.g. `77`)",
+        "2 without a line geometry",
+    ] {
+        assert!(err.contains(part), "`{part}` not in {err}");
+    }
+    // Nothing joins: an error, not an empty success; the output of the run
+    // before stays.
+    let before = std::fs::read(d.path().join("scored.gpkg")).unwrap();
+    let (code, err, out) = score_case(
+        d.path(),
+        &[
+            (Some("LINESTRING(0 50,100 50)"), Some("x1")),
+            (Some("LINESTRING(0 50,100 50)"), Some("x2")),
+        ],
+        &key,
+    );
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("no skeleton line could be joined"), "{err}");
+    assert_eq!(std::fs::read(&out).unwrap(), before);
+}
+
+#[test]
+fn score_of_geographic_layers_names_its_own_option() {
+    let d = tmp();
+    let polys = d.path().join("geo.gpkg");
+    make_layer(&polys, "p", 4326, &[Some("POLYGON((0 0,1 0,1 1,0 1,0 0))")]);
+    make_layer(&polys, "l", 4326, &[Some("LINESTRING(0 0.5,1 0.5)")]);
+    let o = skeletonise(&[
+        "score",
+        "--polygons",
+        polys.to_str().unwrap(),
+        "--polygons-layer",
+        "p",
+        "--skeletons",
+        polys.to_str().unwrap(),
+        "--skeletons-layer",
+        "l",
+        "-o",
+        d.path().join("o.gpkg").to_str().unwrap(),
+    ]);
+    let (code, err) = code_and_err(&o);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("--reproject EPSG:<code>"), "{err}");
+    assert!(!err.contains("input.reproject"), "{err}");
+}

@@ -159,6 +159,25 @@ pub fn orient(a: Coord<f64>, b: Coord<f64>, c: Coord<f64>) -> f64 {
     )
 }
 
+/// Where segment `pq` meets segment `ab`, as the parameter `t` of
+/// `p + t (q − p)`, when they meet in one point (not parallel).
+pub fn segment_parameter(
+    p: Coord<f64>,
+    q: Coord<f64>,
+    a: Coord<f64>,
+    b: Coord<f64>,
+) -> Option<f64> {
+    let (r, s) = (q - p, b - a);
+    let den = r.x * s.y - r.y * s.x;
+    if den == 0.0 {
+        return None;
+    }
+    let d = a - p;
+    let t = (d.x * s.y - d.y * s.x) / den;
+    let u = (d.x * r.y - d.y * r.x) / den;
+    ((0.0..=1.0).contains(&t) && (0.0..=1.0).contains(&u)).then_some(t)
+}
+
 /// True when segments `pq` and `ab` cross at a single point interior to both
 /// (a proper crossing); touching at an endpoint or running along each other is
 /// not a crossing.

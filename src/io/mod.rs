@@ -73,12 +73,14 @@ pub enum IoError {
         reason: String,
     },
     /// A geographic CRS and no reprojection.
-    #[error("layer `{layer}` has the geographic CRS {crs}; skeleton radii and scores need a projected CRS: add `input.reproject: EPSG:<code>` (e.g. the layer's UTM zone) to the pipeline")]
+    #[error("layer `{layer}` has the geographic CRS {crs}; skeleton radii and scores need a projected CRS: {fix}")]
     Geographic {
         /// Layer name.
         layer: String,
         /// The CRS's name.
         crs: String,
+        /// How to reproject, in the words of the command.
+        fix: &'static str,
     },
     /// The reprojection target is unusable.
     #[error("invalid `input.reproject` value `{target}`: {reason}")]

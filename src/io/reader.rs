@@ -76,6 +76,8 @@ fn target_srs(
             return Err(IoError::Geographic {
                 layer: layer_name.to_string(),
                 crs: s.name().unwrap_or_else(|| "(unnamed)".into()),
+                fix:
+                    "add `input.reproject: EPSG:<code>` (e.g. the layer's UTM zone) to the pipeline",
             });
         }
         return Ok(None);

@@ -332,6 +332,7 @@ fn finish(
         bars: all_bars,
         widths,
         graphs,
+        note: None,
     };
     (c, cast_time + clock.elapsed().saturating_sub(in_casts))
 }

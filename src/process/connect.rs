@@ -130,15 +130,7 @@ impl Network {
 /// The intersection point of segments `pq` and `ab`, when they meet (not
 /// parallel).
 fn intersection(p: Coord<f64>, q: Coord<f64>, a: Coord<f64>, b: Coord<f64>) -> Option<Coord<f64>> {
-    let (r, s) = (q - p, b - a);
-    let den = r.x * s.y - r.y * s.x;
-    if den == 0.0 {
-        return None;
-    }
-    let d = a - p;
-    let t = (d.x * s.y - d.y * s.x) / den;
-    let u = (d.x * r.y - d.y * r.x) / den;
-    ((0.0..=1.0).contains(&t) && (0.0..=1.0).contains(&u)).then(|| p + r * t)
+    crate::geometry::boundary::segment_parameter(p, q, a, b).map(|t| p + (q - p) * t)
 }
 
 /// `g` with a leg to every connection point: straight from the nearest

@@ -184,6 +184,9 @@ pub struct CandidateSkeleton {
     /// The finished skeleton graph of every polygon part, when the pipeline
     /// collapses (the `collapse` step works on graphs).
     pub graphs: Vec<crate::graph::SkeletonGraph>,
+    /// Something the scores alone do not tell (e.g. a given skeleton that
+    /// leaves its polygon), for the row's `note`.
+    pub note: Option<String>,
 }
 
 /// What the pipeline writes for one feature.
@@ -375,8 +378,22 @@ pub fn process_given(
     if lines.0.iter().all(|l| l.0.len() < 2) {
         return Processed::Rejected(format!("{label}: no skeleton lines joined to this polygon"));
     }
+    let (outside, total) = length_outside(lines, &prepared);
+    if total > 0.0 && outside > 0.5 * total {
+        return Processed::Rejected(format!(
+            "{label}: {:.0} % of the skeleton's length lies outside its polygon, so it is not this polygon's skeleton; check the join (`--skeleton-key`/`--polygon-key`, or the location) and that both layers are in the same CRS",
+            100.0 * outside / total
+        ));
+    }
     let clock = clock::CpuClock::start();
-    let result = Ok(candidates::given(&prepared, lines, params));
+    let mut given = candidates::given(&prepared, lines, params);
+    if outside > 1e-6 * total {
+        given.note = Some(format!(
+            "{:.2} % of the skeleton's length ({outside:.3} CRS units) lies outside the polygon; bars cannot hit it there",
+            100.0 * outside / total
+        ));
+    }
+    let result = Ok(given);
     let candidate = Candidate {
         method: MethodId::EXTERNAL,
         result,
@@ -386,6 +403,39 @@ pub fn process_given(
         },
     };
     choose(vec![candidate], prepared.len(), params)
+}
+
+/// The length of `lines` outside every polygon part, and their whole
+/// length: each segment is split where it crosses a boundary and every
+/// piece is placed by its midpoint.
+fn length_outside(lines: &MultiLineString<f64>, parts: &[PreparedPolygon]) -> (f64, f64) {
+    let (mut outside, mut total) = (0.0, 0.0);
+    for w in lines.0.iter().flat_map(|l| l.0.windows(2)) {
+        let (a, b) = (w[0], w[1]);
+        let len = crate::geometry::norm(b - a);
+        if len == 0.0 {
+            continue;
+        }
+        total += len;
+        let mut ts = vec![0.0, 1.0];
+        for p in parts {
+            let bd = p.boundary();
+            for i in bd.segments_near(a, b) {
+                let s = &bd.segments()[i];
+                if let Some(t) = crate::geometry::boundary::segment_parameter(a, b, s.a, s.b) {
+                    ts.push(t);
+                }
+            }
+        }
+        ts.sort_by(f64::total_cmp);
+        for t in ts.windows(2).filter(|t| t[1] > t[0]) {
+            let m = a + (b - a) * (0.5 * (t[0] + t[1]));
+            if !parts.iter().any(|p| p.boundary().contains(m)) {
+                outside += (t[1] - t[0]) * len;
+            }
+        }
+    }
+    (outside, total)
 }
 
 /// The polygon parts of a feature's geometry, normalised and checked, or

@@ -164,6 +164,17 @@ fn score_note(s: &crate::score::Scores) -> Option<String> {
     }
 }
 
+/// The row's note: the candidate's own and why its scores are missing.
+fn notes(c: &crate::process::CandidateSkeleton) -> Option<String> {
+    let parts: Vec<String> = c
+        .note
+        .iter()
+        .cloned()
+        .chain(c.scores.and_then(|s| score_note(&s)))
+        .collect();
+    (!parts.is_empty()).then(|| parts.join("; "))
+}
+
 fn rejected(f: &Feature, reason: String) -> RejectedRow {
     RejectedRow {
         src_fid: f.fid,
@@ -208,7 +219,7 @@ fn outcome_rows(
         components: chosen.components,
         legs: chosen.legs,
         repaired: f.repaired,
-        note: chosen.scores.and_then(|s| score_note(&s)),
+        note: notes(chosen),
         collapsed,
         members: members.clone(),
         measures,
