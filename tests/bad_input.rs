@@ -1146,3 +1146,57 @@ fn score_of_geographic_layers_names_its_own_option() {
     assert!(err.contains("--reproject EPSG:<code>"), "{err}");
     assert!(!err.contains("input.reproject"), "{err}");
 }
+
+const SQUARE_AND_SLIVER: &str =
+    "MULTIPOLYGON(((0 0,100 0,100 100,0 100,0 0)),((200 0,1000200 0,1000200 0.001,200 0.001,200 0)))";
+const MA_ONLY: [&str; 2] = ["--set", "steps.skeleton.methods=[MA]"];
+
+// MA has no skeleton of the sliver part: alone the feature is rejected
+// with that part's reason, never written without the part.
+geometry_case!(
+    a_part_no_method_can_skeletonise_rejects_the_feature_with_the_reason,
+    [Some(SQUARE_AND_SLIVER)],
+    MA_ONLY,
+    ok(1, 0, 1),
+    "part 1: MA gives no skeleton of this polygon part"
+);
+
+#[test]
+fn the_method_chosen_for_a_multipolygon_has_a_skeleton_of_every_part() {
+    let (_d, out) = case(
+        "all methods",
+        3035,
+        &[Some(SQUARE_AND_SLIVER)],
+        &["--set", "output.report=null"],
+        ok(1, 1, 0),
+    );
+    let ds = open(&out);
+    assert_eq!(ints(&ds, "skeletons", "components"), [Some(2)]);
+    let errors = strings(&ds, "candidates", "error");
+    let methods = strings(&ds, "candidates", "method");
+    let ma = methods
+        .iter()
+        .position(|m| m.as_deref() == Some("MA"))
+        .unwrap();
+    assert!(
+        errors[ma].as_deref().unwrap_or("").contains("part 1"),
+        "{errors:?}"
+    );
+}
+
+// With `explode`, a part that cannot be processed rejects the feature once
+// (counted once, its other parts not written).
+geometry_case!(
+    explode_with_a_bad_part_rejects_the_feature_once,
+    [Some(SQUARE_AND_SLIVER), Some(SQUARE)],
+    [
+        "--set",
+        "steps.skeleton.methods=[MA]",
+        "--set",
+        "output.explode=true",
+        "--set",
+        "output.report=null"
+    ],
+    ok(2, 1, 1),
+    "part 1: "
+);

@@ -51,8 +51,11 @@ pub(super) fn computed(
         for (_, t) in per_part.iter().map(|r| &r[k]) {
             time += *t;
         }
-        let parts: Result<Vec<PartSkeleton>, String> =
-            per_part.iter().map(|r| r[k].0.clone()).collect();
+        let parts: Result<Vec<PartSkeleton>, String> = per_part
+            .iter()
+            .map(|r| r[k].0.clone())
+            .collect::<Result<_, _>>()
+            .and_then(|parts| every_part_has_a_skeleton(parts, m));
         let result = parts.map(|parts| finish(prepared, &rays, &parts, params, parallel));
         let result = result.map(|(c, t)| {
             time.score += t + rays_share;
@@ -73,6 +76,28 @@ pub(super) fn computed(
         }
     }
     candidates
+}
+
+/// The skeletons of a multipolygon's parts, or the error naming a part
+/// that `m` has no skeleton of while it has one of others: a candidate
+/// that lost a polygon part is no candidate of the feature (alone, the
+/// part would be rejected with the reason).
+fn every_part_has_a_skeleton(
+    parts: Vec<PartSkeleton>,
+    m: crate::methods::MethodId,
+) -> Result<Vec<PartSkeleton>, String> {
+    let n = parts.len();
+    let empty = parts.iter().position(|p| p.graph.is_empty());
+    match empty {
+        Some(i) if parts.iter().any(|p| !p.graph.is_empty()) => Err(part_reason(
+            i,
+            n,
+            &format!(
+                "{m} gives no skeleton of this polygon part (too thin or too small for the method)"
+            ),
+        )),
+        _ => Ok(parts),
+    }
 }
 
 /// A feature of at most this many boundary vertices is worked on one

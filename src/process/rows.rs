@@ -121,6 +121,15 @@ pub fn feature_rows(
             }
         }
     }
+    // A feature is written whole or rejected whole: with `explode`, a part
+    // that cannot be processed rejects the feature (one row, every part's
+    // reason), and its other parts' rows are not written.
+    if rows.rejected.len() > 1 || (!rows.rejected.is_empty() && !methods.is_empty()) {
+        let reasons: Vec<String> = rows.rejected.drain(..).map(|r| r.reason).collect();
+        rows = Rows::default();
+        rows.rejected.push(rejected(f, reasons.join("; ")));
+        methods.clear();
+    }
     let status = if !rows.rejected.is_empty() {
         Status::Rejected
     } else if methods.is_empty() {
