@@ -604,6 +604,18 @@ pub const RUNS: LayerDef<RunRecord> = LayerDef {
     ],
 };
 
+/// The names of every layer the tool writes besides the skeleton layer
+/// (whose name `output.layer` gives and must not be one of these).
+pub const TOOL_LAYERS: [&str; 7] = [
+    CANDIDATES.name,
+    BARS.name,
+    WIDTHS.name,
+    AREAS.name,
+    CONNECTIONS.name,
+    REJECTED.name,
+    RUNS.name,
+];
+
 /// The rows one feature produces, layer by layer.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Rows {

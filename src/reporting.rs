@@ -76,6 +76,9 @@ pub enum ReportError {
         /// What failed.
         reason: String,
     },
+    /// The selection names no feature of the file.
+    #[error("nothing to report: {0}")]
+    Nothing(String),
     /// The HTML file cannot be written.
     #[error("cannot write the report `{path}`: {reason}")]
     Write {
@@ -227,7 +230,10 @@ fn choose(
         Selection::Top(n) => ranking.into_iter().take(*n).collect(),
         Selection::Fids(fids) => {
             let mut v = Vec::new();
-            for &fid in fids {
+            let mut seen = std::collections::HashSet::new();
+            let mut unknown = Vec::new();
+            // Each FID once, in the order first given.
+            for &fid in fids.iter().filter(|f| seen.insert(**f)) {
                 let found: Vec<(Key, f64)> = ranking
                     .iter()
                     .filter(|(k, _)| k.0 == Some(fid))
@@ -236,8 +242,19 @@ fn choose(
                 if found.is_empty() {
                     tracing::warn!("source FID {fid} is not in `{}`", file.path());
                     notes.push(format!("Source FID {fid} is not in the file."));
+                    unknown.push(fid.to_string());
                 }
                 v.extend(found);
+            }
+            if v.is_empty() {
+                return Err(ReportError::Nothing(format!(
+                    "none of the source FIDs {} is in `{}`; `ogrinfo {} {} -sql \"SELECT src_fid FROM {}\"` lists them",
+                    unknown.join(", "),
+                    file.path(),
+                    file.path(),
+                    file.skeleton_layer(),
+                    file.skeleton_layer()
+                )));
             }
             v
         }

@@ -1200,3 +1200,59 @@ geometry_case!(
     ok(2, 1, 1),
     "part 1: "
 );
+
+#[test]
+fn a_skeleton_layer_named_like_one_of_the_tools_layers_is_an_invalid_pipeline() {
+    let d = tmp();
+    let out = d.path().join("o.gpkg");
+    for name in [
+        "rejected",
+        "Candidates",
+        "skeletonise_runs",
+        "gpkg_contents",
+        "",
+    ] {
+        for cmd in ["validate", "run"] {
+            let o = skeletonise(&[
+                cmd,
+                "pipelines/demo.yaml",
+                "-o",
+                out.to_str().unwrap(),
+                "--set",
+                &format!("output.layer=\"{name}\""),
+            ]);
+            let (code, err) = code_and_err(&o);
+            assert_eq!(code, 78, "{cmd} `{name}`: {err}");
+            assert!(err.contains("output.layer"), "{err}");
+            assert!(!out.exists(), "{cmd} `{name}`: processed");
+        }
+    }
+}
+
+#[test]
+fn a_report_of_unknown_fids_is_an_error_and_repeated_fids_show_once() {
+    let d = tmp();
+    let (_, out) = demo_output(d.path());
+    let html = d.path().join("r.html");
+    let (o, h) = (out.to_str().unwrap(), html.to_str().unwrap());
+    refused(
+        "unknown FIDs",
+        &["report", o, "-o", h, "--fid", "999,1000"],
+        "none of the source FIDs 999, 1000",
+        &[],
+    );
+    assert!(!html.exists());
+    let ok = skeletonise(&["report", o, "-o", h, "--fid", "1,1,1,999", "-q"]);
+    assert_eq!(code_and_err(&ok).0, 0, "{}", code_and_err(&ok).1);
+    let page = std::fs::read_to_string(&html).unwrap();
+    let ids: Vec<&str> = page
+        .split(" id=\"")
+        .skip(1)
+        .map(|t| &t[..t.find('"').unwrap()])
+        .collect();
+    let mut unique = ids.clone();
+    unique.sort_unstable();
+    unique.dedup();
+    assert_eq!(ids.len(), unique.len(), "duplicate ids: {ids:?}");
+    assert!(page.contains("Source FID 999 is not in the file."));
+}

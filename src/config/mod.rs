@@ -463,6 +463,7 @@ fn validate(f: &PipelineFile) -> Result<(), (String, String)> {
             "give the output GeoPackage path".into(),
         ));
     }
+    skeleton_layer_name(&f.output.layer).map_err(|m| ("output.layer".to_string(), m))?;
     if let Some(r) = &f.output.report {
         r.features
             .validate()
@@ -473,6 +474,33 @@ fn validate(f: &PipelineFile) -> Result<(), (String, String)> {
                 "the report would overwrite the GeoPackage; give a path ending in .html".into(),
             ));
         }
+    }
+    Ok(())
+}
+
+/// Checks the name of the skeleton layer: not empty, none of the tool's
+/// other layers (SQLite compares table names without case) and none of the
+/// names GeoPackage and SQLite keep for themselves.
+fn skeleton_layer_name(name: &str) -> Result<(), String> {
+    let lower = name.to_ascii_lowercase();
+    if name.trim().is_empty() {
+        return Err("give the skeleton layer a name, e.g. `skeletons`".into());
+    }
+    if let Some(taken) = crate::output::TOOL_LAYERS
+        .iter()
+        .find(|t| t.eq_ignore_ascii_case(name))
+    {
+        return Err(format!(
+            "`{name}` is the name of the tool's own layer `{taken}`; choose another name for the skeleton layer"
+        ));
+    }
+    if ["gpkg_", "rtree_", "sqlite_"]
+        .iter()
+        .any(|p| lower.starts_with(p))
+    {
+        return Err(format!(
+            "`{name}` starts with a prefix GeoPackage and SQLite keep for their own tables; choose another name"
+        ));
     }
     Ok(())
 }
