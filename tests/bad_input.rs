@@ -1256,3 +1256,32 @@ fn a_report_of_unknown_fids_is_an_error_and_repeated_fids_show_once() {
     assert_eq!(ids.len(), unique.len(), "duplicate ids: {ids:?}");
     assert!(page.contains("Source FID 999 is not in the file."));
 }
+
+#[test]
+fn a_tiny_collapse_width_runs_like_any_other() {
+    // 1e-7 m on the demo's lakes, islands and river: nothing but tips is
+    // that narrow; the samples stay at 1e-4 of each polygon's extent (the
+    // library's test counts them), so every feature is written.
+    let d = tmp();
+    let out = d.path().join("o.gpkg");
+    let o = skeletonise(&[
+        "run",
+        "pipelines/demo.yaml",
+        "-o",
+        out.to_str().unwrap(),
+        "--set",
+        "steps.skeleton.methods=[MA]",
+        "--set",
+        "steps.collapse={width: 1e-7}",
+        "--set",
+        "output.report=null",
+        "-q",
+    ]);
+    assert_eq!(code_and_err(&o).0, 0, "{}", code_and_err(&o).1);
+    let ds = open(&out);
+    assert_eq!(count(&ds, "rejected"), 0);
+    assert_eq!(
+        ints(&ds, "skeletonise_runs", "features_written"),
+        [Some(17)]
+    );
+}

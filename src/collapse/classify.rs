@@ -12,6 +12,12 @@ use std::collections::BinaryHeap;
 /// At most this many samples per polygon part: beyond it, wider spacing.
 const MAX_SAMPLES: f64 = 2_000_000.0;
 
+/// The finest spacing of samples, relative to the polygon part's extent: a
+/// change of class is placed no finer than this however small `width` is
+/// (a width of a micrometre on a lake would otherwise sample it millions of
+/// times for nothing: nothing but its tips is that narrow).
+const MIN_STEP: f64 = 1e-4;
+
 /// The sampled skeleton: vertices with their radius, segments between them.
 pub(super) struct Samples {
     /// Positions.
@@ -35,7 +41,9 @@ impl Samples {
     /// Samples every edge of `g` at most `width / 4` apart.
     pub fn of(g: &SkeletonGraph, p: &PreparedPolygon, width: f64) -> Self {
         let total = g.total_length();
-        let step = (width / 4.0).max(total / MAX_SAMPLES);
+        let step = (width / 4.0)
+            .max(total / MAX_SAMPLES)
+            .max(MIN_STEP * p.extent());
         let mut pos: Vec<Coord<f64>> = g.nodes().iter().map(|n| n.pos).collect();
         let mut inserted = vec![false; pos.len()];
         let mut segments = Vec::new();
@@ -268,4 +276,30 @@ pub(super) struct Stretch {
     pub narrow: bool,
     /// Every sample's stretch label (shared by all stretches).
     pub labels: std::rc::Rc<Vec<usize>>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::graph::GraphBuilder;
+    use geo::polygon;
+
+    #[test]
+    fn a_tiny_width_samples_no_finer_than_the_polygons_resolution() {
+        let t = polygon![(x: 0., y: 0.), (x: 100., y: 0.), (x: 50., y: 80.)];
+        let p = PreparedPolygon::new(&t).unwrap();
+        let mut b = GraphBuilder::new();
+        b.segment(Coord { x: 50., y: 30. }, Coord { x: 0., y: 0. });
+        b.segment(Coord { x: 50., y: 30. }, Coord { x: 100., y: 0. });
+        b.segment(Coord { x: 50., y: 30. }, Coord { x: 50., y: 80. });
+        let g = b.finish(p.boundary());
+        let s = Samples::of(&g, &p, 1e-9);
+        // About 170 units of skeleton at 1e-4 × extent (1 cm).
+        assert!(s.pos.len() < 20_000, "{} samples", s.pos.len());
+        let coarse = Samples::of(&g, &p, 1.0);
+        assert!(
+            coarse.pos.len() > 500,
+            "a width of 1 still samples every 0.25"
+        );
+    }
 }
