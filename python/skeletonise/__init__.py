@@ -151,6 +151,13 @@ def _prepare(arr: np.ndarray, make_valid: bool) -> tuple[np.ndarray, np.ndarray,
         present = ~shapely.is_missing(arr)
         bad = present & ~shapely.is_valid(arr)
         if bad.any():
+            # A NaN or infinite coordinate cannot be repaired (GEOS raises for
+            # the whole array): such a feature goes to Rust as it is and is
+            # rejected alone, with the reason.
+            rows = np.flatnonzero(bad)
+            coords, at = shapely.get_coordinates(arr[rows], return_index=True)
+            bad[rows[np.unique(at[~np.isfinite(coords).all(axis=1)])]] = False
+        if bad.any():
             arr = arr.copy()
             arr[bad] = shapely.make_valid(arr[bad])
             repaired = bad
@@ -392,6 +399,26 @@ def _fids(index: pd.Index | None, n: int) -> np.ndarray:
     return np.arange(n, dtype=np.int64)
 
 
+def _check_call(crs: Any, threads: Any) -> None:
+    """What the command line refuses before any work: a geographic CRS (radii
+    and scores would be in degrees) and a number of threads out of range."""
+    if crs is not None and getattr(crs, "is_geographic", False):
+        raise ValueError(
+            f"the geometries have the geographic CRS {crs.to_string()}; skeleton radii and "
+            "scores need a projected CRS: reproject first, e.g. gdf.to_crs(gdf.estimate_utm_crs())"
+        )
+    if threads is not None and (
+        isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or not 1 <= threads <= _MAX_THREADS
+    ):
+        raise ValueError(
+            f"threads={threads!r}: give between 1 and {_MAX_THREADS} worker threads, or None for one per core"
+        )
+
+
+# As the command line's `--threads`.
+_MAX_THREADS = 256
+
+
 def _run(
     pipeline: "_core.Pipeline",
     arr: np.ndarray,
@@ -408,6 +435,7 @@ def _run(
 ):
     import geopandas as gpd
 
+    _check_call(crs, threads)
     t0 = time.perf_counter()
     arr, repaired, t_valid = _prepare(arr, pipeline.make_valid)
     payload = _encode(arr, exchange)

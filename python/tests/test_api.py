@@ -289,3 +289,31 @@ def test_apply_on_an_empty_frame_gives_the_typed_empty_frame():
 def test_describe_and_schema():
     assert "MA    medial axis" in skeletonise.describe()
     assert "steps" in skeletonise.schema()["properties"]
+
+
+def test_a_nan_or_infinite_coordinate_rejects_its_feature_alone():
+    # GEOS cannot repair such a polygon (it raises for the whole array): the
+    # feature is rejected with the reason, the others are skeletonised.
+    nan = Polygon([(0, 0), (10, 0), (float("nan"), 5), (0, 10)])
+    inf = Polygon([(0, 0), (10, 0), (float("inf"), 5), (0, 10)])
+    geoms = gpd.GeoSeries([RIVER, nan, BOW_TIE, inf], crs="EPSG:3035")
+    out = skeletonise.skeletonise(geoms)
+    assert list(out["method"].isna()) == [False, True, False, True]
+    for i in (1, 3):
+        assert "non-finite coordinate" in out["rejected"][i], out["rejected"][i]
+    assert out["repaired"][2] == 1 and pd.isna(out["rejected"][2])
+    frame = gpd.GeoDataFrame({"name": ["a", "b", "c", "d"]}, geometry=geoms)
+    applied = skeletonise.apply(frame, ROOT / "pipelines" / "demo.yaml")
+    assert list(applied["rejected"].notna()) == [False, True, False, True]
+
+
+def test_a_geographic_crs_and_threads_out_of_range_are_refused_as_on_the_command_line():
+    lonlat = gpd.GeoSeries([box(10, 50, 10.1, 50.01)], crs="EPSG:4326")
+    with pytest.raises(ValueError, match="geographic CRS .*projected CRS: reproject first"):
+        skeletonise.skeletonise(lonlat)
+    with pytest.raises(ValueError, match="geographic CRS"):
+        skeletonise.apply(gpd.GeoDataFrame(geometry=lonlat), ROOT / "pipelines" / "demo.yaml")
+    for bad in (-1, 0, 257, 2.5, True):
+        with pytest.raises(ValueError, match="give between 1 and 256 worker threads"):
+            skeletonise.skeletonise([RIVER], threads=bad)
+    assert skeletonise.skeletonise([RIVER], threads=1)["method"][0] == "MA"
