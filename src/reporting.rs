@@ -308,11 +308,14 @@ fn polygon_spec(file: &OutputFile, job: &ReportJob) -> Result<InputSpec, ReportE
     })
 }
 
-/// The polygons of the keys by source FID.
+/// The polygons of the keys by source FID; a feature that stands for
+/// several (`input.merge_adjacent`: its `members`) gets their union, as the
+/// run dissolved them.
 fn polygons(
     file: &OutputFile,
     job: &ReportJob,
     keys: &[(Key, f64)],
+    members: &HashMap<u64, Vec<u64>>,
 ) -> Result<(HashMap<u64, Geometry<f64>>, String), ReportError> {
     let spec = polygon_spec(file, job)?;
     let reader = Reader::open(&spec).map_err(|e| ReportError::Polygons {
@@ -327,13 +330,31 @@ fn polygons(
         }
         .to_string(),
     })?;
-    let mut fids: Vec<u64> = keys.iter().filter_map(|(k, _)| k.0).collect();
+    let shown: Vec<u64> = keys.iter().filter_map(|(k, _)| k.0).collect();
+    let mut fids: Vec<u64> = shown
+        .iter()
+        .flat_map(|f| members.get(f).cloned().unwrap_or_else(|| vec![*f]))
+        .collect();
     fids.sort_unstable();
     fids.dedup();
-    let by_fid = reader
+    let mut read: HashMap<u64, Feature> = reader
         .read_fids(&fids, true)?
         .into_iter()
-        .filter_map(|f| Some((f.fid?, f.geometry?)))
+        .filter_map(|f| Some((f.fid?, f)))
+        .collect();
+    let by_fid = shown
+        .iter()
+        .filter_map(|&fid| {
+            let feature = match members.get(&fid) {
+                Some(m) if m.len() > 1 => {
+                    let group: Vec<Feature> =
+                        m.iter().filter_map(|f| read.get(f).cloned()).collect();
+                    (group.len() == m.len()).then(|| crate::process::merge::dissolve(group))?
+                }
+                _ => read.remove(&fid)?,
+            };
+            Some((fid, feature.geometry?))
+        })
         .collect();
     Ok((
         by_fid,
@@ -395,7 +416,18 @@ fn sections(
         .into_iter()
         .map(|r| ((r.src_fid, r.polygon_part), r))
         .collect();
-    let (polys, source) = polygons(file, job, keys)?;
+    let members: HashMap<u64, Vec<u64>> = rows
+        .values()
+        .filter_map(|r| {
+            let list = r.members.as_deref()?;
+            let fids: Vec<u64> = list
+                .split(',')
+                .filter_map(|x| x.trim().parse().ok())
+                .collect();
+            Some((r.src_fid?, fids))
+        })
+        .collect();
+    let (polys, source) = polygons(file, job, keys, &members)?;
     let stored_bars = file.has_layer(crate::output::BARS.name);
     let mut bars: HashMap<u64, Vec<BarRow>> = HashMap::new();
     if stored_bars {

@@ -1285,3 +1285,155 @@ fn a_tiny_collapse_width_runs_like_any_other() {
         [Some(17)]
     );
 }
+
+/// The bounding box of an SVG path of `M x y` and relative `l dx dy …`
+/// steps (as the report draws polygons).
+fn path_extent(d: &str) -> (f64, f64) {
+    let mut nums = Vec::new();
+    let (mut x, mut y) = (0.0, 0.0);
+    let (mut lo, mut hi) = ((f64::MAX, f64::MAX), (f64::MIN, f64::MIN));
+    let mut mode = 'M';
+    let mut flush = |mode: char, nums: &mut Vec<f64>, x: &mut f64, y: &mut f64| {
+        for p in nums.chunks(2).filter(|p| p.len() == 2) {
+            if mode == 'M' {
+                (*x, *y) = (p[0], p[1]);
+            } else {
+                (*x, *y) = (*x + p[0], *y + p[1]);
+            }
+            lo = (lo.0.min(*x), lo.1.min(*y));
+            hi = (hi.0.max(*x), hi.1.max(*y));
+        }
+        nums.clear();
+    };
+    for tok in d.split(|c: char| c.is_whitespace()).flat_map(|t| {
+        let mut parts = Vec::new();
+        let mut cur = String::new();
+        for c in t.chars() {
+            if c.is_ascii_alphabetic() {
+                if !cur.is_empty() {
+                    parts.push(std::mem::take(&mut cur));
+                }
+                parts.push(c.to_string());
+            } else {
+                cur.push(c);
+            }
+        }
+        if !cur.is_empty() {
+            parts.push(cur);
+        }
+        parts
+    }) {
+        match tok.as_str() {
+            "M" | "l" | "z" => {
+                flush(mode, &mut nums, &mut x, &mut y);
+                mode = tok.chars().next().unwrap();
+            }
+            n => nums.push(n.parse().unwrap()),
+        }
+    }
+    flush(mode, &mut nums, &mut x, &mut y);
+    (hi.0 - lo.0, hi.1 - lo.1)
+}
+
+#[test]
+fn the_report_of_a_merged_feature_draws_and_scores_all_its_members() {
+    // Three reaches of a 3000 × 100 channel, merged into one feature.
+    let d = tmp();
+    let src = d.path().join("reaches.gpkg");
+    make_layer(
+        &src,
+        "reaches",
+        3035,
+        &[
+            Some("POLYGON((0 0,1000 0,1000 100,0 100,0 0))"),
+            Some("POLYGON((1000 0,2000 0,2000 100,1000 100,1000 0))"),
+            Some("POLYGON((2000 0,3000 0,3000 100,2000 100,2000 0))"),
+        ],
+    );
+    let out = d.path().join("o.gpkg");
+    let html = d.path().join("o.html");
+    let o = skeletonise(&[
+        "run",
+        "pipelines/demo.yaml",
+        "-i",
+        src.to_str().unwrap(),
+        "--set",
+        "input.layer=reaches",
+        "--set",
+        "input.merge_adjacent=true",
+        "-o",
+        out.to_str().unwrap(),
+        "--set",
+        &format!("output.report.path={}", html.display()),
+        "-q",
+    ]);
+    assert_eq!(code_and_err(&o).0, 0, "{}", code_and_err(&o).1);
+    let page = std::fs::read_to_string(&html).unwrap();
+    assert!(!page.contains("lie outside this polygon"), "a false alarm");
+    let d_attr = page
+        .split("<path class=\"poly\" d=\"")
+        .nth(1)
+        .and_then(|t| t.split('"').next())
+        .expect("the polygon is drawn");
+    let (w, h) = path_extent(d_attr);
+    assert!(
+        (w / h - 30.0).abs() < 1.0,
+        "the whole 3000 × 100 channel: {w} × {h}"
+    );
+}
+
+#[test]
+fn null_merge_by_values_are_kept_apart() {
+    let d = tmp();
+    let src = d.path().join("reaches.gpkg");
+    make_layer(
+        &src,
+        "reaches",
+        3035,
+        &[
+            Some("POLYGON((0 0,1000 0,1000 100,0 100,0 0))"),
+            Some("POLYGON((1000 0,2000 0,2000 100,1000 100,1000 0))"),
+            Some("POLYGON((2000 0,3000 0,3000 100,2000 100,2000 0))"),
+        ],
+    );
+    // `river` NULL for all three: as in SQL, NULL equals nothing.
+    let ds = gdal::Dataset::open_ex(
+        &src,
+        gdal::DatasetOptions {
+            open_flags: gdal::GdalOpenFlags::GDAL_OF_UPDATE | gdal::GdalOpenFlags::GDAL_OF_VECTOR,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    ds.execute_sql(
+        "ALTER TABLE reaches ADD COLUMN river TEXT",
+        None,
+        gdal::vector::sql::Dialect::SQLITE,
+    )
+    .unwrap();
+    drop(ds);
+    let out = d.path().join("o.gpkg");
+    let o = skeletonise(&[
+        "run",
+        "pipelines/demo.yaml",
+        "-i",
+        src.to_str().unwrap(),
+        "--set",
+        "input.layer=reaches",
+        "--set",
+        "input.merge_adjacent=true",
+        "--set",
+        "input.merge_by=river",
+        "-o",
+        out.to_str().unwrap(),
+        "--set",
+        "output.report=null",
+        "-q",
+    ]);
+    assert_eq!(code_and_err(&o).0, 0, "{}", code_and_err(&o).1);
+    let members = strings(&open(&out), "skeletons", "members");
+    assert_eq!(
+        members,
+        [Some("1".into()), Some("2".into()), Some("3".into())]
+    );
+}

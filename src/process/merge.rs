@@ -32,10 +32,15 @@ pub fn merge_adjacent(features: Vec<Feature>, by: Option<usize>) -> Vec<Feature>
     let mut edges: HashMap<EdgeKey, usize> = HashMap::new();
     for (i, f) in features.iter().enumerate() {
         let Some(parts) = polygons(f) else { continue };
-        let key = by
-            .and_then(|k| f.attributes.get(k))
-            .and_then(|v| v.as_text())
-            .unwrap_or_default();
+        // As in SQL, NULL equals nothing: a feature whose `merge_by` value
+        // is NULL merges with no other.
+        let key = match by {
+            None => String::new(),
+            Some(k) => match f.attributes.get(k).and_then(|v| v.as_text()) {
+                Some(v) => v,
+                None => continue,
+            },
+        };
         for p in &parts {
             for ring in std::iter::once(p.exterior()).chain(p.interiors()) {
                 for w in ring.0.windows(2) {
@@ -94,8 +99,8 @@ fn snap(c: Coord<f64>) -> (i64, i64) {
 }
 
 /// One feature from a group of adjacent ones (the first, by FID, gives the
-/// attributes).
-fn dissolve(mut group: Vec<Feature>) -> Feature {
+/// attributes), its geometry their union, `members` their FIDs.
+pub fn dissolve(mut group: Vec<Feature>) -> Feature {
     group.sort_by_key(|f| f.fid);
     let ring = |l: &LineString<f64>| -> Vec<[f64; 2]> {
         let n = l.0.len().saturating_sub(1);
@@ -163,5 +168,25 @@ mod tests {
         };
         assert!((p.unsigned_area() - 2.0).abs() < 1e-9);
         assert!(out.iter().any(|f| f.fid == Some(7) && f.members.is_empty()));
+    }
+
+    #[test]
+    fn null_merge_by_values_merge_with_nothing_as_in_sql() {
+        use crate::feature::Value;
+        let with = |f: Feature, v: Value| Feature {
+            attributes: vec![v],
+            ..f
+        };
+        let out = merge_adjacent(
+            vec![
+                with(square(1, 0.0), Value::Null),
+                with(square(2, 1.0), Value::Null),
+                with(square(3, 2.0), Value::Text("a".into())),
+                with(square(4, 3.0), Value::Text("a".into())),
+            ],
+            Some(0),
+        );
+        let members: Vec<Vec<u64>> = out.iter().map(|f| f.members.clone()).collect();
+        assert_eq!(members, [vec![], vec![], vec![3, 4]]);
     }
 }
