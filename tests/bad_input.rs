@@ -1437,3 +1437,21 @@ fn null_merge_by_values_are_kept_apart() {
         [Some("1".into()), Some("2".into()), Some("3".into())]
     );
 }
+
+#[test]
+fn deeply_nested_brackets_are_refused_before_the_yaml_parser_sees_them() {
+    // 200 KB of `[` after a key: the YAML scanner took 18 s (quadratic)
+    // before its recursion limit; the check before it answers at once, with
+    // the place (its own message proves the parser never ran).
+    let d = tmp();
+    let text = format!("input: {}", "[".repeat(200_000));
+    let p = pipeline(d.path(), "deep.yaml", &text);
+    for cmd in ["validate", "run"] {
+        let (code, err) = code_and_err(&skeletonise(&[cmd, p.to_str().unwrap()]));
+        assert_eq!(code, 78, "{err}");
+        assert!(
+            err.contains("deep.yaml:1:136: invalid YAML: brackets nested deeper than 128 levels"),
+            "{err}"
+        );
+    }
+}

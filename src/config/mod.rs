@@ -310,6 +310,13 @@ fn parse<T: serde::de::DeserializeOwned>(
             message,
         },
     };
+    if let Some((line, column)) = too_deep(text) {
+        return Err(err(
+            Some((line, column)),
+            "",
+            format!("invalid YAML: brackets nested deeper than {MAX_NESTING} levels; a pipeline file needs a handful"),
+        ));
+    }
     let mut value: Value = serde_yaml_ng::from_str(text).map_err(|e| {
         let pos = e.location().map(|l| (l.line(), l.column()));
         err(pos, "", format!("invalid YAML: {e}"))
@@ -361,6 +368,51 @@ fn parse<T: serde::de::DeserializeOwned>(
     };
     check(&file).map_err(|(k, m)| err(locs.key(&k), &k, m))?;
     Ok(file)
+}
+
+/// Deepest nesting of flow collections (`[`, `{`) a pipeline file may have
+/// (the YAML deserialiser's own recursion limit).
+const MAX_NESTING: usize = 128;
+
+/// Where the flow brackets of `text` first nest deeper than
+/// [`MAX_NESTING`] (line and column, from 1), if they do. Checked before
+/// the YAML parser sees the text: its scanner takes time quadratic in the
+/// depth (200 KB of `[` took 18 s) before it reports its recursion limit.
+/// Brackets inside quotes and comments do not count; one in a plain scalar
+/// does, which only matters past a hundred of them.
+fn too_deep(text: &str) -> Option<(usize, usize)> {
+    let (mut depth, mut line, mut column) = (0usize, 1usize, 0usize);
+    let mut quote: Option<char> = None;
+    let (mut comment, mut escaped, mut prev) = (false, false, '\n');
+    for c in text.chars() {
+        column += 1;
+        if c == '\n' {
+            (line, column, comment) = (line + 1, 0, false);
+            prev = c;
+            continue;
+        }
+        match quote {
+            Some('"') if escaped => escaped = false,
+            Some('"') if c == '\\' => escaped = true,
+            Some(q) if c == q => quote = None,
+            Some(_) => {}
+            None if comment => {}
+            None => match c {
+                '#' if prev.is_whitespace() => comment = true,
+                '"' | '\'' => quote = Some(c),
+                '[' | '{' => {
+                    depth += 1;
+                    if depth > MAX_NESTING {
+                        return Some((line, column));
+                    }
+                }
+                ']' | '}' => depth = depth.saturating_sub(1),
+                _ => {}
+            },
+        }
+        prev = c;
+    }
+    None
 }
 
 /// The `skeleton` step takes its own keys and every registered method's
@@ -938,6 +990,23 @@ mod tests {
                 .contains("`SKELETONISE_TEST_EMPTY` is set but empty"),
             "{e}"
         );
+    }
+
+    #[test]
+    fn deep_brackets_are_refused_before_parsing_and_quoted_ones_do_not_count() {
+        let deep = format!("input: {}", "[".repeat(100_000));
+        let e = load_str(&deep, "p.yaml", &[]).unwrap_err();
+        assert_eq!(e.position, Some((1, 8 + MAX_NESTING)), "{e}");
+        assert!(e.message.contains("nested deeper than 128"), "{e}");
+        let quoted = OK.replace(
+            "path: out.gpkg",
+            &format!(
+                "path: out.gpkg\n  layer: \"{}\" # {}",
+                "[".repeat(300),
+                "{".repeat(300)
+            ),
+        );
+        assert!(load_str(&quoted, "p.yaml", &[]).is_ok());
     }
 
     #[test]
