@@ -1455,3 +1455,42 @@ fn deeply_nested_brackets_are_refused_before_the_yaml_parser_sees_them() {
         );
     }
 }
+
+#[test]
+fn a_crs_unit_name_is_escaped_once_in_the_report() {
+    // Trinidad 1903 / Trinidad Grid: its unit is "Clarke's foot".
+    let d = tmp();
+    let src = d.path().join("in.gpkg");
+    make_layer(
+        &src,
+        "bad",
+        2314,
+        &[Some(SQUARE), Some("POLYGON((0 0,300 0,300 20,0 20,0 0))")],
+    );
+    let out = d.path().join("o.gpkg");
+    let html = d.path().join("o.html");
+    let o = skeletonise(&[
+        "run",
+        "pipelines/compare-methods.yaml",
+        "-i",
+        src.to_str().unwrap(),
+        "--set",
+        "input.layer=bad",
+        "-o",
+        out.to_str().unwrap(),
+        "--set",
+        &format!("output.report.path={}", html.display()),
+        "-q",
+    ]);
+    assert_eq!(code_and_err(&o).0, 0, "{}", code_and_err(&o).1);
+    let page = std::fs::read_to_string(&html).unwrap();
+    assert!(
+        page.contains("<th>s (Clarke&#39;s foot)</th>"),
+        "the score table's label"
+    );
+    assert!(
+        page.contains("mean s (Clarke&#39;s foot)"),
+        "the summary's label"
+    );
+    assert!(!page.contains("&amp;#39;"), "escaped twice");
+}

@@ -75,11 +75,12 @@ fn cell(key: &str, x: f64, kind: Num, class: &str) -> String {
     )
 }
 
+/// ` (unit)` after a label, as text (escaped where it is written).
 fn unit(units: &str) -> String {
     if units.is_empty() {
         String::new()
     } else {
-        format!(" ({})", esc(units))
+        format!(" ({units})")
     }
 }
 
@@ -132,7 +133,7 @@ fn summary(r: &Report) -> String {
         r.features,
         esc(&r.selection)
     );
-    let u = unit(&r.units);
+    let u = esc(&unit(&r.units));
     let _ = write!(
         s,
         r#"<div class="summary-row"><table id="summary-table"><thead><tr><th>method</th><th>features won</th><th>mean Z</th><th>mean s{u}</th><th>mean S{u}</th><th>mean coverage</th><th>mean legs</th><th>failed</th><th>with hits</th></tr></thead><tbody>"#
