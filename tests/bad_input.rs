@@ -1022,7 +1022,7 @@ fn score_case(
     for (i, (_, k)) in lines.iter().enumerate() {
         let v = k.map_or("NULL".to_string(), |k| format!("'{k}'"));
         ds.execute_sql(
-            &format!("UPDATE l SET pkey = {v} WHERE id = {i}"),
+            format!("UPDATE l SET pkey = {v} WHERE id = {i}"),
             None,
             gdal::vector::sql::Dialect::SQLITE,
         )

@@ -876,3 +876,272 @@ fn the_report_of_a_collapse_run_draws_each_feature_once_with_all_its_lines() {
         "the collapsed and kept rows are drawn as one skeleton"
     );
 }
+
+/// A 3 km lake with a 200 m river arm to the east; one island touches the
+/// shore at a vertex, a second touches the first at a vertex, and a third
+/// leaves a 100 m channel along the south shore (OGC-valid, all of it).
+const TOUCHING: &str = "POLYGON((0 0,3000 0,3000 1400,8000 1400,8000 1600,3000 1600,3000 3000,0 3000,0 1500,0 0),(0 1500,800 1700,800 1300,0 1500),(800 1700,1100 2300,1400 1900,800 1700),(1000 100,1500 500,2000 100,1000 100))";
+
+/// GEOS (through GDAL) on a polygon: valid or the reason.
+fn geos_valid(p: &Polygon<f64>) -> bool {
+    use gdal::vector::ToGdal;
+    p.to_gdal().unwrap().is_valid()
+}
+
+/// Length of `lines` inside the polygons `areas` shrunk by 1 cm (a line
+/// on a cut does not count), by GEOS.
+fn length_inside(lines: &[LineString<f64>], areas: &[Polygon<f64>]) -> f64 {
+    use gdal::vector::ToGdal;
+    let mut total = 0.0;
+    for a in areas {
+        let shrunk = a.to_gdal().unwrap().buffer(-0.01, 8).unwrap();
+        for l in lines {
+            let g = l.to_gdal().unwrap().intersection(&shrunk);
+            total += g.map_or(0.0, |g| g.length());
+        }
+    }
+    total
+}
+
+/// Every vertex of every area either is one of `source`'s vertices bit for
+/// bit, or lies on its boundary (a cut's end, inserted into an edge), or
+/// lies farther than `far` from it (a cut's change point).
+fn vertices_exact(areas: &[Polygon<f64>], source: &[Polygon<f64>], far: f64) -> Result<(), String> {
+    let mut vertices = std::collections::HashSet::new();
+    for p in source {
+        for r in std::iter::once(p.exterior()).chain(p.interiors()) {
+            vertices.extend(r.0.iter().map(|c| (c.x.to_bits(), c.y.to_bits())));
+        }
+    }
+    let prepared: Vec<PreparedPolygon> = source
+        .iter()
+        .map(|p| PreparedPolygon::new(p).unwrap())
+        .collect();
+    for a in areas {
+        for r in std::iter::once(a.exterior()).chain(a.interiors()) {
+            for c in &r.0 {
+                if vertices.contains(&(c.x.to_bits(), c.y.to_bits())) {
+                    continue;
+                }
+                let d = prepared
+                    .iter()
+                    .map(|p| p.boundary().distance(*c))
+                    .fold(f64::INFINITY, f64::min);
+                let extent = prepared.iter().map(|p| p.extent()).fold(0.0, f64::max);
+                if d > 1e-9 * extent && d < far {
+                    return Err(format!(
+                        "area vertex {c:?} lies {d:e} from the source boundary: moved"
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Checks a collapse output against its source polygons: valid areas,
+/// exact vertices, no sliver, no collapsed line inside an area, every kept
+/// line inside one. Returns (areas, collapsed length).
+fn check_areas(
+    out: &Path,
+    source: &std::collections::BTreeMap<i64, Vec<Polygon<f64>>>,
+) -> (usize, f64) {
+    let (areas, skel) = (rows(out, "areas"), rows(out, "skeletons"));
+    let mut n = 0;
+    let mut collapsed_length = 0.0;
+    for (fid, parts) in source {
+        let a: Vec<Polygon<f64>> = areas
+            .iter()
+            .filter(|r| r.src_fid == *fid)
+            .flat_map(|r| polygons(&r.geometry))
+            .collect();
+        n += a.len();
+        for p in &a {
+            assert!(geos_valid(p), "fid {fid}: an invalid area {p:?}");
+            assert!(
+                p.unsigned_area() > 1.0,
+                "fid {fid}: a sliver of {} m²",
+                p.unsigned_area()
+            );
+        }
+        vertices_exact(&a, parts, 1.0).unwrap_or_else(|e| panic!("fid {fid}: {e}"));
+        let of = |c: bool| -> Vec<LineString<f64>> {
+            skel.iter()
+                .filter(|s| s.src_fid == *fid && s.collapsed == Some(c))
+                .flat_map(|s| lines(&s.geometry))
+                .collect()
+        };
+        let (collapsed, kept) = (of(true), of(false));
+        use geo::{Euclidean, Length};
+        collapsed_length += collapsed.iter().map(|l| Euclidean.length(l)).sum::<f64>();
+        let inside = length_inside(&collapsed, &a);
+        assert!(
+            inside < 1e-6,
+            "fid {fid}: {inside} m of collapsed line inside the kept areas"
+        );
+        let kept_len: f64 = kept.iter().map(|l| Euclidean.length(l)).sum();
+        let grown: Vec<Polygon<f64>> = a
+            .iter()
+            .map(|p| {
+                use gdal::vector::ToGdal;
+                let g = p
+                    .to_gdal()
+                    .unwrap()
+                    .buffer(0.02, 8)
+                    .unwrap()
+                    .to_geo()
+                    .unwrap();
+                polygons(&g).remove(0)
+            })
+            .collect();
+        let kept_inside = length_inside(&kept, &grown);
+        assert!(
+            (kept_len - kept_inside).abs() < 1e-6 * kept_len.max(1.0),
+            "fid {fid}: kept lines outside the areas: {kept_len} vs {kept_inside}"
+        );
+    }
+    (n, collapsed_length)
+}
+
+#[test]
+fn holes_touching_the_shore_and_each_other_give_valid_exact_areas_and_no_collapsed_line_in_them() {
+    let dir = tmp();
+    let src = wkt_layer(dir.path(), &[TOUCHING]);
+    let source = sources(&src, "shapes");
+    for width in [300, 500] {
+        let out = collapse_pipeline(dir.path(), &src, "shapes", &format!("{{ width: {width} }}"));
+        let (areas, collapsed) = check_areas(&out, &source);
+        assert_eq!(areas, 1, "width {width}: one lake");
+        // The arm (5 km) and the south channel collapse at least.
+        assert!(
+            collapsed > 5000.0 + 1000.0,
+            "width {width}: {collapsed} m collapsed"
+        );
+    }
+}
+
+#[test]
+fn real_collapsed_areas_keep_the_source_vertices_and_hold_no_collapsed_line() {
+    let dir = tmp();
+    for (layer, width) in [
+        ("river_lena", 1000),
+        ("river_st_lawrence", 1500),
+        ("lakes_scotland", 1500),
+        ("islands_hebrides", 300),
+    ] {
+        let out = collapse_pipeline(dir.path(), TRAIN, layer, &format!("{{ width: {width} }}"));
+        let (areas, collapsed) = check_areas(&out, &sources(TRAIN, layer));
+        assert!(
+            areas > 0 && collapsed > 0.0,
+            "{layer}: {areas} areas, {collapsed} m collapsed"
+        );
+    }
+}
+
+#[test]
+fn a_connection_leg_in_a_kept_lake_is_kept_and_cuts_no_notch() {
+    let dir = tmp();
+    let src = wkt_layer(dir.path(), &[TOUCHING]);
+    let net = dir.path().join("net.gpkg");
+    make_layer(
+        &net,
+        "net",
+        3857,
+        &[
+            Some("LINESTRING(1500 4000,1500 3000)"),
+            Some("LINESTRING(-1000 500,0 500)"),
+        ],
+    );
+    let plain = collapse_pipeline(dir.path(), &src, "shapes", "{ width: 300 }");
+    let area = |out: &Path| -> f64 {
+        rows(out, "areas")
+            .iter()
+            .flat_map(|r| polygons(&r.geometry))
+            .map(|p| p.unsigned_area())
+            .sum()
+    };
+    let before = area(&plain);
+    let out = dir.path().join("connected.gpkg");
+    let text = format!(
+        "input: {{ source: {src}, layer: shapes, connect: {{ source: {}, layer: net }} }}\nsteps:\n  - skeleton: {{ methods: [MA] }}\n  - prune: {{}}\n  - extend: {{}}\n  - collapse: {{ width: 300 }}\noutput: {{ path: {} }}\n",
+        net.display(),
+        out.display()
+    );
+    let p = pipeline(dir.path(), "connected.yaml", &text);
+    let o = skeletonise(&["run", p.to_str().unwrap(), "-q"]);
+    assert!(o.status.success(), "{}", code_and_err(&o).1);
+    check_areas(&out, &sources(&src, "shapes"));
+    // Both legs reach the shore as kept lines, and the lake loses nothing.
+    let skel = rows(&out, "skeletons");
+    for end in [
+        Coord {
+            x: 1500.0,
+            y: 3000.0,
+        },
+        Coord { x: 0.0, y: 500.0 },
+    ] {
+        let holder = skel.iter().find(|s| {
+            lines(&s.geometry)
+                .iter()
+                .any(|l| l.0.iter().any(|c| dist(*c, end) < 1e-6))
+        });
+        assert_eq!(
+            holder.and_then(|s| s.collapsed),
+            Some(false),
+            "the leg to {end:?}"
+        );
+    }
+    assert!(
+        (area(&out) - before).abs() < 1e-6 * before,
+        "{} vs {before}",
+        area(&out)
+    );
+}
+
+#[test]
+fn collapse_with_another_method_than_ma_is_refused_with_the_reason() {
+    let dir = tmp();
+    let src = wkt_layer(dir.path(), &[TOUCHING]);
+    let out = dir.path().join("o.gpkg");
+    for methods in ["[MA, CDT]", "[StSk]", "[DVD]"] {
+        let text = format!(
+            "input: {{ source: {src}, layer: shapes }}\nsteps:\n  - skeleton: {{ methods: {methods} }}\n  - collapse: {{ width: 300 }}\noutput: {{ path: {} }}\n",
+            out.display()
+        );
+        let p = pipeline(dir.path(), "p.yaml", &text);
+        for cmd in ["validate", "run"] {
+            let (code, err) = code_and_err(&skeletonise(&[cmd, p.to_str().unwrap()]));
+            assert_eq!(code, 78, "{cmd} {methods}: {err}");
+            assert!(
+                err.contains("`steps[0].skeleton.methods`") && err.contains("list MA alone"),
+                "{err}"
+            );
+            assert!(!out.exists());
+        }
+    }
+}
+
+#[test]
+fn a_star_of_a_hundred_spikes_gets_a_hundred_cuts() {
+    // Spikes 2 km long on a 1 km disc, 63 m wide at their base: each is
+    // collapsed and cut off at its base, the cuts of neighbours meeting on
+    // the reflex vertex between them.
+    let n = 100;
+    let mut pts: Vec<String> = (0..2 * n)
+        .map(|i| {
+            let r = if i % 2 == 0 { 3000.0 } else { 1000.0 };
+            let a = std::f64::consts::PI * f64::from(i) / f64::from(n);
+            format!("{:.3} {:.3}", r * a.cos(), r * a.sin())
+        })
+        .collect();
+    pts.push(pts[0].clone());
+    let star = format!("POLYGON(({}))", pts.join(","));
+    let dir = tmp();
+    let src = wkt_layer(dir.path(), &[&star]);
+    let out = collapse_pipeline(dir.path(), &src, "shapes", "{ width: 100 }");
+    let areas = rows(&out, "areas");
+    assert_eq!(areas.len(), 1, "the disc");
+    let ds = open(&out);
+    assert_eq!(common::ints(&ds, "areas", "cuts"), [Some(100)]);
+    check_areas(&out, &sources(&src, "shapes"));
+}

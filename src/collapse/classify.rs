@@ -35,11 +35,20 @@ pub(super) struct Samples {
     pub narrow: Vec<bool>,
     /// The collapse width.
     pub width: f64,
+    /// Samples of connection legs, each with the sample where its leg
+    /// leaves the skeleton: they take that sample's class.
+    follows: Vec<(u32, u32)>,
 }
 
 impl Samples {
-    /// Samples every edge of `g` at most `width / 4` apart.
-    pub fn of(g: &SkeletonGraph, p: &PreparedPolygon, width: f64) -> Self {
+    /// Samples every edge of `g` at most `width / 4` apart; `legs` are the
+    /// connection legs added to `g` (from the skeleton to the boundary).
+    pub fn of(
+        g: &SkeletonGraph,
+        p: &PreparedPolygon,
+        width: f64,
+        legs: &[(Coord<f64>, Coord<f64>)],
+    ) -> Self {
         let total = g.total_length();
         let step = (width / 4.0)
             .max(total / MAX_SAMPLES)
@@ -47,10 +56,22 @@ impl Samples {
         let mut pos: Vec<Coord<f64>> = g.nodes().iter().map(|n| n.pos).collect();
         let mut inserted = vec![false; pos.len()];
         let mut segments = Vec::new();
+        let mut follows = Vec::new();
         for e in 0..g.edges().len() {
             let id = crate::graph::EdgeId(e as u32);
             let edge = g.edge(id);
             let coords = g.edge_coords(id);
+            let (first, last) = (coords[0], coords[coords.len() - 1]);
+            let attachment = legs.iter().find_map(|&(s, c)| {
+                if (first, last) == (s, c) {
+                    Some(edge.a.0)
+                } else if (first, last) == (c, s) {
+                    Some(edge.b.0)
+                } else {
+                    None
+                }
+            });
+            let before = pos.len();
             let mut prev = edge.a.0;
             for k in 1..coords.len() {
                 let (a, b) = (coords[k - 1], coords[k]);
@@ -71,6 +92,11 @@ impl Samples {
                 };
                 segments.push((prev, cur));
                 prev = cur;
+            }
+            if let Some(a) = attachment {
+                let end = if a == edge.a.0 { edge.b.0 } else { edge.a.0 };
+                follows.extend((before as u32..pos.len() as u32).map(|i| (i, a)));
+                follows.push((end, a));
             }
         }
         let boundary = p.boundary();
@@ -96,6 +122,17 @@ impl Samples {
             adj,
             narrow: vec![false; n],
             width,
+            follows,
+        }
+    }
+
+    /// Connection legs take the class of the skeleton where they leave it:
+    /// they are the network's lines continued, not the polygon's shape (a
+    /// leg to a lake's shore is as narrow as the shore, and must neither be
+    /// collapsed inside the lake nor cut a notch out of it).
+    pub fn follow_legs(&mut self) {
+        for &(i, a) in &self.follows {
+            self.narrow[i as usize] = self.narrow[a as usize];
         }
     }
 
@@ -257,7 +294,6 @@ impl Samples {
                 root,
                 length,
                 neighbours,
-                narrow: self.narrow[root],
                 labels: labels.clone(),
             })
             .collect()
@@ -272,8 +308,6 @@ pub(super) struct Stretch {
     pub length: f64,
     /// It meets a stretch of the other class.
     pub neighbours: bool,
-    /// Collapsed.
-    pub narrow: bool,
     /// Every sample's stretch label (shared by all stretches).
     pub labels: std::rc::Rc<Vec<usize>>,
 }
@@ -293,10 +327,10 @@ mod tests {
         b.segment(Coord { x: 50., y: 30. }, Coord { x: 100., y: 0. });
         b.segment(Coord { x: 50., y: 30. }, Coord { x: 50., y: 80. });
         let g = b.finish(p.boundary());
-        let s = Samples::of(&g, &p, 1e-9);
+        let s = Samples::of(&g, &p, 1e-9, &[]);
         // About 170 units of skeleton at 1e-4 × extent (1 cm).
         assert!(s.pos.len() < 20_000, "{} samples", s.pos.len());
-        let coarse = Samples::of(&g, &p, 1.0);
+        let coarse = Samples::of(&g, &p, 1.0, &[]);
         assert!(
             coarse.pos.len() > 500,
             "a width of 1 still samples every 0.25"

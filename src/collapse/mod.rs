@@ -25,9 +25,23 @@
 //! 4. At each change of class the polygon is cut by the two radii from the
 //!    change point p to the nearest boundary points on either side of the
 //!    skeleton (the inscribed disc's contacts; each is visible from p, so the
-//!    cut lies inside P). The pieces holding a wide stretch (or no stretch)
-//!    are the kept areas; the skeleton is split at p, so each collapsed line
-//!    ends on a cut, on ∂P, or at another line.
+//!    cut lies inside P; a contact within `1e-9 × extent` of a vertex is that
+//!    vertex). The polygon is split exactly along the cuts
+//!    ([`crate::geometry::arrangement`]): its own vertices keep their
+//!    coordinates, a cut's ends are inserted into the edges they meet, rings
+//!    touching at a vertex give valid pieces. A piece holding a wide stretch
+//!    (or none) is kept; kept pieces that share a cut are one area. The
+//!    skeleton is split at p (and wherever it passes a cut or a point of ∂P),
+//!    and every piece of it is collapsed or kept as the piece of the polygon
+//!    it lies in, so no collapsed line runs through a kept area; each
+//!    collapsed line ends on a cut, on ∂P, or at another line.
+//! 5. Connection legs (`input.connect`) take the class of the skeleton where
+//!    they leave it: they continue the network, they are not the polygon's
+//!    shape, so a leg to a kept lake's shore is kept and cuts no notch.
+//!
+//! The step works on the medial axis (MA alone in `skeleton.methods`): its
+//! discs are what the local width and the cuts are made of, and another
+//! method's lines are not centred on them.
 
 mod classify;
 mod split;
@@ -144,8 +158,15 @@ pub struct PartCollapse {
 }
 
 /// Collapses polygon part `p` with its finished skeleton `g` (see the
-/// module documentation).
-pub fn collapse(g: &SkeletonGraph, p: &PreparedPolygon, params: &CollapseParams) -> PartCollapse {
+/// module documentation); `legs` are the connection legs `g` holds (from
+/// the skeleton to the boundary), which take the class of the skeleton
+/// where they leave it.
+pub fn collapse(
+    g: &SkeletonGraph,
+    p: &PreparedPolygon,
+    params: &CollapseParams,
+    legs: &[(Coord<f64>, Coord<f64>)],
+) -> PartCollapse {
     if g.is_empty() {
         return PartCollapse {
             areas: vec![Area {
@@ -155,12 +176,14 @@ pub fn collapse(g: &SkeletonGraph, p: &PreparedPolygon, params: &CollapseParams)
             ..PartCollapse::default()
         };
     }
-    let mut s = classify::Samples::of(g, p, params.width);
+    let mut s = classify::Samples::of(g, p, params.width, legs);
     s.classify(params);
+    s.follow_legs();
     match params.mode {
         CollapseMode::Partial => s.merge_short(params.min_length()),
         CollapseMode::Whole => s.whole(),
     }
+    s.follow_legs();
     split::split(&s, p)
 }
 
@@ -181,7 +204,12 @@ mod tests {
         let p = PreparedPolygon::new(&r).unwrap();
         let mut b = GraphBuilder::new();
         b.segment(Coord { x: 0., y: 5. }, Coord { x: 100., y: 5. });
-        collapse(&b.finish(p.boundary()), &p, &CollapseParams::new(width))
+        collapse(
+            &b.finish(p.boundary()),
+            &p,
+            &CollapseParams::new(width),
+            &[],
+        )
     }
 
     #[test]

@@ -1,112 +1,56 @@
 //! Step 4 of the module documentation: the cuts at every change of class,
-//! the polygon sliced along them into pieces, the pieces kept or collapsed
-//! by the stretches they hold, and the skeleton split at the change points.
+//! the polygon split exactly along them ([`crate::geometry::arrangement`]:
+//! its vertices kept bit for bit, a cut's ends inserted into the edges they
+//! meet), every face kept or collapsed by the stretches it holds, and the
+//! skeleton split at the change points, each piece collapsed or kept as the
+//! face it lies in — so no collapsed line ever runs through a kept area.
 
 use super::classify::Samples;
 use super::{Area, PartCollapse};
+use crate::geometry::arrangement::{self, Face};
 use crate::geometry::PreparedPolygon;
 use crate::graph::GraphBuilder;
-use geo::{BoundingRect, Coord, Intersects, LineString, Polygon, Rect};
-use i_overlay::core::fill_rule::FillRule;
-use i_overlay::float::simplify::SimplifyShape;
-use i_overlay::float::slice::FloatSlice;
+use geo::{Coord, LineString};
 use std::collections::HashSet;
-
-/// How far a cut continues beyond ∂P, relative to its radius, so that the
-/// slicing sees it cross the boundary rather than end on it.
-const OVERSHOOT: f64 = 1e-4;
 
 /// A change of class on segment `segment` of the samples, at `point`.
 struct Change {
     segment: usize,
     point: Coord<f64>,
-    /// The cut, when both contacts exist.
+    /// The cut: from one contact of the inscribed disc at `point` through
+    /// it to the other, when both exist.
     cut: Option<LineString<f64>>,
 }
 
 /// The collapse of one polygon part from its classified samples.
 pub(super) fn split(s: &Samples, p: &PreparedPolygon) -> PartCollapse {
-    let changes: Vec<Change> = s.changes().map(|i| change(s, p, i)).collect();
+    let mut changes: Vec<Change> = s.changes().map(|i| change(s, p, i)).collect();
+    drop_crossing_cuts(&mut changes);
     let cuts: Vec<LineString<f64>> = changes.iter().filter_map(|c| c.cut.clone()).collect();
-    let pieces = if cuts.is_empty() {
-        vec![p.polygon().clone()]
-    } else {
-        slice(p.polygon(), &cuts)
-    };
-    // One representative sample per stretch, far from the cuts and from ∂P.
-    let stretches = s.stretches();
-    let ends: HashSet<u32> = changes
-        .iter()
-        .flat_map(|c| {
-            let (a, b, _) = s.segments[c.segment];
-            [a, b]
-        })
+    let faces = split_or_whole(p, &cuts);
+    let pieces = Pieces::of(s, &changes, p.extent());
+    // Each run of pieces lies in one face: placed by its piece farthest
+    // from ∂P.
+    let face: Vec<Option<usize>> = pieces
+        .representatives()
+        .into_iter()
+        .map(|c| face_of(&faces, c))
         .collect();
-    let d_cut = s.distances(|i, _| ends.contains(&(i as u32)));
-    let mut rep: std::collections::HashMap<usize, (usize, f64)> = Default::default();
-    if let Some(first) = stretches.first() {
-        for &(a, _, _) in &s.segments {
-            let i = a as usize;
-            let score = d_cut[i].min(s.r[i]);
-            let e = rep.entry(first.labels[i]).or_insert((i, f64::NEG_INFINITY));
-            if score > e.1 {
-                *e = (i, score);
-            }
-        }
-    }
-    let boxes: Vec<Rect<f64>> = pieces
-        .iter()
-        .map(|q| q.bounding_rect().expect("a piece has vertices"))
-        .collect();
-    let piece_of = |c: Coord<f64>| {
-        (0..pieces.len()).find(|&k| boxes[k].intersects(&c) && pieces[k].intersects(&c))
-    };
-    let mut holds_wide = vec![false; pieces.len()];
-    let mut holds_any = vec![false; pieces.len()];
-    let mut rep_piece: std::collections::HashMap<usize, Option<usize>> = Default::default();
-    for st in &stretches {
-        let Some(&(i, _)) = rep.get(&st.root) else {
-            continue;
-        };
-        let k = piece_of(s.pos[i]);
-        if let Some(k) = k {
+    // A face is kept when it holds a wide run, or none at all.
+    let mut holds_wide = vec![false; faces.len()];
+    let mut holds_any = vec![false; faces.len()];
+    for (run, f) in face.iter().enumerate() {
+        if let Some(k) = *f {
             holds_any[k] = true;
-            holds_wide[k] |= !st.narrow;
+            holds_wide[k] |= !pieces.run_narrow[run];
         }
-        rep_piece.insert(st.root, k);
     }
-    let kept_piece: Vec<bool> = (0..pieces.len())
+    let kept: Vec<bool> = (0..faces.len())
         .map(|k| holds_wide[k] || !holds_any[k])
         .collect();
-    // A sample is collapsed when narrow and its stretch's piece is not kept.
-    let labels = stretches.first().map(|st| st.labels.clone());
-    let collapsed = |i: usize| {
-        s.narrow[i]
-            && labels.as_ref().is_some_and(|l| {
-                rep_piece
-                    .get(&l[i])
-                    .copied()
-                    .flatten()
-                    .is_none_or(|k| !kept_piece[k])
-            })
-    };
-    let (collapsed_lines, kept_lines) = lines(s, &changes, collapsed);
-    let kept: Vec<Polygon<f64>> = pieces
-        .into_iter()
-        .zip(&kept_piece)
-        .filter(|(_, &k)| k)
-        .map(|(polygon, _)| polygon)
-        .collect();
-    let areas = merge(kept)
-        .into_iter()
-        .map(|polygon| {
-            let n = changes
-                .iter()
-                .filter(|c| c.cut.is_some() && on_boundary(&polygon, c.point, p.extent()))
-                .count();
-            Area { polygon, cuts: n }
-        })
-        .collect();
+    let collapsed = |run: usize| face[run].is_some_and(|k| !kept[k]);
+    let (collapsed_lines, kept_lines) = pieces.lines(s, collapsed);
+    let areas = areas(p, &cuts, &faces, &kept);
     PartCollapse {
         collapsed: collapsed_lines,
         kept: kept_lines,
@@ -116,20 +60,350 @@ pub(super) fn split(s: &Samples, p: &PreparedPolygon) -> PartCollapse {
     }
 }
 
-/// `c` lies on the boundary of `polygon` (within the slicing's rounding).
-fn on_boundary(polygon: &Polygon<f64>, c: Coord<f64>, extent: f64) -> bool {
-    use geo::{Distance, Euclidean};
-    let tol = 1e-7 * extent;
-    let Some(b) = polygon.bounding_rect() else {
-        return false;
-    };
-    let (lo, hi) = (b.min(), b.max());
-    if c.x < lo.x - tol || c.x > hi.x + tol || c.y < lo.y - tol || c.y > hi.y + tol {
-        return false;
+/// The sampled skeleton cut into pieces wherever it meets a face's
+/// boundary — at a change point, where it crosses a cut, at a point where
+/// it touches ∂P (rings touching at a vertex) — and the pieces joined into
+/// runs: each run lies in one face.
+struct Pieces {
+    /// From, to, and the run each piece belongs to.
+    pieces: Vec<(Coord<f64>, Coord<f64>, usize)>,
+    /// Per run: narrow (its samples' class).
+    run_narrow: Vec<bool>,
+    /// Per run: the piece farthest from ∂P (by the radius at its sample end).
+    deepest: Vec<(usize, f64)>,
+}
+
+/// A piece of a sample segment before the pieces are joined into runs.
+#[derive(Debug, Clone, Copy)]
+struct RawPiece {
+    from: Coord<f64>,
+    to: Coord<f64>,
+    /// The class of its samples.
+    narrow: bool,
+    /// The samples it starts and ends at, when it may be joined there (a
+    /// sample away from ∂P).
+    ends: [Option<u32>; 2],
+    /// The radius at its samples (0 where it starts or ends on a cut).
+    depth: f64,
+}
+
+/// The cuts' segments, each with the sample segment whose change made it.
+struct CutIndex(
+    rstar::RTree<rstar::primitives::GeomWithData<rstar::primitives::Line<[f64; 2]>, usize>>,
+);
+
+impl CutIndex {
+    fn of(changes: &[Change]) -> Self {
+        use rstar::primitives::{GeomWithData, Line};
+        Self(rstar::RTree::bulk_load(
+            changes
+                .iter()
+                .filter_map(|c| Some((c.segment, c.cut.as_ref()?)))
+                .flat_map(|(i, cut)| cut.0.windows(2).map(move |w| (i, w[0], w[1])))
+                .map(|(i, a, b)| GeomWithData::new(Line::new([a.x, a.y], [b.x, b.y]), i))
+                .collect(),
+        ))
     }
-    std::iter::once(polygon.exterior())
-        .chain(polygon.interiors())
-        .any(|r| Euclidean.distance(&geo::Point(c), r) <= tol)
+
+    /// Where sample segment `i` (`pa`–`pb`) crosses another change's cut,
+    /// by parameter (its own cut meets it at its change point, not across).
+    fn crossings(
+        &self,
+        i: usize,
+        pa: Coord<f64>,
+        pb: Coord<f64>,
+    ) -> impl Iterator<Item = f64> + '_ {
+        let env = rstar::AABB::from_corners(
+            [pa.x.min(pb.x), pa.y.min(pb.y)],
+            [pa.x.max(pb.x), pa.y.max(pb.y)],
+        );
+        self.0
+            .locate_in_envelope_intersecting(&env)
+            .filter(move |l| l.data != i)
+            .filter_map(move |l| {
+                let (c0, c1) = (l.geom().from, l.geom().to);
+                let (c0, c1) = (Coord { x: c0[0], y: c0[1] }, Coord { x: c1[0], y: c1[1] });
+                use crate::geometry::boundary::{properly_cross, segment_parameter};
+                properly_cross(pa, pb, c0, c1)
+                    .then(|| segment_parameter(pa, pb, c0, c1))
+                    .flatten()
+            })
+    }
+}
+
+impl Pieces {
+    fn of(s: &Samples, changes: &[Change], extent: f64) -> Self {
+        let at_change: std::collections::HashMap<usize, Coord<f64>> =
+            changes.iter().map(|c| (c.segment, c.point)).collect();
+        let cuts = CutIndex::of(changes);
+        let touch = 1e-9 * extent;
+        let mut raw: Vec<RawPiece> = Vec::new();
+        for (i, &(a, b, _)) in s.segments.iter().enumerate() {
+            let (ia, ib) = (a as usize, b as usize);
+            let (pa, pb) = (s.pos[ia], s.pos[ib]);
+            let d = pb - pa;
+            // Where the segment must be cut, by parameter: its change point
+            // and its crossings with other changes' cuts.
+            let mut ts: Vec<(f64, bool)> = cuts.crossings(i, pa, pb).map(|t| (t, false)).collect();
+            if let Some(&q) = at_change.get(&i) {
+                let t = if d.x.abs() >= d.y.abs() {
+                    (q.x - pa.x) / d.x
+                } else {
+                    (q.y - pa.y) / d.y
+                };
+                ts.push((t, true));
+            }
+            ts.sort_by(|x, y| x.0.total_cmp(&y.0));
+            let joinable = |k: usize| (s.r[k] > touch).then_some(k as u32);
+            let mut piece = RawPiece {
+                from: pa,
+                to: pb,
+                narrow: s.narrow[ia],
+                ends: [joinable(ia), None],
+                depth: s.r[ia],
+            };
+            for &(t, is_change) in &ts {
+                let q = pa + d * t;
+                if q != piece.from {
+                    raw.push(RawPiece { to: q, ..piece });
+                    piece = RawPiece {
+                        from: q,
+                        ends: [None, None],
+                        depth: 0.0,
+                        ..piece
+                    };
+                }
+                if is_change {
+                    piece.narrow = s.narrow[ib];
+                }
+            }
+            piece.ends[1] = joinable(ib);
+            piece.depth = piece.depth.max(s.r[ib]);
+            raw.push(piece);
+        }
+        Self::runs(&raw)
+    }
+
+    /// The pieces joined into runs through the samples they share.
+    fn runs(raw: &[RawPiece]) -> Self {
+        let mut uf = crate::graph::UnionFind::new(raw.len());
+        let mut first_at: std::collections::HashMap<u32, usize> = Default::default();
+        for (k, r) in raw.iter().enumerate() {
+            for v in r.ends.iter().flatten() {
+                match first_at.get(v) {
+                    Some(&j) => uf.union(j, k),
+                    None => {
+                        first_at.insert(*v, k);
+                    }
+                }
+            }
+        }
+        let mut run_of_root: std::collections::HashMap<usize, usize> = Default::default();
+        let mut run_narrow = Vec::new();
+        let mut deepest: Vec<(usize, f64)> = Vec::new();
+        let mut pieces = Vec::with_capacity(raw.len());
+        for (k, r) in raw.iter().enumerate() {
+            let root = uf.find(k);
+            let run = *run_of_root.entry(root).or_insert_with(|| {
+                run_narrow.push(r.narrow);
+                deepest.push((k, f64::NEG_INFINITY));
+                run_narrow.len() - 1
+            });
+            if r.depth > deepest[run].1 {
+                deepest[run] = (k, r.depth);
+            }
+            pieces.push((r.from, r.to, run));
+        }
+        Self {
+            pieces,
+            run_narrow,
+            deepest,
+        }
+    }
+
+    /// A point of every run: the middle of its deepest piece.
+    fn representatives(&self) -> Vec<Coord<f64>> {
+        self.deepest
+            .iter()
+            .map(|&(k, _)| (self.pieces[k].0 + self.pieces[k].1) * 0.5)
+            .collect()
+    }
+
+    /// The pieces as lines, collapsed or kept by their run, without the
+    /// vertices the sampling inserted.
+    fn lines(
+        &self,
+        s: &Samples,
+        collapsed: impl Fn(usize) -> bool,
+    ) -> (Vec<LineString<f64>>, Vec<LineString<f64>>) {
+        let mut parts = [GraphBuilder::new(), GraphBuilder::new()];
+        for &(a, b, run) in &self.pieces {
+            parts[usize::from(!collapsed(run))].segment(a, b);
+        }
+        let inserted: HashSet<(u64, u64)> = (0..s.pos.len())
+            .filter(|&i| s.inserted[i])
+            .map(|i| (s.pos[i].x.to_bits(), s.pos[i].y.to_bits()))
+            .collect();
+        let [c, k] = parts.map(|b| {
+            b.finish_raw()
+                .to_multilinestring()
+                .0
+                .into_iter()
+                .map(|l| {
+                    let n = l.0.len();
+                    LineString(
+                        l.0.iter()
+                            .enumerate()
+                            .filter(|&(j, p)| {
+                                j == 0
+                                    || j == n - 1
+                                    || !inserted.contains(&(p.x.to_bits(), p.y.to_bits()))
+                            })
+                            .map(|(_, p)| *p)
+                            .collect(),
+                    )
+                })
+                .collect()
+        });
+        (c, k)
+    }
+}
+
+/// The faces of `p` split by `cuts`; the whole polygon as one face if the
+/// cuts cannot split it (a cut that ends off the boundary: never expected).
+fn split_or_whole(p: &PreparedPolygon, cuts: &[LineString<f64>]) -> Vec<Face> {
+    arrangement::split(p, cuts).unwrap_or_else(|_| {
+        arrangement::split(p, &[]).expect("a polygon without chords splits into itself")
+    })
+}
+
+/// The kept areas: the faces of `p` split only by the cuts between a kept
+/// and a collapsed face (kept faces that share a cut are one area), each
+/// with the number of cuts on its boundary.
+fn areas(
+    p: &PreparedPolygon,
+    cuts: &[LineString<f64>],
+    faces: &[Face],
+    kept: &[bool],
+) -> Vec<Area> {
+    let mut sides: Vec<Vec<bool>> = vec![Vec::new(); cuts.len()];
+    for (f, &k) in faces.iter().zip(kept) {
+        for &c in &f.chords {
+            sides[c].push(k);
+        }
+    }
+    let between: Vec<LineString<f64>> = cuts
+        .iter()
+        .zip(&sides)
+        .filter(|(_, s)| s.iter().any(|&k| k) && s.iter().any(|&k| !k))
+        .map(|(c, _)| c.clone())
+        .collect();
+    let merged = split_or_whole(p, &between);
+    merged
+        .into_iter()
+        .filter(|m| {
+            // Of the first split's faces, those inside this one decide.
+            faces
+                .iter()
+                .zip(kept)
+                .find(|(f, _)| interior_point(f).is_some_and(|c| in_face(m, c)))
+                .is_none_or(|(_, &k)| k)
+        })
+        .map(|m| Area {
+            cuts: m.chords.len(),
+            polygon: m.polygon,
+        })
+        .collect()
+}
+
+/// A point strictly inside a face: the middle of the shortest of the
+/// segments from a vertex of its shell's first edge straight across into
+/// the face, found by casting along the inward normal of that edge.
+fn interior_point(f: &Face) -> Option<Coord<f64>> {
+    let ring = f.polygon.exterior();
+    for w in ring.0.windows(2) {
+        let d = w[1] - w[0];
+        let len = crate::geometry::norm(d);
+        if len == 0.0 {
+            continue;
+        }
+        // The shell is counter-clockwise: the face is on the left.
+        let n = Coord {
+            x: -d.y / len,
+            y: d.x / len,
+        };
+        let m = (w[0] + w[1]) * 0.5;
+        // The nearest crossing of the ray from m along n with any ring.
+        let mut t_min = f64::INFINITY;
+        for r in std::iter::once(ring).chain(f.polygon.interiors()) {
+            for e in r.0.windows(2) {
+                if e[0] == w[0] && e[1] == w[1] {
+                    continue;
+                }
+                if let Some(t) = ray_hit(m, n, e[0], e[1]) {
+                    t_min = t_min.min(t);
+                }
+            }
+        }
+        if t_min.is_finite() && t_min > 0.0 {
+            return Some(m + n * (0.5 * t_min));
+        }
+    }
+    None
+}
+
+/// Where the ray `o + t n` (t > 0) meets segment `a`–`b`.
+fn ray_hit(o: Coord<f64>, n: Coord<f64>, a: Coord<f64>, b: Coord<f64>) -> Option<f64> {
+    let s = b - a;
+    let den = n.x * s.y - n.y * s.x;
+    if den == 0.0 {
+        return None;
+    }
+    let d = a - o;
+    let t = (d.x * s.y - d.y * s.x) / den;
+    let u = (d.x * n.y - d.y * n.x) / den;
+    (t > 0.0 && (0.0..=1.0).contains(&u)).then_some(t)
+}
+
+/// The face that holds `c`.
+fn face_of(faces: &[Face], c: Coord<f64>) -> Option<usize> {
+    faces.iter().position(|f| in_face(f, c))
+}
+
+/// Whether `c` lies in face `f` (inside its shell, outside its holes).
+fn in_face(f: &Face, c: Coord<f64>) -> bool {
+    let inside = |r: &LineString<f64>| {
+        let mut inside = false;
+        for w in r.0.windows(2) {
+            let (a, b) = (w[0], w[1]);
+            if (a.y > c.y) != (b.y > c.y) && c.x < a.x + (c.y - a.y) / (b.y - a.y) * (b.x - a.x) {
+                inside = !inside;
+            }
+        }
+        inside
+    };
+    inside(f.polygon.exterior()) && !f.polygon.interiors().iter().any(inside)
+}
+
+/// Cuts that cross an earlier one are left out (the inscribed discs'
+/// radii do not cross; an approximate contact could make two do so, and a
+/// crossing would not split the polygon into faces).
+fn drop_crossing_cuts(changes: &mut [Change]) {
+    let mut kept: Vec<LineString<f64>> = Vec::new();
+    for c in changes.iter_mut() {
+        let Some(cut) = &c.cut else { continue };
+        let crosses = kept.iter().any(|k| {
+            cut.0.windows(2).any(|a| {
+                k.0.windows(2)
+                    .any(|b| crate::geometry::boundary::properly_cross(a[0], a[1], b[0], b[1]))
+            })
+        });
+        if crosses {
+            c.cut = None;
+        } else {
+            kept.push(cut.clone());
+        }
+    }
 }
 
 /// The change on segment `i`: where the width crosses the collapse width
@@ -152,11 +426,12 @@ fn change(s: &Samples, p: &PreparedPolygon, i: usize) -> Change {
     let r = boundary.distance(point);
     let cut = (r > 0.0)
         .then(|| {
+            let snap = |c: Coord<f64>| snap_to_vertex(p, c);
             let (left, _) = boundary.nearest_in_half_plane(point, normal)?;
             let (right, _) = boundary.nearest_in_half_plane(point, -normal)?;
-            let beyond = |c: Coord<f64>| c + (c - point) * OVERSHOOT;
-            (left != point && right != point)
-                .then(|| LineString(vec![beyond(left), left, point, right, beyond(right)]))
+            let (left, right) = (snap(left), snap(right));
+            (left != point && right != point && left != right)
+                .then(|| LineString(vec![left, point, right]))
         })
         .flatten();
     Change {
@@ -166,110 +441,21 @@ fn change(s: &Samples, p: &PreparedPolygon, i: usize) -> Change {
     }
 }
 
-/// A polygon's rings as i_overlay contours (not closed).
-fn contours(polygon: &Polygon<f64>) -> Vec<Vec<[f64; 2]>> {
-    let ring = |l: &LineString<f64>| -> Vec<[f64; 2]> {
-        let n = l.0.len().saturating_sub(1);
-        l.0[..n].iter().map(|c| [c.x, c.y]).collect()
+/// A contact on ∂P, moved onto the vertex of its edge when within
+/// `1e-9 × extent` of it: a disc touching a reflex vertex touches the
+/// vertex, and two cuts to one vertex must end on the same point (a contact
+/// a hair beside it can make them cross).
+fn snap_to_vertex(p: &PreparedPolygon, c: Coord<f64>) -> Coord<f64> {
+    let Some((_, i, _)) = p.boundary().nearest(c) else {
+        return c;
     };
-    let mut shape = vec![ring(polygon.exterior())];
-    shape.extend(polygon.interiors().iter().map(ring));
-    shape
-}
-
-/// i_overlay shapes (outer contour, then holes) as polygons.
-fn polygons(shapes: Vec<Vec<Vec<[f64; 2]>>>) -> Vec<Polygon<f64>> {
-    let closed = |c: &Vec<[f64; 2]>| {
-        let mut v: Vec<Coord<f64>> = c.iter().map(|p| Coord { x: p[0], y: p[1] }).collect();
-        if let Some(&f) = v.first() {
-            v.push(f);
-        }
-        LineString(v)
-    };
-    shapes
-        .iter()
-        .filter(|contours| !contours.is_empty())
-        .map(|contours| {
-            Polygon::new(
-                closed(&contours[0]),
-                contours[1..].iter().map(closed).collect(),
-            )
-        })
-        .collect()
-}
-
-/// `polygon` sliced along `cuts` into pieces.
-fn slice(polygon: &Polygon<f64>, cuts: &[LineString<f64>]) -> Vec<Polygon<f64>> {
-    let strings: Vec<Vec<[f64; 2]>> = cuts
-        .iter()
-        .map(|c| c.0.iter().map(|p| [p.x, p.y]).collect())
-        .collect();
-    polygons(contours(polygon).slice_by(&strings, FillRule::NonZero))
-}
-
-/// Kept pieces that share a cut (both its sides wide, as where cuts meet
-/// at a junction) merged into one area.
-fn merge(pieces: Vec<Polygon<f64>>) -> Vec<Polygon<f64>> {
-    if pieces.len() < 2 {
-        return pieces;
+    let s = &p.boundary().segments()[i];
+    let eps = 1e-9 * p.extent();
+    if crate::geometry::norm(c - s.a) <= eps {
+        s.a
+    } else if crate::geometry::norm(c - s.b) <= eps {
+        s.b
+    } else {
+        c
     }
-    let shapes: Vec<Vec<Vec<[f64; 2]>>> = pieces.iter().map(contours).collect();
-    polygons(shapes.simplify_shape(FillRule::NonZero))
-}
-
-/// The skeleton split at the change points into collapsed lines and lines
-/// through kept areas, without the vertices the sampling inserted.
-fn lines(
-    s: &Samples,
-    changes: &[Change],
-    collapsed: impl Fn(usize) -> bool,
-) -> (Vec<LineString<f64>>, Vec<LineString<f64>>) {
-    let mut parts = [GraphBuilder::new(), GraphBuilder::new()];
-    let split_at: std::collections::HashMap<usize, Coord<f64>> =
-        changes.iter().map(|c| (c.segment, c.point)).collect();
-    for (i, &(a, b, _)) in s.segments.iter().enumerate() {
-        let (a, b) = (a as usize, b as usize);
-        let side = |k: usize| usize::from(!collapsed(k));
-        match split_at.get(&i) {
-            Some(&q) => {
-                parts[side(a)].segment(s.pos[a], q);
-                parts[side(b)].segment(q, s.pos[b]);
-            }
-            None if side(a) == side(b) => {
-                parts[side(a)].segment(s.pos[a], s.pos[b]);
-            }
-            // A narrow stretch inside a kept piece meets a wide one.
-            None => {
-                let q = super::lerp(s.pos[a], s.pos[b], 0.5);
-                parts[side(a)].segment(s.pos[a], q);
-                parts[side(b)].segment(q, s.pos[b]);
-            }
-        }
-    }
-    let inserted: HashSet<(u64, u64)> = (0..s.pos.len())
-        .filter(|&i| s.inserted[i])
-        .map(|i| (s.pos[i].x.to_bits(), s.pos[i].y.to_bits()))
-        .collect();
-    let [c, k] = parts.map(|b| {
-        b.finish_raw()
-            .to_multilinestring()
-            .0
-            .into_iter()
-            .map(|l| {
-                let n = l.0.len();
-                LineString(
-                    l.0.iter()
-                        .enumerate()
-                        .filter(|&(j, p)| {
-                            j == 0
-                                || j == n - 1
-                                || !inserted.contains(&(p.x.to_bits(), p.y.to_bits()))
-                        })
-                        .map(|(_, p)| *p)
-                        .collect(),
-                )
-            })
-            .collect()
-    });
-    (c, k)
 }

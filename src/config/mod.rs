@@ -603,7 +603,26 @@ fn validate_steps(steps: &[Step]) -> Result<(), (String, String)> {
         s.validate()
             .map_err(|(k, m)| (format!("steps[{i}].{}.{k}", s.name()), m))?;
     }
-    Ok(())
+    collapse_on_ma(steps)
+}
+
+/// `collapse` cuts the polygon by the medial axis's inscribed discs and
+/// draws the lines on the medial axis: the skeleton step must list MA
+/// alone. Another method's lines are not centred on those discs, so its
+/// collapsed lines would cross the kept areas.
+fn collapse_on_ma(steps: &[Step]) -> Result<(), (String, String)> {
+    let collapses = steps.iter().any(|s| matches!(s, Step::Collapse(_)));
+    let skeleton = steps.iter().enumerate().find_map(|(i, s)| match s {
+        Step::Skeleton(p) => Some((i, p)),
+        _ => None,
+    });
+    match skeleton {
+        Some((i, p)) if collapses && p.methods != [crate::methods::MethodId::MA] => Err((
+            format!("steps[{i}].skeleton.methods"),
+            "`collapse` cuts the polygon where the medial axis's inscribed discs meet the collapse width and draws the medial axis: list MA alone (`skeleton: { methods: [MA] }`); other methods' lines are not centred on those discs, so their collapsed lines would cross the kept areas".into(),
+        )),
+        _ => Ok(()),
+    }
 }
 
 /// Applies `KEY=VALUE` (dotted path; `steps.NAME.key` addresses a step by name

@@ -5,6 +5,7 @@
 //!
 //! Everything here works on owned [`geo`] types; nothing touches GDAL.
 
+pub mod arrangement;
 pub mod boundary;
 pub mod densify;
 pub mod lanes;

@@ -298,13 +298,18 @@ pub fn process(geom: Option<&Geometry<f64>>, params: &ProcessParams) -> Processe
         connect_chosen(o, &prepared, net);
     }
     if let (Some(c), Processed::Done(o)) = (&params.collapse, &mut processed) {
+        let legs: Vec<(geo::Coord<f64>, geo::Coord<f64>)> = o
+            .connections
+            .iter()
+            .filter_map(|l| Some((*l.leg.0.first()?, *l.leg.0.last()?)))
+            .collect();
         let (_, chosen) = o.chosen();
         o.collapse = Some(
             chosen
                 .graphs
                 .iter()
                 .zip(&prepared)
-                .map(|(g, p)| collapse(g, p, c))
+                .map(|(g, p)| collapse(g, p, c, &legs))
                 .collect(),
         );
     }

@@ -1,0 +1,423 @@
+//! A polygon split exactly by chords: the faces of the planar graph of its
+//! rings and of polylines that run through its interior from boundary to
+//! boundary (the cuts of `collapse`, the new boundaries of a partition).
+//!
+//! Exact means: every vertex of the polygon keeps its coordinates bit for
+//! bit; a chord's end is inserted into the ring edge it lies on (or is that
+//! edge's vertex when it is within `1e-12 × extent` of it); a vertex where
+//! two faces meet is one coordinate used by both, so the faces form a valid
+//! coverage of the polygon (no gap, no overlap, the same vertices on both
+//! sides of every shared edge).
+//!
+//! The faces are the cycles of half-edges with P on their left: at every
+//! vertex the outgoing half-edges are sorted by angle, and a cycle leaves a
+//! vertex by the first half-edge clockwise from the one it came in on.
+//! Rings that touch at a vertex (OGC-valid) give cycles that pass that
+//! vertex twice; they are split there, so every face is an OGC-valid
+//! polygon: a shell and the holes inside it.
+
+use super::{norm, PreparedPolygon};
+use geo::{Coord, LineString, Polygon};
+use rustc_hash::FxHashMap;
+
+/// One face of a split polygon.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Face {
+    /// The face as a polygon (shell counter-clockwise, holes clockwise).
+    pub polygon: Polygon<f64>,
+    /// The chords on its boundary (indices into the chords given), sorted,
+    /// each once.
+    pub chords: Vec<usize>,
+}
+
+/// A vertex of the arrangement.
+type VertexId = u32;
+
+/// A half-edge: from `from` to `to`; `chord` when it belongs to one,
+/// `outside` when it is a ring edge walked against the ring (P on its
+/// right).
+#[derive(Debug, Clone, Copy)]
+struct HalfEdge {
+    from: VertexId,
+    to: VertexId,
+    chord: Option<u32>,
+    outside: bool,
+}
+
+/// The planar graph of rings and chords.
+struct Graph {
+    pos: Vec<Coord<f64>>,
+    ids: FxHashMap<(u64, u64), VertexId>,
+    half: Vec<HalfEdge>,
+}
+
+impl Graph {
+    fn vertex(&mut self, c: Coord<f64>) -> VertexId {
+        let key = (c.x.to_bits(), c.y.to_bits());
+        if let Some(&v) = self.ids.get(&key) {
+            return v;
+        }
+        let v = self.pos.len() as VertexId;
+        self.pos.push(c);
+        self.ids.insert(key, v);
+        v
+    }
+
+    /// Both half-edges of the edge `a`–`b` (nothing for a zero-length one).
+    fn edge(&mut self, a: Coord<f64>, b: Coord<f64>, chord: Option<u32>, ring: bool) {
+        let (u, v) = (self.vertex(a), self.vertex(b));
+        if u == v {
+            return;
+        }
+        self.half.push(HalfEdge {
+            from: u,
+            to: v,
+            chord,
+            outside: false,
+        });
+        self.half.push(HalfEdge {
+            from: v,
+            to: u,
+            chord,
+            outside: ring,
+        });
+    }
+}
+
+/// Where a chord's end meets ∂P: ring edge `(ring, index)` and the point
+/// (exactly a vertex of the edge when within the tolerance of it).
+fn attach(p: &PreparedPolygon, c: Coord<f64>) -> Option<((u32, u32), Coord<f64>)> {
+    let b = p.boundary();
+    let (_, i, d) = b.nearest(c)?;
+    let tol = 1e-9 * p.extent();
+    if d > tol {
+        return None;
+    }
+    let s = &b.segments()[i];
+    let snap = 1e-12 * p.extent();
+    let at = if norm(c - s.a) <= snap {
+        s.a
+    } else if norm(c - s.b) <= snap {
+        s.b
+    } else {
+        c
+    };
+    Some(((s.ring, s.index), at))
+}
+
+/// Why a polygon could not be split.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SplitError {
+    /// A chord's end does not lie on the boundary.
+    #[error("chord {0} does not end on the polygon's boundary")]
+    Detached(usize),
+}
+
+/// The faces of `p` split by `chords` (see the module documentation).
+/// Each chord is a polyline whose first and last points lie on ∂P (within
+/// `1e-9 × extent`) and whose other points lie inside P; chords may share
+/// points (exactly equal coordinates) but must not cross each other or ∂P.
+pub fn split(p: &PreparedPolygon, chords: &[LineString<f64>]) -> Result<Vec<Face>, SplitError> {
+    let rings: Vec<&LineString<f64>> = p.rings().collect();
+    // The points to insert into each ring edge, and the chords with their
+    // ends moved onto ∂P exactly.
+    let mut inserts: FxHashMap<(u32, u32), Vec<Coord<f64>>> = FxHashMap::default();
+    let mut lines: Vec<Vec<Coord<f64>>> = Vec::with_capacity(chords.len());
+    for (k, chord) in chords.iter().enumerate() {
+        let mut pts = chord.0.clone();
+        if pts.len() < 2 {
+            continue;
+        }
+        for end in [0, pts.len() - 1] {
+            let (edge, at) = attach(p, pts[end]).ok_or(SplitError::Detached(k))?;
+            pts[end] = at;
+            inserts.entry(edge).or_default().push(at);
+        }
+        lines.push(pts);
+    }
+    let mut g = Graph {
+        pos: Vec::new(),
+        ids: FxHashMap::default(),
+        half: Vec::new(),
+    };
+    for (r, ring) in rings.iter().enumerate() {
+        for (i, w) in ring.0.windows(2).enumerate() {
+            let mut pts = vec![w[0]];
+            if let Some(extra) = inserts.get_mut(&(r as u32, i as u32)) {
+                let d = w[1] - w[0];
+                let t = |c: &Coord<f64>| (c.x - w[0].x) * d.x + (c.y - w[0].y) * d.y;
+                extra.sort_by(|a, b| t(a).total_cmp(&t(b)));
+                pts.extend(extra.iter().filter(|&&c| c != w[0] && c != w[1]));
+            }
+            pts.push(w[1]);
+            pts.dedup();
+            for s in pts.windows(2) {
+                g.edge(s[0], s[1], None, true);
+            }
+        }
+    }
+    for (k, l) in lines.iter().enumerate() {
+        for s in l.windows(2) {
+            g.edge(s[0], s[1], Some(k as u32), false);
+        }
+    }
+    Ok(faces(&g))
+}
+
+/// The cycles of half-edges with P on their left, as faces.
+fn faces(g: &Graph) -> Vec<Face> {
+    let n = g.pos.len();
+    // Outgoing half-edges of every vertex, counter-clockwise by angle.
+    let mut out: Vec<Vec<u32>> = vec![Vec::new(); n];
+    for (h, e) in g.half.iter().enumerate() {
+        out[e.from as usize].push(h as u32);
+    }
+    let dir = |h: u32| {
+        let e = g.half[h as usize];
+        g.pos[e.to as usize] - g.pos[e.from as usize]
+    };
+    for list in &mut out {
+        list.sort_by(|&a, &b| angle_order(dir(a), dir(b)));
+    }
+    // Where each half-edge sits in its origin's list.
+    let mut slot = vec![0u32; g.half.len()];
+    for list in &out {
+        for (i, &h) in list.iter().enumerate() {
+            slot[h as usize] = i as u32;
+        }
+    }
+    let twin = |h: u32| h ^ 1;
+    let next = |h: u32| {
+        let t = twin(h);
+        let list = &out[g.half[t as usize].from as usize];
+        let i = slot[t as usize] as usize;
+        list[(i + list.len() - 1) % list.len()]
+    };
+    let mut seen = vec![false; g.half.len()];
+    let mut shells: Vec<(Vec<Coord<f64>>, Vec<u32>)> = Vec::new();
+    let mut holes: Vec<Hole> = Vec::new();
+    for start in 0..g.half.len() as u32 {
+        if seen[start as usize] {
+            continue;
+        }
+        let mut cycle = Vec::new();
+        let mut h = start;
+        let mut outside = false;
+        while !seen[h as usize] {
+            seen[h as usize] = true;
+            outside |= g.half[h as usize].outside;
+            cycle.push(h);
+            h = next(h);
+        }
+        if outside {
+            continue;
+        }
+        for part in simple_cycles(g, &cycle) {
+            let coords: Vec<Coord<f64>> = part
+                .iter()
+                .map(|&h| g.pos[g.half[h as usize].from as usize])
+                .collect();
+            let chords = part
+                .iter()
+                .filter_map(|&h| g.half[h as usize].chord)
+                .collect();
+            if signed_area(&coords) > 0.0 {
+                shells.push((coords, chords));
+            } else {
+                // A hole of the face: a ring, or rings joined by chords. It
+                // is placed by the middle of a ring edge, which no other
+                // face has on its boundary.
+                let h = part
+                    .iter()
+                    .copied()
+                    .find(|&h| g.half[h as usize].chord.is_none())
+                    .unwrap_or(part[0]);
+                let e = g.half[h as usize];
+                let probe = (g.pos[e.from as usize] + g.pos[e.to as usize]) * 0.5;
+                holes.push(Hole {
+                    coords,
+                    chords,
+                    probe,
+                });
+            }
+        }
+    }
+    assemble(shells, holes)
+}
+
+/// A cycle with P on its left that turns clockwise: a hole of the face
+/// around it.
+struct Hole {
+    coords: Vec<Coord<f64>>,
+    chords: Vec<u32>,
+    /// A point on it that lies on no other face's boundary.
+    probe: Coord<f64>,
+}
+
+/// A cycle of half-edges split at the vertices it passes more than once
+/// (rings touching at a point), into cycles that pass each vertex once.
+fn simple_cycles(g: &Graph, cycle: &[u32]) -> Vec<Vec<u32>> {
+    let mut at: FxHashMap<VertexId, usize> = FxHashMap::default();
+    let mut stack: Vec<u32> = Vec::with_capacity(cycle.len());
+    let mut out = Vec::new();
+    for &h in cycle {
+        let from = g.half[h as usize].from;
+        if let Some(&i) = at.get(&from) {
+            // The loop since the last visit of `from` closes here.
+            let part: Vec<u32> = stack.drain(i..).collect();
+            for &x in &part {
+                at.remove(&g.half[x as usize].from);
+            }
+            out.push(part);
+        }
+        at.insert(from, stack.len());
+        stack.push(h);
+    }
+    if !stack.is_empty() {
+        out.push(stack);
+    }
+    out
+}
+
+/// Shells with the holes that lie in them (each hole in the smallest shell
+/// that contains it).
+fn assemble(mut shells: Vec<(Vec<Coord<f64>>, Vec<u32>)>, holes: Vec<Hole>) -> Vec<Face> {
+    let areas: Vec<f64> = shells.iter().map(|(c, _)| signed_area(c)).collect();
+    let mut inner: Vec<Vec<LineString<f64>>> = vec![Vec::new(); shells.len()];
+    for hole in holes {
+        let owner = (0..shells.len())
+            .filter(|&k| contains(&shells[k].0, hole.probe))
+            .min_by(|&a, &b| areas[a].total_cmp(&areas[b]));
+        if let Some(k) = owner {
+            inner[k].push(closed(hole.coords));
+            shells[k].1.extend(hole.chords);
+        }
+    }
+    shells
+        .into_iter()
+        .zip(inner)
+        .map(|((coords, mut chords), interiors)| {
+            chords.sort_unstable();
+            chords.dedup();
+            Face {
+                polygon: Polygon::new(closed(coords), interiors),
+                chords: chords.into_iter().map(|c| c as usize).collect(),
+            }
+        })
+        .collect()
+}
+
+fn closed(mut c: Vec<Coord<f64>>) -> LineString<f64> {
+    if let Some(&f) = c.first() {
+        c.push(f);
+    }
+    LineString(c)
+}
+
+/// Twice the signed area of an open ring (positive counter-clockwise).
+fn signed_area(c: &[Coord<f64>]) -> f64 {
+    let n = c.len();
+    (0..n)
+        .map(|i| {
+            let (a, b) = (c[i], c[(i + 1) % n]);
+            a.x * b.y - a.y * b.x
+        })
+        .sum()
+}
+
+/// Whether `p` lies inside the open ring `c` (even-odd).
+fn contains(c: &[Coord<f64>], p: Coord<f64>) -> bool {
+    let n = c.len();
+    let mut inside = false;
+    for i in 0..n {
+        let (a, b) = (c[i], c[(i + 1) % n]);
+        if (a.y > p.y) != (b.y > p.y) {
+            let x = a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x);
+            if p.x < x {
+                inside = !inside;
+            }
+        }
+    }
+    inside
+}
+
+/// Counter-clockwise order of directions by angle from the positive x axis
+/// (exact: half-plane, then the sign of the cross product).
+fn angle_order(a: Coord<f64>, b: Coord<f64>) -> std::cmp::Ordering {
+    let half = |d: Coord<f64>| u8::from(d.y < 0.0 || (d.y == 0.0 && d.x < 0.0));
+    half(a).cmp(&half(b)).then_with(|| {
+        let cross = a.x * b.y - a.y * b.x;
+        0.0f64.total_cmp(&cross)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use geo::{polygon, Area};
+
+    fn area(faces: &[Face]) -> f64 {
+        faces.iter().map(|f| f.polygon.unsigned_area()).sum()
+    }
+
+    #[test]
+    fn a_rectangle_cut_twice_gives_three_faces_that_keep_its_vertices() {
+        let r = polygon![(x: 0., y: 0.), (x: 30., y: 0.), (x: 30., y: 10.), (x: 0., y: 10.)];
+        let p = PreparedPolygon::new(&r).unwrap();
+        let cuts = [
+            LineString::from(vec![(10., 0.), (10., 5.), (10., 10.)]),
+            LineString::from(vec![(20., 10.), (20., 0.)]),
+        ];
+        let f = split(&p, &cuts).unwrap();
+        assert_eq!(f.len(), 3);
+        assert!((area(&f) - 300.0).abs() < 1e-9);
+        let mut chords: Vec<Vec<usize>> = f.iter().map(|f| f.chords.clone()).collect();
+        chords.sort();
+        assert_eq!(chords, [vec![0], vec![0, 1], vec![1]]);
+        for corner in [(0., 0.), (30., 0.), (30., 10.), (0., 10.)] {
+            let c = Coord::from(corner);
+            assert!(f.iter().any(|f| f.polygon.exterior().0.contains(&c)));
+        }
+    }
+
+    #[test]
+    fn holes_touching_the_shell_and_each_other_give_valid_faces() {
+        use geo::Validation;
+        // Two triangular holes touching each other at (50, 50), one of them
+        // touching the shell at (0, 50).
+        let p = Polygon::new(
+            LineString::from(vec![
+                (0., 0.),
+                (100., 0.),
+                (100., 100.),
+                (0., 100.),
+                (0., 50.),
+                (0., 0.),
+            ]),
+            vec![
+                LineString::from(vec![(0., 50.), (50., 50.), (25., 60.), (0., 50.)]),
+                LineString::from(vec![(50., 50.), (75., 40.), (75., 60.), (50., 50.)]),
+            ],
+        );
+        let pp = PreparedPolygon::new(&p).unwrap();
+        let whole = split(&pp, &[]).unwrap();
+        assert!((area(&whole) - p.unsigned_area()).abs() < 1e-9);
+        for f in &whole {
+            assert!(f.polygon.is_valid(), "{:?}", f.polygon);
+        }
+        let cut = split(&pp, &[LineString::from(vec![(90., 0.), (90., 100.)])]).unwrap();
+        assert_eq!(cut.len(), 2);
+        assert!((area(&cut) - p.unsigned_area()).abs() < 1e-9);
+        for f in &cut {
+            assert!(f.polygon.is_valid(), "{:?}", f.polygon);
+        }
+    }
+
+    #[test]
+    fn a_chord_end_off_the_boundary_is_an_error() {
+        let r = polygon![(x: 0., y: 0.), (x: 10., y: 0.), (x: 10., y: 10.), (x: 0., y: 10.)];
+        let p = PreparedPolygon::new(&r).unwrap();
+        let e = split(&p, &[LineString::from(vec![(5., 0.), (5., 5.)])]).unwrap_err();
+        assert_eq!(e, SplitError::Detached(0));
+    }
+}
