@@ -27,7 +27,7 @@ pub(super) fn split(s: &Samples, p: &PreparedPolygon) -> PartCollapse {
     let mut changes: Vec<Change> = s.changes().map(|i| change(s, p, i)).collect();
     drop_crossing_cuts(&mut changes);
     let cuts: Vec<LineString<f64>> = changes.iter().filter_map(|c| c.cut.clone()).collect();
-    let faces = split_or_whole(p, &cuts);
+    let (cuts, faces) = split_or_whole(p, &cuts);
     let pieces = Pieces::of(s, &changes, p.extent());
     // Each run of pieces lies in one face: placed by its piece farthest
     // from ∂P.
@@ -269,12 +269,22 @@ impl Pieces {
     }
 }
 
-/// The faces of `p` split by `cuts`; the whole polygon as one face if the
-/// cuts cannot split it (a cut that ends off the boundary: never expected).
-fn split_or_whole(p: &PreparedPolygon, cuts: &[LineString<f64>]) -> Vec<Face> {
-    arrangement::split(p, cuts).unwrap_or_else(|_| {
-        arrangement::split(p, &[]).expect("a polygon without chords splits into itself")
-    })
+/// The faces of `p` split by `cuts`, leaving out any cut that does not
+/// end on the boundary (not expected: contacts are boundary points).
+/// Returns the cuts used, which the faces' chord indices refer to.
+fn split_or_whole(
+    p: &PreparedPolygon,
+    cuts: &[LineString<f64>],
+) -> (Vec<LineString<f64>>, Vec<Face>) {
+    let mut cuts = cuts.to_vec();
+    loop {
+        match arrangement::split(p, &cuts) {
+            Ok(faces) => return (cuts, faces),
+            Err(arrangement::SplitError::Detached(k)) => {
+                cuts.remove(k);
+            }
+        }
+    }
 }
 
 /// The kept areas: the faces of `p` split only by the cuts between a kept
@@ -298,7 +308,7 @@ fn areas(
         .filter(|(_, s)| s.iter().any(|&k| k) && s.iter().any(|&k| !k))
         .map(|(c, _)| c.clone())
         .collect();
-    let merged = split_or_whole(p, &between);
+    let (_, merged) = split_or_whole(p, &between);
     merged
         .into_iter()
         .filter(|m| {

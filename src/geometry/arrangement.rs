@@ -89,12 +89,15 @@ impl Graph {
 fn attach(p: &PreparedPolygon, c: Coord<f64>) -> Option<((u32, u32), Coord<f64>)> {
     let b = p.boundary();
     let (_, i, d) = b.nearest(c)?;
-    let tol = 1e-9 * p.extent();
+    // Relative to the polygon's size, but never below what its coordinates
+    // can resolve (a small polygon far from the origin).
+    let resolution = 8.0 * f64::EPSILON * c.x.abs().max(c.y.abs());
+    let tol = (1e-9 * p.extent()).max(resolution);
     if d > tol {
         return None;
     }
     let s = &b.segments()[i];
-    let snap = 1e-12 * p.extent();
+    let snap = (1e-12 * p.extent()).max(resolution);
     let at = if norm(c - s.a) <= snap {
         s.a
     } else if norm(c - s.b) <= snap {
@@ -314,12 +317,15 @@ fn closed(mut c: Vec<Coord<f64>>) -> LineString<f64> {
     LineString(c)
 }
 
-/// Twice the signed area of an open ring (positive counter-clockwise).
+/// Twice the signed area of an open ring (positive counter-clockwise),
+/// summed relative to its first vertex (raw products of coordinates far
+/// from the origin would cancel away a small ring's area).
 fn signed_area(c: &[Coord<f64>]) -> f64 {
     let n = c.len();
-    (0..n)
+    let o = c[0];
+    (1..n.saturating_sub(1))
         .map(|i| {
-            let (a, b) = (c[i], c[(i + 1) % n]);
+            let (a, b) = (c[i] - o, c[i + 1] - o);
             a.x * b.y - a.y * b.x
         })
         .sum()
@@ -411,6 +417,41 @@ mod tests {
         for f in &cut {
             assert!(f.polygon.is_valid(), "{:?}", f.polygon);
         }
+    }
+
+    #[test]
+    fn a_small_polygon_far_from_the_origin_keeps_its_holes_as_holes() {
+        // 6 cm across at 10 000 km: products of raw coordinates lose the
+        // holes' orientation.
+        let (x, y) = (1e7, 1e7);
+        let p = Polygon::new(
+            LineString::from(vec![
+                (x, y),
+                (x + 0.06, y),
+                (x + 0.06, y + 0.06),
+                (x, y + 0.06),
+                (x, y),
+            ]),
+            vec![LineString::from(vec![
+                (x + 0.01, y + 0.01),
+                (x + 0.02, y + 0.01),
+                (x + 0.02, y + 0.02),
+                (x + 0.01, y + 0.01),
+            ])],
+        );
+        let pp = PreparedPolygon::new(&p).unwrap();
+        let f = split(
+            &pp,
+            &[LineString::from(vec![(x + 0.03, y), (x + 0.03, y + 0.06)])],
+        )
+        .unwrap();
+        assert_eq!(f.len(), 2);
+        assert!(
+            (area(&f) - p.unsigned_area()).abs() < 1e-12,
+            "{} vs {}",
+            area(&f),
+            p.unsigned_area()
+        );
     }
 
     #[test]
