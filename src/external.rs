@@ -52,7 +52,7 @@ pub struct ScoreJob {
     pub output: OutputSpec,
 }
 
-use crate::process::connect::lines_of;
+use crate::connect::lines_of;
 
 fn key_text(f: &Feature, field: Option<usize>) -> Option<String> {
     match field {
@@ -138,6 +138,7 @@ pub fn score_external(job: &ScoreJob, keep_bars: bool) -> Result<RunSummary, Run
         on_error: OnError::Reject,
         given: Some(&given),
         other_inputs: vec![("the skeletons source", job.skeletons.source.clone())],
+        plan: crate::config::plan_of(&output, Some(&job.polygons), &[]),
     };
     run_job(&run, &RunOptions::default())
 }

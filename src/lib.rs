@@ -21,6 +21,7 @@
 
 pub mod collapse;
 pub mod config;
+pub mod connect;
 #[cfg(feature = "gdal")]
 pub mod external;
 pub mod feature;
@@ -28,6 +29,7 @@ pub mod geometry;
 pub mod graph;
 #[cfg(feature = "gdal")]
 pub mod io;
+pub mod layer;
 pub mod methods;
 pub mod output;
 #[cfg(feature = "gdal")]

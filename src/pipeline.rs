@@ -162,6 +162,8 @@ pub struct Job<'a> {
     /// Other data sources the job reads (never to be written over), each
     /// with what it is to the job (e.g. "the skeletons source").
     pub other_inputs: Vec<(&'static str, String)>,
+    /// The layers and columns the job writes.
+    pub plan: crate::output::Plan,
 }
 
 impl<'a> Job<'a> {
@@ -176,6 +178,7 @@ impl<'a> Job<'a> {
             on_error: p.file.on_error,
             given: None,
             other_inputs: Vec::new(),
+            plan: p.plan(),
         }
     }
 
@@ -416,14 +419,7 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
             params.connect = Some(std::sync::Arc::new(read_network(c, &info)?));
         }
         let params = &params;
-        let writer = Writer::create(
-            job.output,
-            &info,
-            &job.protected(),
-            job.params.collapse.is_some(),
-            job.input.merge_adjacent,
-            job.input.connect.is_some(),
-        )?;
+        let writer = Writer::create(&job.plan, job.output, &info, &job.protected())?;
         tracing::info!(
             pipeline = %job.name,
             source = %info.source,
@@ -438,7 +434,7 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
         let writing = scope.spawn(move || write_batches(writer, rows_rx));
         let every = opts.progress_every.unwrap_or(PROGRESS_EVERY);
         let mut progress = Progress::new(opts.progress, info.selected, every);
-        let row_opts = RowOptions::from(job.output);
+        let row_opts = RowOptions::of(&job.plan);
         let mut counts = Counts::default();
         let workers = Workers {
             job,
@@ -678,7 +674,7 @@ fn merge_field(input: &InputSpec, info: &SourceInfo) -> Result<Option<usize>, Io
 fn read_network(
     c: &crate::config::ConnectSpec,
     polygons: &SourceInfo,
-) -> Result<crate::process::connect::Network, RunError> {
+) -> Result<crate::connect::Network, RunError> {
     let mut reader =
         Reader::open(&c.input(polygons.srs_wkt.as_deref())).map_err(|e| connect_error(c, e))?;
     let mut lines = Vec::new();
@@ -688,7 +684,7 @@ fn read_network(
         for f in batch {
             let mut ls = Vec::new();
             if let Some(g) = &f.geometry {
-                crate::process::connect::lines_of(g, &mut ls);
+                crate::connect::lines_of(g, &mut ls);
             }
             lines.extend(ls.into_iter().map(|l| (f.fid, l)));
         }
@@ -698,7 +694,7 @@ fn read_network(
         return Err(no_lines(c, reader.info(), features));
     }
     tracing::info!(source = %c.source, layer = %reader.info().layer, crs = %reader.info().crs_name, lines = lines.len(), "connect: line network read");
-    Ok(crate::process::connect::Network::new(lines, c.snap))
+    Ok(crate::connect::Network::new(lines, c.snap))
 }
 
 /// An error opening `input.connect`, said to be about it.

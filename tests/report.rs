@@ -222,7 +222,7 @@ fn features_are_chosen_by_fid_or_by_where_and_a_bad_filter_names_itself() {
     };
     assert_eq!(want.len(), 4);
     assert_eq!(attr_values(&read(&lakes), "section", "data-fid"), want);
-    let o = skeletonise(&["report", g, "--where", "kind = = 'lake'"]);
+    let o = skeletonise(&["report", g, "--where", "kind = = 'lake'", "--overwrite"]);
     let (code, err) = code_and_err(&o);
     assert_eq!(code, 1);
     assert!(

@@ -10,7 +10,6 @@
 //! declarative tables of `skeletonise::output` describe them.
 
 mod run;
-mod table;
 mod wkb;
 
 /// mimalloc for the Rust side's own allocations, as in the command line
@@ -22,7 +21,7 @@ static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use skeletonise::config::{self, ConfigError, OnError, Steps};
-use skeletonise::output::{ColumnType, LayerDef, When, CANDIDATES, SKELETONS};
+use skeletonise::output::{ColumnType, Layer, Plan, When, CANDIDATE_LAYER, SKELETON_LAYER};
 
 pyo3::create_exception!(
     _core,
@@ -181,22 +180,23 @@ impl Pipeline {
 #[pyfunction]
 #[pyo3(signature = (layer, explode = false))]
 fn columns(layer: &str, explode: bool) -> PyResult<(Vec<(&'static str, &'static str)>, bool)> {
-    fn of<R>(def: &LayerDef<R>, explode: bool) -> (Vec<(&'static str, &'static str)>, bool) {
-        let cols = def
-            .columns
-            .iter()
-            .filter(|c| c.when == When::Always || (c.when == When::Explode && explode))
-            .map(|c| (c.name, type_name(c.ty)))
-            .collect();
-        (cols, def.attributes.is_some())
-    }
-    match layer {
-        "skeletons" => Ok(of(&SKELETONS, explode)),
-        "candidates" => Ok(of(&CANDIDATES, explode)),
-        other => Err(PyValueError::new_err(format!(
-            "no layer `{other}`; the layers are `skeletons` and `candidates`"
-        ))),
-    }
+    let layer: &dyn Layer = match layer {
+        "skeletons" => &SKELETON_LAYER,
+        "candidates" => &CANDIDATE_LAYER,
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "no layer `{other}`; the layers are `skeletons` and `candidates`"
+            )))
+        }
+    };
+    let holds = if explode { vec![When::Explode] } else { vec![] };
+    let plan = Plan::new(skeletonise::output::SKELETONS.name, holds, &[]);
+    let cols = plan
+        .columns(layer)
+        .into_iter()
+        .map(|(_, name, ty)| (name, type_name(ty)))
+        .collect();
+    Ok((cols, layer.has_attributes()))
 }
 
 pub(crate) fn type_name(t: ColumnType) -> &'static str {

@@ -1,7 +1,6 @@
 //! One call of `Pipeline.run`: geometries in, the layer's columns out, all
 //! the work done with the GIL released.
 
-use crate::table::{self, ColumnData, Out, Values};
 use crate::{type_name, wkb, RejectedError};
 use geo::{Coord, Geometry, LineString, MultiPolygon, Polygon};
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
@@ -9,7 +8,8 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyList, PyTuple};
 use skeletonise::feature::Feature;
-use skeletonise::output::{ColumnType, CANDIDATES, SKELETONS};
+use skeletonise::output::columns::{self as table, ColumnData, Item, Values};
+use skeletonise::output::{ColumnType, Layer, Plan, Rows, When, CANDIDATE_LAYER, SKELETON_LAYER};
 use skeletonise::process::{
     feature_rows, map_in_order, FeatureRows, ProcessParams, RowOptions, Skeletons, Status,
 };
@@ -159,34 +159,51 @@ fn features(
     })
 }
 
-/// The output rows of every feature, in input order, and the reason of
-/// each rejected one.
-fn outputs<'a, R>(
-    results: &'a [FeatureRows],
+/// The rows of every feature in one [`Rows`], and the output rows of
+/// `layer` in input order: the input row of each, the item (a row of the
+/// layer, or an empty row for a rejected or filtered feature) and the
+/// reason of each rejected one.
+fn outputs(
+    results: Vec<FeatureRows>,
     feats: &[Feature],
-    layer_rows: impl Fn(&'a FeatureRows) -> &'a [R],
-) -> (Vec<i64>, Vec<Out<'a, R>>, Vec<Option<String>>) {
-    let (mut idx, mut outs, mut reasons) = (Vec::new(), Vec::new(), Vec::new());
-    for (i, (r, f)) in results.iter().zip(feats).enumerate() {
-        let before = outs.len();
-        for row in layer_rows(r) {
+    layer: &dyn Layer,
+) -> (Vec<i64>, Rows, Vec<Item>, Vec<Option<String>>) {
+    let (mut idx, mut items, mut reasons) = (Vec::new(), Vec::new(), Vec::new());
+    let mut all = Rows::default();
+    for (i, (r, f)) in results.into_iter().zip(feats).enumerate() {
+        let before = layer.count(&all);
+        let rejected: Vec<String> = r.rows.rejected.iter().map(|j| j.reason.clone()).collect();
+        all.append(r.rows);
+        let after = layer.count(&all);
+        for k in before..after {
             idx.push(i as i64);
-            outs.push(Out::Row(row));
+            items.push(Item::Row(k));
             reasons.push(None);
         }
-        for rej in &r.rows.rejected {
+        let none = after == before && rejected.is_empty();
+        for reason in rejected {
             idx.push(i as i64);
-            outs.push(Out::Empty(f.fid));
-            reasons.push(Some(rej.reason.clone()));
+            items.push(Item::Empty(f.fid));
+            reasons.push(Some(reason));
         }
-        if outs.len() == before {
+        if none {
             // Filtered by `min_area`: a row all the same, never a lost one.
             idx.push(i as i64);
-            outs.push(Out::Empty(f.fid));
+            items.push(Item::Empty(f.fid));
             reasons.push(None);
         }
     }
-    (idx, outs, reasons)
+    (idx, all, items, reasons)
+}
+
+/// The plan of a call: the skeleton layer (with `polygon_part` when
+/// exploded) or the candidates layer (which always has it).
+pub fn plan_of(opts: &Options) -> Plan {
+    let mut holds = vec![When::Candidates];
+    if opts.explode {
+        holds.push(When::Explode);
+    }
+    Plan::new(skeletonise::output::SKELETONS.name, holds, &[])
 }
 
 fn work(
@@ -231,23 +248,15 @@ fn work(
             Status::Filtered => counts[3] += 1,
         }
     }
-    let (rows, columns, rejected, lines) = if opts.candidates {
-        let (idx, outs, reasons) = outputs(&results, &feats, |r| &r.rows.candidates);
-        (
-            idx,
-            table::columns(&CANDIDATES, true, &outs),
-            reasons,
-            table::lines(&CANDIDATES, &outs),
-        )
+    let plan = plan_of(opts);
+    let layer: &dyn Layer = if opts.candidates {
+        &CANDIDATE_LAYER
     } else {
-        let (idx, outs, reasons) = outputs(&results, &feats, |r| &r.rows.skeletons);
-        (
-            idx,
-            table::columns(&SKELETONS, opts.explode, &outs),
-            reasons,
-            table::lines(&SKELETONS, &outs),
-        )
+        &SKELETON_LAYER
     };
+    let (rows, all, items, rejected) = outputs(results, &feats, layer);
+    let columns = table::columns(layer, &plan, &all, &items);
+    let lines = table::lines(layer, &all, &items);
     let geometry = if opts.geoarrow_out {
         Encoded::Ragged(table::ragged(&lines))
     } else {

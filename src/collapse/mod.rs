@@ -44,7 +44,10 @@
 //! method's lines are not centred on them.
 
 mod classify;
+mod layer;
 mod split;
+
+pub use layer::{AreaRow, AREAS};
 
 use crate::geometry::PreparedPolygon;
 use crate::graph::SkeletonGraph;

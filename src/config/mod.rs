@@ -125,9 +125,9 @@ pub struct Pipeline {
     pub overrides: Vec<String>,
 }
 
-/// The per-feature parameters of `steps` (and of the `output` switches that
-/// ask for bars and widths).
-pub fn process_params(steps: &[Step], output: Option<&OutputSpec>) -> ProcessParams {
+/// The per-feature parameters of `steps`, keeping what `plan` writes (the
+/// bars, the widths, the measures).
+pub fn process_params(steps: &[Step], plan: &crate::output::Plan) -> ProcessParams {
     let mut p = ProcessParams::default();
     for s in steps {
         match s {
@@ -140,12 +140,40 @@ pub fn process_params(steps: &[Step], output: Option<&OutputSpec>) -> ProcessPar
             Step::Select(x) => p.select = Some(*x),
         }
     }
-    if let Some(o) = output {
-        p.keep_bars = o.bars;
-        p.keep_widths = o.widths;
-        p.keep_measures = o.measures == Measures::Width;
-    }
+    use crate::output::When;
+    p.keep_bars = plan.holds(When::Bars);
+    p.keep_widths = plan.holds(When::Widths);
+    p.keep_measures = plan.holds(When::Measures);
     p
+}
+
+/// The output plan of `output` for `steps` reading `input` (when the
+/// caller reads it: the Python package brings its own data): which of the
+/// conditions layers and columns depend on hold.
+pub fn plan_of(
+    output: &OutputSpec,
+    input: Option<&InputSpec>,
+    steps: &[Step],
+) -> crate::output::Plan {
+    use crate::output::When;
+    let mut holds = Vec::new();
+    let mut flag = |on: bool, w: When| {
+        if on {
+            holds.push(w);
+        }
+    };
+    flag(output.explode, When::Explode);
+    flag(output.candidates, When::Candidates);
+    flag(output.bars, When::Bars);
+    flag(output.widths, When::Widths);
+    flag(output.measures == Measures::Width, When::Measures);
+    flag(
+        steps.iter().any(|s| matches!(s, Step::Collapse(_))),
+        When::Collapse,
+    );
+    flag(input.is_some_and(|i| i.merge_adjacent), When::Merge);
+    flag(input.is_some_and(|i| i.connect.is_some()), When::Connect);
+    crate::output::Plan::new(output.layer.clone(), holds, &[])
 }
 
 /// The error text of a feature rejected under `on_error: fail` (`fid` as
@@ -190,9 +218,26 @@ pub struct Steps {
 }
 
 impl Steps {
+    /// The output plan of the steps: the skeleton layer and what the file's
+    /// `output` section (when it has one) asks for.
+    pub fn plan(&self) -> crate::output::Plan {
+        let output = self.file.output.clone().unwrap_or_else(|| OutputSpec {
+            path: String::new(),
+            layer: crate::output::SKELETONS.name.into(),
+            overwrite: false,
+            candidates: false,
+            bars: false,
+            explode: false,
+            widths: false,
+            measures: Measures::None,
+            report: None,
+        });
+        plan_of(&output, None, &self.file.steps)
+    }
+
     /// The per-feature parameters of the steps.
     pub fn process_params(&self) -> ProcessParams {
-        process_params(&self.file.steps, self.file.output.as_ref())
+        process_params(&self.file.steps, &self.plan())
     }
 }
 
@@ -223,7 +268,12 @@ pub fn load_steps_str(
 impl Pipeline {
     /// The per-feature parameters of the steps.
     pub fn process_params(&self) -> ProcessParams {
-        process_params(&self.file.steps, Some(&self.file.output))
+        process_params(&self.file.steps, &self.plan())
+    }
+
+    /// The output plan: the layers and columns the run writes.
+    pub fn plan(&self) -> crate::output::Plan {
+        plan_of(&self.file.output, Some(&self.file.input), &self.file.steps)
     }
 
     /// The pipeline text with the overrides appended as comments, for provenance.
@@ -538,8 +588,10 @@ fn skeleton_layer_name(name: &str) -> Result<(), String> {
     if name.trim().is_empty() {
         return Err("give the skeleton layer a name, e.g. `skeletons`".into());
     }
-    if let Some(taken) = crate::output::TOOL_LAYERS
-        .iter()
+    let plan = crate::output::Plan::new(name, [], &[]);
+    if let Some(taken) = plan
+        .tool_layer_names()
+        .into_iter()
         .find(|t| t.eq_ignore_ascii_case(name))
     {
         return Err(format!(

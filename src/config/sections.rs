@@ -219,15 +219,3 @@ pub struct ReportSpec {
     #[serde(default)]
     pub features: Selection,
 }
-
-impl From<&OutputSpec> for crate::process::RowOptions {
-    fn from(o: &OutputSpec) -> Self {
-        Self {
-            explode: o.explode,
-            candidates: o.candidates,
-            bars: o.bars,
-            widths: o.widths,
-            measures: o.measures == Measures::Width,
-        }
-    }
-}

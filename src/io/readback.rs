@@ -6,7 +6,7 @@ use super::reader::value;
 use super::IoError;
 use crate::feature::Value;
 use crate::output::{
-    BarRow, CandidateRow, RunRecord, SkeletonRow, BARS, CANDIDATES, RUNS, SKELETONS,
+    name, BarRow, CandidateRow, RunRecord, SkeletonRow, BARS, CANDIDATES, RUNS, SKELETONS,
 };
 use crate::score::Scores;
 use gdal::vector::{Feature, LayerAccess};
@@ -59,26 +59,27 @@ impl Fields {
     }
 
     fn fid(&self, f: &Feature<'_>) -> Option<u64> {
-        self.int(f, "src_fid").and_then(|v| u64::try_from(v).ok())
+        self.int(f, name::SRC_FID)
+            .and_then(|v| u64::try_from(v).ok())
     }
 
     fn polygon_part(&self, f: &Feature<'_>) -> Option<usize> {
-        self.int(f, "polygon_part")
+        self.int(f, name::POLYGON_PART)
             .and_then(|v| usize::try_from(v).ok())
     }
 
     /// The paper's scores of a row; `None` when the run did not score.
     fn scores(&self, f: &Feature<'_>) -> Option<Scores> {
-        let bars = usize::try_from(self.int(f, "bars")?).ok()?;
+        let bars = usize::try_from(self.int(f, name::BARS)?).ok()?;
         let r = |n: &str| self.real(f, n).unwrap_or(f64::NAN);
         Some(Scores {
             bars,
-            hits: self.count(f, "hits"),
-            coverage: self.real(f, "coverage").unwrap_or(0.0),
-            deviation: r("deviation"),
-            deviation_parts: r("deviation_parts"),
-            distortion_sum: r("distortion_sum"),
-            distortion: r("distortion"),
+            hits: self.count(f, name::HITS),
+            coverage: self.real(f, name::COVERAGE).unwrap_or(0.0),
+            deviation: r(name::DEVIATION),
+            deviation_parts: r(name::DEVIATION_PARTS),
+            distortion_sum: r(name::DISTORTION_SUM),
+            distortion: r(name::DISTORTION),
         })
     }
 }
@@ -252,23 +253,23 @@ impl OutputFile {
             let t = |n: &str| c.text(f, n).unwrap_or_default();
             let n = |n: &str| c.int(f, n).and_then(|v| u64::try_from(v).ok()).unwrap_or(0);
             RunRecord {
-                name: t("name"),
-                started_utc: t("started_utc"),
-                finished_utc: t("finished_utc"),
-                tool_version: t("tool_version"),
-                pipeline: t("pipeline"),
-                input: t("input"),
-                input_source: t("input_source"),
-                input_layer: t("input_layer"),
-                input_reproject: c.text(f, "input_reproject"),
-                skeleton_layer: t("skeleton_layer"),
-                read: n("features_read"),
-                written: n("features_written"),
-                rejected: n("features_rejected"),
-                filtered: n("features_filtered"),
-                elapsed_s: c.real(f, "elapsed_s").unwrap_or(f64::NAN),
-                threads: c.count(f, "threads"),
-                stage_seconds: t("stage_seconds"),
+                name: t(name::run::NAME),
+                started_utc: t(name::run::STARTED_UTC),
+                finished_utc: t(name::run::FINISHED_UTC),
+                tool_version: t(name::run::TOOL_VERSION),
+                pipeline: t(name::run::PIPELINE),
+                input: t(name::run::INPUT),
+                input_source: t(name::run::INPUT_SOURCE),
+                input_layer: t(name::run::INPUT_LAYER),
+                input_reproject: c.text(f, name::run::INPUT_REPROJECT),
+                skeleton_layer: t(name::run::SKELETON_LAYER),
+                read: n(name::run::FEATURES_READ),
+                written: n(name::run::FEATURES_WRITTEN),
+                rejected: n(name::run::FEATURES_REJECTED),
+                filtered: n(name::run::FEATURES_FILTERED),
+                elapsed_s: c.real(f, name::run::ELAPSED_S).unwrap_or(f64::NAN),
+                threads: c.count(f, name::run::THREADS),
+                stage_seconds: t(name::run::STAGE_SECONDS),
             }
         })?;
         Ok(runs.into_iter().last())
@@ -284,14 +285,14 @@ impl OutputFile {
         self.rows(CANDIDATES.name, filter, |c, f| CandidateRow {
             src_fid: c.fid(f),
             polygon_part: c.polygon_part(f),
-            method: c.text(f, "method").unwrap_or_default(),
+            method: c.text(f, name::METHOD).unwrap_or_default(),
             geometry: if geometry { lines(f) } else { None },
             scores: c.scores(f),
-            chosen: c.int(f, "chosen") == Some(1),
-            components: c.count(f, "components"),
-            legs_raw: c.count(f, "legs_raw"),
-            legs: c.count(f, "legs"),
-            error: c.text(f, "error"),
+            chosen: c.int(f, name::CHOSEN) == Some(1),
+            components: c.count(f, name::COMPONENTS),
+            legs_raw: c.count(f, name::LEGS_RAW),
+            legs: c.count(f, name::LEGS),
+            error: c.text(f, name::ERROR),
         })
     }
 
@@ -334,14 +335,14 @@ impl OutputFile {
                 .then(|| lines(f))
                 .flatten()
                 .unwrap_or_else(|| geo::MultiLineString(Vec::new())),
-            method: c.text(f, "method").unwrap_or_default(),
+            method: c.text(f, name::METHOD).unwrap_or_default(),
             scores: c.scores(f),
-            components: c.count(f, "components"),
-            legs: c.count(f, "legs"),
-            repaired: c.int(f, "repaired") == Some(1),
-            note: c.text(f, "note"),
-            collapsed: c.int(f, "collapsed").map(|v| v == 1),
-            members: c.text(f, "members"),
+            components: c.count(f, name::COMPONENTS),
+            legs: c.count(f, name::LEGS),
+            repaired: c.int(f, name::REPAIRED) == Some(1),
+            note: c.text(f, name::NOTE),
+            collapsed: c.int(f, name::COLLAPSED).map(|v| v == 1),
+            members: c.text(f, name::MEMBERS),
             measures: None,
         })?;
         Ok(whole_skeletons(rows))
@@ -351,15 +352,15 @@ impl OutputFile {
     pub fn bars(&self, filter: Option<&str>) -> Result<Vec<BarRow>, IoError> {
         self.rows(BARS.name, filter, |c, f| BarRow {
             src_fid: c.fid(f),
-            method: c.text(f, "method").unwrap_or_default(),
+            method: c.text(f, name::METHOD).unwrap_or_default(),
             geometry: lines(f)
                 .and_then(|m| m.0.into_iter().next())
                 .unwrap_or_else(|| geo::LineString(Vec::new())),
-            d_left: c.real(f, "d_left"),
-            d_right: c.real(f, "d_right"),
-            delta_d: c.real(f, "delta_d"),
-            z: c.real(f, "z"),
-            branch: c.int(f, "branch").and_then(|v| usize::try_from(v).ok()),
+            d_left: c.real(f, name::D_LEFT),
+            d_right: c.real(f, name::D_RIGHT),
+            delta_d: c.real(f, name::DELTA_D),
+            z: c.real(f, name::Z),
+            branch: c.int(f, name::BRANCH).and_then(|v| usize::try_from(v).ok()),
         })
     }
 }

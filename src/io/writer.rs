@@ -1,11 +1,11 @@
 //! Writer: the output GeoPackage (SPEC §9).
 //!
-//! Layers: `skeletons` (name configurable; one row per feature, or per part
-//! with `explode`; with a `collapse` step one per feature and value of
-//! `collapsed`), optional `candidates`, `bars` and `widths`, `areas` with a
-//! `collapse` step, `rejected`,
-//! and the attribute table `skeletonise_runs` — each created and filled from
-//! its description in [`crate::output`]. Everything is written to a temporary
+//! Layers: those of the run's [`Plan`] — `skeletons` (name configurable;
+//! one row per feature, or per part with `explode`; with a `collapse` step
+//! one per feature and value of `collapsed`), optional `candidates`, `bars`
+//! and `widths`, the steps' own (`areas`, `connections`, a registered
+//! step's), `rejected`, and the attribute table `skeletonise_runs` — each
+//! created and filled from its description. Everything is written to a temporary
 //! file beside the output, in one transaction per batch, and renamed over the
 //! output only when the run succeeds: a killed run never leaves a half-written
 //! output.
@@ -15,8 +15,7 @@ use super::reader::{FieldInfo, SourceInfo};
 use super::{signals, IoError};
 use crate::feature::Value;
 use crate::output::{
-    Cell, Column, ColumnType, GeometryKind, LayerDef, Rows, RunRecord, Shape, When, AREAS, BARS,
-    CANDIDATES, CONNECTIONS, REJECTED, RUNS, SKELETONS, WIDTHS,
+    Cell, ColumnType, GeometryKind, Layer, Plan, Rows, RunRecord, Shape, SKELETONS,
 };
 use gdal::spatial_ref::SpatialRef;
 use gdal::vector::{
@@ -34,10 +33,8 @@ pub struct Writer {
     tmp: PathBuf,
     path: PathBuf,
     spec: OutputSpec,
-    /// The pipeline collapses: the `areas` layer and the `collapsed` column.
-    collapse: bool,
-    /// `input.merge_adjacent`: the `members` column.
-    merge: bool,
+    /// The layers and columns to write.
+    plan: Plan,
     source_fields: Vec<(String, FieldInfo)>,
     /// Rows written in the open transaction (`None`: none open).
     in_transaction: Option<usize>,
@@ -141,6 +138,7 @@ fn shape_to_gdal(s: Shape<'_>) -> Result<Geometry, IoError> {
         Shape::Wkb(w) => {
             Geometry::from_wkb(w).map_err(|e| IoError::gdal("reading a WKB geometry", e))
         }
+        Shape::Geometry(g) => to_gdal(g),
     }
 }
 
@@ -164,19 +162,14 @@ fn to_gdal<G: ToGdal>(g: &G) -> Result<Geometry, IoError> {
 }
 
 impl Writer {
-    /// Creates the temporary GeoPackage and its layers. Fails, touching
-    /// nothing, when the output is refused by [`check_output`] (`protected`:
-    /// the data sources the run reads). `collapse`: the pipeline has a
-    /// `collapse` step (the `areas` layer, the `collapsed` column); `merge`:
-    /// the input merges adjacent polygons (the `members` column); `connect`:
-    /// the input has a line network (the `connections` layer).
+    /// Creates the temporary GeoPackage and the layers of `plan`. Fails,
+    /// touching nothing, when the output is refused by [`check_output`]
+    /// (`protected`: the data sources the run reads).
     pub fn create(
+        plan: &Plan,
         spec: &OutputSpec,
         source: &SourceInfo,
         protected: &[Protected<'_>],
-        collapse: bool,
-        merge: bool,
-        connect: bool,
     ) -> Result<Self, IoError> {
         let target = output_target(spec, protected);
         target.check()?;
@@ -196,56 +189,19 @@ impl Writer {
             .map(SpatialRef::from_wkt)
             .transpose()
             .map_err(|e| IoError::gdal("reading the CRS", e))?;
-        // Source fields whose names clash with the tool's get a `src_` prefix.
-        let source_fields: Vec<(String, FieldInfo)> = source
-            .fields
-            .iter()
-            .map(|f| {
-                let clash = SKELETONS
-                    .column_names()
-                    .any(|n| n.eq_ignore_ascii_case(&f.name));
-                (
-                    if clash {
-                        format!("src_{}", f.name)
-                    } else {
-                        f.name.clone()
-                    },
-                    f.clone(),
-                )
-            })
-            .collect();
         let mut w = Writer {
             ds: None,
             tmp,
             path,
             spec: spec.clone(),
-            collapse,
-            merge,
-            source_fields,
+            plan: plan.clone(),
+            source_fields: source_fields(source),
             in_transaction: None,
         };
-        let r = (|| -> Result<(), IoError> {
-            let srs = srs.as_ref();
-            w.create_layer(&mut ds, &SKELETONS, &spec.layer, srs)?;
-            if spec.candidates {
-                w.create_layer(&mut ds, &CANDIDATES, CANDIDATES.name, srs)?;
-            }
-            if spec.bars {
-                w.create_layer(&mut ds, &BARS, BARS.name, srs)?;
-            }
-            if spec.widths {
-                w.create_layer(&mut ds, &WIDTHS, WIDTHS.name, srs)?;
-            }
-            if collapse {
-                w.create_layer(&mut ds, &AREAS, AREAS.name, srs)?;
-            }
-            if connect {
-                w.create_layer(&mut ds, &CONNECTIONS, CONNECTIONS.name, srs)?;
-            }
-            w.create_layer(&mut ds, &REJECTED, REJECTED.name, srs)?;
-            w.create_layer(&mut ds, &RUNS, RUNS.name, None)?;
-            Ok(())
-        })();
+        let r = plan
+            .layers()
+            .into_iter()
+            .try_for_each(|l| w.create_layer(&mut ds, l, srs.as_ref()));
         w.ds = Some(ds);
         if let Err(e) = r {
             w.abort();
@@ -254,38 +210,35 @@ impl Writer {
         Ok(w)
     }
 
-    /// Creates the layer `name` described by `def`.
-    fn create_layer<R>(
+    /// Creates `layer` (under the plan's name for it).
+    fn create_layer(
         &self,
         ds: &mut Dataset,
-        def: &LayerDef<R>,
-        name: &str,
+        layer: &dyn Layer,
         srs: Option<&SpatialRef>,
     ) -> Result<(), IoError> {
+        let name = self.plan.name_of(layer);
         // `output.measures: width`: the skeleton layer's lines carry M.
-        let measured = name == self.spec.layer
-            && def.geometry == GeometryKind::MultiLineString
-            && self.spec.measures == crate::config::Measures::Width;
-        let ty = if measured {
+        let ty = if self.plan.measured(layer) {
             OGRwkbGeometryType::wkbMultiLineStringM
         } else {
-            ogr_geometry(def.geometry)
+            ogr_geometry(layer.geometry())
         };
         // The spatial index is made now, while the layer is empty, so every
         // batch's rows enter it as they are written (on the writer thread,
         // alongside the workers) rather than all at once when the file is
         // closed (GDAL's deferred index: a serial tail after the last batch,
         // 0.8 s for 100 000 skeletons).
-        let spatial = def.geometry != GeometryKind::None;
+        let spatial = layer.geometry() != GeometryKind::None;
         let l = ds
             .create_layer(LayerOptions {
                 name,
-                srs,
+                srs: if spatial { srs } else { None },
                 ty,
                 options: spatial.then_some(&["SPATIAL_INDEX=NO"][..]),
             })
             .map_err(|e| IoError::gdal(format!("creating layer `{name}`"), e))?;
-        if def.attributes.is_some() {
+        if layer.has_attributes() {
             for (fname, f) in &self.source_fields {
                 let d = FieldDefn::new(fname, f.kind)
                     .map_err(|e| IoError::gdal("copying a field", e))?;
@@ -295,8 +248,8 @@ impl Writer {
                     .map_err(|e| IoError::gdal(format!("copying field `{fname}`"), e))?;
             }
         }
-        for c in self.columns(def) {
-            field(&l, c.name, ogr_type(c.ty))?;
+        for (_, cname, ty) in self.plan.columns(layer) {
+            field(&l, cname, ogr_type(ty))?;
         }
         if spatial {
             let column = l
@@ -316,51 +269,34 @@ impl Writer {
         Ok(())
     }
 
-    /// The columns of `def` this output has.
-    fn columns<'d, R>(&self, def: &'d LayerDef<R>) -> impl Iterator<Item = &'d Column<R>> {
-        let (explode, collapse, merge) = (self.spec.explode, self.collapse, self.merge);
-        def.columns.iter().filter(move |c| match c.when {
-            When::Always => true,
-            When::Explode => explode,
-            When::Collapse => collapse,
-            When::Merge => merge,
-        })
-    }
-
-    /// Writes `rows` to the layer `name` described by `def`.
-    fn write_rows<R>(
-        &self,
-        ds: &Dataset,
-        def: &LayerDef<R>,
-        name: &str,
-        rows: &[R],
-    ) -> Result<(), IoError> {
-        if rows.is_empty() {
+    /// Writes the rows of `layer` in `rows`.
+    fn write_rows(&self, ds: &Dataset, layer: &dyn Layer, rows: &Rows) -> Result<(), IoError> {
+        let n = layer.count(rows);
+        if n == 0 {
             return Ok(());
         }
+        let name = self.plan.name_of(layer);
         let l = ds
             .layer_by_name(name)
             .map_err(|e| IoError::gdal(format!("opening layer `{name}`"), e))?;
-        let n_source = if def.attributes.is_some() {
+        let n_source = if layer.has_attributes() {
             self.source_fields.len()
         } else {
             0
         };
-        let columns: Vec<&Column<R>> = self.columns(def).collect();
-        for r in rows {
+        let columns = self.plan.columns(layer);
+        for i in 0..n {
             let mut f =
                 Feature::new(l.defn()).map_err(|e| IoError::gdal("creating a feature", e))?;
-            if let Some(s) = (def.shape)(r) {
+            if let Some(s) = layer.shape(rows, i) {
                 f.set_geometry(shape_to_gdal(s)?)
                     .map_err(|e| IoError::gdal("setting a geometry", e))?;
             }
-            if let Some(attrs) = def.attributes {
-                for (i, v) in attrs(r).iter().enumerate().take(n_source) {
-                    set_field(&mut f, i, attribute_value(v))?;
-                }
+            for (k, v) in layer.attributes(rows, i).iter().enumerate().take(n_source) {
+                set_field(&mut f, k, attribute_value(v))?;
             }
-            for (k, c) in columns.iter().enumerate() {
-                set_field(&mut f, n_source + k, cell_value((c.get)(r), c.ty))?;
+            for (k, &(c, _, ty)) in columns.iter().enumerate() {
+                set_field(&mut f, n_source + k, cell_value(layer.cell(rows, i, c), ty))?;
             }
             f.create(&l)
                 .map_err(|e| IoError::gdal(format!("writing a row of `{name}`"), e))?;
@@ -383,13 +319,9 @@ impl Writer {
                 }
             };
             self.in_transaction = Some(written);
-            self.write_rows(&ds, &SKELETONS, &self.spec.layer, &rows.skeletons)?;
-            self.write_rows(&ds, &CANDIDATES, CANDIDATES.name, &rows.candidates)?;
-            self.write_rows(&ds, &BARS, BARS.name, &rows.bars)?;
-            self.write_rows(&ds, &WIDTHS, WIDTHS.name, &rows.widths)?;
-            self.write_rows(&ds, &AREAS, AREAS.name, &rows.areas)?;
-            self.write_rows(&ds, &CONNECTIONS, CONNECTIONS.name, &rows.connections)?;
-            self.write_rows(&ds, &REJECTED, REJECTED.name, &rows.rejected)?;
+            for layer in self.plan.layers() {
+                self.write_rows(&ds, layer, rows)?;
+            }
             let written = written + rows.len();
             self.in_transaction = Some(written);
             if written >= ROWS_PER_COMMIT {
@@ -427,7 +359,13 @@ impl Writer {
     /// The last commit, the run record, closing and the rename.
     fn close(&mut self, ds: Dataset, run: &RunRecord) -> Result<PathBuf, IoError> {
         self.commit(&ds)?;
-        self.write_rows(&ds, &RUNS, RUNS.name, std::slice::from_ref(run))?;
+        let record = Rows {
+            runs: vec![run.clone()],
+            ..Rows::default()
+        };
+        for layer in self.plan.layers() {
+            self.write_rows(&ds, layer, &record)?;
+        }
         // Closing flushes the file before it is renamed into place.
         close_dataset(ds).map_err(|reason| IoError::Output {
             path: self.spec.path.clone(),
@@ -451,6 +389,28 @@ impl Writer {
         signals::remove_with_companions(&self.tmp);
         signals::unregister(&self.tmp);
     }
+}
+
+/// The source's fields as the output names them: those whose names clash
+/// with a column of the skeleton layer get a `src_` prefix.
+fn source_fields(source: &SourceInfo) -> Vec<(String, FieldInfo)> {
+    source
+        .fields
+        .iter()
+        .map(|f| {
+            let clash = SKELETONS
+                .column_names()
+                .any(|n| n.eq_ignore_ascii_case(&f.name));
+            (
+                if clash {
+                    format!("src_{}", f.name)
+                } else {
+                    f.name.clone()
+                },
+                f.clone(),
+            )
+        })
+        .collect()
 }
 
 /// Closes a dataset, with GDAL's reason when closing fails (the last

@@ -5,7 +5,6 @@
 
 mod candidates;
 pub mod clock;
-pub mod connect;
 pub mod merge;
 pub mod rows;
 
@@ -29,6 +28,7 @@ pub fn map_in_order<T: Sync, U: Send>(
 }
 
 use crate::collapse::{collapse, CollapseParams, PartCollapse};
+use crate::connect;
 use crate::geometry::PreparedPolygon;
 use crate::graph::extend::ExtendParams;
 use crate::graph::prune::PruneParams;

@@ -4,11 +4,11 @@
 //! through the same steps from `score` on and give the same rows.
 
 use super::{process, process_given, FeatureOutcome, ProcessParams, Processed, StageTimes};
+use crate::collapse::AreaRow;
+use crate::connect::ConnectionRow;
 use crate::feature::Feature;
 use crate::methods::MethodId;
-use crate::output::{
-    AreaRow, BarRow, CandidateRow, ConnectionRow, RejectedRow, Rows, SkeletonRow, WidthRow,
-};
+use crate::output::{BarRow, CandidateRow, RejectedRow, Rows, SkeletonRow, WidthRow};
 use geo::{Geometry, MultiLineString};
 
 /// Where a feature's skeletons come from.
@@ -39,6 +39,20 @@ pub struct RowOptions {
     pub widths: bool,
     /// M values (local width) on the skeleton layer's lines.
     pub measures: bool,
+}
+
+impl RowOptions {
+    /// What a run with `plan` keeps of every feature.
+    pub fn of(plan: &crate::output::Plan) -> Self {
+        use crate::output::When;
+        Self {
+            explode: plan.holds(When::Explode),
+            candidates: plan.holds(When::Candidates),
+            bars: plan.holds(When::Bars),
+            widths: plan.holds(When::Widths),
+            measures: plan.holds(When::Measures),
+        }
+    }
 }
 
 /// How a feature counts in the run's summary.

@@ -1,20 +1,25 @@
-//! Rows of a layer to columns, from the layer's declarative table
-//! (`skeletonise::output::LayerDef`): the names, types and values are the
-//! ones the command line writes to the GeoPackage.
+//! A layer's rows as columns (one vector of values per column), with the
+//! names, types and values the writer gives them: the table the Python
+//! package hands to pandas, and a way to see any layer's rows without a
+//! GeoPackage.
 
+use super::plan::Plan;
+use super::rows::{Layer, Rows};
+use crate::layer::{Cell, ColumnType, Shape};
 use geo::MultiLineString;
-use skeletonise::output::{Cell, ColumnType, LayerDef, Shape, When};
 
-/// One output row: a row of the layer, or a feature without one (rejected
+/// One output row: row `i` of the layer, or a feature without one (rejected
 /// or filtered), of which only `src_fid` is known.
-pub enum Out<'a, R> {
-    /// A row of the layer.
-    Row(&'a R),
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Item {
+    /// Row `i` of the layer in the [`Rows`].
+    Row(usize),
     /// A rejected or filtered feature.
     Empty(Option<u64>),
 }
 
 /// The values of one column.
+#[derive(Debug, Clone, PartialEq)]
 pub enum Values {
     /// Integers and where they are NULL.
     Int(Vec<i64>, Vec<bool>),
@@ -25,37 +30,34 @@ pub enum Values {
 }
 
 /// A column: name, type and values.
+#[derive(Debug, Clone, PartialEq)]
 pub struct ColumnData {
     /// Column name.
     pub name: &'static str,
     /// Column type.
     pub ty: ColumnType,
-    /// Values, one per row.
+    /// Values, one per item.
     pub values: Values,
 }
 
-/// The columns of `def` (those with `explode` included when asked) over
-/// `rows`.
-pub fn columns<R>(def: &LayerDef<R>, explode: bool, rows: &[Out<'_, R>]) -> Vec<ColumnData> {
-    def.columns
-        .iter()
-        .filter(|c| c.when == When::Always || (c.when == When::Explode && explode))
-        .map(|c| {
-            let cell = |r: &Out<'_, R>| match r {
-                Out::Row(r) => (c.get)(r),
-                Out::Empty(fid) if c.name == "src_fid" => fid
-                    .and_then(|f| i64::try_from(f).ok())
-                    .map_or(Cell::Null, Cell::Int),
-                Out::Empty(_) => Cell::Null,
+/// The columns of `layer` that `plan` writes, over `items` of `rows`.
+pub fn columns(layer: &dyn Layer, plan: &Plan, rows: &Rows, items: &[Item]) -> Vec<ColumnData> {
+    plan.columns(layer)
+        .into_iter()
+        .map(|(k, name, ty)| {
+            let cell = |it: &Item| match *it {
+                Item::Row(i) => layer.cell(rows, i, k),
+                Item::Empty(fid) if name == super::name::SRC_FID => crate::layer::fid(fid),
+                Item::Empty(_) => Cell::Null,
             };
-            let values = match c.ty {
+            let values = match ty {
                 ColumnType::Int32 | ColumnType::Int64 => {
                     let (mut v, mut null) = (
-                        Vec::with_capacity(rows.len()),
-                        Vec::with_capacity(rows.len()),
+                        Vec::with_capacity(items.len()),
+                        Vec::with_capacity(items.len()),
                     );
-                    for r in rows {
-                        match cell(r) {
+                    for it in items {
+                        match cell(it) {
                             Cell::Int(i) => {
                                 v.push(i);
                                 null.push(false);
@@ -69,8 +71,9 @@ pub fn columns<R>(def: &LayerDef<R>, explode: bool, rows: &[Out<'_, R>]) -> Vec<
                     Values::Int(v, null)
                 }
                 ColumnType::Real => Values::Real(
-                    rows.iter()
-                        .map(|r| match cell(r) {
+                    items
+                        .iter()
+                        .map(|it| match cell(it) {
                             Cell::Real(x) if x.is_finite() => x,
                             Cell::Int(i) => i as f64,
                             _ => f64::NAN,
@@ -78,37 +81,35 @@ pub fn columns<R>(def: &LayerDef<R>, explode: bool, rows: &[Out<'_, R>]) -> Vec<
                         .collect(),
                 ),
                 ColumnType::Text => Values::Text(
-                    rows.iter()
-                        .map(|r| match cell(r) {
+                    items
+                        .iter()
+                        .map(|it| match cell(it) {
                             Cell::Text(s) => Some(s),
                             _ => None,
                         })
                         .collect(),
                 ),
             };
-            ColumnData {
-                name: c.name,
-                ty: c.ty,
-                values,
-            }
+            ColumnData { name, ty, values }
         })
         .collect()
 }
 
-/// The geometry of every row, from the layer's `shape`: lines, or `None`.
-pub fn lines<'a, R>(
-    def: &LayerDef<R>,
-    rows: &'a [Out<'a, R>],
-) -> Vec<Option<MultiLineString<f64>>> {
-    rows.iter()
-        .map(|r| match r {
-            Out::Row(r) => match (def.shape)(r) {
-                Some(Shape::Lines(m)) => Some(m.clone()),
+/// The lines of every item (from the layer's geometry), or `None`.
+pub fn lines(layer: &dyn Layer, rows: &Rows, items: &[Item]) -> Vec<Option<MultiLineString<f64>>> {
+    items
+        .iter()
+        .map(|it| match *it {
+            Item::Row(i) => match layer.shape(rows, i) {
+                Some(Shape::Lines(m)) | Some(Shape::LinesM(m, _)) => Some(m.clone()),
                 Some(Shape::Line(l)) => Some(MultiLineString(vec![l])),
-                Some(Shape::LinesM(m, _)) => Some(m.clone()),
-                Some(Shape::Polygon(_) | Shape::Wkb(_)) | None => None,
+                Some(Shape::Geometry(geo::Geometry::MultiLineString(m))) => Some(m.clone()),
+                Some(Shape::Geometry(geo::Geometry::LineString(l))) => {
+                    Some(MultiLineString(vec![l.clone()]))
+                }
+                _ => None,
             },
-            Out::Empty(_) => None,
+            Item::Empty(_) => None,
         })
         .collect()
 }
@@ -116,6 +117,7 @@ pub fn lines<'a, R>(
 /// Geometries as GeoArrow MULTILINESTRING buffers: interleaved x, y; the
 /// start of every line in points; the start of every geometry in lines;
 /// and which are NULL.
+#[derive(Debug, Clone, PartialEq)]
 pub struct Ragged {
     /// x0, y0, x1, y1, …
     pub coords: Vec<f64>,

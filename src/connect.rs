@@ -9,6 +9,7 @@
 
 use crate::geometry::PreparedPolygon;
 use crate::graph::{GraphBuilder, SkeletonGraph};
+use crate::layer::{col, fid, ColumnType, GeometryKind, LayerDef, Shape, When};
 use geo::{BoundingRect, Coord, Geometry, LineString, Rect};
 
 /// The lines of a geometry, appended to `out` (other kinds are skipped).
@@ -247,6 +248,31 @@ fn nearest_visible(
         .find(|&(_, _, _, q)| b.reaches(q, c))
         .map(|(_, k, i, q)| (k, i, q))
 }
+
+/// One row of the `connections` layer: a leg added to a skeleton for a
+/// line of `input.connect`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ConnectionRow {
+    /// Source FID of the polygon.
+    pub src_fid: Option<u64>,
+    /// FID of the network line the leg serves.
+    pub line_fid: Option<u64>,
+    /// The leg, from the skeleton to the connection point on the boundary.
+    pub geometry: geo::LineString<f64>,
+}
+
+/// The `connections` layer (with `input.connect`).
+pub const CONNECTIONS: LayerDef<ConnectionRow> = LayerDef {
+    name: "connections",
+    when: When::Connect,
+    geometry: GeometryKind::LineString,
+    shape: |r| Some(Shape::Line(r.geometry.clone())),
+    attributes: None,
+    columns: &[
+        col("src_fid", ColumnType::Int64, |r| fid(r.src_fid)),
+        col("line_fid", ColumnType::Int64, |r| fid(r.line_fid)),
+    ],
+};
 
 #[cfg(test)]
 mod tests {

@@ -1,0 +1,209 @@
+//! The declarative description of an output layer, below every step so
+//! that each can declare its own layers and columns next to its code (as a
+//! PDAL stage declares its dimensions): a [`LayerDef`] is a layer's name,
+//! when it is written, its geometry type and its columns, each column with
+//! its type, when it is written and how its value is taken from a row. The
+//! writer (`io::writer`), the Python table and the reader of an output
+//! (`io::readback`) all work from these descriptions, gathered in one
+//! [`crate::output::Plan`].
+
+use crate::feature::Value;
+
+/// The type of a column.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ColumnType {
+    /// 32-bit integer.
+    Int32,
+    /// 64-bit integer.
+    Int64,
+    /// Floating point.
+    Real,
+    /// Text.
+    Text,
+}
+
+/// A value written to a column.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Cell {
+    /// NULL.
+    Null,
+    /// An integer (written as the column's integer type).
+    Int(i64),
+    /// A number; non-finite values are written as NULL.
+    Real(f64),
+    /// Text.
+    Text(String),
+}
+
+/// The geometry type of a layer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GeometryKind {
+    /// MULTILINESTRING.
+    MultiLineString,
+    /// LINESTRING.
+    LineString,
+    /// POLYGON.
+    Polygon,
+    /// Any geometry (the `rejected` layer keeps the input's).
+    Unknown,
+    /// An attribute table.
+    None,
+}
+
+/// A row's geometry, borrowed or made for writing.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Shape<'a> {
+    /// Lines.
+    Lines(&'a geo::MultiLineString<f64>),
+    /// One line.
+    Line(geo::LineString<f64>),
+    /// One polygon.
+    Polygon(&'a geo::Polygon<f64>),
+    /// Lines with an M value per vertex (line by line).
+    LinesM(&'a geo::MultiLineString<f64>, &'a [Vec<f64>]),
+    /// A geometry as WKB.
+    Wkb(&'a [u8]),
+    /// Any geometry (a registered step's rows).
+    Geometry(&'a geo::Geometry<f64>),
+}
+
+/// When a layer or a column is part of the output: always, or only when
+/// the pipeline has what it says ([`crate::output::Plan`] knows which hold).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum When {
+    /// Always.
+    Always,
+    /// With `output.explode`.
+    Explode,
+    /// When the pipeline has a `collapse` step.
+    Collapse,
+    /// With `input.merge_adjacent`.
+    Merge,
+    /// With `input.connect`.
+    Connect,
+    /// With `output.candidates`.
+    Candidates,
+    /// With `output.bars`.
+    Bars,
+    /// With `output.widths`.
+    Widths,
+    /// With `output.measures: width` (the skeleton layer's lines carry M).
+    Measures,
+    /// When the pipeline has the step of this name (a registered step's
+    /// own layers and columns).
+    Step(&'static str),
+}
+
+/// One column of a layer.
+pub struct Column<R> {
+    /// Column name.
+    pub name: &'static str,
+    /// Column type.
+    pub ty: ColumnType,
+    /// The column's value in a row.
+    pub get: fn(&R) -> Cell,
+    /// When the column is written.
+    pub when: When,
+}
+
+/// A column written always.
+pub const fn col<R>(name: &'static str, ty: ColumnType, get: fn(&R) -> Cell) -> Column<R> {
+    Column {
+        name,
+        ty,
+        get,
+        when: When::Always,
+    }
+}
+
+/// A column written only when `when` holds.
+pub const fn col_when<R>(
+    when: When,
+    name: &'static str,
+    ty: ColumnType,
+    get: fn(&R) -> Cell,
+) -> Column<R> {
+    Column {
+        name,
+        ty,
+        get,
+        when,
+    }
+}
+
+impl<R> Clone for Column<R> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<R> Copy for Column<R> {}
+
+/// One output layer.
+pub struct LayerDef<R: 'static> {
+    /// Layer name (the skeleton layer's is configurable: `output.layer`).
+    pub name: &'static str,
+    /// When the layer is written.
+    pub when: When,
+    /// Geometry type.
+    pub geometry: GeometryKind,
+    /// The row's geometry.
+    pub shape: for<'a> fn(&'a R) -> Option<Shape<'a>>,
+    /// The source feature's attributes, written first under the source's
+    /// field names (the skeleton layer).
+    pub attributes: Option<fn(&R) -> &[Value]>,
+    /// The tool's columns.
+    pub columns: &'static [Column<R>],
+}
+
+impl<R> LayerDef<R> {
+    /// The names of the tool's columns.
+    pub fn column_names(&self) -> impl Iterator<Item = &'static str> + '_ {
+        self.columns.iter().map(|c| c.name)
+    }
+}
+
+/// An integer cell; NULL when the value does not fit.
+pub fn int(v: impl TryInto<i64>) -> Cell {
+    v.try_into().map_or(Cell::Null, Cell::Int)
+}
+
+/// A text cell.
+pub fn text(s: &str) -> Cell {
+    Cell::Text(s.to_string())
+}
+
+/// A source FID cell (NULL for none).
+pub fn fid(v: Option<u64>) -> Cell {
+    v.map_or(Cell::Null, int)
+}
+
+/// A number cell (NULL for none).
+pub fn real(v: Option<f64>) -> Cell {
+    v.map_or(Cell::Null, Cell::Real)
+}
+
+/// One row of a layer that a registered step declares ([`StepLayer`]):
+/// its geometry and its cells in the order of the layer's columns; the
+/// feature's `src_fid` (and source fields, when the layer has them) are
+/// added by the per-feature path.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StepRow {
+    /// The row's geometry.
+    pub geometry: Option<geo::Geometry<f64>>,
+    /// One cell per column of the layer, in order.
+    pub cells: Vec<Cell>,
+}
+
+/// A layer declared by a registered step: its rows are [`StepRow`]s.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StepLayer {
+    /// Layer name.
+    pub name: &'static str,
+    /// Geometry type.
+    pub geometry: GeometryKind,
+    /// Whether the source feature's fields come first.
+    pub attributes: bool,
+    /// The step's columns (after `src_fid`), in order.
+    pub columns: &'static [(&'static str, ColumnType)],
+}

@@ -1,0 +1,94 @@
+//! The output plan: made once from the pipeline file, it says which layers
+//! a run writes and which of their columns, for every part of the tool that
+//! needs to know — the per-feature path (what rows to keep), the writer,
+//! the Python table and the reader of an output.
+
+use super::rows::{Layer, BUILTIN};
+use crate::layer::{ColumnType, StepLayer, When};
+use std::collections::BTreeSet;
+
+/// The layers and columns of a run's output (see the module documentation).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Plan {
+    skeleton_layer: String,
+    holds: BTreeSet<When>,
+    steps: Vec<&'static StepLayer>,
+}
+
+impl Plan {
+    /// The plan of an output whose skeleton layer is called
+    /// `skeleton_layer`, where the conditions `holds` hold (besides
+    /// [`When::Always`]) and registered steps add the layers `steps`.
+    pub fn new(
+        skeleton_layer: impl Into<String>,
+        holds: impl IntoIterator<Item = When>,
+        steps: &[&'static StepLayer],
+    ) -> Self {
+        let mut holds: BTreeSet<When> = holds.into_iter().collect();
+        holds.insert(When::Always);
+        Self {
+            skeleton_layer: skeleton_layer.into(),
+            holds,
+            steps: steps.to_vec(),
+        }
+    }
+
+    /// Whether `when` holds.
+    pub fn holds(&self, when: When) -> bool {
+        self.holds.contains(&when)
+    }
+
+    /// The name of the skeleton layer (`output.layer`).
+    pub fn skeleton_layer(&self) -> &str {
+        &self.skeleton_layer
+    }
+
+    /// The layers written, in order: the built-in ones whose condition
+    /// holds (the run record last), then the registered steps'.
+    pub fn layers(&self) -> Vec<&dyn Layer> {
+        BUILTIN
+            .iter()
+            .copied()
+            .filter(|l| self.holds(l.when()))
+            .chain(self.steps.iter().map(|l| *l as &dyn Layer))
+            .collect()
+    }
+
+    /// The name `layer` is written under (the skeleton layer's is
+    /// configurable).
+    pub fn name_of<'a>(&'a self, layer: &dyn Layer) -> &'a str {
+        if layer.name() == super::SKELETONS.name {
+            &self.skeleton_layer
+        } else {
+            layer.name()
+        }
+    }
+
+    /// Whether `layer` is the skeleton layer and its lines carry M values.
+    pub fn measured(&self, layer: &dyn Layer) -> bool {
+        layer.name() == super::SKELETONS.name && self.holds(When::Measures)
+    }
+
+    /// The columns of `layer` this output has, with their index among the
+    /// layer's columns.
+    pub fn columns(&self, layer: &dyn Layer) -> Vec<(usize, &'static str, ColumnType)> {
+        layer
+            .columns()
+            .into_iter()
+            .enumerate()
+            .filter(|(_, c)| self.holds(c.when))
+            .map(|(i, c)| (i, c.name, c.ty))
+            .collect()
+    }
+
+    /// The names of every layer the tool may write besides the skeleton
+    /// layer (which must be none of them), the run record's included.
+    pub fn tool_layer_names(&self) -> Vec<&'static str> {
+        BUILTIN
+            .iter()
+            .map(|l| l.name())
+            .filter(|n| *n != super::SKELETONS.name)
+            .chain(self.steps.iter().map(|l| l.name))
+            .collect()
+    }
+}
