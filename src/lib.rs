@@ -19,6 +19,7 @@
 
 #![warn(missing_docs)]
 
+pub mod clock;
 pub mod collapse;
 pub mod config;
 pub mod connect;

@@ -2,8 +2,8 @@
 //! skeletons part by part, the reference's structure, pruning, extension,
 //! scores, bars and widths.
 
-use super::clock::{CpuClock, Stopwatch};
 use super::{part_reason, CandidateSkeleton, ProcessParams, StageTimes};
+use crate::clock::{CpuClock, Stopwatch};
 use crate::geometry::PreparedPolygon;
 use crate::graph::extend::prune_and_extend;
 use crate::graph::SkeletonGraph;

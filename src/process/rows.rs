@@ -269,6 +269,16 @@ fn outcome_rows(
         }));
     }
     candidate_rows(f, part, o, &name, opts, rows);
+    for (layer, row) in &o.extra {
+        rows.extra
+            .entry(layer)
+            .or_default()
+            .push(crate::output::ExtraRow {
+                src_fid: f.fid,
+                attributes: f.attributes.clone(),
+                row: row.clone(),
+            });
+    }
     method
 }
 

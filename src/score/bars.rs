@@ -1,9 +1,9 @@
 //! Bars, hits and sides (SPEC §6.1–6.3).
 
 use super::{metrics, Bar, BarHit, Scores};
+use crate::clock::CpuClock;
 use crate::geometry::{boundary::orient, Boundary, BoundarySegment, PreparedPolygon};
 use crate::graph::{Branch, GraphBuilder, SkeletonGraph};
-use crate::process::clock::CpuClock;
 use geo::{Coord, MultiLineString};
 use rayon::prelude::*;
 

@@ -1,0 +1,182 @@
+//! The `prepare` step: a feature's geometry as polygon parts, normalised
+//! and checked, or what becomes of the feature instead (rejected with the
+//! reason, or filtered by `min_area`).
+
+use crate::geometry::PreparedPolygon;
+use geo::{Area, Geometry, Polygon};
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+/// Why a feature has no polygon parts to work on.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum NotPrepared {
+    /// Skipped by `min_area` (counted as filtered, not rejected).
+    Filtered,
+    /// Rejected, with the reason.
+    Rejected(String),
+}
+
+impl From<NotPrepared> for super::Processed {
+    fn from(n: NotPrepared) -> Self {
+        match n {
+            NotPrepared::Filtered => Self::Filtered,
+            NotPrepared::Rejected(r) => Self::Rejected(r),
+        }
+    }
+}
+
+/// Options of the `prepare` step.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct PrepareParams {
+    /// Repair invalid polygons (GDAL MakeValid) instead of rejecting them.
+    pub make_valid: bool,
+    /// Polygon parts smaller than this (CRS units²) are skipped; a feature all
+    /// of whose parts are skipped is counted as filtered.
+    pub min_area: f64,
+    /// A feature with more boundary vertices than this is rejected with the
+    /// reason, before any method runs (0: no limit).
+    pub max_vertices: usize,
+}
+
+impl PrepareParams {
+    /// Checks the options: `(key, message)` of the first that is wrong.
+    pub fn validate(&self) -> Result<(), (String, String)> {
+        if self.min_area.is_nan() || self.min_area < 0.0 {
+            return Err((
+                "min_area".into(),
+                "min_area must be ≥ 0 (CRS units²)".into(),
+            ));
+        }
+        Ok(())
+    }
+}
+
+impl Default for PrepareParams {
+    fn default() -> Self {
+        Self {
+            make_valid: true,
+            min_area: 0.0,
+            max_vertices: 5_000_000,
+        }
+    }
+}
+
+/// The polygon parts of a geometry, or why it has none.
+pub fn polygon_parts(geom: Option<&Geometry<f64>>) -> Result<Vec<Polygon<f64>>, String> {
+    let Some(geom) = geom else {
+        return Err("NULL geometry: the feature has no geometry to skeletonise".into());
+    };
+    let parts = match geom {
+        Geometry::Polygon(p) => vec![p.clone()],
+        Geometry::MultiPolygon(mp) => mp.0.clone(),
+        Geometry::Rect(r) => vec![r.to_polygon()],
+        Geometry::Triangle(t) => vec![t.to_polygon()],
+        Geometry::GeometryCollection(gc) => {
+            let mut v = Vec::new();
+            for g in gc.iter() {
+                match polygon_parts(Some(g)) {
+                    Ok(p) => v.extend(p),
+                    Err(_) => {
+                        return Err(format!(
+                            "geometry collection with a non-polygon member ({}); only polygons can be skeletonised",
+                            kind(g)
+                        ))
+                    }
+                }
+            }
+            v
+        }
+        other => {
+            return Err(format!(
+                "{} geometry: only polygons and multipolygons can be skeletonised",
+                kind(other)
+            ))
+        }
+    };
+    let parts: Vec<Polygon<f64>> = parts
+        .into_iter()
+        .filter(|p| !p.exterior().0.is_empty())
+        .collect();
+    if parts.is_empty() {
+        return Err("empty geometry: the polygon has no vertices".into());
+    }
+    Ok(parts)
+}
+
+fn kind(g: &Geometry<f64>) -> &'static str {
+    match g {
+        Geometry::Point(_) => "point",
+        Geometry::MultiPoint(_) => "multipoint",
+        Geometry::Line(_) | Geometry::LineString(_) => "line",
+        Geometry::MultiLineString(_) => "multilinestring",
+        Geometry::Polygon(_) => "polygon",
+        Geometry::MultiPolygon(_) => "multipolygon",
+        Geometry::GeometryCollection(_) => "geometry collection",
+        Geometry::Rect(_) => "rectangle",
+        Geometry::Triangle(_) => "triangle",
+    }
+}
+
+/// The polygon parts of a feature's geometry, normalised and checked, or
+/// what becomes of the feature instead (rejected, or filtered by
+/// `min_area`).
+pub fn prepare(
+    geom: Option<&Geometry<f64>>,
+    params: &PrepareParams,
+) -> Result<Vec<PreparedPolygon>, NotPrepared> {
+    let parts = polygon_parts(geom).map_err(NotPrepared::Rejected)?;
+    let parts: Vec<Polygon<f64>> = parts
+        .into_iter()
+        .filter(|p| params.min_area <= 0.0 || p.unsigned_area() >= params.min_area)
+        .collect();
+    if parts.is_empty() {
+        return Err(NotPrepared::Filtered);
+    }
+    let vertices: usize = parts
+        .iter()
+        .map(|p| p.exterior().0.len() + p.interiors().iter().map(|r| r.0.len()).sum::<usize>())
+        .sum();
+    if params.max_vertices > 0 && vertices > params.max_vertices {
+        return Err(NotPrepared::Rejected(format!(
+            "the polygon has {vertices} vertices, more than `prepare.max_vertices` = {}; raise it, or simplify the polygon first",
+            params.max_vertices
+        )));
+    }
+    let mut prepared = Vec::with_capacity(parts.len());
+    for (i, p) in parts.iter().enumerate() {
+        match PreparedPolygon::new(p) {
+            Ok(pp) => prepared.push(pp),
+            Err(e) => return Err(NotPrepared::Rejected(part_reason(i, parts.len(), &e))),
+        }
+    }
+    if let Some(reason) = invalidity(&prepared, params.make_valid) {
+        return Err(NotPrepared::Rejected(reason));
+    }
+    Ok(prepared)
+}
+
+/// A reason for polygon part `i` of `n`: prefixed with the part when there
+/// is more than one.
+pub(crate) fn part_reason(i: usize, n: usize, reason: &dyn std::fmt::Display) -> String {
+    if n > 1 {
+        format!("part {i}: {reason}")
+    } else {
+        reason.to_string()
+    }
+}
+
+/// The reason a prepared polygon is invalid, if it is (self-intersection,
+/// crossing or touching rings, holes outside the shell). The fix suggested
+/// depends on whether `make_valid` already ran.
+fn invalidity(parts: &[PreparedPolygon], make_valid: bool) -> Option<String> {
+    let fix = if make_valid {
+        "GDAL's MakeValid left it so; repair the source geometry"
+    } else {
+        "enable `prepare: { make_valid: true }` to repair it"
+    };
+    parts.iter().enumerate().find_map(|(i, p)| {
+        crate::geometry::validity::problem(p)
+            .map(|err| part_reason(i, parts.len(), &format!("invalid polygon: {err}; {fix}")))
+    })
+}

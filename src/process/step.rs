@@ -1,0 +1,132 @@
+//! Steps registered beside the built-in ones: a step is one [`StepEntry`] —
+//! its name, its place in the step order, its options (parsed from the
+//! pipeline file by its own `build`), the layers it writes
+//! ([`StepLayer`]s, declared next to its code) — and a [`FeatureStep`] that
+//! turns each feature's outcome into rows of those layers. Parsing
+//! (`config::load_with`), validation, the output plan, the writer, the
+//! Python table and `skeletonise methods` follow from the entry, as a
+//! method follows from its `MethodEntry`.
+//!
+//! ```
+//! use skeletonise::output::{Cell, ColumnType, GeometryKind, StepLayer, StepRow};
+//! use skeletonise::process::step::{FeatureStep, StepEntry, StepInput, StepRegistry};
+//!
+//! /// Writes each feature's number of polygon parts.
+//! #[derive(Debug)]
+//! struct Parts;
+//!
+//! impl FeatureStep for Parts {
+//!     fn rows(&self, input: &StepInput<'_>) -> Vec<(&'static str, StepRow)> {
+//!         let cells = vec![Cell::Int(input.parts.len() as i64)];
+//!         vec![("parts", StepRow { geometry: None, cells })]
+//!     }
+//! }
+//!
+//! const LAYERS: &[StepLayer] = &[StepLayer {
+//!     name: "parts",
+//!     geometry: GeometryKind::None,
+//!     attributes: false,
+//!     columns: &[("parts", ColumnType::Int32)],
+//! }];
+//!
+//! let registry = StepRegistry::builtin().with(StepEntry {
+//!     name: "parts",
+//!     after: "select",
+//!     description: "the number of polygon parts of every feature",
+//!     options: &[],
+//!     layers: LAYERS,
+//!     build: |_| Ok(std::sync::Arc::new(Parts)),
+//! });
+//! assert!(registry.get("parts").is_some());
+//! ```
+
+use super::FeatureOutcome;
+use crate::geometry::PreparedPolygon;
+use crate::layer::{StepLayer, StepRow};
+use std::sync::Arc;
+
+/// What a registered step sees of one feature (or one polygon part with
+/// `explode`): its prepared polygon parts and the outcome of the steps
+/// before it (every method's candidate, the chosen one, collapse, legs).
+#[derive(Debug, Clone, Copy)]
+pub struct StepInput<'a> {
+    /// The polygon parts, normalised.
+    pub parts: &'a [PreparedPolygon],
+    /// The outcome so far.
+    pub outcome: &'a FeatureOutcome,
+}
+
+/// A registered step's work on one feature: rows of its own layers, each
+/// with the layer's name.
+pub trait FeatureStep: Send + Sync + std::fmt::Debug + std::panic::RefUnwindSafe {
+    /// The rows of the step's layers for one feature.
+    fn rows(&self, input: &StepInput<'_>) -> Vec<(&'static str, StepRow)>;
+}
+
+/// Why a step's options are wrong: the key within the step and what to do.
+pub type OptionError = (String, String);
+
+/// One registered step.
+#[derive(Debug, Clone, Copy)]
+pub struct StepEntry {
+    /// Its key in the pipeline file's `steps`.
+    pub name: &'static str,
+    /// The built-in step it runs after (its place in `Step::ORDER`).
+    pub after: &'static str,
+    /// One line for `skeletonise methods`.
+    pub description: &'static str,
+    /// Its options: name and meaning, for `skeletonise methods`.
+    pub options: &'static [(&'static str, &'static str)],
+    /// The layers it writes.
+    pub layers: &'static [StepLayer],
+    /// The step from its options (the YAML mapping under its key, as JSON).
+    pub build: fn(&serde_json::Value) -> Result<Arc<dyn FeatureStep>, OptionError>,
+}
+
+/// The registered steps (none are built in yet: the built-in steps are the
+/// variants of `config::Step`).
+#[derive(Debug, Clone, Default)]
+pub struct StepRegistry {
+    entries: Vec<StepEntry>,
+}
+
+impl StepRegistry {
+    /// The steps every pipeline file may use.
+    pub fn builtin() -> Self {
+        Self::default()
+    }
+
+    /// This registry and `entry`.
+    pub fn with(mut self, entry: StepEntry) -> Self {
+        self.entries.retain(|e| e.name != entry.name);
+        self.entries.push(entry);
+        self
+    }
+
+    /// The entry of step `name`.
+    pub fn get(&self, name: &str) -> Option<&StepEntry> {
+        self.entries.iter().find(|e| e.name == name)
+    }
+
+    /// Every entry.
+    pub fn entries(&self) -> &[StepEntry] {
+        &self.entries
+    }
+}
+
+/// A registered step of a pipeline: its entry, its options and the step.
+#[derive(Debug, Clone)]
+pub struct Extra {
+    /// The entry.
+    pub entry: StepEntry,
+    /// The options as written.
+    pub options: serde_json::Value,
+    /// The step.
+    pub step: Arc<dyn FeatureStep>,
+}
+
+impl PartialEq for Extra {
+    fn eq(&self, other: &Self) -> bool {
+        self.entry.name == other.entry.name && self.options == other.options
+    }
+}

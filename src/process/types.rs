@@ -1,0 +1,143 @@
+//! The per-feature path's data: its parameters (the pipeline's steps), one
+//! method's candidate, a feature's outcome.
+
+use super::prepare::PrepareParams;
+use crate::collapse::{CollapseParams, PartCollapse};
+use crate::connect;
+use crate::graph::extend::ExtendParams;
+use crate::graph::prune::PruneParams;
+use crate::methods::medial_axis::MatSegment;
+use crate::methods::{MethodId, Registry, SkeletonParams};
+use crate::score::select::SelectParams;
+use crate::score::{Bar, ScoreParams, Scores};
+use geo::MultiLineString;
+
+pub use crate::clock::StageTimes;
+
+/// Everything the per-feature work needs: the steps of the pipeline.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ProcessParams {
+    /// `prepare` step.
+    pub prepare: PrepareParams,
+    /// `skeleton` step.
+    pub skeleton: SkeletonParams,
+    /// `prune` step, when present.
+    pub prune: Option<PruneParams>,
+    /// `extend` step, when present.
+    pub extend: Option<ExtendParams>,
+    /// `collapse` step, when present: the chosen skeleton collapses the
+    /// polygon where it is narrow.
+    pub collapse: Option<CollapseParams>,
+    /// `input.connect`: the line network the chosen skeleton gets legs to.
+    pub connect: Option<std::sync::Arc<connect::Network>>,
+    /// `score` step, when present.
+    pub score: Option<ScoreParams>,
+    /// `select` step, when present.
+    pub select: Option<SelectParams>,
+    /// Keep every bar (for the diagnostic `bars` layer).
+    pub keep_bars: bool,
+    /// Keep the local widths of the skeleton (for the `widths` layer).
+    pub keep_widths: bool,
+    /// The local width at every vertex of the written lines (M values,
+    /// `output.measures: width`).
+    pub keep_measures: bool,
+    /// The methods `skeleton.methods` may name.
+    pub registry: Registry,
+    /// Registered steps, in the pipeline's order.
+    pub extra: Vec<super::step::Extra>,
+}
+
+impl ProcessParams {
+    /// Every step with its defaults, as a pipeline file that lists
+    /// `prepare`, `skeleton`, `prune`, `extend`, `score` and `select` with
+    /// no options runs them.
+    pub fn all_steps() -> Self {
+        Self {
+            prune: Some(PruneParams::default()),
+            extend: Some(ExtendParams::default()),
+            score: Some(ScoreParams::default()),
+            select: Some(SelectParams::default()),
+            ..Self::default()
+        }
+    }
+}
+
+/// One method's result for one feature.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Candidate {
+    /// The method.
+    pub method: MethodId,
+    /// The skeleton, or why the method failed on this feature.
+    pub result: Result<CandidateSkeleton, String>,
+    /// How long each step took for this method.
+    pub time: StageTimes,
+}
+
+/// A successful skeleton of one feature (all its polygon parts).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CandidateSkeleton {
+    /// The final skeleton (after pruning and extension).
+    pub geometry: MultiLineString<f64>,
+    /// The paper's metrics, when the pipeline scores.
+    pub scores: Option<Scores>,
+    /// Connected components of the final skeleton (summed over parts).
+    pub components: usize,
+    /// Legs of the raw skeleton, before pruning.
+    pub legs_raw: usize,
+    /// Legs after pruning and extension.
+    pub legs: usize,
+    /// Bars, when requested (`part` indices are unique across polygon parts).
+    pub bars: Vec<Bar>,
+    /// The skeleton's segments with the disc radius at both ends (the medial
+    /// axis transform for MA), when requested.
+    pub widths: Vec<MatSegment>,
+    /// The finished skeleton graph of every polygon part, when the pipeline
+    /// collapses (the `collapse` step works on graphs).
+    pub graphs: Vec<crate::graph::SkeletonGraph>,
+    /// Something the scores alone do not tell (e.g. a given skeleton that
+    /// leaves its polygon), for the row's `note`.
+    pub note: Option<String>,
+}
+
+/// What the pipeline writes for one feature.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FeatureOutcome {
+    /// Every method's candidate, in `methods` order.
+    pub candidates: Vec<Candidate>,
+    /// Index of the chosen candidate.
+    pub chosen: usize,
+    /// Polygon parts skeletonised.
+    pub parts: usize,
+    /// The chosen skeleton's collapse, part by part, when the pipeline has a
+    /// `collapse` step.
+    pub collapse: Option<Vec<PartCollapse>>,
+    /// The legs added to the chosen skeleton for `input.connect`.
+    pub connections: Vec<connect::ConnectionLeg>,
+    /// With `output.measures: width`: the local width at every vertex of the
+    /// chosen skeleton, line by line.
+    pub measures: Option<Vec<Vec<f64>>>,
+    /// Rows of the registered steps' layers, each with its layer's name.
+    pub extra: Vec<(&'static str, crate::layer::StepRow)>,
+}
+
+impl FeatureOutcome {
+    /// The chosen candidate's skeleton.
+    pub fn chosen(&self) -> (&MethodId, &CandidateSkeleton) {
+        let c = &self.candidates[self.chosen];
+        (
+            &c.method,
+            c.result.as_ref().expect("the chosen candidate succeeded"),
+        )
+    }
+}
+
+/// Result of processing one feature.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Processed {
+    /// Skeletonised.
+    Done(FeatureOutcome),
+    /// Skipped by `min_area` (counted as filtered, not rejected).
+    Filtered,
+    /// Could not be processed; the reason goes to the `rejected` layer.
+    Rejected(String),
+}
