@@ -116,6 +116,60 @@ impl Stopwatch {
     }
 }
 
+/// A step of a method's work on one polygon, as [`StageTimes`] counts it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stage {
+    /// The raw skeleton.
+    Skeleton,
+    /// Pruning and extension (and the shared structure, or conforming to it).
+    Prune,
+    /// Bars, hits, sides and metrics.
+    Score,
+}
+
+/// The recorder of a method's stage times on one polygon: the work is done
+/// in closures it times (`stages.time(Stage::Prune, || …)`), so that what
+/// is computed reads apart from how long it took.
+#[derive(Debug, Clone, Copy)]
+pub struct Stages {
+    cpu: bool,
+    times: StageTimes,
+}
+
+impl Stages {
+    /// An empty record, timed on the thread's CPU clock when `cpu` (a
+    /// feature split between threads), else on the wall clock (scaled for
+    /// the feature afterwards: [`Stopwatch::scale`]).
+    pub fn new(cpu: bool) -> Self {
+        Self {
+            cpu,
+            times: StageTimes::default(),
+        }
+    }
+
+    /// Runs `f`, adding the time it took to `stage`.
+    pub fn time<T>(&mut self, stage: Stage, f: impl FnOnce() -> T) -> T {
+        let watch = Stopwatch::start(self.cpu);
+        let out = f();
+        self.add(stage, watch.elapsed());
+        out
+    }
+
+    /// Adds `d` to `stage` (time taken elsewhere for this method).
+    pub fn add(&mut self, stage: Stage, d: Duration) {
+        match stage {
+            Stage::Skeleton => self.times.skeleton += d,
+            Stage::Prune => self.times.prune_extend += d,
+            Stage::Score => self.times.score += d,
+        }
+    }
+
+    /// What was recorded.
+    pub fn times(&self) -> StageTimes {
+        self.times
+    }
+}
+
 /// CPU time the calling thread has used (zero where the clock is missing).
 fn thread_cpu_time() -> Duration {
     let mut t = libc::timespec {

@@ -3,7 +3,7 @@
 //! scores, bars and widths.
 
 use super::{part_reason, CandidateSkeleton, ProcessParams, StageTimes};
-use crate::clock::{CpuClock, Stopwatch};
+use crate::clock::{CpuClock, Stage, Stages, Stopwatch};
 use crate::geometry::PreparedPolygon;
 use crate::graph::extend::prune_and_extend;
 use crate::graph::SkeletonGraph;
@@ -152,105 +152,180 @@ pub(super) struct PartSkeleton {
 }
 
 /// Every method's finished skeleton of one polygon part, in `methods`
-/// order: raw skeletons in parallel, then the reference pruned and extended,
-/// then the others pruned to its structure (or each on its own). With each
-/// result, the time its skeleton and its pruning took.
+/// order, as the SPEC sequences them: the raw skeletons, then the
+/// reference's pruned and extended skeleton (the structure every method
+/// shares), then the others conformed to it (or each finished on its own).
+/// With each result, the time its skeleton and its pruning took.
 pub(super) fn part_skeletons(
     p: &PreparedPolygon,
     params: &ProcessParams,
     parallel: bool,
 ) -> Vec<(Result<PartSkeleton, String>, StageTimes)> {
-    use crate::graph::prune::{PruneMode, Structure as Sharing};
-    use crate::graph::structure::{conform, Structure};
-    let methods = &params.skeleton.methods;
-    let finish = |raw: &crate::graph::SkeletonGraph| {
-        prune_and_extend(raw, p, params.prune.as_ref(), params.extend.as_ref())
-    };
-    let shared = params
-        .prune
-        .filter(|pr| pr.mode != PruneMode::None && pr.structure == Sharing::Shared);
-    let trunk = params.prune.is_some_and(|pr| pr.mode == PruneMode::Trunk);
-    // The reference: the first method in the reference order whose finished
-    // skeleton is not empty (a polygon thinner than MA's grid has no medial
-    // axis). The first listed one is finished in its own task, as soon as
-    // its raw skeleton is there, while the other methods' are still being
-    // made (the others wait for the structure; on one huge polygon this
-    // keeps both cores busy).
-    // One method has no other to share its structure with: it is finished on
-    // its own (the same skeleton as its reference path would give).
-    let shared = shared.filter(|_| methods.len() > 1);
-    let order: Vec<usize> = shared.map_or_else(Vec::new, |_| {
-        params
-            .skeleton
-            .reference_order()
-            .into_iter()
-            .filter_map(|m| methods.iter().position(|&x| x == m))
-            .collect()
-    });
-    let reference_of = |k: usize, raw: &crate::graph::SkeletonGraph| {
-        let g = finish(raw);
-        (!g.is_empty()).then(|| (k, Structure::of(&g, p, trunk), g))
-    };
-    type Reference = Option<(usize, Structure, crate::graph::SkeletonGraph)>;
-    let raws: Vec<(
-        Result<crate::graph::SkeletonGraph, String>,
-        StageTimes,
-        Reference,
-    )> = super::map_in_order(methods, parallel, |k, &m| {
-        let mut clock = Stopwatch::start(parallel);
-        let raw = params
-            .registry
-            .build(m, &params.skeleton)
-            .and_then(|method| {
-                guarded(m, || {
-                    crate::methods::budget::with_budget(m, params.skeleton.budget(), || {
-                        method.skeletonise(p)
+    let work = PartWork::new(p, params, parallel);
+    let mut raws = work.raw_skeletons();
+    let reference = work.reference(&mut raws);
+    work.conformed(raws, reference.as_ref())
+}
+
+/// The reference's index among the methods, its structure and its finished
+/// skeleton.
+type Reference = (usize, crate::graph::structure::Structure, SkeletonGraph);
+
+/// One method's raw skeleton of a polygon part, the time taken so far, and
+/// (for the first method of the reference order) its finished skeleton.
+struct Raw {
+    graph: Result<SkeletonGraph, String>,
+    stages: Stages,
+    reference: Option<Reference>,
+}
+
+/// The work on one polygon part: the polygon, the steps, whether its work
+/// is split between threads, and the methods in the order they are tried as
+/// the reference (empty when the structure is not shared).
+struct PartWork<'a> {
+    p: &'a PreparedPolygon,
+    params: &'a ProcessParams,
+    parallel: bool,
+    order: Vec<usize>,
+    trunk: bool,
+}
+
+impl<'a> PartWork<'a> {
+    fn new(p: &'a PreparedPolygon, params: &'a ProcessParams, parallel: bool) -> Self {
+        use crate::graph::prune::{PruneMode, Structure as Sharing};
+        let methods = &params.skeleton.methods;
+        // One method has no other to share its structure with: it is
+        // finished on its own (the same skeleton as its reference path).
+        let shared = params
+            .prune
+            .filter(|pr| pr.mode != PruneMode::None && pr.structure == Sharing::Shared)
+            .filter(|_| methods.len() > 1);
+        let order = shared.map_or_else(Vec::new, |_| {
+            params
+                .skeleton
+                .reference_order()
+                .into_iter()
+                .filter_map(|m| methods.iter().position(|&x| x == m))
+                .collect()
+        });
+        Self {
+            p,
+            params,
+            parallel,
+            order,
+            trunk: params.prune.is_some_and(|pr| pr.mode == PruneMode::Trunk),
+        }
+    }
+
+    /// A raw skeleton pruned and extended on its own.
+    fn finish(&self, raw: &SkeletonGraph) -> SkeletonGraph {
+        prune_and_extend(
+            raw,
+            self.p,
+            self.params.prune.as_ref(),
+            self.params.extend.as_ref(),
+        )
+    }
+
+    /// Method `k`'s finished skeleton as the reference, when not empty (a
+    /// polygon thinner than MA's grid has no medial axis).
+    fn reference_of(&self, k: usize, raw: &SkeletonGraph) -> Option<Reference> {
+        let g = self.finish(raw);
+        (!g.is_empty()).then(|| {
+            (
+                k,
+                crate::graph::structure::Structure::of(&g, self.p, self.trunk),
+                g,
+            )
+        })
+    }
+
+    /// Every method's raw skeleton. The first of the reference order is
+    /// finished in its own task as soon as its raw skeleton is there, while
+    /// the other methods' are still being made (on one huge polygon this
+    /// keeps both cores busy).
+    fn raw_skeletons(&self) -> Vec<Raw> {
+        let methods = &self.params.skeleton.methods;
+        super::map_in_order(methods, self.parallel, |k, &m| {
+            let mut stages = Stages::new(self.parallel);
+            let graph = stages.time(Stage::Skeleton, || {
+                self.params
+                    .registry
+                    .build(m, &self.params.skeleton)
+                    .and_then(|method| {
+                        guarded(m, || {
+                            crate::methods::budget::with_budget(
+                                m,
+                                self.params.skeleton.budget(),
+                                || method.skeletonise(self.p),
+                            )
+                            .map_err(|e| e.to_string())
+                        })
                     })
-                    .map_err(|e| e.to_string())
+            });
+            let reference = match &graph {
+                Ok(g) if self.order.first() == Some(&k) => {
+                    stages.time(Stage::Prune, || self.reference_of(k, g))
+                }
+                _ => None,
+            };
+            Raw {
+                graph,
+                stages,
+                reference,
+            }
+        })
+    }
+
+    /// The reference: the first method in the reference order whose
+    /// finished skeleton is not empty (the first one's was finished with
+    /// its raw skeleton; the others are tried in turn, their time theirs).
+    fn reference(&self, raws: &mut [Raw]) -> Option<Reference> {
+        if let Some(r) = raws.iter_mut().find_map(|r| r.reference.take()) {
+            return Some(r);
+        }
+        for &k in self.order.iter().skip(1) {
+            let Ok(raw) = &raws[k].graph else { continue };
+            let mut stages = Stages::new(self.parallel);
+            let r = stages.time(Stage::Prune, || self.reference_of(k, raw));
+            raws[k]
+                .stages
+                .add(Stage::Prune, stages.times().prune_extend);
+            if r.is_some() {
+                return r;
+            }
+        }
+        None
+    }
+
+    /// Every method's finished skeleton: the reference's own, the others
+    /// conformed to its structure (or, with no structure to share, each
+    /// pruned and extended on its own).
+    fn conformed(
+        &self,
+        raws: Vec<Raw>,
+        reference: Option<&Reference>,
+    ) -> Vec<(Result<PartSkeleton, String>, StageTimes)> {
+        let methods = &self.params.skeleton.methods;
+        super::map_in_order(&raws, self.parallel, |k, raw| {
+            let mut stages = raw.stages;
+            let result = stages.time(Stage::Prune, || {
+                let g = raw.graph.as_ref().map_err(Clone::clone)?;
+                let finished = guarded(methods[k], || {
+                    Ok(match reference {
+                        Some((r, _, g)) if *r == k => g.clone(),
+                        Some((_, s, _)) => crate::graph::structure::conform(g, s, self.p),
+                        None => self.finish(g),
+                    })
+                })?;
+                Ok(PartSkeleton {
+                    graph: finished,
+                    legs_raw: g.leg_count(),
                 })
             });
-        let mut time = StageTimes {
-            skeleton: clock.lap(),
-            ..StageTimes::default()
-        };
-        let reference = match &raw {
-            Ok(g) if order.first() == Some(&k) => reference_of(k, g),
-            _ => None,
-        };
-        time.prune_extend = clock.lap();
-        (raw, time, reference)
-    });
-    let mut reference_time = vec![std::time::Duration::ZERO; methods.len()];
-    let first = raws.iter().find_map(|r| r.2.as_ref());
-    let fallback = match first {
-        Some(_) => None,
-        None => order.iter().skip(1).find_map(|&k| {
-            let clock = Stopwatch::start(parallel);
-            let found = reference_of(k, raws[k].0.as_ref().ok()?);
-            reference_time[k] += clock.elapsed();
-            found
-        }),
-    };
-    let structure = first.or(fallback.as_ref());
-    super::map_in_order(&raws, parallel, |k, (raw, time, _)| {
-        let clock = Stopwatch::start(parallel);
-        let result = raw.as_ref().map_err(Clone::clone).and_then(|raw| {
-            let g = guarded(methods[k], || {
-                Ok(match structure {
-                    Some((r, _, g)) if *r == k => g.clone(),
-                    Some((_, s, _)) => conform(raw, s, p),
-                    None => finish(raw),
-                })
-            })?;
-            Ok(PartSkeleton {
-                graph: g,
-                legs_raw: raw.leg_count(),
-            })
-        });
-        let mut time = *time;
-        time.prune_extend += reference_time[k] + clock.elapsed();
-        (result, time)
-    })
+            (result, stages.times())
+        })
+    }
 }
 
 /// Runs one method's work on one polygon; a panic (a bug, which must never
