@@ -1,0 +1,170 @@
+//! The reader thread: the source opened on its own thread, its features in
+//! batches (every one first, dissolved, with `input.merge_adjacent`), and
+//! the line network of `input.connect`.
+
+use super::{Batch, RunError};
+use crate::config::InputSpec;
+use crate::io::reader::Reader;
+use crate::io::{IoError, SourceInfo};
+use std::sync::mpsc;
+
+/// The reader thread: opens the source, sends what it holds, then its
+/// features batch by batch until the source ends, an error, or nobody
+/// listens any more.
+pub(super) fn read_batches(
+    input: &InputSpec,
+    batch: usize,
+    make_valid: bool,
+    info_tx: mpsc::SyncSender<Result<SourceInfo, IoError>>,
+    batch_tx: mpsc::SyncSender<Batch>,
+) {
+    let mut reader = match Reader::open(input) {
+        Ok(r) => r,
+        Err(e) => {
+            let _ = info_tx.send(Err(e));
+            return;
+        }
+    };
+    if info_tx.send(Ok(reader.info().clone())).is_err() {
+        return;
+    }
+    if input.merge_adjacent {
+        return read_merged(&mut reader, input, batch, make_valid, batch_tx);
+    }
+    let r = reader.read::<Stop>(batch, make_valid, |features| {
+        batch_tx.send(Ok(features)).map_err(|_| Stop::Gone)
+    });
+    if let Err(Stop::Failed(e)) = r {
+        let _ = batch_tx.send(Err(e));
+    }
+}
+
+/// The index of `input.merge_by` among the source's fields, or the error
+/// naming the fields there are.
+pub(super) fn merge_field(input: &InputSpec, info: &SourceInfo) -> Result<Option<usize>, IoError> {
+    let Some(name) = &input.merge_by else {
+        return Ok(None);
+    };
+    let fields = &info.fields;
+    fields
+        .iter()
+        .position(|f| &f.name == name)
+        .map(Some)
+        .ok_or_else(|| {
+            let names: Vec<&str> = fields.iter().map(|f| f.name.as_str()).collect();
+            IoError::Read {
+                source_name: input.source.clone(),
+                reason: format!(
+                    "`input.merge_by`: the layer has no field `{name}`; its fields are {}",
+                    names.join(", ")
+                ),
+            }
+        })
+}
+
+/// The lines of `input.connect`, reprojected to the CRS the polygons are
+/// handed out in (`polygons`); a layer without lines is an error.
+pub(super) fn read_network(
+    c: &crate::config::ConnectSpec,
+    polygons: &SourceInfo,
+) -> Result<crate::connect::Network, RunError> {
+    let mut reader =
+        Reader::open(&c.input(polygons.srs_wkt.as_deref())).map_err(|e| connect_error(c, e))?;
+    let mut lines = Vec::new();
+    let mut features = 0;
+    reader.read::<IoError>(1024, false, |batch| {
+        features += batch.len();
+        for f in batch {
+            let mut ls = Vec::new();
+            if let Some(g) = &f.geometry {
+                crate::connect::lines_of(g, &mut ls);
+            }
+            lines.extend(ls.into_iter().map(|l| (f.fid, l)));
+        }
+        Ok(())
+    })?;
+    if lines.is_empty() {
+        return Err(no_lines(c, reader.info(), features));
+    }
+    tracing::info!(source = %c.source, layer = %reader.info().layer, crs = %reader.info().crs_name, lines = lines.len(), "connect: line network read");
+    Ok(crate::connect::Network::new(lines, c.snap))
+}
+
+/// An error opening `input.connect`, said to be about it.
+pub(super) fn connect_error(c: &crate::config::ConnectSpec, e: IoError) -> RunError {
+    RunError::Io(IoError::Read {
+        source_name: c.source.clone(),
+        reason: format!("`input.connect`: {e}"),
+    })
+}
+
+/// The error of a connect layer without lines.
+pub(super) fn no_lines(
+    c: &crate::config::ConnectSpec,
+    info: &SourceInfo,
+    features: usize,
+) -> RunError {
+    RunError::Io(IoError::Read {
+        source_name: c.source.clone(),
+        reason: format!(
+            "`input.connect`: layer `{}` has no lines ({features} features read, none a LINESTRING or MULTILINESTRING); give the layer of the line network (`input.connect.layer`)",
+            info.layer
+        ),
+    })
+}
+
+/// `input.merge_adjacent`: every feature read first, the adjacent ones
+/// dissolved into one per group, then sent in batches.
+fn read_merged(
+    reader: &mut Reader,
+    input: &InputSpec,
+    batch: usize,
+    make_valid: bool,
+    batch_tx: mpsc::SyncSender<Batch>,
+) {
+    let by = match merge_field(input, reader.info()) {
+        Ok(by) => by,
+        Err(e) => {
+            let _ = batch_tx.send(Err(e));
+            return;
+        }
+    };
+    let mut all = Vec::new();
+    let r = reader.read::<Stop>(batch, make_valid, |features| {
+        all.extend(features);
+        Ok(())
+    });
+    if let Err(Stop::Failed(e)) = r {
+        let _ = batch_tx.send(Err(e));
+        return;
+    }
+    let merged = crate::process::merge::merge_adjacent(all, by);
+    for chunk in merged.chunks(batch) {
+        if batch_tx.send(Ok(chunk.to_vec())).is_err() {
+            return;
+        }
+    }
+}
+
+/// Why the reader thread stops before the end of the source.
+enum Stop {
+    /// Nobody takes batches any more (the run stopped).
+    Gone,
+    /// Reading failed.
+    Failed(IoError),
+}
+
+impl From<IoError> for Stop {
+    fn from(e: IoError) -> Self {
+        Stop::Failed(e)
+    }
+}
+
+/// The reader thread ended without a word: it panicked.
+pub(super) fn reader_gone(reader: std::thread::ScopedJoinHandle<'_, ()>) -> RunError {
+    let _ = reader.join();
+    RunError::Io(IoError::Output {
+        path: String::new(),
+        reason: "the reader thread failed with an internal error; please report it".into(),
+    })
+}
