@@ -46,16 +46,6 @@ impl CpuClock {
     pub fn elapsed(&self) -> Duration {
         thread_cpu_time().saturating_sub(self.0)
     }
-
-    /// CPU time since the start or the last lap, and a new lap starts: one
-    /// reading of the clock per stage (a reading is a system call that takes
-    /// a lock; on a small polygon they add up to several per cent of a run).
-    pub fn lap(&mut self) -> Duration {
-        let now = thread_cpu_time();
-        let lap = now.saturating_sub(self.0);
-        self.0 = now;
-        lap
-    }
 }
 
 /// The stopwatch of a feature's stages. A feature split between threads
@@ -92,19 +82,6 @@ impl Stopwatch {
         }
     }
 
-    /// Time since the start or the last lap, and a new lap starts.
-    pub fn lap(&mut self) -> Duration {
-        match self {
-            Self::Cpu(c) => c.lap(),
-            Self::Wall(w) => {
-                let now = std::time::Instant::now();
-                let lap = now.saturating_duration_since(*w);
-                *w = now;
-                lap
-            }
-        }
-    }
-
     /// The factor that turns wall-clock stage times of one thread into CPU
     /// time: `cpu` (the thread's CPU time over the whole feature) over
     /// `wall` (its wall time), at most 1.
@@ -123,8 +100,6 @@ pub enum Stage {
     Skeleton,
     /// Pruning and extension (and the shared structure, or conforming to it).
     Prune,
-    /// Bars, hits, sides and metrics.
-    Score,
 }
 
 /// The recorder of a method's stage times on one polygon: the work is done
@@ -160,7 +135,6 @@ impl Stages {
         match stage {
             Stage::Skeleton => self.times.skeleton += d,
             Stage::Prune => self.times.prune_extend += d,
-            Stage::Score => self.times.score += d,
         }
     }
 
@@ -206,38 +180,33 @@ mod tests {
     }
 
     #[test]
-    fn laps_add_up_to_the_elapsed_time() {
-        // Busy until this thread has used `d` of CPU time since `from`.
-        let spin = |from: CpuClock, d: Duration| {
+    fn the_recorder_counts_each_stage_and_not_the_time_between() {
+        // Busy until this thread has used `d` of CPU time.
+        let spin = |d: Duration| {
+            let from = CpuClock::start();
             let mut x = 0u64;
             while from.elapsed() < d {
                 x = x.wrapping_add(std::hint::black_box(1));
             }
             x
         };
-        let start = CpuClock::start();
-        let mut lap = start;
-        assert!(spin(start, Duration::from_millis(20)) > 0);
-        let first = lap.lap();
+        let mut stages = Stages::new(true);
+        assert!(stages.time(Stage::Skeleton, || spin(Duration::from_millis(20))) > 0);
         std::thread::sleep(Duration::from_millis(30));
-        let idle = lap.lap();
-        assert!(spin(lap, Duration::from_millis(10)) > 0);
-        let third = lap.lap();
-        let total = start.elapsed();
-        assert!(first >= Duration::from_millis(20) && idle < Duration::from_millis(10));
-        assert!(third >= Duration::from_millis(10));
-        assert!(
-            first + idle + third <= total
-                && total - (first + idle + third) < Duration::from_millis(5)
-        );
+        assert!(stages.time(Stage::Prune, || spin(Duration::from_millis(10))) > 0);
+        stages.add(Stage::Prune, Duration::from_millis(5));
+        let t = stages.times();
+        assert!(t.skeleton >= Duration::from_millis(20) && t.skeleton < Duration::from_millis(30));
+        assert!(t.prune_extend >= Duration::from_millis(15));
+        assert_eq!(t.score, Duration::ZERO);
     }
 
     #[test]
     fn a_wall_stopwatch_counts_sleep_and_the_scale_takes_it_out() {
         let cpu = CpuClock::start();
-        let mut wall = Stopwatch::start(false);
+        let wall = Stopwatch::start(false);
         std::thread::sleep(Duration::from_millis(30));
-        let slept = wall.lap();
+        let slept = wall.elapsed();
         let c = cpu.elapsed();
         assert!(slept >= Duration::from_millis(30) && c < Duration::from_millis(10));
         let k = Stopwatch::scale(c, slept);

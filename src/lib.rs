@@ -17,9 +17,34 @@
 //! without GDAL, for bindings and distributed engines that bring their own
 //! I/O.
 
+//! ## Quick start
+//!
+//! One polygon through every step, as the command line's per-feature path
+//! runs it: the medial axis of a 100 × 10 strip is its centre line, and it
+//! scores a distortion of zero.
+//!
+//! ```
+//! use geo::{polygon, Geometry};
+//! use skeletonise::process::{process, ProcessParams, Processed};
+//!
+//! let strip = Geometry::Polygon(polygon![
+//!     (x: 0., y: 0.), (x: 100., y: 0.), (x: 100., y: 10.), (x: 0., y: 10.)
+//! ]);
+//! let Processed::Done(outcome) = process(Some(&strip), &ProcessParams::all_steps()) else {
+//!     panic!("a strip is skeletonised");
+//! };
+//! let (method, skeleton) = outcome.chosen();
+//! assert_eq!(method.as_str(), "MA");
+//! assert!(skeleton.scores.unwrap().distortion < 1e-9);
+//! ```
+//!
+//! A pipeline file (`config::load`) gives the same parameters, and
+//! `pipeline::run` (with the `gdal` feature) reads any OGR source and writes
+//! the GeoPackage.
+
 #![warn(missing_docs)]
 
-pub mod clock;
+pub(crate) mod clock;
 pub mod collapse;
 pub mod config;
 pub mod connect;

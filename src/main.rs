@@ -324,7 +324,7 @@ fn main() -> ExitCode {
     std::panic::set_hook(Box::new(|info| {
         tracing::error!(target: "skeletonise::panic", "internal error: {info}");
     }));
-    if let Err(e) = skeletonise::io::signals::install() {
+    if let Err(e) = skeletonise::io::install_signal_handlers() {
         tracing::warn!(
             "signal handlers not installed ({e}): a killed run may leave its temporary file"
         );

@@ -416,27 +416,10 @@ fn sections(
         .into_iter()
         .map(|r| ((r.src_fid, r.polygon_part), r))
         .collect();
-    let members: HashMap<u64, Vec<u64>> = rows
-        .values()
-        .filter_map(|r| {
-            let list = r.members.as_deref()?;
-            let fids: Vec<u64> = list
-                .split(',')
-                .filter_map(|x| x.trim().parse().ok())
-                .collect();
-            Some((r.src_fid?, fids))
-        })
-        .collect();
-    let (polys, source) = polygons(file, job, keys, &members)?;
+    let (polys, source) = polygons(file, job, keys, &members(&rows))?;
     let stored_bars = file.has_layer(crate::output::BARS.name);
-    let mut bars: HashMap<u64, Vec<BarRow>> = HashMap::new();
-    if stored_bars {
-        for b in file.bars(Some(&filter))? {
-            if let Some(f) = b.src_fid {
-                bars.entry(f).or_default().push(b);
-            }
-        }
-    } else {
+    let bars = stored_bars_of(file, &filter)?;
+    if !stored_bars {
         notes.push("The file has no bars layer: the bars shown were computed from the written skeletons for the features shown (`output.bars: true` writes them for every feature).".into());
     }
     let mut missing = 0;
@@ -475,6 +458,35 @@ fn sections(
         out.par_iter_mut().for_each(compute_bars);
     }
     Ok(out)
+}
+
+/// The members of every merged feature (`input.merge_adjacent`) by its
+/// source FID, from its `members` column.
+fn members(rows: &HashMap<Key, SkeletonRow>) -> HashMap<u64, Vec<u64>> {
+    rows.values()
+        .filter_map(|r| {
+            let list = r.members.as_deref()?;
+            let fids: Vec<u64> = list
+                .split(',')
+                .filter_map(|x| x.trim().parse().ok())
+                .collect();
+            Some((r.src_fid?, fids))
+        })
+        .collect()
+}
+
+/// The stored bars passing `filter` by source FID (none without a bars
+/// layer).
+fn stored_bars_of(file: &OutputFile, filter: &str) -> Result<HashMap<u64, Vec<BarRow>>, IoError> {
+    let mut bars: HashMap<u64, Vec<BarRow>> = HashMap::new();
+    if file.has_layer(crate::output::BARS.name) {
+        for b in file.bars(Some(filter))? {
+            if let Some(f) = b.src_fid {
+                bars.entry(f).or_default().push(b);
+            }
+        }
+    }
+    Ok(bars)
 }
 
 /// Whether the chosen skeleton lies within the polygon's bounding box

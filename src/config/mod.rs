@@ -215,7 +215,7 @@ pub struct StepsFile {
     /// Ignored (the caller brings the data).
     #[serde(default)]
     pub input: Option<InputSpec>,
-    /// Steps, in the order prepare → skeleton → prune → extend → score → select; only `skeleton` is required.
+    /// Steps, in the order prepare → skeleton → prune → extend → collapse → score → select (`Step::ORDER`); only `skeleton` is required.
     pub steps: Vec<Step>,
     /// Only `explode` is used (the caller writes the data).
     #[serde(default)]

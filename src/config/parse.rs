@@ -19,47 +19,14 @@ pub(super) fn parse<T: serde::de::DeserializeOwned + HasSteps>(
     registry: &StepRegistry,
     check: impl Fn(&T) -> Result<(), (String, String)>,
 ) -> Result<T, ConfigError> {
-    // An error in a key that a `--set` gave is the override's, not the file's.
-    let overridden = |key: &str| {
-        let plain = strip_indices(key);
-        overrides.iter().find(|o| {
-            let k = o.split_once('=').map_or(o.as_str(), |(k, _)| k);
-            plain == k || plain.starts_with(&format!("{k}.")) || k.starts_with(&format!("{plain}."))
-        })
+    // The nesting is checked before anything parses the text (the YAML
+    // scanner's time is quadratic in it), the keys located after.
+    let mut value = yaml(text, origin)?;
+    let r = Reading {
+        origin,
+        overrides,
+        locs: Locations::index(text),
     };
-    let err = |position, key: &str, message: String| match overridden(key) {
-        Some(o) if !key.is_empty() => ConfigError {
-            origin: format!("--set {o}"),
-            position: None,
-            key: key.to_string(),
-            message,
-        },
-        _ => ConfigError {
-            origin: origin.to_string(),
-            position,
-            key: key.to_string(),
-            message,
-        },
-    };
-    if let Some((line, column)) = too_deep(text) {
-        return Err(err(
-            Some((line, column)),
-            "",
-            format!("invalid YAML: brackets nested deeper than {MAX_NESTING} levels; a pipeline file needs a handful"),
-        ));
-    }
-    let mut value: Value = serde_yaml_ng::from_str(text).map_err(|e| {
-        let pos = e.location().map(|l| (l.line(), l.column()));
-        err(pos, "", format!("invalid YAML: {e}"))
-    })?;
-    if value.is_null() {
-        return Err(err(
-            None,
-            "",
-            "the pipeline file is empty; see `skeletonise schema` or pipelines/demo.yaml".into(),
-        ));
-    }
-    let locs = Locations::index(text);
     for o in overrides {
         apply_override(&mut value, o, registry).map_err(|m| ConfigError {
             origin: "--set".into(),
@@ -69,43 +36,119 @@ pub(super) fn parse<T: serde::de::DeserializeOwned + HasSteps>(
         })?;
     }
     let mut typed = Typed::new();
-    substitute_env(&mut value, "", &mut typed).map_err(|(k, m)| err(locs.value(&k), &k, m))?;
-    unknown_skeleton_keys(&value).map_err(|(k, m)| err(locs.key(&k), &k, m))?;
-    let extras =
-        take_registered(&mut value, registry).map_err(|(k, m)| err(locs.key(&k), &k, m))?;
-    let file: T = loop {
-        // Enums are written as single-key maps (`prune: {...}`, `densify: {factor: 4}`).
-        let mut track = serde_path_to_error::Track::new();
-        let de = serde_path_to_error::Deserializer::new(value.clone(), &mut track);
-        let parsed: Result<T, _> = serde_yaml_ng::with::singleton_map_recursive::deserialize(de);
-        let e = match parsed {
-            Ok(file) => break file,
-            Err(e) => e,
-        };
-        let key = path_string(&track.path());
-        // A substituted number or boolean where a string does not do.
-        if let Some(t) = typed.remove(&key) {
-            if let Some(slot) = value_at(&mut value, &key) {
-                *slot = t;
-                continue;
-            }
-        }
-        let inner = e.to_string();
-        // Point unknown keys at the key itself.
-        let pos = match unknown_field(&inner) {
-            Some(f) if key.ends_with(&f) => locs.key(&key),
-            Some(f) => locs.key(&locate::join(&key, &f)),
-            None => locs.value(&key),
-        };
-        return Err(err(pos, &key, hint(&inner)));
-    };
-    let mut file = file;
+    substitute_env(&mut value, "", &mut typed).map_err(|(k, m)| r.at_value(&k, m))?;
+    unknown_skeleton_keys(&value).map_err(|(k, m)| r.at_key(&k, m))?;
+    let extras = take_registered(&mut value, registry).map_err(|(k, m)| r.at_key(&k, m))?;
+    let mut file: T = r.deserialize(value, typed)?;
     for (i, extra) in extras {
         let steps = file.steps_mut();
         steps.insert(i.min(steps.len()), Step::Extra(extra));
     }
-    check(&file).map_err(|(k, m)| err(locs.key(&k), &k, m))?;
+    check(&file).map_err(|(k, m)| r.at_key(&k, m))?;
     Ok(file)
+}
+
+/// The text as YAML (not empty, not too deep); `origin` names it in errors.
+fn yaml(text: &str, origin: &str) -> Result<Value, ConfigError> {
+    let error = |position, message: String| ConfigError {
+        origin: origin.to_string(),
+        position,
+        key: String::new(),
+        message,
+    };
+    if let Some(at) = too_deep(text) {
+        return Err(error(
+            Some(at),
+            format!("invalid YAML: brackets nested deeper than {MAX_NESTING} levels; a pipeline file needs a handful"),
+        ));
+    }
+    let value: Value = serde_yaml_ng::from_str(text).map_err(|e| {
+        let pos = e.location().map(|l| (l.line(), l.column()));
+        error(pos, format!("invalid YAML: {e}"))
+    })?;
+    if value.is_null() {
+        return Err(error(
+            None,
+            "the pipeline file is empty; see `skeletonise schema` or pipelines/demo.yaml".into(),
+        ));
+    }
+    Ok(value)
+}
+
+/// A file being read: where it came from, the overrides, where its keys are.
+struct Reading<'a> {
+    origin: &'a str,
+    overrides: &'a [String],
+    locs: Locations,
+}
+
+impl Reading<'_> {
+    /// The error at `position` in key `key`: the override's when a `--set`
+    /// gave the key, else the file's.
+    fn error(&self, position: Option<(usize, usize)>, key: &str, message: String) -> ConfigError {
+        let plain = strip_indices(key);
+        let overridden = self.overrides.iter().find(|o| {
+            let k = o.split_once('=').map_or(o.as_str(), |(k, _)| k);
+            plain == k || plain.starts_with(&format!("{k}.")) || k.starts_with(&format!("{plain}."))
+        });
+        match overridden {
+            Some(o) if !key.is_empty() => ConfigError {
+                origin: format!("--set {o}"),
+                position: None,
+                key: key.to_string(),
+                message,
+            },
+            _ => ConfigError {
+                origin: self.origin.to_string(),
+                position,
+                key: key.to_string(),
+                message,
+            },
+        }
+    }
+
+    /// The error of key `key`, pointing at the key.
+    fn at_key(&self, key: &str, message: String) -> ConfigError {
+        self.error(self.locs.key(key), key, message)
+    }
+
+    /// The error of key `key`, pointing at its value.
+    fn at_value(&self, key: &str, message: String) -> ConfigError {
+        self.error(self.locs.value(key), key, message)
+    }
+
+    /// The value as a `T`; a substituted number or boolean that was kept a
+    /// string is put in as such where the string does not do.
+    fn deserialize<T: serde::de::DeserializeOwned>(
+        &self,
+        mut value: Value,
+        mut typed: Typed,
+    ) -> Result<T, ConfigError> {
+        loop {
+            // Enums are written as single-key maps (`prune: {...}`, `densify: {factor: 4}`).
+            let mut track = serde_path_to_error::Track::new();
+            let de = serde_path_to_error::Deserializer::new(value.clone(), &mut track);
+            let e = match serde_yaml_ng::with::singleton_map_recursive::deserialize(de) {
+                Ok(file) => return Ok(file),
+                Err(e) => e,
+            };
+            let key = path_string(&track.path());
+            if let Some(t) = typed.remove(&key) {
+                if let Some(slot) = value_at(&mut value, &key) {
+                    *slot = t;
+                    continue;
+                }
+            }
+            let inner = e.to_string();
+            // Point unknown keys at the key itself.
+            let pos = match unknown_field(&inner) {
+                Some(f) if key.ends_with(&f) => self.locs.key(&key),
+                Some(f) => self.locs.key(&locate::join(&key, &f)),
+                None => self.locs.value(&key),
+            };
+            return Err(self.error(pos, &key, hint(&inner)));
+        }
+    }
 }
 
 /// A file whose `steps` registered steps are put back into after parsing.
@@ -312,7 +355,7 @@ fn unknown_field(msg: &str) -> Option<String> {
 
 fn hint(msg: &str) -> String {
     if msg.starts_with("unknown variant") && msg.contains("prepare") {
-        format!("{msg}; steps are prepare, skeleton, prune, extend, score, select")
+        format!("{msg}; steps are {}", Step::ORDER.join(", "))
     } else if msg.starts_with("unknown field") {
         format!("{msg}; `skeletonise schema` lists every key")
     } else {

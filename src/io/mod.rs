@@ -7,8 +7,16 @@ pub mod gdal_errors;
 pub mod guard;
 pub mod readback;
 pub mod reader;
-pub mod signals;
+pub(crate) mod signals;
 pub mod writer;
+
+/// Removes the temporary files of the runs in progress on SIGTERM, SIGINT
+/// and SIGHUP, then exits with 128 + the signal (once per process; the
+/// command line calls it at start). Fails only when the handlers cannot be
+/// installed.
+pub fn install_signal_handlers() -> std::io::Result<()> {
+    signals::install()
+}
 
 pub use reader::{read_layer_polygons, FieldInfo, InputSpec, LayerRef, Reader, SourceInfo};
 
