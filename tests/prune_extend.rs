@@ -7,8 +7,9 @@ mod common;
 #[cfg(feature = "gdal")]
 use common::TRAIN;
 use geo::{Coord, LineString, Polygon};
+use skeletonise::geometry::tolerance::SAME_POINT;
 use skeletonise::geometry::PreparedPolygon;
-use skeletonise::graph::extend::{extend, prune_and_extend, ExtendMode, ExtendParams, ON_BOUNDARY};
+use skeletonise::graph::extend::{extend, prune_and_extend, ExtendMode, ExtendParams};
 use skeletonise::graph::planar::crossings;
 use skeletonise::graph::prune::{prune, PruneMode, PruneParams};
 use skeletonise::graph::{GraphBuilder, SkeletonGraph};
@@ -51,7 +52,7 @@ fn is_simple_path(g: &SkeletonGraph) -> bool {
 }
 
 fn assert_leaves_on_boundary(g: &SkeletonGraph, p: &PreparedPolygon, what: &str) {
-    let tol = 10.0 * ON_BOUNDARY * p.extent();
+    let tol = 10.0 * SAME_POINT * p.extent();
     for l in leaves(g) {
         let d = p.boundary().distance(l);
         assert!(d <= tol, "{what}: leaf {l:?} is {d} from the boundary");

@@ -10,7 +10,7 @@ use common::{LAYERS, TRAIN};
 use geo::{Coord, Geometry, LineString, MultiLineString, Polygon};
 #[cfg(feature = "gdal")]
 use rayon::prelude::*;
-use skeletonise::geometry::boundary::closest_on_segment;
+use skeletonise::geometry::segment::closest_on_segment;
 use skeletonise::geometry::PreparedPolygon;
 use skeletonise::graph::planar::crossings;
 use skeletonise::graph::prune::{PruneMode, PruneParams};

@@ -65,7 +65,11 @@ fn the_output_is_never_the_input() {
         "--overwrite",
     ]);
     assert_eq!(code_and_err(&o).0, 1, "{}", out_err(&o));
-    assert!(out_err(&o).contains("it is the polygons source"), "{}", out_err(&o));
+    assert!(
+        out_err(&o).contains("it is the polygons source"),
+        "{}",
+        out_err(&o)
+    );
     assert_eq!(std::fs::read(&input).unwrap(), before, "the input changed");
 }
 

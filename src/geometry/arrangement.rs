@@ -16,7 +16,9 @@
 //! vertex twice; they are split there, so every face is an OGC-valid
 //! polygon: a shell and the holes inside it.
 
-use super::{norm, PreparedPolygon};
+use super::tolerance::{SAME_POINT, VERTEX_SNAP};
+use super::vector::{cross, norm};
+use super::PreparedPolygon;
 use geo::{Coord, LineString, Polygon};
 use rustc_hash::FxHashMap;
 
@@ -89,12 +91,12 @@ impl Graph {
 fn attach(p: &PreparedPolygon, c: Coord<f64>) -> Option<((u32, u32), Coord<f64>)> {
     let b = p.boundary();
     let (_, i, d) = b.nearest(c)?;
-    let tol = 1e-9 * p.extent();
+    let tol = SAME_POINT * p.extent();
     if d > tol {
         return None;
     }
     let s = &b.segments()[i];
-    let snap = 1e-12 * p.extent();
+    let snap = VERTEX_SNAP * p.extent();
     let at = if norm(c - s.a) <= snap {
         s.a
     } else if norm(c - s.b) <= snap {
@@ -320,7 +322,7 @@ fn signed_area(c: &[Coord<f64>]) -> f64 {
     (0..n)
         .map(|i| {
             let (a, b) = (c[i], c[(i + 1) % n]);
-            a.x * b.y - a.y * b.x
+            cross(a, b)
         })
         .sum()
 }
@@ -345,10 +347,9 @@ fn contains(c: &[Coord<f64>], p: Coord<f64>) -> bool {
 /// (exact: half-plane, then the sign of the cross product).
 fn angle_order(a: Coord<f64>, b: Coord<f64>) -> std::cmp::Ordering {
     let half = |d: Coord<f64>| u8::from(d.y < 0.0 || (d.y == 0.0 && d.x < 0.0));
-    half(a).cmp(&half(b)).then_with(|| {
-        let cross = a.x * b.y - a.y * b.x;
-        0.0f64.total_cmp(&cross)
-    })
+    half(a)
+        .cmp(&half(b))
+        .then_with(|| 0.0f64.total_cmp(&cross(a, b)))
 }
 
 #[cfg(test)]

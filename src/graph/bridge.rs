@@ -10,6 +10,7 @@
 //! they are, and still counted in `components`.
 
 use super::{SkeletonGraph, UnionFind};
+use crate::geometry::vector::hypot;
 use crate::geometry::PreparedPolygon;
 use rstar::{primitives::GeomWithData, RTree};
 
@@ -48,7 +49,7 @@ pub fn bridge(graph: &SkeletonGraph, polygon: &PreparedPolygon) -> SkeletonGraph
                 continue;
             }
             let other = graph.nodes()[w];
-            let d = (other.pos - node.pos).x.hypot((other.pos - node.pos).y);
+            let d = hypot(other.pos - node.pos);
             if d > MAX_GAP * node.radius.max(other.radius) {
                 continue;
             }

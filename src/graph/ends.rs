@@ -57,10 +57,10 @@
 use super::cut::{cut_ends, CutEnd};
 use super::line::{end_turn, point_at, HOOK_DEG};
 use super::{Adjacency, EdgeId, NodeId, SkeletonGraph};
+use crate::geometry::tolerance::ON_BOUNDARY_END;
+use crate::geometry::vector::{cross, dot, hypot};
 use crate::geometry::{Boundary, PreparedPolygon};
 use geo::Coord;
-
-pub use super::line::ON_BOUNDARY_END as END_ON_BOUNDARY;
 
 /// Largest angle between the line's course and a removed leg that the line
 /// follows.
@@ -258,23 +258,15 @@ impl Heights {
 }
 
 fn unit(v: Coord<f64>) -> Option<Coord<f64>> {
-    let n = v.x.hypot(v.y);
+    let n = hypot(v);
     (n > 0.0 && n.is_finite()).then(|| v / n)
-}
-
-fn dot(a: Coord<f64>, b: Coord<f64>) -> f64 {
-    a.x * b.x + a.y * b.y
-}
-
-fn cross(a: Coord<f64>, b: Coord<f64>) -> f64 {
-    a.x * b.y - a.y * b.x
 }
 
 impl<'a> Extender<'a> {
     fn new(m: &'a SkeletonGraph, polygon: &'a PreparedPolygon) -> Self {
         let boundary = polygon.boundary();
         let span = boundary.bbox_max() - boundary.bbox_min();
-        let tol = END_ON_BOUNDARY * polygon.extent();
+        let tol = ON_BOUNDARY_END * polygon.extent();
         Self {
             m,
             boundary,
@@ -287,7 +279,7 @@ impl<'a> Extender<'a> {
                 .map(|i| m.edge_length(EdgeId(i as u32)))
                 .collect(),
             tol,
-            max_t: 2.0 * span.x.hypot(span.y) + 1.0,
+            max_t: 2.0 * hypot(span) + 1.0,
             forest: m.edges().iter().all(|e| e.a != e.b)
                 && m.edges().len() + m.components() == m.nodes().len(),
             heights: std::cell::RefCell::new(Heights {

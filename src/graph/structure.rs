@@ -38,10 +38,12 @@
 
 use super::bridge::bridge;
 use super::ends::assemble;
-use super::line::{end_radius, point_at, ON_BOUNDARY_END as END_ON_BOUNDARY};
+use super::line::{end_radius, point_at};
 use super::prune::trunk::shortest_path;
 use super::{EdgeId, NodeId, SkeletonGraph, UnionFind};
 use crate::geometry::packed::{box_distance_2, Bbox, PackedTree};
+use crate::geometry::tolerance::ON_BOUNDARY_END;
+use crate::geometry::vector::hypot;
 use crate::geometry::PreparedPolygon;
 use geo::Coord;
 use std::ops::ControlFlow;
@@ -76,7 +78,7 @@ pub struct Structure {
 impl Structure {
     /// The structure of a finished reference skeleton: its leaves.
     pub fn of(reference: &SkeletonGraph, polygon: &PreparedPolygon, trunk: bool) -> Self {
-        let tol = END_ON_BOUNDARY * polygon.extent();
+        let tol = ON_BOUNDARY_END * polygon.extent();
         let deg = reference.degrees();
         let labels = reference.component_labels();
         let adj = reference.adjacency();
@@ -109,7 +111,7 @@ pub fn conform(
     if g.is_empty() {
         return g;
     }
-    let tol = END_ON_BOUNDARY * polygon.extent();
+    let tol = ON_BOUNDARY_END * polygon.extent();
     let tree = NodeIndex::new(&g);
     let served: Vec<Option<(NodeId, bool)>> = structure
         .contacts
@@ -141,7 +143,7 @@ pub fn conform(
                 return None;
             }
             let p = g.node(t).pos;
-            let d = (p - c.point).x.hypot((p - c.point).y);
+            let d = hypot(p - c.point);
             (c.on_boundary && d > tol).then_some((t, c.point))
         })
         .collect();
@@ -277,7 +279,7 @@ fn best_seeing(
         let mut keys: Vec<(f64, f64, u32)> = Vec::new();
         tree.within(q, r2, |n| {
             let node = g.node(NodeId(n));
-            let d = (node.pos - q).x.hypot((node.pos - q).y);
+            let d = hypot(node.pos - q);
             keys.push((score(d, node.radius), d, n));
         });
         keys.sort_unstable_by(|a, b| {

@@ -26,6 +26,7 @@
 //! ```
 
 use super::{MethodError, MethodId, SkeletonMethod};
+use crate::geometry::vector::dot;
 use crate::geometry::PreparedPolygon;
 use crate::graph::{GraphBuilder, SkeletonGraph};
 use geo::Coord;
@@ -225,7 +226,7 @@ impl Nodes {
                 .iter()
                 .map(|&c| {
                     let d = x - c;
-                    d.x * d.x + d.y * d.y
+                    dot(d, d)
                 })
                 .fold(f64::INFINITY, f64::min);
             self.bound[id] = self.bound[id].min(d2.sqrt());

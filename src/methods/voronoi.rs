@@ -56,17 +56,16 @@
 //! ```
 
 use super::{MethodError, MethodId, SkeletonMethod};
-use crate::geometry::{boundary::orient, densify, densify::Density, PreparedPolygon};
+use crate::geometry::segment::orient;
+use crate::geometry::tolerance::{BOUND_MARGIN, SAME_POINT};
+use crate::geometry::vector::{hypot, norm, within_hypot};
+use crate::geometry::{densify, densify::Density, PreparedPolygon};
 use crate::graph::UnionFind;
 use crate::graph::{GraphBuilder, SkeletonGraph};
 use geo::{Coord, LineString};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use spade::{DelaunayTriangulation, InsertionError, Point2, Triangulation};
-
-/// Relative tolerance (× the polygon's extent) for "on ∂P" and for merging
-/// coincident Voronoi vertices (SPEC §3: points within 1e-9 × extent of P).
-pub const RELATIVE_TOLERANCE: f64 = 1e-9;
 
 /// Densification of the boundary for DVD.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
@@ -204,7 +203,7 @@ fn densified_count<'a>(
     for ring in rings {
         for l in ring.lines() {
             let d = l.end - l.start;
-            total = total.saturating_add(density.pieces(d.x.hypot(d.y)));
+            total = total.saturating_add(density.pieces(hypot(d)));
             if total > cap {
                 return total;
             }
@@ -224,7 +223,7 @@ impl SkeletonMethod for Voronoi {
 
     fn skeletonise(&self, polygon: &PreparedPolygon) -> Result<SkeletonGraph, MethodError> {
         let sites = self.sites(polygon)?;
-        let tol = RELATIVE_TOLERANCE * polygon.extent();
+        let tol = SAME_POINT * polygon.extent();
         let vd = VoronoiDiagram::new(&sites, tol).map_err(|e| MethodError::Failed {
             method: self.id(),
             reason: format!("the boundary points cannot be triangulated: {e:?}"),
@@ -315,7 +314,7 @@ impl<'a> Locator<'a> {
     /// `p` to a site (a point of ∂P up to rounding): it bounds the search
     /// (the same answer, fewer nodes queued).
     fn locate(&self, p: Coord<f64>, to_site: f64, tol: f64) -> Option<f64> {
-        let limit = to_site * (1.0 + 1e-9) + tol;
+        let limit = to_site * (1.0 + BOUND_MARGIN) + tol;
         let (_, k, d) = self
             .boundary
             .nearest_within(p, limit)
@@ -372,7 +371,7 @@ impl VoronoiDiagram {
             }
             let (f, g) = (f.fix().index(), g.fix().index());
             let (cf, cg) = (centre[f], centre[g]);
-            if crate::geometry::within_hypot(cf - cg, merge_tolerance) {
+            if within_hypot(cf - cg, merge_tolerance) {
                 uf.union(f, g);
             } else {
                 dual.push((f, g));
@@ -396,7 +395,7 @@ impl VoronoiDiagram {
                 vertices.push(centre[r]);
                 // A bound of the search for the nearest boundary point,
                 // which never changes its answer: no need for `hypot`.
-                site_distance.push(crate::geometry::norm(centre[r] - corner[r]));
+                site_distance.push(norm(centre[r] - corner[r]));
             }
             id[f] = id[r];
         }
@@ -423,10 +422,10 @@ impl VoronoiDiagram {
 fn circumcentre([a, b, c]: [Point2<f64>; 3]) -> Coord<f64> {
     let (bx, by) = (b.x - a.x, b.y - a.y);
     let (cx, cy) = (c.x - a.x, c.y - a.y);
-    let det = robust::orient2d(
-        robust::Coord { x: a.x, y: a.y },
-        robust::Coord { x: b.x, y: b.y },
-        robust::Coord { x: c.x, y: c.y },
+    let det = orient(
+        Coord { x: a.x, y: a.y },
+        Coord { x: b.x, y: b.y },
+        Coord { x: c.x, y: c.y },
     );
     let d = 2.0 * det;
     let (lb, lc) = (bx * bx + by * by, cx * cx + cy * cy);
@@ -488,7 +487,7 @@ mod tests {
 
     /// Raw output invariants: points in P, no crossing, radius = distance to ∂P.
     fn assert_valid(p: &PreparedPolygon, g: &SkeletonGraph) {
-        let tol = RELATIVE_TOLERANCE * p.extent();
+        let tol = SAME_POINT * p.extent();
         for n in g.nodes() {
             assert!(
                 p.boundary().contains_with_tolerance(n.pos, tol),
@@ -666,7 +665,7 @@ mod tests {
             interiors: [[(x: 0.25, y: 0.25), (x: 0.25, y: 0.75), (x: 0.75, y: 0.75), (x: 0.75, y: 0.25)]],
         ));
         let loc = Locator::new(&p);
-        let tol = RELATIVE_TOLERANCE * p.extent();
+        let tol = SAME_POINT * p.extent();
         let mut inside = 0;
         for i in -10..=90 {
             for j in -10..=90 {

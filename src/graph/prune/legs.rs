@@ -23,9 +23,11 @@
 //! (a polygon with holes) are removed down to the cycles.
 
 use super::{LegMeasure, PruneParams};
+use crate::geometry::tolerance::ON_BOUNDARY_END;
+use crate::geometry::vector::dot;
 use crate::geometry::Boundary;
 use crate::graph::cut::cut_ends;
-use crate::graph::line::{point_at, ON_BOUNDARY_END};
+use crate::graph::line::point_at;
 use crate::graph::{EdgeId, NodeId, SkeletonGraph};
 use geo::Coord;
 use std::cmp::{Ordering, Reverse};
@@ -376,7 +378,7 @@ fn main_axis(m: &SkeletonGraph, labels: &[usize], c: usize, keep: &mut [bool]) {
         for (i, &a) in leaves.iter().enumerate() {
             for &b in &leaves[i + 1..] {
                 let d = m.node(a).pos - m.node(b).pos;
-                let d2 = d.x * d.x + d.y * d.y;
+                let d2 = dot(d, d);
                 if best.is_none_or(|(bd, _, _)| d2 > bd) {
                     best = Some((d2, a, b));
                 }

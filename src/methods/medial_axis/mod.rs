@@ -61,6 +61,7 @@ mod arc;
 mod quantise;
 
 use super::{MethodError, MethodId, SkeletonMethod};
+use crate::geometry::vector::hypot;
 use crate::geometry::{Boundary, PreparedPolygon};
 use crate::graph::{NodeId, SkeletonGraph};
 use arc::Parabola;
@@ -565,7 +566,7 @@ pub fn medial_axis_transform(
                 for (k, c) in coords.iter().enumerate() {
                     if k > 0 {
                         let d = *c - coords[k - 1];
-                        acc += d.x.hypot(d.y);
+                        acc += hypot(d);
                     }
                     let t = if total > 0.0 { acc / total } else { 0.0 };
                     r.push(ra + (rb - ra) * t);

@@ -89,19 +89,19 @@ pub mod wavefront;
 
 use super::{MethodError, MethodId, SkeletonMethod};
 use crate::geometry::packed::{boxes_meet, Bbox, PackedTree};
+use crate::geometry::segment::{lines_meet, properly_cross};
+use crate::geometry::tolerance::{SAME_POINT, TRACE_CROSSING};
+use crate::geometry::vector::{cross, dot, hypot, within_hypot};
 use crate::geometry::{Boundary, PreparedPolygon};
 use crate::graph::{GraphBuilder, SkeletonGraph};
 use events::{edge_collapse_time, split_candidates, EventKind, EventQueue, SplitCandidate};
 use geo::Coord;
 use std::ops::ControlFlow;
-use wavefront::{dot, Line, LineId, VertexId, Wavefront};
+use wavefront::{Line, LineId, VertexId, Wavefront};
 
 /// The straight-skeleton method.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct StraightSkeleton;
-
-/// Relative tolerance: `tol = REL_TOL · extent` (see the module doc).
-pub const REL_TOL: f64 = 1e-9;
 
 /// Counts of one propagation, for tests and benchmarks.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -240,7 +240,7 @@ impl<'a> Propagation<'a> {
             arcs: Vec::with_capacity(2 * n),
             work,
             now: 0.0,
-            tol: REL_TOL * extent,
+            tol: SAME_POINT * extent,
             extent,
             max_pops: 1000 * n + 10_000,
             max_candidates: crate::methods::budget::memory_limit()
@@ -362,9 +362,9 @@ impl<'a> Propagation<'a> {
 
     /// Whether vertex `v` is at `p` now, within `tol · (1 + speed)`.
     fn at(&self, v: VertexId, p: Coord<f64>) -> bool {
-        let speed = self.w.v(v).vel.map_or(0.0, |s| s.x.hypot(s.y));
+        let speed = self.w.v(v).vel.map_or(0.0, hypot);
         let d = self.w.pos(v, self.now) - p;
-        crate::geometry::within_hypot(d, self.tol * (1.0 + speed))
+        within_hypot(d, self.tol * (1.0 + speed))
     }
 
     /// Handles the valid event `ev` (popped at time `now`) together with
@@ -670,8 +670,8 @@ impl<'a> Propagation<'a> {
         let t = self.now;
         let pz = self.w.pos(z, t);
         let (pw, pu) = (self.w.pos(w, t), self.w.pos(u, t));
-        let dw = (pw - pz).x.hypot((pw - pz).y);
-        let du = (pu - pz).x.hypot((pu - pz).y);
+        let dw = hypot(pw - pz);
+        let du = hypot(pu - pz);
         let (zl, zr) = (self.w.v(z).left, self.w.v(z).right);
         if (dw - du).abs() <= self.tol {
             let (before, after) = (self.w.v(w).prev, self.w.v(u).next);
@@ -741,8 +741,8 @@ impl<'a> Propagation<'a> {
             }
             let (px, py) = (w.pos(x, t), w.pos(y, t));
             let (sx, sy) = (dot(l.dir, px), dot(l.dir, py));
-            let at_x = crate::geometry::within_hypot(px - p, tol);
-            let at_y = crate::geometry::within_hypot(py - p, tol);
+            let at_x = within_hypot(px - p, tol);
+            let at_y = within_hypot(py - p, tol);
             // Touching a zero-length piece, or a piece end that already
             // carries one of v's own lines, changes nothing: not a split.
             // A vertex made by an event touching a piece end at once: the
@@ -785,7 +785,7 @@ impl<'a> Propagation<'a> {
     fn candidate_lines(&self, z: VertexId) -> Option<(Vec<LineId>, f64)> {
         let vx = *self.w.v(z);
         let s = vx.vel?;
-        let speed = s.x.hypot(s.y);
+        let speed = hypot(s);
         let dir = s / speed;
         let start = vx.start + self.origin;
         let reach = self
@@ -934,7 +934,7 @@ fn propagate(polygon: &PreparedPolygon, search: Search) -> Result<(Vec<Arc>, Sta
 /// the traces bounding that face or leaves P). Crossings closer than
 /// `1e-6 · extent` to an end of either trace are rounding, not misses.
 fn verify(polygon: &PreparedPolygon, arcs: &[Arc]) -> Result<(), MethodError> {
-    let tol = 1e-6 * polygon.extent();
+    let tol = TRACE_CROSSING * polygon.extent();
     if let Some(a) = arcs
         .iter()
         .find(|a| !polygon.boundary().contains_with_tolerance(a.to, tol))
@@ -984,24 +984,20 @@ fn crossing(
     b: Coord<f64>,
     tol: f64,
 ) -> Option<Coord<f64>> {
-    if !crate::geometry::boundary::properly_cross(p, q, a, b) {
+    if !properly_cross(p, q, a, b) {
         return None;
     }
-    let (d, e) = (q - p, b - a);
-    let den = wavefront::cross(d, e);
-    if den == 0.0 {
-        return None;
-    }
-    let s = wavefront::cross(a - p, e) / den;
+    let d = q - p;
+    let (s, _) = lines_meet(p, d, a, b)?;
     let x = p + d * s;
     let far = |c: Coord<f64>| {
         // `hypot > tol`, the hypot only when no component alone decides.
         let d = c - x;
-        d.x.abs() > tol || d.y.abs() > tol || d.x.hypot(d.y) > tol
+        d.x.abs() > tol || d.y.abs() > tol || hypot(d) > tol
     };
     let off = |u: Coord<f64>, v: Coord<f64>, c: Coord<f64>| {
         let w = v - u;
-        wavefront::cross(w, c - u).abs() / w.x.hypot(w.y)
+        cross(w, c - u).abs() / hypot(w)
     };
     let apart = off(p, q, a).max(off(p, q, b)) > tol && off(a, b, p).max(off(a, b, q)) > tol;
     (apart && far(p) && far(q) && far(a) && far(b)).then_some(x)

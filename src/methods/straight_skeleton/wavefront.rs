@@ -8,6 +8,7 @@
 //! when that vertex is still active (lazy invalidation, no version counter
 //! needed).
 
+use crate::geometry::vector::{cross, dot, hypot};
 use geo::Coord;
 
 /// Index of a supporting line (one per original boundary edge).
@@ -46,7 +47,7 @@ impl Line {
     /// The line through the edge `a → b` (which must have non-zero length).
     pub fn new(a: Coord<f64>, b: Coord<f64>) -> Self {
         let d = b - a;
-        let len = d.x.hypot(d.y);
+        let len = hypot(d);
         let dir = Coord {
             x: d.x / len,
             y: d.y / len,
@@ -106,16 +107,6 @@ pub struct Vertex {
 /// Nearly antiparallel lines above it keep their (fast) vertex: zipping
 /// them up as a fold would end traces off their offset lines.
 pub const FOLD_EPS: f64 = 1e-12;
-
-/// `a · b`.
-pub fn dot(a: Coord<f64>, b: Coord<f64>) -> f64 {
-    a.x * b.x + a.y * b.y
-}
-
-/// `a × b` (z component).
-pub fn cross(a: Coord<f64>, b: Coord<f64>) -> f64 {
-    a.x * b.y - a.y * b.x
-}
 
 /// Velocity of the intersection of two lines moving along their unit
 /// normals at unit speed: `(n1 + n2) / (1 + n1·n2)`, `None` for a fold.
