@@ -8,10 +8,9 @@ mod common;
 use common::{LAYERS, TRAIN};
 use geo::{polygon, Coord, LineString, Polygon};
 use skeletonise::geometry::PreparedPolygon;
+use skeletonise::graph::widths::medial_axis_transform;
 use skeletonise::graph::{EdgeId, SkeletonGraph};
-use skeletonise::methods::medial_axis::{
-    medial_axis_transform, resolution, ArcTolerance, MedialAxis,
-};
+use skeletonise::methods::medial_axis::{resolution, ArcTolerance, MedialAxis};
 use skeletonise::methods::{MethodError, SkeletonMethod};
 
 fn c(x: f64, y: f64) -> Coord<f64> {

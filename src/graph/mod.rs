@@ -17,6 +17,7 @@ pub mod line;
 pub mod planar;
 pub mod prune;
 pub mod structure;
+pub mod widths;
 
 use crate::geometry::Boundary;
 use geo::{Coord, LineString, MultiLineString};
@@ -371,6 +372,17 @@ impl SkeletonGraph {
                 .map(|b| LineString(b.coords))
                 .collect(),
         )
+    }
+
+    /// The graph of skeleton lines made by any tool: each line one edge,
+    /// end points shared bit for bit one node, radii 0 (see
+    /// [`GraphBuilder::polyline`] for the lines it leaves out).
+    pub fn from_lines(lines: &MultiLineString<f64>) -> SkeletonGraph {
+        let mut b = GraphBuilder::new();
+        for l in &lines.0 {
+            b.polyline(&l.0);
+        }
+        b.finish_raw()
     }
 
     /// Recomputes every node's radius as its distance to ∂P.

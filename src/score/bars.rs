@@ -5,7 +5,7 @@ use crate::geometry::segment::orient;
 use crate::geometry::tolerance::{BAR_ORIGIN, BOUND_MARGIN};
 use crate::geometry::vector::{dot, hypot, norm};
 use crate::geometry::{Boundary, BoundarySegment, PreparedPolygon};
-use crate::graph::{Branch, GraphBuilder, SkeletonGraph};
+use crate::graph::{Branch, SkeletonGraph};
 use crate::process::clock::CpuClock;
 use geo::{Coord, MultiLineString};
 use rayon::prelude::*;
@@ -368,11 +368,8 @@ pub fn score_skeleton(
     polygon: &PreparedPolygon,
     skeleton: &MultiLineString<f64>,
 ) -> (Scores, Vec<Bar>) {
-    let mut gb = GraphBuilder::new();
-    for line in &skeleton.0 {
-        gb.polyline(&line.0);
-    }
-    let graph = gb.finish(polygon.boundary());
+    let mut graph = SkeletonGraph::from_lines(skeleton);
+    graph.set_radii(polygon.boundary());
     let b = bars(polygon, &graph);
     (metrics(&b), b)
 }
