@@ -123,7 +123,7 @@ fn print_hooks(fid: Option<u64>, lines: &geo::MultiLineString<f64>, parts: &[Pre
         }) else {
             continue;
         };
-        let line = g.line_from(skeletonise::graph::NodeId(n as u32), &adj);
+        let line = g.line_from(skeletonise::graph::NodeId::from_index(n), &adj);
         if let Some(t) = skeletonise::score::defects::end_turn(&line, p) {
             if t > HOOK_DEG {
                 println!(

@@ -53,7 +53,7 @@ fn check_invariants(pp: &PreparedPolygon, g: &SkeletonGraph) {
         );
     }
     for i in 0..g.edges().len() {
-        let pts = g.edge_coords(EdgeId(i as u32));
+        let pts = g.edge_coords(EdgeId::from_index(i));
         for w in pts.windows(2) {
             assert!(
                 !b.crosses(w[0], w[1]),
@@ -285,7 +285,7 @@ fn l_shape_has_the_analytic_parabola_within_tolerance() {
                 ArcTolerance::Relative(f) => f * r_min,
                 ArcTolerance::Absolute(d) => d,
             };
-            let pts = g.edge_coords(EdgeId(i as u32));
+            let pts = g.edge_coords(EdgeId::from_index(i));
             for k in 0..=40 {
                 let t = k as f64 / 40.0;
                 let q = pts[0] + (pts[1] - pts[0]) * t;

@@ -9,7 +9,7 @@
 //! [`MAX_GAP`] local radii and stays in P. Pieces farther apart are left as
 //! they are, and still counted in `components`.
 
-use super::{SkeletonGraph, UnionFind};
+use super::{NodeId, SkeletonGraph, UnionFind};
 use crate::geometry::vector::hypot;
 use crate::geometry::PreparedPolygon;
 use rstar::{primitives::GeomWithData, RTree};
@@ -76,7 +76,11 @@ pub fn bridge(graph: &SkeletonGraph, polygon: &PreparedPolygon) -> SkeletonGraph
             continue;
         }
         uf.union(v as usize, w as usize);
-        out.add_edge(super::NodeId(v), super::NodeId(w), Vec::new());
+        out.add_edge(
+            NodeId::from_index(v as usize),
+            NodeId::from_index(w as usize),
+            Vec::new(),
+        );
     }
     out
 }

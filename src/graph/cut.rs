@@ -81,11 +81,11 @@ pub fn cut_ends(m: &SkeletonGraph, boundary: &Boundary, tol: f64) -> Vec<CutEnd>
         if edges.len() != 3 {
             continue;
         }
-        let jn = NodeId(j as u32);
+        let jn = NodeId::from_index(j);
         let legs: Vec<(EdgeId, NodeId)> = edges
             .iter()
             .map(|&e| (e, m.opposite(e, jn)))
-            .filter(|&(_, o)| o != jn && deg[o.0 as usize] == 1 && m.node(o).radius <= tol)
+            .filter(|&(_, o)| o != jn && deg[o.index()] == 1 && m.node(o).radius <= tol)
             .collect();
         let [(e1, c1), (e2, c2)] = legs[..] else {
             continue;
@@ -168,9 +168,9 @@ fn course_line(
         }
         let is_leg = |e: EdgeId| {
             let o = m.opposite(e, at);
-            deg[o.0 as usize] == 1 && m.node(o).radius <= tol
+            deg[o.index()] == 1 && m.node(o).radius <= tol
         };
-        let onward: Vec<EdgeId> = adj[at.0 as usize]
+        let onward: Vec<EdgeId> = adj[at.index()]
             .iter()
             .copied()
             .filter(|&e| e != via && !is_leg(e))

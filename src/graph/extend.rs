@@ -116,7 +116,7 @@ pub fn extend(
             continue;
         }
         for (leaf, from_leaf) in [(b.start, false), (b.end, true)] {
-            if deg[leaf.0 as usize] != 1 {
+            if deg[leaf.index()] != 1 {
                 continue;
             }
             let p = graph.node(leaf).pos;

@@ -187,7 +187,7 @@ pub fn end_turns(g: &SkeletonGraph, polygon: &PreparedPolygon) -> Vec<f64> {
         if adj[n].len() != 1 {
             continue;
         }
-        let coords = g.line_from(NodeId(n as u32), &adj);
+        let coords = g.line_from(NodeId::from_index(n), &adj);
         if let Some(t) = end_turn(&coords, polygon) {
             out.push(t);
         }

@@ -106,7 +106,7 @@ pub fn node_crossings(g: SkeletonGraph, boundary: &Boundary) -> (SkeletonGraph, 
         }
     }
     for (ei, e) in g.edges().iter().enumerate() {
-        let coords = g.edge_coords(super::EdgeId(ei as u32));
+        let coords = g.edge_coords(super::EdgeId::from_index(ei));
         let mut from = e.a;
         let mut interior: Vec<Coord<f64>> = Vec::new();
         // Walk the polyline segment by segment; the k-th segment runs from

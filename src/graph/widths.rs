@@ -53,7 +53,7 @@ pub fn medial_axis_transform(
 ) -> Vec<MatSegment> {
     let mut out = Vec::new();
     for (i, e) in graph.edges().iter().enumerate() {
-        let coords = graph.edge_coords(EdgeId(i as u32));
+        let coords = graph.edge_coords(EdgeId::from_index(i));
         let (ra, rb) = (graph.node(e.a).radius, graph.node(e.b).radius);
         let radii: Vec<f64> = match boundary {
             Some(b) => {

@@ -218,7 +218,7 @@ struct Nodes {
 impl Nodes {
     fn segment(&mut self, p: Coord<f64>, q: Coord<f64>, corners: &[Coord<f64>; 3]) {
         for x in [p, q] {
-            let id = self.graph.node(x).0 as usize;
+            let id = self.graph.node(x).index();
             if self.bound.len() <= id {
                 self.bound.resize(id + 1, f64::INFINITY);
             }

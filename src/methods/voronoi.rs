@@ -270,7 +270,7 @@ impl SkeletonMethod for Voronoi {
             for (k, r) in [(u, ru), (v, rv)] {
                 if node_of[k].is_none() {
                     let n = b.node(pos[k]);
-                    if n.0 as usize == radii.len() {
+                    if n.index() == radii.len() {
                         radii.push(r);
                     }
                     node_of[k] = Some(n);

@@ -217,14 +217,14 @@ impl<'a> Propagation<'a> {
             }
             let first = w.vertices.len();
             for i in 0..m {
-                let left = LineId((base + (i + m - 1) % m) as u32);
-                let right = LineId((base + i) as u32);
+                let left = LineId::from_index(base + (i + m - 1) % m);
+                let right = LineId::from_index(base + i);
                 let id = w.add_vertex(pts[i], 0.0, left, right, Some(abs[i]));
                 work.push(id);
             }
             for i in 0..m {
-                let a = VertexId((first + i) as u32);
-                let b = VertexId((first + (i + 1) % m) as u32);
+                let a = VertexId::from_index(first + i);
+                let b = VertexId::from_index(first + (i + 1) % m);
                 w.link(a, b);
             }
         }
@@ -328,7 +328,7 @@ impl<'a> Propagation<'a> {
                         continue;
                     }
                     self.now = self.now.max(ev.t);
-                    let c = self.candidates[v.0 as usize][candidate as usize];
+                    let c = self.candidates[v.index()][candidate as usize];
                     if self.find_piece(v, c.line).is_none() {
                         self.push_candidate(v, candidate + 1);
                         self.drain_work()?;
@@ -415,7 +415,7 @@ impl<'a> Propagation<'a> {
         match ev.kind {
             EventKind::Edge { x, y } => self.edge_event(x, y),
             EventKind::Split { v, candidate } => {
-                let c = self.candidates[v.0 as usize][candidate as usize];
+                let c = self.candidates[v.index()][candidate as usize];
                 match self.find_piece(v, c.line) {
                     Some(x) => self.split_event(v, x, c.line),
                     None => {
@@ -478,7 +478,7 @@ impl<'a> Propagation<'a> {
                 EventKind::Split { v, candidate } => {
                     let mut i = candidate as usize;
                     let mut hit = false;
-                    while let Some(&c) = self.candidates[v.0 as usize].get(i) {
+                    while let Some(&c) = self.candidates[v.index()].get(i) {
                         if i > candidate as usize && c.t > t0 + self.tol {
                             break;
                         }
@@ -731,7 +731,7 @@ impl<'a> Propagation<'a> {
         let l = *self.w.line(line);
         let sp = dot(l.dir, p);
         let w = &mut self.w;
-        let mut pieces = std::mem::take(&mut w.pieces[line.0 as usize]);
+        let mut pieces = std::mem::take(&mut w.pieces[line.index()]);
         pieces.retain(|&x| w.v(x).active);
         let tol = self.tol;
         let found = pieces.iter().copied().find(|&x| {
@@ -759,7 +759,7 @@ impl<'a> Propagation<'a> {
             }
             sx - tol <= sp && sp <= sy + tol
         });
-        w.pieces[line.0 as usize] = pieces;
+        w.pieces[line.index()] = pieces;
         found
     }
 
@@ -810,13 +810,13 @@ impl<'a> Propagation<'a> {
                 self.tree.visit(
                     |b| boxes_meet(b, &env),
                     |i| {
-                        lines.push(LineId(i));
+                        lines.push(LineId::from_index(i as usize));
                         ControlFlow::<()>::Continue(())
                     },
                 );
                 lines
             }
-            Search::All => (0..self.w.lines.len() as u32).map(LineId).collect(),
+            Search::All => (0..self.w.lines.len()).map(LineId::from_index).collect(),
         };
         Some((lines, t_max))
     }
@@ -831,7 +831,7 @@ impl<'a> Propagation<'a> {
         self.stats.tried += lines.len();
         let c = split_candidates(&self.w, z, lines.into_iter(), t_max, self.tol);
         self.stats.candidates += c.len();
-        self.candidates[z.0 as usize] = c;
+        self.candidates[z.index()] = c;
         if self.stats.candidates > self.max_candidates {
             return Err(MethodError::OverBudget {
                 method: MethodId::STSK,
@@ -851,8 +851,8 @@ impl<'a> Propagation<'a> {
     /// budget), that estimate is returned without the rest — on a huge
     /// polygon each sampled vertex can cost a scan of every edge.
     fn predict(&self, hopeless: impl Fn((f64, f64)) -> bool) -> (f64, f64) {
-        let reflex: Vec<VertexId> = (0..self.w.vertices.len() as u32)
-            .map(VertexId)
+        let reflex: Vec<VertexId> = (0..self.w.vertices.len())
+            .map(VertexId::from_index)
             .filter(|&v| self.w.v(v).reflex)
             .collect();
         if reflex.is_empty() {
@@ -890,7 +890,7 @@ impl<'a> Propagation<'a> {
     }
 
     fn push_candidate(&mut self, v: VertexId, i: u32) {
-        if let Some(c) = self.candidates[v.0 as usize].get(i as usize) {
+        if let Some(c) = self.candidates[v.index()].get(i as usize) {
             let t = c.t.max(self.now);
             self.q.push(t, EventKind::Split { v, candidate: i });
         }
