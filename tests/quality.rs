@@ -17,6 +17,7 @@ use skeletonise::graph::prune::{PruneMode, PruneParams};
 use skeletonise::graph::SkeletonGraph;
 #[cfg(feature = "gdal")]
 use skeletonise::io::read_layer_polygons;
+use skeletonise::methods::MethodContext;
 use skeletonise::methods::{build, MethodId, SkeletonParams};
 use skeletonise::process::{polygon_parts, process, FeatureOutcome, ProcessParams, Processed};
 use skeletonise::score::defects::{end_turns, HOOK_DEG};
@@ -134,7 +135,7 @@ fn a_tapering_tip_is_reached_along_the_medial_axis_own_leg() {
     // Every point of the end near the tip lies on the raw medial axis.
     let pp = PreparedPolygon::new(&p).unwrap();
     let raw = build(MethodId::MA, &SkeletonParams::default())
-        .skeletonise(&pp)
+        .skeletonise(&pp, &MethodContext::default())
         .unwrap();
     let raw_lines = raw.to_multilinestring();
     let dist = |q: Coord<f64>| {

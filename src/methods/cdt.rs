@@ -18,14 +18,15 @@
 //!
 //! ```
 //! use skeletonise::geometry::PreparedPolygon;
-//! use skeletonise::methods::{cdt::Cdt, SkeletonMethod};
+//! use skeletonise::methods::{cdt::Cdt, MethodContext, SkeletonMethod};
 //! use geo::polygon;
 //! let p = polygon![(x: 0., y: 0.), (x: 10., y: 0.), (x: 10., y: 2.), (x: 0., y: 2.)];
-//! let g = Cdt.skeletonise(&PreparedPolygon::new(&p).unwrap()).unwrap();
+//! let p = PreparedPolygon::new(&p).unwrap();
+//! let g = Cdt.skeletonise(&p, &MethodContext::default()).unwrap();
 //! assert!(g.edges().len() >= 2);
 //! ```
 
-use super::{MethodError, MethodId, SkeletonMethod};
+use super::{MethodContext, MethodError, MethodId, SkeletonMethod};
 use crate::geometry::vector::dot;
 use crate::geometry::PreparedPolygon;
 use crate::graph::{GraphBuilder, SkeletonGraph};
@@ -165,7 +166,11 @@ impl SkeletonMethod for Cdt {
         MethodId::CDT
     }
 
-    fn skeletonise(&self, polygon: &PreparedPolygon) -> Result<SkeletonGraph, MethodError> {
+    fn skeletonise(
+        &self,
+        polygon: &PreparedPolygon,
+        _ctx: &MethodContext,
+    ) -> Result<SkeletonGraph, MethodError> {
         let triangles = inside_triangles(polygon)?;
         let mut b = Nodes::default();
         for t in &triangles {
@@ -249,7 +254,11 @@ mod tests {
     use geo::polygon;
 
     fn run(p: geo::Polygon<f64>) -> SkeletonGraph {
-        Cdt.skeletonise(&PreparedPolygon::new(&p).unwrap()).unwrap()
+        Cdt.skeletonise(
+            &PreparedPolygon::new(&p).unwrap(),
+            &MethodContext::default(),
+        )
+        .unwrap()
     }
 
     #[test]
@@ -296,7 +305,10 @@ mod tests {
     #[test]
     fn self_intersecting_boundary_is_an_error_not_a_panic() {
         let p = polygon![(x: 0., y: 0.), (x: 4., y: 4.), (x: 4., y: 0.), (x: 0., y: 6.)];
-        let r = Cdt.skeletonise(&PreparedPolygon::new(&p).unwrap());
+        let r = Cdt.skeletonise(
+            &PreparedPolygon::new(&p).unwrap(),
+            &MethodContext::default(),
+        );
         assert!(r.is_err());
     }
 }

@@ -40,22 +40,25 @@
 //! ```
 //! use geo::polygon;
 //! use skeletonise::geometry::{densify::Density, PreparedPolygon};
-//! use skeletonise::methods::{voronoi::Voronoi, SkeletonMethod};
+//! use skeletonise::methods::{voronoi::Voronoi, MethodContext, SkeletonMethod};
 //!
 //! let p = polygon![(x: 0., y: 0.), (x: 10., y: 0.), (x: 10., y: 2.), (x: 0., y: 2.)];
 //! let p = PreparedPolygon::new(&p).unwrap();
 //! // Four cocircular corners: the Voronoi diagram is one point, no edge.
-//! assert!(Voronoi::plain().skeletonise(&p).unwrap().is_empty());
+//! let no_limit = MethodContext::default();
+//! assert!(Voronoi::plain().skeletonise(&p, &no_limit).unwrap().is_empty());
 //! // Densified to pieces of at most 0.5: the centre line y = 1 (where the
 //! // inscribed disc has the half width as radius) and short legs into the corners.
-//! let g = Voronoi::densified(Density::Spacing(0.5), 1_000_000).skeletonise(&p).unwrap();
+//! let g = Voronoi::densified(Density::Spacing(0.5), 1_000_000)
+//!     .skeletonise(&p, &no_limit)
+//!     .unwrap();
 //! assert_eq!(g.components(), 1);
 //! assert_eq!(g.leg_count(), 4);
 //! let on_centre_line = g.nodes().iter().filter(|n| n.pos.y == 1.0 && n.radius == 1.0);
 //! assert_eq!(on_centre_line.count(), 18);
 //! ```
 
-use super::{MethodError, MethodId, SkeletonMethod};
+use super::{MethodContext, MethodError, MethodId, SkeletonMethod};
 use crate::geometry::segment::orient;
 use crate::geometry::tolerance::{BOUND_MARGIN, SAME_POINT};
 use crate::geometry::vector::{hypot, norm, within_hypot};
@@ -221,7 +224,11 @@ impl SkeletonMethod for Voronoi {
         }
     }
 
-    fn skeletonise(&self, polygon: &PreparedPolygon) -> Result<SkeletonGraph, MethodError> {
+    fn skeletonise(
+        &self,
+        polygon: &PreparedPolygon,
+        _ctx: &MethodContext,
+    ) -> Result<SkeletonGraph, MethodError> {
         let sites = self.sites(polygon)?;
         let tol = SAME_POINT * polygon.extent();
         let vd = VoronoiDiagram::new(&sites, tol).map_err(|e| MethodError::Failed {
@@ -463,7 +470,9 @@ mod tests {
     }
 
     fn vd(p: &PreparedPolygon) -> SkeletonGraph {
-        Voronoi::plain().skeletonise(p).unwrap()
+        Voronoi::plain()
+            .skeletonise(p, &MethodContext::default())
+            .unwrap()
     }
 
     /// Every edge as its two end points, sorted, for comparison with a known answer.
@@ -526,7 +535,7 @@ mod tests {
         let p = prepared(Polygon::new(LineString(ring), vec![]));
         assert!(vd(&p).is_empty());
         let g = Voronoi::densified(Density::Factor(3), usize::MAX)
-            .skeletonise(&p)
+            .skeletonise(&p, &MethodContext::default())
             .unwrap();
         assert_valid(&p, &g);
         let deg = g.degrees();
@@ -710,7 +719,7 @@ mod tests {
             VoronoiDiagram::new(&distinct, 1e-8).unwrap().edges.len()
         );
         let g = Voronoi::densified(Density::Factor(8), usize::MAX)
-            .skeletonise(&p)
+            .skeletonise(&p, &MethodContext::default())
             .unwrap();
         assert_valid(&p, &g);
         assert!(!g.is_empty());
@@ -724,7 +733,7 @@ mod tests {
             .unwrap();
         assert_eq!(ok.len(), 16);
         assert_eq!(
-            Voronoi::densified(Density::Factor(4), 15).skeletonise(&p),
+            Voronoi::densified(Density::Factor(4), 15).skeletonise(&p, &MethodContext::default()),
             Err(MethodError::TooManyPoints {
                 points: 16,
                 max: 15
@@ -732,7 +741,7 @@ mod tests {
         );
         // A spacing so small that the count would overflow `usize`.
         let e = Voronoi::densified(Density::Spacing(1e-300), 2_000_000)
-            .skeletonise(&p)
+            .skeletonise(&p, &MethodContext::default())
             .unwrap_err();
         assert!(
             matches!(e, MethodError::TooManyPoints { points, max: 2_000_000 } if points > 2_000_000),

@@ -202,8 +202,8 @@ pub(super) fn part_skeletons(
             .build(m, &params.skeleton)
             .and_then(|method| {
                 guarded(m, || {
-                    crate::methods::budget::with_budget(m, params.skeleton.budget(), || {
-                        method.skeletonise(p)
+                    crate::methods::budget::with_budget(m, params.skeleton.budget(), |ctx| {
+                        method.skeletonise(p, ctx)
                     })
                     .map_err(|e| e.to_string())
                 })

@@ -45,11 +45,11 @@
 //! use geo::polygon;
 //! use skeletonise::geometry::PreparedPolygon;
 //! use skeletonise::methods::medial_axis::{ArcTolerance, MedialAxis};
-//! use skeletonise::methods::SkeletonMethod;
+//! use skeletonise::methods::{MethodContext, SkeletonMethod};
 //! // A 10 × 4 rectangle: centre segment plus four 45° corner legs.
 //! let p = polygon![(x: 0., y: 0.), (x: 10., y: 0.), (x: 10., y: 4.), (x: 0., y: 4.)];
 //! let g = MedialAxis::new(ArcTolerance::default())
-//!     .skeletonise(&PreparedPolygon::new(&p).unwrap())
+//!     .skeletonise(&PreparedPolygon::new(&p).unwrap(), &MethodContext::default())
 //!     .unwrap();
 //! assert_eq!(g.edges().len(), 5);
 //! assert_eq!(g.leg_count(), 4);
@@ -60,7 +60,7 @@
 mod arc;
 mod quantise;
 
-use super::{MethodError, MethodId, SkeletonMethod};
+use super::{MethodContext, MethodError, MethodId, SkeletonMethod};
 use crate::geometry::PreparedPolygon;
 /// The Medial Axis Transform's pieces, at their old path for the
 /// per-feature path (`process`), which imports them from here; their home
@@ -183,7 +183,11 @@ impl SkeletonMethod for MedialAxis {
         MethodId::MA
     }
 
-    fn skeletonise(&self, polygon: &PreparedPolygon) -> Result<SkeletonGraph, MethodError> {
+    fn skeletonise(
+        &self,
+        polygon: &PreparedPolygon,
+        _ctx: &MethodContext,
+    ) -> Result<SkeletonGraph, MethodError> {
         self.tolerance.validate().map_err(fail)?;
         let grid = Grid::new(polygon.origin(), polygon.extent()).ok_or_else(|| {
             fail(format!(

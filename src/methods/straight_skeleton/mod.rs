@@ -75,10 +75,11 @@
 //!
 //! ```
 //! use skeletonise::geometry::PreparedPolygon;
-//! use skeletonise::methods::{straight_skeleton::StraightSkeleton, SkeletonMethod};
+//! use skeletonise::methods::{straight_skeleton::StraightSkeleton, MethodContext, SkeletonMethod};
 //! use geo::polygon;
 //! let p = polygon![(x: 0., y: 0.), (x: 10., y: 0.), (x: 10., y: 2.), (x: 0., y: 2.)];
-//! let g = StraightSkeleton.skeletonise(&PreparedPolygon::new(&p).unwrap()).unwrap();
+//! let p = PreparedPolygon::new(&p).unwrap();
+//! let g = StraightSkeleton.skeletonise(&p, &MethodContext::default()).unwrap();
 //! // The centre segment from (1, 1) to (9, 1) and four legs to the corners.
 //! assert_eq!(g.leg_count(), 4);
 //! assert!(g.nodes().iter().all(|n| n.time.is_some()));
@@ -87,7 +88,7 @@
 pub mod events;
 pub mod wavefront;
 
-use super::{MethodError, MethodId, SkeletonMethod};
+use super::{MethodContext, MethodError, MethodId, SkeletonMethod};
 use crate::geometry::packed::{boxes_meet, Bbox, PackedTree};
 use crate::geometry::segment::{lines_meet, properly_cross};
 use crate::geometry::tolerance::{SAME_POINT, TRACE_CROSSING};
@@ -175,6 +176,8 @@ enum Search {
 const SEARCH_PASSES: [Search; 3] = [Search::Near(2.0), Search::Near(16.0), Search::All];
 
 struct Propagation<'a> {
+    /// The method's budget: its deadline is checked on the event queue.
+    ctx: &'a MethodContext,
     w: Wavefront,
     q: EventQueue,
     /// The original edges, item `i` being `LineId(i)`.
@@ -197,7 +200,7 @@ struct Propagation<'a> {
 }
 
 impl<'a> Propagation<'a> {
-    fn new(polygon: &'a PreparedPolygon, search: Search) -> Self {
+    fn new(polygon: &'a PreparedPolygon, search: Search, ctx: &'a MethodContext) -> Self {
         let origin = polygon.origin();
         let n = polygon.vertex_count();
         let extent = polygon.extent().max(f64::MIN_POSITIVE);
@@ -230,6 +233,7 @@ impl<'a> Propagation<'a> {
         }
         work.reverse();
         Self {
+            ctx,
             candidates: vec![Vec::new(); w.vertices.len()],
             w,
             q: EventQueue::default(),
@@ -243,7 +247,8 @@ impl<'a> Propagation<'a> {
             tol: SAME_POINT * extent,
             extent,
             max_pops: 1000 * n + 10_000,
-            max_candidates: crate::methods::budget::memory_limit()
+            max_candidates: ctx
+                .memory_limit()
                 .map_or(usize::MAX, |b| (b / CANDIDATE_BYTES as u64) as usize),
             max_vertices: 16 * n + 64,
             stats: Stats {
@@ -307,7 +312,7 @@ impl<'a> Propagation<'a> {
         while let Some(ev) = self.q.pop() {
             self.stats.pops += 1;
             if self.stats.pops.is_multiple_of(4096) {
-                crate::methods::budget::check()?;
+                self.ctx.check(MethodId::STSK)?;
                 self.stats.max_queue = self.stats.max_queue.max(self.q.len());
             }
             if self.stats.pops > self.max_pops {
@@ -898,20 +903,24 @@ impl<'a> Propagation<'a> {
 }
 
 /// One propagation with the given split-candidate search, verified.
-fn propagate(polygon: &PreparedPolygon, search: Search) -> Result<(Vec<Arc>, Stats), MethodError> {
+fn propagate(
+    polygon: &PreparedPolygon,
+    search: Search,
+    ctx: &MethodContext,
+) -> Result<(Vec<Arc>, Stats), MethodError> {
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        let p = Propagation::new(polygon, search);
+        let p = Propagation::new(polygon, search, ctx);
         // Declined after the first eighth of the sample when that already
         // predicts four times the budget.
         let predicted = p.predict(|(tries, kept)| {
-            crate::methods::budget::afford(
+            ctx.afford(
                 MethodId::STSK,
                 tries * SECONDS_PER_TRY / 4.0,
                 kept * CANDIDATE_BYTES as f64 / 4.0,
             )
             .is_err()
         });
-        crate::methods::budget::afford(
+        ctx.afford(
             MethodId::STSK,
             predicted.0 * SECONDS_PER_TRY,
             predicted.1 * CANDIDATE_BYTES as f64,
@@ -1003,7 +1012,8 @@ fn crossing(
     (apart && far(p) && far(q) && far(a) && far(b)).then_some(x)
 }
 
-/// The straight skeleton of `polygon` and the propagation's counts.
+/// The straight skeleton of `polygon` and the propagation's counts, within
+/// the budget of `ctx`.
 ///
 /// The first pass takes split candidates from edges near each reflex
 /// vertex's path; when its result fails verification (no collapse,
@@ -1011,10 +1021,11 @@ fn crossing(
 /// one exhaustive.
 pub fn straight_skeleton_with_stats(
     polygon: &PreparedPolygon,
+    ctx: &MethodContext,
 ) -> Result<(SkeletonGraph, Stats), MethodError> {
     let mut result = Err(fail("no search pass"));
     for search in SEARCH_PASSES {
-        result = propagate(polygon, search);
+        result = propagate(polygon, search, ctx);
         if result.is_ok() {
             break;
         }
@@ -1036,8 +1047,12 @@ impl SkeletonMethod for StraightSkeleton {
         MethodId::STSK
     }
 
-    fn skeletonise(&self, polygon: &PreparedPolygon) -> Result<SkeletonGraph, MethodError> {
-        straight_skeleton_with_stats(polygon).map(|(g, _)| g)
+    fn skeletonise(
+        &self,
+        polygon: &PreparedPolygon,
+        ctx: &MethodContext,
+    ) -> Result<SkeletonGraph, MethodError> {
+        straight_skeleton_with_stats(polygon, ctx).map(|(g, _)| g)
     }
 }
 
@@ -1048,7 +1063,10 @@ mod tests {
 
     fn run(p: geo::Polygon<f64>) -> SkeletonGraph {
         StraightSkeleton
-            .skeletonise(&PreparedPolygon::new(&p).unwrap())
+            .skeletonise(
+                &PreparedPolygon::new(&p).unwrap(),
+                &MethodContext::default(),
+            )
             .unwrap()
     }
 
@@ -1071,7 +1089,8 @@ mod tests {
             })
             .collect();
         let pp = PreparedPolygon::new(&geo::Polygon::new(ring.into(), vec![])).unwrap();
-        let p = Propagation::new(&pp, Search::Near(1.0));
+        let ctx = MethodContext::default();
+        let p = Propagation::new(&pp, Search::Near(1.0), &ctx);
         let full = p.predict(|_| false);
         let early = p.predict(|_| true);
         assert!(full.0 > 0.0 && full.1 > 0.0, "{full:?}");
