@@ -7,6 +7,7 @@
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use skeletonise::geometry::PreparedPolygon;
 use skeletonise::methods::medial_axis::{ArcTolerance, MedialAxis};
+use skeletonise::methods::MethodContext;
 use skeletonise::methods::SkeletonMethod;
 use std::time::Duration;
 
@@ -39,7 +40,7 @@ fn layers(c: &mut Criterion) {
         group.bench_with_input(BenchmarkId::from_parameter(name), &polys, |b, polys| {
             b.iter(|| {
                 for p in polys {
-                    black_box(method.skeletonise(p).unwrap());
+                    black_box(method.skeletonise(p, &MethodContext::default()).unwrap());
                 }
             })
         });
@@ -74,7 +75,7 @@ fn arcs(c: &mut Criterion) {
     ] {
         let method = MedialAxis::new(tol);
         group.bench_function(label, |b| {
-            b.iter(|| black_box(method.skeletonise(&p).unwrap()))
+            b.iter(|| black_box(method.skeletonise(&p, &MethodContext::default()).unwrap()))
         });
     }
     group.finish();

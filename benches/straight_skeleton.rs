@@ -3,6 +3,7 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use skeletonise::geometry::PreparedPolygon;
 use skeletonise::methods::straight_skeleton::StraightSkeleton;
+use skeletonise::methods::MethodContext;
 use skeletonise::methods::SkeletonMethod;
 
 fn layer(name: &str) -> Vec<PreparedPolygon> {
@@ -27,7 +28,11 @@ fn bench(c: &mut Criterion) {
             b.iter(|| {
                 polys
                     .iter()
-                    .filter(|p| StraightSkeleton.skeletonise(p).is_ok())
+                    .filter(|p| {
+                        StraightSkeleton
+                            .skeletonise(p, &MethodContext::default())
+                            .is_ok()
+                    })
                     .count()
             })
         });

@@ -6,6 +6,7 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use skeletonise::geometry::{densify::Density, PreparedPolygon};
 use skeletonise::io::read_layer_polygons;
+use skeletonise::methods::MethodContext;
 use skeletonise::methods::{voronoi::Voronoi, SkeletonMethod};
 use skeletonise::process::polygon_parts;
 use std::hint::black_box;
@@ -39,7 +40,10 @@ fn bench(c: &mut Criterion) {
             group.bench_function(format!("{name}/{layer}"), |b| {
                 b.iter(|| {
                     for p in &parts {
-                        black_box(m.skeletonise(black_box(p)).unwrap());
+                        black_box(
+                            m.skeletonise(black_box(p), &MethodContext::default())
+                                .unwrap(),
+                        );
                     }
                 })
             });

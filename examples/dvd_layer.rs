@@ -9,6 +9,7 @@
 use rayon::prelude::*;
 use skeletonise::geometry::{densify::Density, PreparedPolygon};
 use skeletonise::io::read_layer_polygons;
+use skeletonise::methods::MethodContext;
 use skeletonise::methods::{voronoi::Voronoi, SkeletonMethod};
 use skeletonise::process::polygon_parts;
 use std::time::Instant;
@@ -51,7 +52,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .filter_map(|p| PreparedPolygon::new(&p).ok())
         .collect();
     let start = Instant::now();
-    let results: Vec<_> = parts.par_iter().map(|p| method.skeletonise(p)).collect();
+    let results: Vec<_> = parts
+        .par_iter()
+        .map(|p| method.skeletonise(p, &MethodContext::default()))
+        .collect();
     let secs = start.elapsed().as_secs_f64();
     let points: usize = parts
         .iter()

@@ -11,6 +11,7 @@
 use rayon::prelude::*;
 use skeletonise::geometry::PreparedPolygon;
 use skeletonise::methods::medial_axis::MedialAxis;
+use skeletonise::methods::MethodContext;
 use skeletonise::methods::SkeletonMethod;
 use std::time::Instant;
 
@@ -34,7 +35,7 @@ fn main() {
     let method = MedialAxis::default();
     let run = |p: &geo::Polygon<f64>| -> (usize, usize, usize, bool) {
         match PreparedPolygon::new(p) {
-            Ok(pp) => match method.skeletonise(&pp) {
+            Ok(pp) => match method.skeletonise(&pp, &MethodContext::default()) {
                 Ok(g) => (pp.vertex_count(), g.nodes().len(), g.edges().len(), true),
                 Err(e) => {
                     eprintln!("rejected: {e}");

@@ -18,8 +18,9 @@ use rayon::prelude::*;
 use skeletonise::geometry::PreparedPolygon;
 use skeletonise::graph::planar::crossings;
 use skeletonise::graph::prune::PruneMode;
+use skeletonise::graph::SkeletonGraph;
 use skeletonise::process::{polygon_parts, process, Processed};
-use skeletonise::score::defects::{end_turns, graph_of, sharp_turns, HOOK_DEG};
+use skeletonise::score::defects::{end_turns, sharp_turns, HOOK_DEG};
 
 #[derive(Default, Clone)]
 struct Tally {
@@ -64,7 +65,7 @@ fn measure(
     scores: Option<&skeletonise::score::Scores>,
     legs: usize,
 ) -> Tally {
-    let g = graph_of(lines);
+    let g = SkeletonGraph::from_lines(lines);
     let mut t = Tally {
         features: 1,
         legs,
@@ -108,7 +109,7 @@ fn measure(
 
 /// Prints `hook FID X Y TURN` for every hooked end of `lines`.
 fn print_hooks(fid: Option<u64>, lines: &geo::MultiLineString<f64>, parts: &[PreparedPolygon]) {
-    let g = graph_of(lines);
+    let g = SkeletonGraph::from_lines(lines);
     let adj = g.adjacency();
     for n in 0..g.nodes().len() {
         if adj[n].len() != 1 {
@@ -122,7 +123,7 @@ fn print_hooks(fid: Option<u64>, lines: &geo::MultiLineString<f64>, parts: &[Pre
         }) else {
             continue;
         };
-        let line = g.line_from(skeletonise::graph::NodeId(n as u32), &adj);
+        let line = g.line_from(skeletonise::graph::NodeId::from_index(n), &adj);
         if let Some(t) = skeletonise::score::defects::end_turn(&line, p) {
             if t > HOOK_DEG {
                 println!(

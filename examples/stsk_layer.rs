@@ -6,6 +6,7 @@
 use rayon::prelude::*;
 use skeletonise::geometry::PreparedPolygon;
 use skeletonise::methods::straight_skeleton::straight_skeleton_with_stats;
+use skeletonise::methods::MethodContext;
 use std::time::Instant;
 
 fn main() {
@@ -37,7 +38,10 @@ fn main() {
             let t = Instant::now();
             let r = PreparedPolygon::new(p)
                 .map_err(|e| e.to_string())
-                .and_then(|pp| straight_skeleton_with_stats(&pp).map_err(|e| e.to_string()));
+                .and_then(|pp| {
+                    straight_skeleton_with_stats(&pp, &MethodContext::default())
+                        .map_err(|e| e.to_string())
+                });
             (*i, r, t.elapsed())
         })
         .collect();

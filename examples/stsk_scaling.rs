@@ -5,6 +5,7 @@
 
 use skeletonise::geometry::PreparedPolygon;
 use skeletonise::methods::straight_skeleton::straight_skeleton_with_stats;
+use skeletonise::methods::MethodContext;
 use std::time::Instant;
 
 /// An ellipse (3000 × 1000) with 50 waves of amplitude 30 and 3000 of
@@ -35,7 +36,7 @@ fn main() {
     for n in ns {
         let pp = PreparedPolygon::new(&wavy_ellipse(n)).expect("valid polygon");
         let t = Instant::now();
-        match straight_skeleton_with_stats(&pp) {
+        match straight_skeleton_with_stats(&pp, &MethodContext::default()) {
             Ok((g, s)) => println!(
                 "n = {n}: {:.3} s, {} edges, {} wavefront vertices, {} pops, at most {} queued, {} edges tried (predicted {:.0}), {} candidates kept (predicted {:.0})",
                 t.elapsed().as_secs_f64(),

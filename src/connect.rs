@@ -149,7 +149,7 @@ pub fn add_legs(
     }
     let tol = 1e-9 * p.extent();
     let mut polylines: Vec<Vec<Coord<f64>>> = (0..g.edges().len())
-        .map(|e| g.edge_coords(crate::graph::EdgeId(e as u32)))
+        .map(|e| g.edge_coords(crate::graph::EdgeId::from_index(e)))
         .collect();
     let mut legs = Vec::new();
     for &(fid, c) in points {

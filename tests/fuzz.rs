@@ -17,8 +17,8 @@ use skeletonise::geometry::PreparedPolygon;
 use skeletonise::graph::extend::{ExtendMode, ExtendParams};
 use skeletonise::graph::planar::crossings;
 use skeletonise::graph::prune::{PruneMode, PruneParams, Structure};
+use skeletonise::graph::SkeletonGraph;
 use skeletonise::process::{process, ProcessParams, Processed};
-use skeletonise::score::defects::graph_of;
 
 /// The steps in one of their modes.
 fn params(prune: usize, extend: usize, shared: bool) -> ProcessParams {
@@ -83,7 +83,7 @@ fn check(geom: &Geometry<f64>, p: &ProcessParams) -> Result<(), String> {
                         }
                     }
                 }
-                if crossings(&graph_of(&s.geometry)) > 0 {
+                if crossings(&SkeletonGraph::from_lines(&s.geometry)) > 0 {
                     return Err(format!("{}: pieces cross", c.method));
                 }
                 if let Some(sc) = s.scores {

@@ -8,10 +8,10 @@ mod common;
 use common::{LAYERS, TRAIN};
 use geo::{polygon, Coord, LineString, Polygon};
 use skeletonise::geometry::PreparedPolygon;
+use skeletonise::graph::widths::medial_axis_transform;
 use skeletonise::graph::{EdgeId, SkeletonGraph};
-use skeletonise::methods::medial_axis::{
-    medial_axis_transform, resolution, ArcTolerance, MedialAxis,
-};
+use skeletonise::methods::medial_axis::{resolution, ArcTolerance, MedialAxis};
+use skeletonise::methods::MethodContext;
 use skeletonise::methods::{MethodError, SkeletonMethod};
 
 fn c(x: f64, y: f64) -> Coord<f64> {
@@ -20,7 +20,9 @@ fn c(x: f64, y: f64) -> Coord<f64> {
 
 fn ma_with(p: &Polygon<f64>, tol: ArcTolerance) -> (PreparedPolygon, SkeletonGraph) {
     let pp = PreparedPolygon::new(p).unwrap();
-    let g = MedialAxis::new(tol).skeletonise(&pp).unwrap();
+    let g = MedialAxis::new(tol)
+        .skeletonise(&pp, &MethodContext::default())
+        .unwrap();
     (pp, g)
 }
 
@@ -54,7 +56,7 @@ fn check_invariants(pp: &PreparedPolygon, g: &SkeletonGraph) {
         );
     }
     for i in 0..g.edges().len() {
-        let pts = g.edge_coords(EdgeId(i as u32));
+        let pts = g.edge_coords(EdgeId::from_index(i));
         for w in pts.windows(2) {
             assert!(
                 !b.crosses(w[0], w[1]),
@@ -286,7 +288,7 @@ fn l_shape_has_the_analytic_parabola_within_tolerance() {
                 ArcTolerance::Relative(f) => f * r_min,
                 ArcTolerance::Absolute(d) => d,
             };
-            let pts = g.edge_coords(EdgeId(i as u32));
+            let pts = g.edge_coords(EdgeId::from_index(i));
             for k in 0..=40 {
                 let t = k as f64 / 40.0;
                 let q = pts[0] + (pts[1] - pts[0]) * t;
@@ -515,7 +517,7 @@ fn invalid_tolerance_is_an_error_not_a_hang() {
         ArcTolerance::Absolute(-1.0),
         ArcTolerance::Relative(f64::NAN),
     ] {
-        let r = MedialAxis::new(t).skeletonise(&pp);
+        let r = MedialAxis::new(t).skeletonise(&pp, &MethodContext::default());
         assert!(
             matches!(r, Err(MethodError::Failed { ref reason, .. }) if reason.contains("arc_tolerance")),
             "{r:?}"
@@ -527,7 +529,7 @@ fn invalid_tolerance_is_an_error_not_a_hang() {
 fn self_intersecting_boundary_is_rejected_with_a_reason() {
     let bow = polygon![(x: 0., y: 0.), (x: 4., y: 4.), (x: 4., y: 0.), (x: 0., y: 6.)];
     let pp = PreparedPolygon::new(&bow).unwrap();
-    let r = MedialAxis::default().skeletonise(&pp);
+    let r = MedialAxis::default().skeletonise(&pp, &MethodContext::default());
     assert!(
         matches!(r, Err(MethodError::Failed { ref reason, .. }) if reason.contains("intersects")),
         "{r:?}"
@@ -555,7 +557,7 @@ fn every_training_layer_runs_with_no_rejected_feature() {
             for part in parts {
                 let pp = PreparedPolygon::new(&part).unwrap();
                 let g = MedialAxis::default()
-                    .skeletonise(&pp)
+                    .skeletonise(&pp, &MethodContext::default())
                     .unwrap_or_else(|e| panic!("{layer} fid {fid:?}: {e}"));
                 assert!(!g.is_empty(), "{layer} fid {fid:?}: empty medial axis");
                 assert_eq!(
@@ -621,7 +623,7 @@ mod random {
             let p = Polygon::new(exterior, holes);
             prop_assume!(p.is_valid());
             let Ok(pp) = PreparedPolygon::new(&p) else { return Ok(()) };
-            let g = MedialAxis::default().skeletonise(&pp).unwrap();
+            let g = MedialAxis::default().skeletonise(&pp, &MethodContext::default()).unwrap();
             check_invariants(&pp, &g);
             prop_assert_eq!(g.components(), 1);
             let used = g.degrees().iter().filter(|&&d| d > 0).count();

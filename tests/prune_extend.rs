@@ -7,13 +7,15 @@ mod common;
 #[cfg(feature = "gdal")]
 use common::TRAIN;
 use geo::{Coord, LineString, Polygon};
+use skeletonise::geometry::tolerance::SAME_POINT;
 use skeletonise::geometry::PreparedPolygon;
-use skeletonise::graph::extend::{extend, prune_and_extend, ExtendMode, ExtendParams, ON_BOUNDARY};
+use skeletonise::graph::extend::{extend, prune_and_extend, ExtendMode, ExtendParams};
 use skeletonise::graph::planar::crossings;
 use skeletonise::graph::prune::{prune, PruneMode, PruneParams};
 use skeletonise::graph::{GraphBuilder, SkeletonGraph};
 #[cfg(feature = "gdal")]
 use skeletonise::io::read_layer_polygons;
+use skeletonise::methods::MethodContext;
 use skeletonise::methods::{build, cdt::Cdt, MethodId, SkeletonMethod, SkeletonParams};
 
 fn c(x: f64, y: f64) -> Coord<f64> {
@@ -51,7 +53,7 @@ fn is_simple_path(g: &SkeletonGraph) -> bool {
 }
 
 fn assert_leaves_on_boundary(g: &SkeletonGraph, p: &PreparedPolygon, what: &str) {
-    let tol = 10.0 * ON_BOUNDARY * p.extent();
+    let tol = 10.0 * SAME_POINT * p.extent();
     for l in leaves(g) {
         let d = p.boundary().distance(l);
         assert!(d <= tol, "{what}: leaf {l:?} is {d} from the boundary");
@@ -119,7 +121,7 @@ fn t_shape_keeps_its_three_arms() {
         ],
         &[],
     );
-    let raw = Cdt.skeletonise(&p).unwrap();
+    let raw = Cdt.skeletonise(&p, &MethodContext::default()).unwrap();
     let (pruned, extended) = default_steps(&raw, &p);
     assert_eq!(pruned.leg_count(), 3, "{:?}", leaves(&pruned));
     assert_eq!(extended.leg_count(), 3);
@@ -176,7 +178,7 @@ fn wavy_river(len: f64, w: f64, h: f64, islands: &[f64]) -> PreparedPolygon {
 #[test]
 fn river_with_bank_noise_keeps_no_spur() {
     let p = wavy_river(1000.0, 10.0, 3.0, &[]);
-    let raw = Cdt.skeletonise(&p).unwrap();
+    let raw = Cdt.skeletonise(&p, &MethodContext::default()).unwrap();
     assert!(raw.leg_count() > 50, "raw legs {}", raw.leg_count());
     let (pruned, extended) = default_steps(&raw, &p);
     assert!(is_simple_path(&pruned), "legs left: {}", pruned.leg_count());
@@ -191,7 +193,7 @@ fn river_with_bank_noise_keeps_no_spur() {
 #[test]
 fn trunk_on_a_polygon_with_holes_is_one_path_from_end_to_end() {
     let p = wavy_river(600.0, 10.0, 3.0, &[150.0, 330.0]);
-    let raw = Cdt.skeletonise(&p).unwrap();
+    let raw = Cdt.skeletonise(&p, &MethodContext::default()).unwrap();
     let trunk = PruneParams {
         mode: PruneMode::Trunk,
         ..Default::default()
@@ -216,7 +218,7 @@ fn trunk_on_a_polygon_with_holes_is_one_path_from_end_to_end() {
 fn long_noisy_river_prunes_to_one_path_quickly() {
     // About 4 000 whiskers: the priority queue keeps this near-linear.
     let p = wavy_river(40_000.0, 10.0, 3.0, &[]);
-    let raw = Cdt.skeletonise(&p).unwrap();
+    let raw = Cdt.skeletonise(&p, &MethodContext::default()).unwrap();
     let t0 = std::time::Instant::now();
     let (pruned, _) = default_steps(&raw, &p);
     println!("{} raw legs pruned in {:?}", raw.leg_count(), t0.elapsed());
@@ -227,7 +229,7 @@ fn long_noisy_river_prunes_to_one_path_quickly() {
 #[test]
 fn pruning_and_extension_are_deterministic() {
     let p = wavy_river(300.0, 10.0, 3.0, &[120.0]);
-    let raw = Cdt.skeletonise(&p).unwrap();
+    let raw = Cdt.skeletonise(&p, &MethodContext::default()).unwrap();
     let a = default_steps(&raw, &p);
     let b = default_steps(&raw, &p);
     assert_eq!(a, b);
@@ -251,7 +253,7 @@ fn check_layer(layer: &str, m: MethodId) -> Option<(usize, usize, usize, usize)>
                 continue;
             };
             parts += 1;
-            let Ok(raw) = method.skeletonise(&p) else {
+            let Ok(raw) = method.skeletonise(&p, &MethodContext::default()) else {
                 failed += 1;
                 continue;
             };

@@ -10,15 +10,17 @@ use common::{LAYERS, TRAIN};
 use geo::{Coord, Geometry, LineString, MultiLineString, Polygon};
 #[cfg(feature = "gdal")]
 use rayon::prelude::*;
-use skeletonise::geometry::boundary::closest_on_segment;
+use skeletonise::geometry::segment::closest_on_segment;
 use skeletonise::geometry::PreparedPolygon;
 use skeletonise::graph::planar::crossings;
 use skeletonise::graph::prune::{PruneMode, PruneParams};
+use skeletonise::graph::SkeletonGraph;
 #[cfg(feature = "gdal")]
 use skeletonise::io::read_layer_polygons;
+use skeletonise::methods::MethodContext;
 use skeletonise::methods::{build, MethodId, SkeletonParams};
 use skeletonise::process::{polygon_parts, process, FeatureOutcome, ProcessParams, Processed};
-use skeletonise::score::defects::{end_turns, graph_of, HOOK_DEG};
+use skeletonise::score::defects::{end_turns, HOOK_DEG};
 
 fn c(x: f64, y: f64) -> Coord<f64> {
     Coord { x, y }
@@ -57,7 +59,7 @@ fn run(p: &Polygon<f64>, params: &ProcessParams) -> FeatureOutcome {
 
 /// The line ends (degree-1 nodes) of a skeleton, sorted.
 fn ends(lines: &MultiLineString<f64>) -> Vec<Coord<f64>> {
-    let g = graph_of(lines);
+    let g = SkeletonGraph::from_lines(lines);
     let deg = g.degrees();
     let mut v: Vec<Coord<f64>> = g
         .nodes()
@@ -133,7 +135,7 @@ fn a_tapering_tip_is_reached_along_the_medial_axis_own_leg() {
     // Every point of the end near the tip lies on the raw medial axis.
     let pp = PreparedPolygon::new(&p).unwrap();
     let raw = build(MethodId::MA, &SkeletonParams::default())
-        .skeletonise(&pp)
+        .skeletonise(&pp, &MethodContext::default())
         .unwrap();
     let raw_lines = raw.to_multilinestring();
     let dist = |q: Coord<f64>| {
@@ -293,7 +295,7 @@ fn layer_defects(layer: &str, params: &ProcessParams) -> (usize, usize, usize, u
             };
             let (method, chosen) = o.chosen();
             let lines = &chosen.geometry;
-            let all = graph_of(lines);
+            let all = SkeletonGraph::from_lines(lines);
             let (mut hooks, mut n_ends, mut not_one_line) = (0, 0, 0);
             for p in &parts {
                 let g = all.filter_edges(|e, _| {

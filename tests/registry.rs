@@ -7,7 +7,9 @@ use skeletonise::geometry::PreparedPolygon;
 use skeletonise::graph::extend::ExtendParams;
 use skeletonise::graph::prune::PruneParams;
 use skeletonise::graph::{GraphBuilder, SkeletonGraph};
-use skeletonise::methods::{MethodEntry, MethodError, MethodId, Registry, SkeletonMethod};
+use skeletonise::methods::{
+    MethodContext, MethodEntry, MethodError, MethodId, Registry, SkeletonMethod,
+};
 use skeletonise::process::{process, ProcessParams, Processed};
 use skeletonise::score::select::SelectParams;
 use skeletonise::score::ScoreParams;
@@ -27,7 +29,11 @@ mod centroid {
             ID
         }
 
-        fn skeletonise(&self, p: &PreparedPolygon) -> Result<SkeletonGraph, MethodError> {
+        fn skeletonise(
+            &self,
+            p: &PreparedPolygon,
+            _ctx: &MethodContext,
+        ) -> Result<SkeletonGraph, MethodError> {
             let c = p.polygon().centroid().ok_or(MethodError::Failed {
                 method: ID,
                 reason: "no centroid".into(),

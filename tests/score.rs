@@ -13,6 +13,7 @@ use skeletonise::geometry::PreparedPolygon;
 use skeletonise::graph::SkeletonGraph;
 #[cfg(feature = "gdal")]
 use skeletonise::io::read_layer_polygons;
+use skeletonise::methods::MethodContext;
 use skeletonise::methods::{build, cdt::Cdt, MethodId, SkeletonMethod, SkeletonParams};
 use skeletonise::process::polygon_parts;
 use skeletonise::score::{bars, metrics, score_skeleton, Bar, Scores};
@@ -159,7 +160,7 @@ fn star(n: usize, seed: f64, scale: f64) -> Polygon<f64> {
 
 fn cdt_scores(poly: &Polygon<f64>) -> (Scores, MultiLineString<f64>) {
     let p = PreparedPolygon::new(poly).unwrap();
-    let g = Cdt.skeletonise(&p).unwrap();
+    let g = Cdt.skeletonise(&p, &MethodContext::default()).unwrap();
     let s = metrics(&bars(&p, &g));
     (s, g.to_multilinestring())
 }
@@ -252,7 +253,7 @@ fn training_layers_score_with_cdt() {
                     continue;
                 };
                 let t0 = Instant::now();
-                let Ok(sk) = Cdt.skeletonise(&p) else {
+                let Ok(sk) = Cdt.skeletonise(&p, &MethodContext::default()) else {
                     continue;
                 };
                 let t1 = Instant::now();
@@ -323,7 +324,7 @@ fn raw_medial_axis_scores_zero_distortion_on_every_training_polygon() {
                     let here = format!("{layer} fid {fid:?} part {k}");
                     let p = PreparedPolygon::new(part).unwrap();
                     let sk = ma
-                        .skeletonise(&p)
+                        .skeletonise(&p, &MethodContext::default())
                         .unwrap_or_else(|e| panic!("{here}: MA failed: {e}"));
                     let b = bars(&p, &sk);
                     let s = metrics(&b);
@@ -444,7 +445,10 @@ fn assert_stsk_equals_ma(name: &str, pts: &[(f64, f64)]) {
     let stsk = build(MethodId::STSK, &SkeletonParams::default());
     {
         let p = prepared(pts);
-        let (g_ma, g_st) = (ma.skeletonise(&p).unwrap(), stsk.skeletonise(&p).unwrap());
+        let (g_ma, g_st) = (
+            ma.skeletonise(&p, &MethodContext::default()).unwrap(),
+            stsk.skeletonise(&p, &MethodContext::default()).unwrap(),
+        );
         let (m_ma, m_st) = (g_ma.to_multilinestring(), g_st.to_multilinestring());
         // The same point set: each lies on the other, to 1e-7 of the extent
         // (MA's Voronoi construction snaps the input to an integer grid).

@@ -9,6 +9,7 @@ use proptest::prelude::*;
 use skeletonise::geometry::PreparedPolygon;
 use skeletonise::graph::SkeletonGraph;
 use skeletonise::methods::straight_skeleton::{straight_skeleton_with_stats, StraightSkeleton};
+use skeletonise::methods::MethodContext;
 use skeletonise::methods::SkeletonMethod;
 
 fn poly(ext: &[(f64, f64)], holes: &[Vec<(f64, f64)>]) -> Polygon<f64> {
@@ -40,7 +41,7 @@ fn line_distances(pp: &PreparedPolygon, p: Coord<f64>) -> Vec<f64> {
 /// * the skeleton is connected when P has no hole (one wavefront).
 fn check(p: &Polygon<f64>) -> (SkeletonGraph, PreparedPolygon) {
     let pp = PreparedPolygon::new(p).unwrap();
-    let (g, stats) = straight_skeleton_with_stats(&pp).unwrap();
+    let (g, stats) = straight_skeleton_with_stats(&pp, &MethodContext::default()).unwrap();
     // Positions and times: 1e-7 of the extent; the line-support check
     // allows 1e-5, since near-simultaneous events (many vertices on one
     // circle) are resolved one after another with rounding in between.
@@ -364,7 +365,7 @@ fn every_training_layer() {
             .par_iter()
             .filter_map(|p| {
                 let pp = PreparedPolygon::new(p).ok()?;
-                match StraightSkeleton.skeletonise(&pp) {
+                match StraightSkeleton.skeletonise(&pp, &MethodContext::default()) {
                     Ok(g) => {
                         let crossing = g
                             .edges()
@@ -410,7 +411,7 @@ fn largest_lena_reach() {
         .unwrap();
     let pp = PreparedPolygon::new(&p).unwrap();
     assert!(pp.vertex_count() > 10_000);
-    let (g, stats) = straight_skeleton_with_stats(&pp).unwrap();
+    let (g, stats) = straight_skeleton_with_stats(&pp, &MethodContext::default()).unwrap();
     assert!(stats.pops <= 1000 * stats.input_vertices + 10_000);
     let tol = 1e-6 * pp.extent();
     for n in g.nodes() {
@@ -463,8 +464,8 @@ fn a_polygon_beyond_the_budget_is_declined_up_front_with_the_reason() {
         time: Some(Duration::from_secs(1)),
         memory: None,
     };
-    match with_budget(MethodId::STSK, one_second, || {
-        StraightSkeleton.skeletonise(&pp)
+    match with_budget(MethodId::STSK, one_second, |ctx| {
+        StraightSkeleton.skeletonise(&pp, ctx)
     }) {
         Err(MethodError::OverBudget { method, reason }) => {
             assert_eq!(method, MethodId::STSK);
@@ -481,8 +482,8 @@ fn a_polygon_beyond_the_budget_is_declined_up_front_with_the_reason() {
         time: None,
         memory: Some(10_000_000),
     };
-    match with_budget(MethodId::STSK, ten_megabytes, || {
-        StraightSkeleton.skeletonise(&pp)
+    match with_budget(MethodId::STSK, ten_megabytes, |ctx| {
+        StraightSkeleton.skeletonise(&pp, ctx)
     }) {
         Err(MethodError::OverBudget { reason, .. }) => {
             assert!(reason.contains("skeleton.max_memory_mb"), "{reason}");
@@ -495,7 +496,10 @@ fn a_polygon_beyond_the_budget_is_declined_up_front_with_the_reason() {
     // The same budgets leave a small polygon alone.
     let small = PreparedPolygon::new(&noisy_circle(400)).unwrap();
     for b in [one_second, ten_megabytes] {
-        let g = with_budget(MethodId::STSK, b, || StraightSkeleton.skeletonise(&small)).unwrap();
+        let g = with_budget(MethodId::STSK, b, |ctx| {
+            StraightSkeleton.skeletonise(&small, ctx)
+        })
+        .unwrap();
         assert!(g.edges().len() > 400);
     }
 }

@@ -12,6 +12,7 @@ use skeletonise::geometry::{densify::Density, PreparedPolygon};
 use skeletonise::graph::SkeletonGraph;
 #[cfg(feature = "gdal")]
 use skeletonise::io::read_layer_polygons;
+use skeletonise::methods::MethodContext;
 use skeletonise::methods::{voronoi::Voronoi, MethodError, SkeletonMethod};
 use skeletonise::process::polygon_parts;
 
@@ -35,7 +36,12 @@ fn run_with_threads(
         .num_threads(threads)
         .build()
         .unwrap();
-    pool.install(|| parts.par_iter().map(|p| method.skeletonise(p)).collect())
+    pool.install(|| {
+        parts
+            .par_iter()
+            .map(|p| method.skeletonise(p, &MethodContext::default()))
+            .collect()
+    })
 }
 
 #[cfg(feature = "gdal")]
@@ -96,7 +102,7 @@ fn densified_skeleton_of_a_real_river_is_connected() {
     // factor 4 must give one connected skeleton.
     let p = &parts("river_danube")[0];
     let g = Voronoi::densified(Density::Factor(4), 2_000_000)
-        .skeletonise(p)
+        .skeletonise(p, &MethodContext::default())
         .unwrap();
     assert_eq!(g.components(), 1);
 }
@@ -142,7 +148,7 @@ fn dvd_converges_to_the_medial_axis() {
         .into_iter()
         .map(|k| {
             let g = Voronoi::densified(Density::Factor(k), 1_000_000)
-                .skeletonise(&p)
+                .skeletonise(&p, &MethodContext::default())
                 .unwrap();
             g.nodes().iter().map(|n| dist(n.pos)).sum::<f64>() / g.nodes().len() as f64
         })
@@ -161,7 +167,7 @@ fn dvd_converges_to_the_medial_axis() {
 fn a_spacing_that_would_create_millions_of_points_is_an_error() {
     let p = &parts("river_danube")[0];
     let e = Voronoi::densified(Density::Spacing(0.01), 2_000_000)
-        .skeletonise(p)
+        .skeletonise(p, &MethodContext::default())
         .unwrap_err();
     match e {
         MethodError::TooManyPoints { points, max } => {

@@ -4,7 +4,7 @@
 
 use super::CollapseParams;
 use crate::geometry::PreparedPolygon;
-use crate::graph::{SkeletonGraph, UnionFind};
+use crate::graph::{EdgeId, NodeId, SkeletonGraph, UnionFind};
 use geo::Coord;
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
@@ -57,22 +57,25 @@ impl Samples {
         let mut inserted = vec![false; pos.len()];
         let mut segments = Vec::new();
         let mut follows = Vec::new();
+        // Sample points: the graph's nodes (same numbers), then the points
+        // inserted along its edges.
+        let sample = |n: NodeId| n.index() as u32;
         for e in 0..g.edges().len() {
-            let id = crate::graph::EdgeId(e as u32);
+            let id = EdgeId::from_index(e);
             let edge = g.edge(id);
             let coords = g.edge_coords(id);
             let (first, last) = (coords[0], coords[coords.len() - 1]);
             let attachment = legs.iter().find_map(|&(s, c)| {
                 if (first, last) == (s, c) {
-                    Some(edge.a.0)
+                    Some(sample(edge.a))
                 } else if (first, last) == (c, s) {
-                    Some(edge.b.0)
+                    Some(sample(edge.b))
                 } else {
                     None
                 }
             });
             let before = pos.len();
-            let mut prev = edge.a.0;
+            let mut prev = sample(edge.a);
             for k in 1..coords.len() {
                 let (a, b) = (coords[k - 1], coords[k]);
                 let n = (crate::geometry::norm(b - a) / step).ceil().max(1.0) as usize;
@@ -84,7 +87,7 @@ impl Samples {
                     prev = cur;
                 }
                 let cur = if k == coords.len() - 1 {
-                    edge.b.0
+                    sample(edge.b)
                 } else {
                     pos.push(b);
                     inserted.push(false);
@@ -94,7 +97,11 @@ impl Samples {
                 prev = cur;
             }
             if let Some(a) = attachment {
-                let end = if a == edge.a.0 { edge.b.0 } else { edge.a.0 };
+                let end = if a == sample(edge.a) {
+                    sample(edge.b)
+                } else {
+                    sample(edge.a)
+                };
                 follows.extend((before as u32..pos.len() as u32).map(|i| (i, a)));
                 follows.push((end, a));
             }

@@ -8,6 +8,9 @@
 use super::classify::Samples;
 use super::{Area, PartCollapse};
 use crate::geometry::arrangement::{self, Face};
+use crate::geometry::segment::{lines_meet, properly_cross, segment_parameter};
+use crate::geometry::tolerance::SAME_POINT;
+use crate::geometry::vector::norm;
 use crate::geometry::PreparedPolygon;
 use crate::graph::GraphBuilder;
 use geo::{Coord, LineString};
@@ -123,7 +126,6 @@ impl CutIndex {
             .filter_map(move |l| {
                 let (c0, c1) = (l.geom().from, l.geom().to);
                 let (c0, c1) = (Coord { x: c0[0], y: c0[1] }, Coord { x: c1[0], y: c1[1] });
-                use crate::geometry::boundary::{properly_cross, segment_parameter};
                 properly_cross(pa, pb, c0, c1)
                     .then(|| segment_parameter(pa, pb, c0, c1))
                     .flatten()
@@ -136,7 +138,7 @@ impl Pieces {
         let at_change: std::collections::HashMap<usize, Coord<f64>> =
             changes.iter().map(|c| (c.segment, c.point)).collect();
         let cuts = CutIndex::of(changes);
-        let touch = 1e-9 * extent;
+        let touch = SAME_POINT * extent;
         let mut raw: Vec<RawPiece> = Vec::new();
         for (i, &(a, b, _)) in s.segments.iter().enumerate() {
             let (ia, ib) = (a as usize, b as usize);
@@ -333,7 +335,7 @@ fn interior_point(f: &Face) -> Option<Coord<f64>> {
     let ring = f.polygon.exterior();
     for w in ring.0.windows(2) {
         let d = w[1] - w[0];
-        let len = crate::geometry::norm(d);
+        let len = norm(d);
         if len == 0.0 {
             continue;
         }
@@ -364,14 +366,7 @@ fn interior_point(f: &Face) -> Option<Coord<f64>> {
 
 /// Where the ray `o + t n` (t > 0) meets segment `a`–`b`.
 fn ray_hit(o: Coord<f64>, n: Coord<f64>, a: Coord<f64>, b: Coord<f64>) -> Option<f64> {
-    let s = b - a;
-    let den = n.x * s.y - n.y * s.x;
-    if den == 0.0 {
-        return None;
-    }
-    let d = a - o;
-    let t = (d.x * s.y - d.y * s.x) / den;
-    let u = (d.x * n.y - d.y * n.x) / den;
+    let (t, u) = lines_meet(o, n, a, b)?;
     (t > 0.0 && (0.0..=1.0).contains(&u)).then_some(t)
 }
 
@@ -405,7 +400,7 @@ fn drop_crossing_cuts(changes: &mut [Change]) {
         let crosses = kept.iter().any(|k| {
             cut.0.windows(2).any(|a| {
                 k.0.windows(2)
-                    .any(|b| crate::geometry::boundary::properly_cross(a[0], a[1], b[0], b[1]))
+                    .any(|b| properly_cross(a[0], a[1], b[0], b[1]))
             })
         });
         if crosses {
@@ -460,10 +455,10 @@ fn snap_to_vertex(p: &PreparedPolygon, c: Coord<f64>) -> Coord<f64> {
         return c;
     };
     let s = &p.boundary().segments()[i];
-    let eps = 1e-9 * p.extent();
-    if crate::geometry::norm(c - s.a) <= eps {
+    let eps = SAME_POINT * p.extent();
+    if norm(c - s.a) <= eps {
         s.a
-    } else if crate::geometry::norm(c - s.b) <= eps {
+    } else if norm(c - s.b) <= eps {
         s.b
     } else {
         c

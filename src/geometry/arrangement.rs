@@ -16,7 +16,9 @@
 //! vertex twice; they are split there, so every face is an OGC-valid
 //! polygon: a shell and the holes inside it.
 
-use super::{norm, PreparedPolygon};
+use super::tolerance::{SAME_POINT, VERTEX_SNAP};
+use super::vector::{cross, norm};
+use super::PreparedPolygon;
 use geo::{Coord, LineString, Polygon};
 use rustc_hash::FxHashMap;
 
@@ -92,12 +94,12 @@ fn attach(p: &PreparedPolygon, c: Coord<f64>) -> Option<((u32, u32), Coord<f64>)
     // Relative to the polygon's size, but never below what its coordinates
     // can resolve (a small polygon far from the origin).
     let resolution = 8.0 * f64::EPSILON * c.x.abs().max(c.y.abs());
-    let tol = (1e-9 * p.extent()).max(resolution);
+    let tol = (SAME_POINT * p.extent()).max(resolution);
     if d > tol {
         return None;
     }
     let s = &b.segments()[i];
-    let snap = (1e-12 * p.extent()).max(resolution);
+    let snap = (VERTEX_SNAP * p.extent()).max(resolution);
     let at = if norm(c - s.a) <= snap {
         s.a
     } else if norm(c - s.b) <= snap {
@@ -325,8 +327,7 @@ fn signed_area(c: &[Coord<f64>]) -> f64 {
     let o = c[0];
     (1..n.saturating_sub(1))
         .map(|i| {
-            let (a, b) = (c[i] - o, c[i + 1] - o);
-            a.x * b.y - a.y * b.x
+            cross(c[i] - o, c[i + 1] - o)
         })
         .sum()
 }
@@ -351,10 +352,9 @@ fn contains(c: &[Coord<f64>], p: Coord<f64>) -> bool {
 /// (exact: half-plane, then the sign of the cross product).
 fn angle_order(a: Coord<f64>, b: Coord<f64>) -> std::cmp::Ordering {
     let half = |d: Coord<f64>| u8::from(d.y < 0.0 || (d.y == 0.0 && d.x < 0.0));
-    half(a).cmp(&half(b)).then_with(|| {
-        let cross = a.x * b.y - a.y * b.x;
-        0.0f64.total_cmp(&cross)
-    })
+    half(a)
+        .cmp(&half(b))
+        .then_with(|| 0.0f64.total_cmp(&cross(a, b)))
 }
 
 #[cfg(test)]

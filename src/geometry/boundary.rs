@@ -1,72 +1,48 @@
 //! Spatial index of a polygon's boundary ∂P.
 //!
-//! One R-tree of boundary segments answers every boundary question the
+//! One index of boundary segments answers every boundary question the
 //! methods and steps ask: distance to ∂P (node radii), point-in-polygon,
 //! "does this segment cross ∂P", the first hit of a ray (leg extension, bars)
 //! and the nearest boundary point (optionally restricted to a half-plane, for
 //! the scoring step's sides). Queries cost O(log n) on real data instead of a
 //! scan of all edges.
+//!
+//! [`Boundary`] is a façade over three backends of one private trait,
+//! chosen in one place for the queries that have a pass over every segment
+//! besides a tree search (nearest segment, first hit of a ray, nearest point
+//! on both sides of a line):
+//!
+//! * the lane passes ([`super::lanes`]): a boundary of at most 64 segments,
+//!   on a processor with AVX2, and a query within [`super::lanes::TAME`];
+//! * the scalar passes ([`super::scan`]): a boundary of at most 64 segments
+//!   otherwise;
+//! * the packed R-tree ([`super::packed`]): a larger boundary, built on the
+//!   first query that needs it.
+//!
+//! All three give the same answers bit for bit, ties included (tested
+//! below). The other queries (half-planes, sectors, crossings, containment,
+//! pairs) always search the tree.
 
 use super::lanes::{self, Columns};
 use super::packed::{
     box_distance_2, box_meets_half_plane, boxes_meet, ray_box, Bbox, Obb, PackedTree, RaySlab,
 };
+use super::scan::Scan;
+use super::segment::{
+    clip_to_half_plane, crosses_rightward, properly_cross, ray_segment, segment_distance_2,
+    BoundarySegment,
+};
+use super::tolerance::{BOUND_MARGIN, SHORT_OF_END};
+use super::vector::norm;
 use geo::{Coord, LineString, Polygon};
 use std::cell::Cell;
 use std::ops::ControlFlow;
 use std::sync::OnceLock;
 
-/// One boundary edge, oriented as its ring (interior on the left).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct BoundarySegment {
-    /// Start vertex.
-    pub a: Coord<f64>,
-    /// End vertex.
-    pub b: Coord<f64>,
-    /// Ring index (0 = exterior).
-    pub ring: u32,
-    /// Index of the start vertex within its ring.
-    pub index: u32,
-}
-
-impl BoundarySegment {
-    /// Segment length.
-    pub fn length(&self) -> f64 {
-        (self.b - self.a).x.hypot((self.b - self.a).y)
-    }
-
-    /// Closest point of the segment to `p`, and its parameter in [0, 1].
-    pub fn closest(&self, p: Coord<f64>) -> (Coord<f64>, f64) {
-        closest_on_segment(self.a, self.b, p)
-    }
-}
-
-/// Closest point of segment `ab` to `p` and its parameter `t` in [0, 1].
-pub fn closest_on_segment(a: Coord<f64>, b: Coord<f64>, p: Coord<f64>) -> (Coord<f64>, f64) {
-    let d = b - a;
-    let l2 = d.x * d.x + d.y * d.y;
-    if l2 == 0.0 {
-        return (a, 0.0);
-    }
-    let t = (((p - a).x * d.x + (p - a).y * d.y) / l2).clamp(0.0, 1.0);
-    (a + d * t, t)
-}
-
-/// [`closest_on_segment`]'s point without its parameter, dividing only when
-/// the foot is interior (see [`segment_distance_2`]: the same point, but
-/// for the sign of a zero coordinate).
-fn closest_point(a: Coord<f64>, b: Coord<f64>, p: Coord<f64>) -> Coord<f64> {
-    let d = b - a;
-    let dot = (p - a).x * d.x + (p - a).y * d.y;
-    let l2 = d.x * d.x + d.y * d.y;
-    if dot <= 0.0 || l2 == 0.0 {
-        a
-    } else if dot < l2 {
-        a + d * (dot / l2)
-    } else {
-        a + d
-    }
-}
+/// Kept at their old paths for the per-feature path (`process`), which
+/// imports them from here; their home is [`super::segment`].
+#[doc(no_inline)]
+pub use super::segment::{closest_on_segment, segment_parameter};
 
 /// The first boundary point met by a ray.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -99,6 +75,121 @@ pub struct Boundary {
     max: Coord<f64>,
 }
 
+/// The queries a boundary answers either by a pass over every segment or
+/// by a tree search: the same answers, ties to the lower segment index.
+trait Backend {
+    /// The segment nearest `p` among those within squared distance
+    /// `limit2`, and its squared distance ([`segment_distance_2`]).
+    fn nearest_2(&self, p: Coord<f64>, limit2: f64) -> Option<(f64, u32)>;
+
+    /// The least ray parameter `t`, `min_t < t ≤ max_t`, at which
+    /// `origin + t · dir` meets a segment ([`ray_segment`]), and the segment.
+    fn first_param(
+        &self,
+        origin: Coord<f64>,
+        dir: Coord<f64>,
+        min_t: f64,
+        max_t: f64,
+    ) -> Option<(f64, usize)>;
+
+    /// The point nearest `q` in each closed half-plane of the line through
+    /// `q` across `normal` (the `normal` side first), and its squared
+    /// distance.
+    fn both_sides(&self, q: Coord<f64>, normal: Coord<f64>) -> [Option<(Coord<f64>, f64)>; 2];
+}
+
+impl Backend for Columns {
+    fn nearest_2(&self, p: Coord<f64>, limit2: f64) -> Option<(f64, u32)> {
+        Columns::nearest_2(self, p, limit2)
+    }
+
+    fn first_param(
+        &self,
+        o: Coord<f64>,
+        d: Coord<f64>,
+        min_t: f64,
+        max_t: f64,
+    ) -> Option<(f64, usize)> {
+        Columns::first_param(self, o, d, min_t, max_t)
+    }
+
+    fn both_sides(&self, q: Coord<f64>, normal: Coord<f64>) -> [Option<(Coord<f64>, f64)>; 2] {
+        Columns::both_sides(self, q, normal)
+    }
+}
+
+impl Backend for Scan<'_> {
+    fn nearest_2(&self, p: Coord<f64>, limit2: f64) -> Option<(f64, u32)> {
+        Scan::nearest_2(self, p, limit2)
+    }
+
+    fn first_param(
+        &self,
+        o: Coord<f64>,
+        d: Coord<f64>,
+        min_t: f64,
+        max_t: f64,
+    ) -> Option<(f64, usize)> {
+        Scan::first_param(self, o, d, min_t, max_t)
+    }
+
+    fn both_sides(&self, q: Coord<f64>, normal: Coord<f64>) -> [Option<(Coord<f64>, f64)>; 2] {
+        Scan::both_sides(self, q, normal)
+    }
+}
+
+/// The tree's searches over `segments` (item `i` of `tree` is segment `i`).
+struct Indexed<'a> {
+    segments: &'a [BoundarySegment],
+    tree: &'a PackedTree,
+}
+
+impl Backend for Indexed<'_> {
+    fn nearest_2(&self, p: Coord<f64>, limit2: f64) -> Option<(f64, u32)> {
+        let (x, y) = (p.x, p.y);
+        self.tree.best_within(
+            limit2,
+            |b| Some(box_distance_2(b, x, y)),
+            Some(|o: &Obb| Some(o.distance_2([x, y]))),
+            |i, _| {
+                let s = &self.segments[i as usize];
+                Some(segment_distance_2(s.a, s.b, p))
+            },
+        )
+    }
+
+    fn first_param(
+        &self,
+        o: Coord<f64>,
+        d: Coord<f64>,
+        min_t: f64,
+        max_t: f64,
+    ) -> Option<(f64, usize)> {
+        let slab = RaySlab::new(pt(o), pt(d), max_t);
+        // Axis-aligned boxes only: a ray crossing the polygon passes as many
+        // oriented boxes as axis-aligned ones, and their test costs more
+        // (callgrind, a noisy circle of 50 000 vertices: the exits 2.3 G
+        // instructions with axis-aligned boxes, 3.1 G with oriented ones).
+        let (t, i) = self.tree.best(
+            |b| slab.enter(b),
+            None::<fn(&Obb) -> Option<f64>>,
+            |i, _| {
+                let s = &self.segments[i as usize];
+                ray_segment(o, d, s.a, s.b)
+                    .map(|(t, _)| t)
+                    .filter(|&t| t > min_t && t <= max_t)
+            },
+        )?;
+        Some((t, i as usize))
+    }
+
+    /// The scalar pass: one pass costs less than two tree searches on the
+    /// boundaries it is asked of (few segments), and gives their answers.
+    fn both_sides(&self, q: Coord<f64>, normal: Coord<f64>) -> [Option<(Coord<f64>, f64)>; 2] {
+        Scan(self.segments).both_sides(q, normal)
+    }
+}
+
 /// A point every query can take: the R-tree's nearest-neighbour search
 /// cannot order NaN distances, so a non-finite point (from a degenerate
 /// computation upstream) gets "no answer" instead.
@@ -118,140 +209,6 @@ type Found = (Coord<f64>, f64, u32);
 /// tree cost more on a small polygon: 2 000 islands of 11 vertices on
 /// average, all five methods, 1.7 % less CPU time at 48 than at 16).
 const FEW_SEGMENTS: usize = 64;
-
-/// Squared distance from `p` to segment `ab` (the nearest point computed as
-/// the projection parameter strictly inside (0, 1), else an end).
-///
-/// The parameter is `dot / l2` (`dot` = (p − a)·(b − a), `l2` = |b − a|²),
-/// but the division is made only when the foot is interior: `0 < dot/l2`
-/// exactly when `0 < dot` (a quotient that underflows to zero gives the
-/// same point `a`), and a quotient of floating-point numbers `dot < l2` is
-/// below one after rounding (the gap below 1 is 2⁻⁵³, and `dot/l2` is at
-/// most 1 − 2⁻⁵³), so `dot/l2 < 1` exactly when `dot < l2`. The same
-/// distance, bit for bit, as dividing first; most segments of a pass have
-/// their nearest point at an end.
-fn segment_distance_2(a: Coord<f64>, b: Coord<f64>, p: Coord<f64>) -> f64 {
-    let dir = b - a;
-    let dot = (p - a).x * dir.x + (p - a).y * dir.y;
-    let l2 = dir.x * dir.x + dir.y * dir.y;
-    let n = if dot <= 0.0 {
-        a
-    } else if dot < l2 {
-        a + dir * (dot / l2)
-    } else {
-        b
-    };
-    let d = n - p;
-    d.x * d.x + d.y * d.y
-}
-
-fn cross(a: Coord<f64>, b: Coord<f64>) -> f64 {
-    a.x * b.y - a.y * b.x
-}
-
-/// Robust orientation of `c` relative to the directed line `a → b`:
-/// positive = left, negative = right, zero = collinear.
-pub fn orient(a: Coord<f64>, b: Coord<f64>, c: Coord<f64>) -> f64 {
-    robust::orient2d(
-        robust::Coord { x: a.x, y: a.y },
-        robust::Coord { x: b.x, y: b.y },
-        robust::Coord { x: c.x, y: c.y },
-    )
-}
-
-/// Where segment `pq` meets segment `ab`, as the parameter `t` of
-/// `p + t (q − p)`, when they meet in one point (not parallel).
-pub fn segment_parameter(
-    p: Coord<f64>,
-    q: Coord<f64>,
-    a: Coord<f64>,
-    b: Coord<f64>,
-) -> Option<f64> {
-    let (r, s) = (q - p, b - a);
-    let den = r.x * s.y - r.y * s.x;
-    if den == 0.0 {
-        return None;
-    }
-    let d = a - p;
-    let t = (d.x * s.y - d.y * s.x) / den;
-    let u = (d.x * r.y - d.y * r.x) / den;
-    ((0.0..=1.0).contains(&t) && (0.0..=1.0).contains(&u)).then_some(t)
-}
-
-/// True when segments `pq` and `ab` cross at a single point interior to both
-/// (a proper crossing); touching at an endpoint or running along each other is
-/// not a crossing.
-pub fn properly_cross(p: Coord<f64>, q: Coord<f64>, a: Coord<f64>, b: Coord<f64>) -> bool {
-    let o1 = orient(p, q, a);
-    let o2 = orient(p, q, b);
-    let o3 = orient(a, b, p);
-    let o4 = orient(a, b, q);
-    o1 * o2 < 0.0 && o3 * o4 < 0.0
-}
-
-/// Intersection parameter of ray `o + t d` with segment `ab`: `(t, s)` where
-/// `s` ∈ [0, 1] is the segment parameter. For a collinear overlap the nearest
-/// overlapping point is returned.
-#[inline]
-pub fn ray_segment(
-    o: Coord<f64>,
-    d: Coord<f64>,
-    a: Coord<f64>,
-    b: Coord<f64>,
-) -> Option<(f64, f64)> {
-    let e = b - a;
-    let den = cross(d, e);
-    let w = a - o;
-    if den == 0.0 {
-        // Parallel: only a collinear overlap counts.
-        if cross(w, d) != 0.0 {
-            return None;
-        }
-        let dd = d.x * d.x + d.y * d.y;
-        if dd == 0.0 {
-            return None;
-        }
-        let ta = (w.x * d.x + w.y * d.y) / dd;
-        let tb = ((b - o).x * d.x + (b - o).y * d.y) / dd;
-        let (t, s) = if ta <= tb { (ta, 0.0) } else { (tb, 1.0) };
-        let (tmax, _) = if ta <= tb { (tb, 1.0) } else { (ta, 0.0) };
-        if tmax < 0.0 {
-            return None;
-        }
-        if t >= 0.0 {
-            return Some((t, s));
-        }
-        // Origin lies on the segment.
-        let sl = e.x * e.x + e.y * e.y;
-        let s0 = if sl == 0.0 {
-            0.0
-        } else {
-            ((o - a).x * e.x + (o - a).y * e.y) / sl
-        };
-        return Some((0.0, s0.clamp(0.0, 1.0)));
-    }
-    // Whether the segment parameter `s = num / den` is in [0, 1], decided
-    // without dividing (most segments a ray is tested against miss it): the
-    // quotient's sign is that of its operands, and a quotient of
-    // floating-point numbers exceeds one after rounding exactly when the
-    // numerator's magnitude exceeds the denominator's (the gap above 1 is
-    // 2⁻⁵², and the quotient is then above 1 + 2⁻⁵³, which rounds up; see
-    // `segment_distance_2` for the gap below). The same decisions as
-    // dividing first, but for a negative quotient below 2⁻¹⁰⁷⁴ in magnitude,
-    // which would have rounded to −0 and counted as 0.
-    let num = cross(w, d);
-    let inside = if den > 0.0 {
-        0.0 <= num && num <= den
-    } else {
-        den <= num && num <= 0.0
-    };
-    if !inside {
-        return None;
-    }
-    let s = num / den;
-    let t = cross(w, e) / den;
-    (t >= 0.0).then_some((t, s))
-}
 
 impl Boundary {
     /// Indexes every edge of every ring of `polygon` (rings must be closed).
@@ -309,16 +266,6 @@ impl Boundary {
         }
     }
 
-    /// The same boundary answering by the scalar passes alone (no columns):
-    /// what the lane passes must agree with.
-    #[cfg(test)]
-    fn scalar(&self) -> Self {
-        Self {
-            columns: None,
-            ..self.clone()
-        }
-    }
-
     /// The packed R-tree of the segments, built on first use.
     fn tree(&self) -> &PackedTree {
         self.tree.get_or_init(|| {
@@ -326,6 +273,22 @@ impl Boundary {
                 self.segments.iter().map(|s| [pt(s.a), pt(s.b)]).collect();
             PackedTree::of_segments(&ends)
         })
+    }
+
+    /// Answers `ask` by the backend for this boundary and a query whose
+    /// points are all `tame` ([`super::lanes::tame`]) or not: the lane
+    /// passes when the boundary has columns and the points are tame, the
+    /// scalar passes for another boundary of few segments, the tree for a
+    /// larger one.
+    fn backend<R>(&self, tame: bool, ask: impl FnOnce(&dyn Backend) -> R) -> R {
+        match &self.columns {
+            Some(c) if tame => ask(c),
+            _ if self.few_segments() => ask(&Scan(&self.segments)),
+            _ => ask(&Indexed {
+                segments: &self.segments,
+                tree: self.tree(),
+            }),
+        }
     }
 
     /// All boundary segments (ring order).
@@ -350,45 +313,9 @@ impl Boundary {
         self.max
     }
 
-    /// The segment nearest to `p` and its squared distance.
-    fn nearest_segment(&self, p: Coord<f64>) -> Option<(f64, u32)> {
-        self.nearest_segment_within(p, f64::INFINITY)
-    }
-
     /// The nearest segment among those within squared distance `limit2`.
     fn nearest_segment_within(&self, p: Coord<f64>, limit2: f64) -> Option<(f64, u32)> {
-        if let Some(c) = self.columns.as_ref().filter(|_| lanes::tame(p)) {
-            // The same pass, several segments at a time.
-            return c.nearest_2(p, limit2);
-        }
-        if self.few_segments() {
-            // Every segment in index order: the tree's answer (least squared
-            // distance within the limit, ties to the lower index).
-            let mut best: Option<(f64, u32)> = None;
-            for (i, s) in self.segments.iter().enumerate() {
-                let d2 = segment_distance_2(s.a, s.b, p);
-                if d2 <= limit2 && best.is_none_or(|(bd, _)| d2 < bd) {
-                    best = Some((d2, i as u32));
-                }
-            }
-            return best;
-        }
-        self.nearest_segment_in_tree(p, limit2)
-    }
-
-    /// [`Boundary::nearest_segment_within`] through the tree, whatever the
-    /// size.
-    fn nearest_segment_in_tree(&self, p: Coord<f64>, limit2: f64) -> Option<(f64, u32)> {
-        let (x, y) = (p.x, p.y);
-        self.tree().best_within(
-            limit2,
-            |b| Some(box_distance_2(b, x, y)),
-            Some(|o: &Obb| Some(o.distance_2([x, y]))),
-            |i, _| {
-                let s = &self.segments[i as usize];
-                Some(segment_distance_2(s.a, s.b, p))
-            },
-        )
+        self.backend(lanes::tame(p), |b| b.nearest_2(p, limit2))
     }
 
     /// [`Boundary::nearest`] among the points at most `limit` from `p`
@@ -401,7 +328,7 @@ impl Boundary {
         let (_, i) = self.nearest_segment_within(p, limit * limit)?;
         let s = &self.segments[i as usize];
         let (c, _) = s.closest(p);
-        Some((c, i as usize, super::norm(c - p)))
+        Some((c, i as usize, norm(c - p)))
     }
 
     /// Nearest boundary point to `p`: (point, segment index, distance).
@@ -414,7 +341,7 @@ impl Boundary {
         if !finite(p) {
             return f64::NAN;
         }
-        self.nearest_segment(p)
+        self.nearest_segment_within(p, f64::INFINITY)
             .map(|(d2, _)| d2.sqrt())
             .unwrap_or(f64::INFINITY)
     }
@@ -423,7 +350,7 @@ impl Boundary {
     /// rounding): the bound keeps the search short and never changes the
     /// answer.
     pub fn distance_within(&self, p: Coord<f64>, bound: f64) -> f64 {
-        let limit = bound * (1.0 + 1e-9) + f64::MIN_POSITIVE;
+        let limit = bound * (1.0 + BOUND_MARGIN) + f64::MIN_POSITIVE;
         if !finite(p) || !limit.is_finite() {
             return self.distance(p);
         }
@@ -471,48 +398,13 @@ impl Boundary {
         q: Coord<f64>,
         normal: Coord<f64>,
     ) -> [Option<(Coord<f64>, f64)>; 2] {
-        // The nearest point on each side so far and its squared distance.
-        let mut best: [Option<(Coord<f64>, f64)>; 2] = [None, None];
         if !finite(q) {
-            return best;
+            return [None, None];
         }
-        if let Some(c) = self
-            .columns
-            .as_ref()
-            .filter(|_| lanes::tame(q) && lanes::tame(normal))
-        {
-            // The same pass, several segments at a time.
-            return c
-                .both_sides(q, normal)
-                .map(|b| b.map(|(c, d2)| (c, d2.sqrt())));
-        }
-        let side = |c: Coord<f64>| (c - q).x * normal.x + (c - q).y * normal.y;
-        for s in &self.segments {
-            let (fa, fb) = (side(s.a), side(s.b));
-            // The segment clipped to each closed half-plane, as
-            // `clip_to_half_plane` clips it (the opposite side's values are
-            // the negated ones, exactly).
-            let parts = [
-                clip_by_sides(s.a, s.b, fa, fb),
-                clip_by_sides(s.a, s.b, -fa, -fb),
-            ];
-            for (k, part) in parts.into_iter().enumerate() {
-                let Some((a, b)) = part else { continue };
-                let c = closest_point(a, b, q);
-                let d2 = (c - q).x * (c - q).x + (c - q).y * (c - q).y;
-                // Segments in index order: the first of equal distances
-                // stays, distances compared as roots (as the tree search
-                // compares them). A root is never smaller when its square
-                // is not, and is smaller when its square is smaller by more
-                // than the roots' rounding (a relative 2⁻⁵³ each): only
-                // squares closer than that need their roots. The root of
-                // the winner is taken at the end: the same answer.
-                if best[k].is_none_or(|(_, bd2)| nearer_2(d2, bd2)) {
-                    best[k] = Some((c, d2));
-                }
-            }
-        }
-        best.map(|b| b.map(|(c, d2)| (c, d2.sqrt())))
+        self.backend(lanes::tame(q) && lanes::tame(normal), |b| {
+            b.both_sides(q, normal)
+        })
+        .map(|b| b.map(|(c, d2)| (c, d2.sqrt())))
     }
 
     /// True when the boundary has so few segments that a pass over all of
@@ -574,7 +466,7 @@ impl Boundary {
                 let s = &self.segments[i as usize];
                 if let Some((a, b)) = clip(s.a, s.b) {
                     let c = closest_on_segment(a, b, q).0;
-                    let d = super::norm(c - q);
+                    let d = norm(c - q);
                     if d <= limit
                         && best
                             .get()
@@ -600,97 +492,35 @@ impl Boundary {
         if !(finite(origin) && finite(dir)) {
             return None;
         }
-        if let Some(c) = self
-            .columns
-            .as_ref()
-            .filter(|_| lanes::tame(origin) && lanes::tame(dir))
-        {
-            // The same pass, several segments at a time.
-            return c
-                .first_param(origin, dir, min_t, max_t)
-                .map(|(t, segment)| RayHit {
-                    t,
-                    point: origin + dir * t,
-                    segment,
-                });
-        }
-        if self.few_segments() {
-            // Every segment in index order: the tree's answer (lowest t,
-            // ties to the lower index) without building or walking it.
-            let mut best: Option<(f64, usize)> = None;
-            for (i, s) in self.segments.iter().enumerate() {
-                let hit = ray_segment(origin, dir, s.a, s.b)
-                    .map(|(t, _)| t)
-                    .filter(|&t| t > min_t && t <= max_t);
-                if let Some(t) = hit {
-                    if best.is_none_or(|(bt, _)| t < bt) {
-                        best = Some((t, i));
-                    }
-                }
-            }
-            return best.map(|(t, segment)| RayHit {
-                t,
-                point: origin + dir * t,
-                segment,
-            });
-        }
-        self.first_hit_in_tree(origin, dir, min_t, max_t)
-    }
-
-    /// [`Boundary::first_hit`] through the tree, whatever the size.
-    fn first_hit_in_tree(
-        &self,
-        origin: Coord<f64>,
-        dir: Coord<f64>,
-        min_t: f64,
-        max_t: f64,
-    ) -> Option<RayHit> {
-        let slab = RaySlab::new(pt(origin), pt(dir), max_t);
-        // Axis-aligned boxes only: a ray crossing the polygon passes as many
-        // oriented boxes as axis-aligned ones, and their test costs more
-        // (callgrind, a noisy circle of 50 000 vertices: the exits 2.3 G
-        // instructions with axis-aligned boxes, 3.1 G with oriented ones).
-        let (t, i) = self.tree().best(
-            |b| slab.enter(b),
-            None::<fn(&Obb) -> Option<f64>>,
-            |i, _| {
-                let s = &self.segments[i as usize];
-                ray_segment(origin, dir, s.a, s.b)
-                    .map(|(t, _)| t)
-                    .filter(|&t| t > min_t && t <= max_t)
-            },
-        )?;
+        let tame = lanes::tame(origin) && lanes::tame(dir);
+        let (t, segment) = self.backend(tame, |b| b.first_param(origin, dir, min_t, max_t))?;
         Some(RayHit {
             t,
             point: origin + dir * t,
-            segment: i as usize,
+            segment,
         })
     }
 
     /// True when the open segment `pq` properly crosses a boundary segment.
     pub fn crosses(&self, p: Coord<f64>, q: Coord<f64>) -> bool {
-        let env = [p.x.min(q.x), p.y.min(q.y), p.x.max(q.x), p.y.max(q.y)];
-        self.tree()
-            .visit(
-                |b| boxes_meet(b, &env),
-                |i| {
-                    let s = &self.segments[i as usize];
-                    if properly_cross(p, q, s.a, s.b) {
-                        ControlFlow::Break(())
-                    } else {
-                        ControlFlow::Continue(())
-                    }
-                },
-            )
-            .is_some()
+        self.visit_segments_near(p, q, |i| {
+            let s = &self.segments[i];
+            if properly_cross(p, q, s.a, s.b) {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            }
+        })
+        .is_some()
     }
 
     /// True when the segment from `p` to the boundary point `q` meets ∂P only
     /// at `q`: [`Boundary::crosses`] on the segment stopped a millionth of
-    /// its length short of `q`, because a point computed on a boundary
-    /// segment lies on it only up to rounding and would "cross" it.
+    /// its length short of `q` ([`SHORT_OF_END`]), because a point computed
+    /// on a boundary segment lies on it only up to rounding and would
+    /// "cross" it.
     pub fn reaches(&self, p: Coord<f64>, q: Coord<f64>) -> bool {
-        !self.crosses(p, q + (p - q) * 1e-6)
+        !self.crosses(p, q + (p - q) * SHORT_OF_END)
     }
 
     /// Point-in-polygon by crossing parity along the ray towards +x
@@ -745,7 +575,7 @@ impl Boundary {
             |i| {
                 let s = &self.segments[i as usize];
                 if ring(s.ring) {
-                    inside ^= crosses_up(s, p);
+                    inside ^= crosses_rightward(s, p);
                 }
                 ControlFlow::<()>::Continue(())
             },
@@ -759,65 +589,14 @@ impl Boundary {
     }
 }
 
-/// True when the ray from `p` towards +x crosses `s` (half-open rule on
-/// vertices).
-fn crosses_up(s: &BoundarySegment, p: Coord<f64>) -> bool {
-    let (a, b) = (s.a, s.b);
-    if (a.y > p.y) == (b.y > p.y) {
-        return false;
-    }
-    let o = orient(a, b, p);
-    let upward = b.y > a.y;
-    (upward && o > 0.0) || (!upward && o < 0.0)
-}
-
-/// Segment `ab` clipped to the half-plane `(x − q) · n ≥ 0`, or `None` when
-/// it lies wholly outside it.
 /// A lower bound of the distance from `q` to any point of the box, so also
 /// to its part in a half-plane or sector: the distance to the whole box
 /// (looser than to the part for a box across an edge line, but cheaper, and
 /// few boxes near `q` are; a search gives the same answer with any lower
-/// bound), shrunk by a relative 1e-9 so that rounding never makes it exceed
-/// a distance computed to a segment in the box.
+/// bound), shrunk by [`BOUND_MARGIN`] so that rounding never makes it
+/// exceed a distance computed to a segment in the box.
 fn box_lower_bound(b: &Bbox, q: Coord<f64>) -> f64 {
-    box_distance_2(b, q.x, q.y).sqrt() * (1.0 - 1e-9)
-}
-
-fn clip_to_half_plane(
-    a: Coord<f64>,
-    b: Coord<f64>,
-    q: Coord<f64>,
-    n: Coord<f64>,
-) -> Option<(Coord<f64>, Coord<f64>)> {
-    let fa = (a - q).x * n.x + (a - q).y * n.y;
-    let fb = (b - q).x * n.x + (b - q).y * n.y;
-    clip_by_sides(a, b, fa, fb)
-}
-
-/// True when the distance whose square is `d2` is smaller than the one
-/// whose square is `best2`, compared as roots (as the tree search compares
-/// them): a root is never smaller when its square is not, and is smaller
-/// when its square is smaller by more than the roots' rounding (a relative
-/// 2⁻⁵³ each), so only squares closer than that need their roots.
-#[inline]
-pub(super) fn nearer_2(d2: f64, best2: f64) -> bool {
-    d2 < best2 && (d2 < best2 * (1.0 - 1e-15) || d2.sqrt() < best2.sqrt())
-}
-
-/// Segment `ab` cut down to where a linear function with values `fa` at `a`
-/// and `fb` at `b` is ≥ 0, or `None` when it is negative at both ends.
-fn clip_by_sides(
-    a: Coord<f64>,
-    b: Coord<f64>,
-    fa: f64,
-    fb: f64,
-) -> Option<(Coord<f64>, Coord<f64>)> {
-    match (fa >= 0.0, fb >= 0.0) {
-        (true, true) => Some((a, b)),
-        (false, false) => None,
-        (true, false) => Some((a, a + (b - a) * (fa / (fa - fb)))),
-        (false, true) => Some((a + (b - a) * (fa / (fa - fb)), b)),
-    }
+    box_distance_2(b, q.x, q.y).sqrt() * (1.0 - BOUND_MARGIN)
 }
 
 #[cfg(test)]
@@ -962,24 +741,28 @@ mod tests {
         assert_eq!(c, Coord { x: 4.0, y: 4.0 });
     }
 
-    /// A boundary of few segments answers ray and nearest-segment queries
-    /// by a pass over them: exactly the tree's answers, ties included.
-    /// The lane passes ([`super::lanes`]) give the scalar passes' answers
-    /// bit for bit: on random small boundaries (1 to 64 segments, some of
-    /// zero length, some collinear) and on a grid where rays run along
-    /// segments, through vertices and points sit on segment lines, with
-    /// ties of equal distances.
-    #[test]
-    fn lane_passes_answer_as_the_scalar_passes_do() {
-        let bits = |x: f64| x.to_bits();
-        let pt_bits = |c: Coord<f64>| (bits(c.x), bits(c.y));
-        let mut state = 0x2545_f491_4f6c_dd1d_u64;
-        let mut next = move || {
+    /// The tree's backend over a boundary of any size.
+    fn indexed(b: &Boundary) -> Indexed<'_> {
+        Indexed {
+            segments: &b.segments,
+            tree: b.tree(),
+        }
+    }
+
+    /// A xorshift generator of numbers in [0, 1).
+    fn uniform(mut state: u64) -> impl FnMut() -> f64 {
+        move || {
             state ^= state << 13;
             state ^= state >> 7;
             state ^= state << 17;
             (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        }
+    }
+
+    /// Random small boundaries (1 to 64 segments, some of zero length,
+    /// some collinear), and a square grid of unit segments (rays along
+    /// them, ties everywhere).
+    fn small_boundaries(next: &mut impl FnMut() -> f64) -> Vec<Boundary> {
         let mut boundaries = Vec::new();
         for n in 1..=64 {
             // Random segments, with grid-snapped coordinates now and then
@@ -1010,7 +793,6 @@ mod tests {
             }
             boundaries.push(Boundary::from_segments(segs));
         }
-        // A square grid of unit segments: rays along them, ties everywhere.
         let mut grid = Vec::new();
         for i in 0..4 {
             for j in 0..4 {
@@ -1026,6 +808,12 @@ mod tests {
             }
         }
         boundaries.push(Boundary::from_segments(grid));
+        boundaries
+    }
+
+    /// Query points (on a half grid now and then: on segment lines and
+    /// vertices) and directions (axis-parallel now and then).
+    fn queries(next: &mut impl FnMut() -> f64) -> Vec<(Coord<f64>, Coord<f64>)> {
         let mut queries = vec![];
         for k in 0..40 {
             let p = Coord {
@@ -1051,37 +839,61 @@ mod tests {
             };
             queries.push((p, dir));
         }
+        queries
+    }
+
+    /// Asks backends `x` and `y` every query at `(p, dir)` and asserts the
+    /// same answers bit for bit; counts the answers found per kind.
+    fn same_answers(
+        x: &dyn Backend,
+        y: &dyn Backend,
+        (p, dir): (Coord<f64>, Coord<f64>),
+        answered: &mut [usize; 3],
+    ) {
+        let bits = |v: f64| v.to_bits();
+        let pt_bits = |c: Coord<f64>| (bits(c.x), bits(c.y));
+        for limit2 in [f64::INFINITY, 9.0, 0.0] {
+            let (a, b) = (x.nearest_2(p, limit2), y.nearest_2(p, limit2));
+            assert_eq!(a.map(|(d, i)| (bits(d), i)), b.map(|(d, i)| (bits(d), i)));
+            answered[0] += usize::from(a.is_some());
+        }
+        for (min_t, max_t) in [(0.0, f64::INFINITY), (1e-9, 5.0)] {
+            let key = |h: Option<(f64, usize)>| h.map(|(t, i)| (bits(t), i));
+            let a = x.first_param(p, dir, min_t, max_t);
+            assert_eq!(key(a), key(y.first_param(p, dir, min_t, max_t)));
+            answered[1] += usize::from(a.is_some());
+        }
+        let key =
+            |r: [Option<(Coord<f64>, f64)>; 2]| r.map(|o| o.map(|(c, d)| (pt_bits(c), bits(d))));
+        let a = x.both_sides(p, dir);
+        assert_eq!(key(a), key(y.both_sides(p, dir)));
+        answered[2] += a.iter().filter(|o| o.is_some()).count();
+    }
+
+    /// The lane passes ([`super::lanes`]) give the scalar passes' answers
+    /// bit for bit: on random small boundaries and on a grid where rays run
+    /// along segments, through vertices and points sit on segment lines,
+    /// with ties of equal distances.
+    #[test]
+    fn lane_passes_answer_as_the_scalar_passes_do() {
+        let mut next = uniform(0x2545_f491_4f6c_dd1d);
+        let boundaries = small_boundaries(&mut next);
+        let queries = queries(&mut next);
         let mut answered = [0usize; 3];
         for b in &boundaries {
             assert_eq!(b.columns.is_some(), lanes::available());
-            let s = b.scalar();
-            for &(p, dir) in &queries {
-                for limit2 in [f64::INFINITY, 9.0, 0.0] {
-                    let (x, y) = (
-                        b.nearest_segment_within(p, limit2),
-                        s.nearest_segment_within(p, limit2),
-                    );
-                    assert_eq!(x.map(|(d, i)| (bits(d), i)), y.map(|(d, i)| (bits(d), i)));
-                    answered[0] += usize::from(x.is_some());
-                }
-                for (min_t, max_t) in [(0.0, f64::INFINITY), (1e-9, 5.0)] {
-                    let key =
-                        |h: Option<RayHit>| h.map(|h| (bits(h.t), pt_bits(h.point), h.segment));
-                    let x = b.first_hit(p, dir, min_t, max_t);
-                    assert_eq!(key(x), key(s.first_hit(p, dir, min_t, max_t)));
-                    answered[1] += usize::from(x.is_some());
-                }
-                let key = |r: [Option<(Coord<f64>, f64)>; 2]| {
-                    r.map(|o| o.map(|(c, d)| (pt_bits(c), bits(d))))
-                };
-                let x = b.nearest_on_both_sides(p, dir);
-                assert_eq!(key(x), key(s.nearest_on_both_sides(p, dir)));
-                answered[2] += x.iter().filter(|o| o.is_some()).count();
+            let Some(columns) = &b.columns else { continue };
+            for &q in &queries {
+                same_answers(columns, &Scan(&b.segments), q, &mut answered);
             }
         }
-        assert!(answered.iter().all(|&n| n > 1000), "{answered:?}");
+        if lanes::available() {
+            assert!(answered.iter().all(|&n| n > 1000), "{answered:?}");
+        }
     }
 
+    /// A boundary of few segments answers ray and nearest-segment queries
+    /// by a pass over them: exactly the tree's answers, ties included.
     #[test]
     fn small_boundaries_answer_as_the_tree_does() {
         // A wavy ring of 60 segments (the pass) and rays from inside and
@@ -1098,6 +910,7 @@ mod tests {
             .collect();
         let b = Boundary::new(&Polygon::new(LineString::from(ring.clone()), vec![]));
         assert!(b.few_segments());
+        let (scan, tree) = (Scan(&b.segments), indexed(&b));
         let mut hits = 0;
         for (k, &(vx, vy)) in ring.iter().enumerate() {
             for (ox, oy) in [(0.0, 0.0), (0.5, -1.25), (30.0, 2.0), (-3.0, 20.0)] {
@@ -1111,18 +924,15 @@ mod tests {
                     },
                 ];
                 for dir in dirs {
-                    let pass = b.first_hit(origin, dir, 1e-9, 1e3);
-                    assert_eq!(pass, b.first_hit_in_tree(origin, dir, 1e-9, 1e3));
+                    let pass = scan.first_param(origin, dir, 1e-9, 1e3);
+                    assert_eq!(pass, tree.first_param(origin, dir, 1e-9, 1e3));
                     hits += usize::from(pass.is_some());
                     // Nearest segments too, from points along the ray (on
                     // the ring's vertices and edges among them).
                     for t in [0.25, 0.5, 1.0, 1.5] {
                         let p = origin + dir * t;
                         for limit2 in [f64::INFINITY, 4.0] {
-                            assert_eq!(
-                                b.nearest_segment_within(p, limit2),
-                                b.nearest_segment_in_tree(p, limit2)
-                            );
+                            assert_eq!(scan.nearest_2(p, limit2), tree.nearest_2(p, limit2));
                         }
                     }
                 }
@@ -1171,7 +981,7 @@ mod tests {
             for s in b.segments() {
                 if let Some((a, c)) = clip(s.a, s.b) {
                     let p = closest_on_segment(a, c, q).0;
-                    let d = crate::geometry::norm(p - q);
+                    let d = norm(p - q);
                     if best.is_none_or(|(_, bd)| d < bd) {
                         best = Some((p, d));
                     }

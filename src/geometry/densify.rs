@@ -1,6 +1,7 @@
 //! Boundary densification for the densified Voronoi diagram (DVD): pseudo-nodes
 //! inserted on every boundary edge.
 
+use super::vector::hypot;
 use geo::{Coord, LineString};
 
 /// How densely to insert pseudo-nodes on boundary edges.
@@ -26,7 +27,7 @@ impl Density {
 /// Number of points a densified closed ring will have (without the closing point).
 pub fn densified_len(ring: &LineString<f64>, density: Density) -> usize {
     ring.lines()
-        .map(|l| density.pieces((l.end - l.start).x.hypot((l.end - l.start).y)))
+        .map(|l| density.pieces(hypot(l.end - l.start)))
         .fold(0usize, usize::saturating_add)
 }
 
@@ -36,7 +37,7 @@ pub fn densify_ring(ring: &LineString<f64>, density: Density) -> Vec<Coord<f64>>
     let mut out = Vec::with_capacity(densified_len(ring, density));
     for l in ring.lines() {
         let d = l.end - l.start;
-        let k = density.pieces(d.x.hypot(d.y));
+        let k = density.pieces(hypot(d));
         out.push(l.start);
         for i in 1..k {
             let t = i as f64 / k as f64;

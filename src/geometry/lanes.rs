@@ -25,12 +25,12 @@
 //! pass); other boundaries and points, and other processors, take the
 //! scalar passes.
 
-use super::boundary::{nearer_2, ray_segment};
+use super::segment::{nearer_2, ray_segment};
 use geo::Coord;
 
 /// Largest coordinate magnitude the columns take (see the module docs):
 /// squares and products of differences stay far below `f64::MAX`.
-pub const TAME: f64 = 1e100;
+pub(crate) const TAME: f64 = 1e100;
 
 /// Segments per step (the columns are padded to a multiple of it).
 const W: usize = 4;
@@ -38,9 +38,9 @@ const W: usize = 4;
 /// A small boundary's segments in columns: start `a`, end `b` and
 /// direction `d = b − a` (computed once, the same value as `b − a` every
 /// time), padded with copies of the first segment to a multiple of [`W`]
-/// (the scans stop at [`Columns::len`]).
+/// (the scans stop at the number of segments).
 #[derive(Debug, Clone)]
-pub struct Columns {
+pub(crate) struct Columns {
     n: usize,
     ax: Vec<f64>,
     ay: Vec<f64>,
@@ -52,7 +52,7 @@ pub struct Columns {
 
 /// True when `c` is within ±[`TAME`] in both coordinates (false for NaN).
 #[inline]
-pub fn tame(c: Coord<f64>) -> bool {
+pub(crate) fn tame(c: Coord<f64>) -> bool {
     c.x.abs() <= TAME && c.y.abs() <= TAME
 }
 
@@ -72,7 +72,9 @@ pub(crate) fn available() -> bool {
 impl Columns {
     /// The columns of `segments` (start, end), or `None` when a coordinate
     /// is not [`tame`] or the processor cannot run the passes.
-    pub fn new(segments: impl ExactSizeIterator<Item = (Coord<f64>, Coord<f64>)>) -> Option<Self> {
+    pub(crate) fn new(
+        segments: impl ExactSizeIterator<Item = (Coord<f64>, Coord<f64>)>,
+    ) -> Option<Self> {
         if !available() {
             return None;
         }
@@ -108,21 +110,11 @@ impl Columns {
         Some(c)
     }
 
-    /// Number of segments.
-    pub fn len(&self) -> usize {
-        self.n
-    }
-
-    /// True when there is no segment.
-    pub fn is_empty(&self) -> bool {
-        self.n == 0
-    }
-
     /// The segment nearest `p` (tame) among those within squared distance
-    /// `limit2`, and its squared distance: `Boundary`'s scalar pass
-    /// (`segment_distance_2` per segment, the least within the limit, ties
-    /// to the lower index).
-    pub fn nearest_2(&self, p: Coord<f64>, limit2: f64) -> Option<(f64, u32)> {
+    /// `limit2`, and its squared distance: the scalar pass
+    /// ([`super::scan::Scan::nearest_2`]: `segment_distance_2` per segment,
+    /// the least within the limit, ties to the lower index).
+    pub(crate) fn nearest_2(&self, p: Coord<f64>, limit2: f64) -> Option<(f64, u32)> {
         #[cfg(target_arch = "x86_64")]
         // SAFETY: columns exist only where the processor has AVX2 (`new`).
         return unsafe { avx2::nearest_2(self, p, limit2) };
@@ -132,10 +124,10 @@ impl Columns {
 
     /// The least ray parameter `t`, `min_t < t ≤ max_t`, at which
     /// `origin + t · dir` (both tame) meets a segment, and the segment:
-    /// `Boundary`'s scalar pass (`ray_segment` per segment, ties to the
-    /// lower index). A segment parallel to the ray is decided by
+    /// the scalar pass ([`super::scan::Scan::first_param`]: `ray_segment`
+    /// per segment, ties to the lower index). A segment parallel to the ray is decided by
     /// `ray_segment` itself.
-    pub fn first_param(
+    pub(crate) fn first_param(
         &self,
         origin: Coord<f64>,
         dir: Coord<f64>,
@@ -151,10 +143,15 @@ impl Columns {
 
     /// The point nearest `q` (tame) in each closed half-plane of the line
     /// through `q` across `normal` (tame) — `(x − q) · normal ≥ 0`, then
-    /// `≤ 0` — and its squared distance: `Boundary`'s scalar two-sided pass
-    /// (each segment cut by `clip_by_sides`, its nearest point by
-    /// `closest_point`, compared by `nearer_2` in index order).
-    pub fn both_sides(&self, q: Coord<f64>, normal: Coord<f64>) -> [Option<(Coord<f64>, f64)>; 2] {
+    /// `≤ 0` — and its squared distance: the scalar two-sided pass
+    /// ([`super::scan::Scan::both_sides`]: each segment cut by
+    /// `clip_by_sides`, its nearest point by `closest_point`, compared by
+    /// `nearer_2` in index order).
+    pub(crate) fn both_sides(
+        &self,
+        q: Coord<f64>,
+        normal: Coord<f64>,
+    ) -> [Option<(Coord<f64>, f64)>; 2] {
         #[cfg(target_arch = "x86_64")]
         // SAFETY: columns exist only where the processor has AVX2 (`new`).
         return unsafe { avx2::both_sides(self, q, normal) };
@@ -217,37 +214,86 @@ mod avx2 {
         _mm256_blendv_pd(y, x, c)
     }
 
+    /// Four lanes of one coordinate pair.
+    type Pair = (__m256d, __m256d);
+
+    /// `a · b` per lane (x products first, as the scalar code adds them).
+    #[inline]
     #[target_feature(enable = "avx2")]
-    pub fn nearest_2(c: &Columns, p: Coord<f64>, limit2: f64) -> Option<(f64, u32)> {
-        let (px, py) = (_mm256_set1_pd(p.x), _mm256_set1_pd(p.y));
+    fn dot(a: Pair, b: Pair) -> __m256d {
+        _mm256_add_pd(_mm256_mul_pd(a.0, b.0), _mm256_mul_pd(a.1, b.1))
+    }
+
+    /// `a − b` per lane.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    fn sub(a: Pair, b: Pair) -> Pair {
+        (_mm256_sub_pd(a.0, b.0), _mm256_sub_pd(a.1, b.1))
+    }
+
+    /// One step's four segments: start `a`, end `b` and direction `d`.
+    #[derive(Clone, Copy)]
+    struct Step {
+        a: Pair,
+        b: Pair,
+        d: Pair,
+    }
+
+    impl Step {
+        /// The four segments from `base`.
+        #[inline]
+        #[target_feature(enable = "avx2")]
+        fn load(c: &Columns, base: usize) -> Self {
+            Self {
+                a: (load(&c.ax, base), load(&c.ay, base)),
+                b: (load(&c.bx, base), load(&c.by, base)),
+                d: (load(&c.dx, base), load(&c.dy, base)),
+            }
+        }
+    }
+
+    /// The projection of `q` on the lines from `a` along `u` per lane:
+    /// `(dot, l2, foot)` with `dot = (q − a) · u`, `l2 = u · u` and the
+    /// foot `a + u · (dot / l2)`, as `segment_distance_2` and
+    /// `closest_point` compute them (used only where they divide).
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    fn project(a: Pair, u: Pair, q: Pair) -> (__m256d, __m256d, Pair) {
+        let along = dot(sub(q, a), u);
+        let l2 = dot(u, u);
+        let f = _mm256_div_pd(along, l2);
+        let foot = (
+            _mm256_add_pd(a.0, _mm256_mul_pd(u.0, f)),
+            _mm256_add_pd(a.1, _mm256_mul_pd(u.1, f)),
+        );
+        (along, l2, foot)
+    }
+
+    /// Squared distance from `q` to `p` per lane.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    fn distance_2(p: Pair, q: Pair) -> __m256d {
+        let e = sub(p, q);
+        dot(e, e)
+    }
+
+    #[target_feature(enable = "avx2")]
+    pub(super) fn nearest_2(c: &Columns, p: Coord<f64>, limit2: f64) -> Option<(f64, u32)> {
+        let q = (_mm256_set1_pd(p.x), _mm256_set1_pd(p.y));
         let (zero, limit) = (_mm256_setzero_pd(), _mm256_set1_pd(limit2));
         let (mut best_d2, mut best) = (f64::INFINITY, usize::MAX);
         let mut base = 0;
         while base < c.n {
-            let (ax, ay) = (load(&c.ax, base), load(&c.ay, base));
-            let (bx, by) = (load(&c.bx, base), load(&c.by, base));
-            let (dx, dy) = (load(&c.dx, base), load(&c.dy, base));
+            let s = Step::load(c, base);
             // segment_distance_2: the projection's foot, else an end.
-            let dot = _mm256_add_pd(
-                _mm256_mul_pd(_mm256_sub_pd(px, ax), dx),
-                _mm256_mul_pd(_mm256_sub_pd(py, ay), dy),
+            let (along, l2, foot) = project(s.a, s.d, q);
+            let start = _mm256_cmp_pd::<_CMP_LE_OQ>(along, zero);
+            let inner = _mm256_cmp_pd::<_CMP_LT_OQ>(along, l2);
+            let n = (
+                pick(start, s.a.0, pick(inner, foot.0, s.b.0)),
+                pick(start, s.a.1, pick(inner, foot.1, s.b.1)),
             );
-            let l2 = _mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy));
-            let f = _mm256_div_pd(dot, l2);
-            let start = _mm256_cmp_pd::<_CMP_LE_OQ>(dot, zero);
-            let inner = _mm256_cmp_pd::<_CMP_LT_OQ>(dot, l2);
-            let nx = pick(
-                start,
-                ax,
-                pick(inner, _mm256_add_pd(ax, _mm256_mul_pd(dx, f)), bx),
-            );
-            let ny = pick(
-                start,
-                ay,
-                pick(inner, _mm256_add_pd(ay, _mm256_mul_pd(dy, f)), by),
-            );
-            let (ex, ey) = (_mm256_sub_pd(nx, px), _mm256_sub_pd(ny, py));
-            let d2 = _mm256_add_pd(_mm256_mul_pd(ex, ex), _mm256_mul_pd(ey, ey));
+            let d2 = distance_2(n, q);
             // Only lanes within the limit and below the best so far can win
             // (the best only falls within a step): in index order, each
             // that is still below the best becomes it. The squares of tame
@@ -270,7 +316,7 @@ mod avx2 {
     }
 
     #[target_feature(enable = "avx2")]
-    pub fn first_param(
+    pub(super) fn first_param(
         c: &Columns,
         o: Coord<f64>,
         d: Coord<f64>,
@@ -346,106 +392,88 @@ mod avx2 {
     }
 
     #[target_feature(enable = "avx2")]
-    pub fn both_sides(
+    pub(super) fn both_sides(
         c: &Columns,
         q: Coord<f64>,
         nrm: Coord<f64>,
     ) -> [Option<(Coord<f64>, f64)>; 2] {
-        let (qx, qy) = (_mm256_set1_pd(q.x), _mm256_set1_pd(q.y));
-        let (nx, ny) = (_mm256_set1_pd(nrm.x), _mm256_set1_pd(nrm.y));
-        let (zero, nan) = (_mm256_setzero_pd(), _mm256_set1_pd(f64::NAN));
+        let q = (_mm256_set1_pd(q.x), _mm256_set1_pd(q.y));
+        let n = (_mm256_set1_pd(nrm.x), _mm256_set1_pd(nrm.y));
         let sign = _mm256_set1_pd(-0.0);
         let mut best: [Option<(Coord<f64>, f64)>; 2] = [None, None];
         let mut base = 0;
         while base < c.n {
-            let (ax, ay) = (load(&c.ax, base), load(&c.ay, base));
-            let (bx, by) = (load(&c.bx, base), load(&c.by, base));
-            let (dx, dy) = (load(&c.dx, base), load(&c.dy, base));
+            let s = Step::load(c, base);
             // The side function at both ends; the opposite side's values are
             // their negations (a sign flip, as `-x` is).
-            let fa0 = _mm256_add_pd(
-                _mm256_mul_pd(_mm256_sub_pd(ax, qx), nx),
-                _mm256_mul_pd(_mm256_sub_pd(ay, qy), ny),
-            );
-            let fb0 = _mm256_add_pd(
-                _mm256_mul_pd(_mm256_sub_pd(bx, qx), nx),
-                _mm256_mul_pd(_mm256_sub_pd(by, qy), ny),
-            );
+            let fa0 = dot(sub(s.a, q), n);
+            let fb0 = dot(sub(s.b, q), n);
             for (k, best) in best.iter_mut().enumerate() {
                 let (fa, fb) = if k == 0 {
                     (fa0, fb0)
                 } else {
                     (_mm256_xor_pd(fa0, sign), _mm256_xor_pd(fb0, sign))
                 };
-                // clip_by_sides: the whole segment, nothing, or cut where the
-                // side function is zero.
-                let ia = _mm256_cmp_pd::<_CMP_GE_OQ>(fa, zero);
-                let ib = _mm256_cmp_pd::<_CMP_GE_OQ>(fb, zero);
-                // Four segments wholly on the other side (as neighbours
-                // along a bank often are) have nothing here.
-                let part = _mm256_or_pd(ia, ib);
-                if bits(part) == 0 {
-                    continue;
-                }
-                let r = _mm256_div_pd(fa, _mm256_sub_pd(fa, fb));
-                let mx = _mm256_add_pd(ax, _mm256_mul_pd(dx, r));
-                let my = _mm256_add_pd(ay, _mm256_mul_pd(dy, r));
-                let (cax, cay) = (pick(ia, ax, mx), pick(ia, ay, my));
-                let (cbx, cby) = (pick(ib, bx, mx), pick(ib, by, my));
-                // closest_point of the part to q.
-                let (ux, uy) = (_mm256_sub_pd(cbx, cax), _mm256_sub_pd(cby, cay));
-                let dot = _mm256_add_pd(
-                    _mm256_mul_pd(_mm256_sub_pd(qx, cax), ux),
-                    _mm256_mul_pd(_mm256_sub_pd(qy, cay), uy),
-                );
-                let l2 = _mm256_add_pd(_mm256_mul_pd(ux, ux), _mm256_mul_pd(uy, uy));
-                let f = _mm256_div_pd(dot, l2);
-                let start = _mm256_or_pd(
-                    _mm256_cmp_pd::<_CMP_LE_OQ>(dot, zero),
-                    _mm256_cmp_pd::<_CMP_EQ_OQ>(l2, zero),
-                );
-                let inner = _mm256_cmp_pd::<_CMP_LT_OQ>(dot, l2);
-                let x = pick(
-                    start,
-                    cax,
-                    pick(
-                        inner,
-                        _mm256_add_pd(cax, _mm256_mul_pd(ux, f)),
-                        _mm256_add_pd(cax, ux),
-                    ),
-                );
-                let y = pick(
-                    start,
-                    cay,
-                    pick(
-                        inner,
-                        _mm256_add_pd(cay, _mm256_mul_pd(uy, f)),
-                        _mm256_add_pd(cay, uy),
-                    ),
-                );
-                let (ex, ey) = (_mm256_sub_pd(x, qx), _mm256_sub_pd(y, qy));
-                let d2 = _mm256_add_pd(_mm256_mul_pd(ex, ex), _mm256_mul_pd(ey, ey));
-                // Lanes with a part on this side that may be nearer than the
-                // best so far (`nearer_2` needs a smaller square).
-                let maybe = match best {
-                    Some((_, bd2)) => {
-                        _mm256_and_pd(part, _mm256_cmp_pd::<_CMP_LT_OQ>(d2, _mm256_set1_pd(*bd2)))
-                    }
-                    None => part,
-                };
-                let d2 = store(pick(part, d2, nan));
-                let (xs, ys) = (store(x), store(y));
-                let mut set = bits(maybe);
-                while set != 0 {
-                    let l = next_lane(&mut set);
-                    let d2 = d2[l];
-                    if !d2.is_nan() && best.is_none_or(|(_, bd2)| nearer_2(d2, bd2)) {
-                        *best = Some((Coord { x: xs[l], y: ys[l] }, d2));
-                    }
-                }
+                nearest_on_side(&s, q, (fa, fb), best);
             }
             base += W;
         }
         best
+    }
+
+    /// One side of [`both_sides`] for one step's four segments, whose side
+    /// function is `fa` at their starts and `fb` at their ends: each
+    /// segment's part where it is ≥ 0, that part's point nearest `q`, and
+    /// `best` replaced by the first (in index order) that is nearer.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    fn nearest_on_side(s: &Step, q: Pair, (fa, fb): Pair, best: &mut Option<(Coord<f64>, f64)>) {
+        let (zero, nan) = (_mm256_setzero_pd(), _mm256_set1_pd(f64::NAN));
+        // clip_by_sides: the whole segment, nothing, or cut where the
+        // side function is zero.
+        let ia = _mm256_cmp_pd::<_CMP_GE_OQ>(fa, zero);
+        let ib = _mm256_cmp_pd::<_CMP_GE_OQ>(fb, zero);
+        // Four segments wholly on the other side (as neighbours
+        // along a bank often are) have nothing here.
+        let part = _mm256_or_pd(ia, ib);
+        if bits(part) == 0 {
+            return;
+        }
+        let r = _mm256_div_pd(fa, _mm256_sub_pd(fa, fb));
+        let m = (
+            _mm256_add_pd(s.a.0, _mm256_mul_pd(s.d.0, r)),
+            _mm256_add_pd(s.a.1, _mm256_mul_pd(s.d.1, r)),
+        );
+        let ca = (pick(ia, s.a.0, m.0), pick(ia, s.a.1, m.1));
+        let cb = (pick(ib, s.b.0, m.0), pick(ib, s.b.1, m.1));
+        // closest_point of the part to q.
+        let u = sub(cb, ca);
+        let (along, l2, foot) = project(ca, u, q);
+        let start = _mm256_or_pd(
+            _mm256_cmp_pd::<_CMP_LE_OQ>(along, zero),
+            _mm256_cmp_pd::<_CMP_EQ_OQ>(l2, zero),
+        );
+        let inner = _mm256_cmp_pd::<_CMP_LT_OQ>(along, l2);
+        let x = pick(start, ca.0, pick(inner, foot.0, _mm256_add_pd(ca.0, u.0)));
+        let y = pick(start, ca.1, pick(inner, foot.1, _mm256_add_pd(ca.1, u.1)));
+        let d2 = distance_2((x, y), q);
+        // Lanes with a part on this side that may be nearer than the
+        // best so far (`nearer_2` needs a smaller square).
+        let maybe = match best {
+            Some((_, bd2)) => {
+                _mm256_and_pd(part, _mm256_cmp_pd::<_CMP_LT_OQ>(d2, _mm256_set1_pd(*bd2)))
+            }
+            None => part,
+        };
+        let d2 = store(pick(part, d2, nan));
+        let (xs, ys) = (store(x), store(y));
+        let mut set = bits(maybe);
+        while set != 0 {
+            let l = next_lane(&mut set);
+            let d2 = d2[l];
+            if !d2.is_nan() && best.is_none_or(|(_, bd2)| nearer_2(d2, bd2)) {
+                *best = Some((Coord { x: xs[l], y: ys[l] }, d2));
+            }
+        }
     }
 }

@@ -3,39 +3,34 @@
 //! boundary ([`boundary`]) used for radii, containment, crossing tests, ray casts
 //! and nearest-point queries.
 //!
+//! The ground floor, which every other file here and every layer above
+//! builds on and which imports nothing of the project: vector arithmetic
+//! ([`vector`]), segment predicates and their tie rules ([`segment`]) and
+//! the table of tolerances ([`tolerance`]). The boundary index is a façade
+//! ([`Boundary`]) over three backends: the packed R-tree (`packed`), the
+//! scalar passes over few segments (`scan`) and the same passes four
+//! segments at a time (`lanes`); those three import only the ground floor.
+//!
 //! Everything here works on owned [`geo`] types; nothing touches GDAL.
 
 pub mod arrangement;
 pub mod boundary;
 pub mod densify;
-pub mod lanes;
-pub mod packed;
+pub(crate) mod lanes;
+pub(crate) mod packed;
 pub mod ring;
+pub(crate) mod scan;
+pub mod segment;
+pub mod tolerance;
 pub mod validity;
+pub mod vector;
 
-pub use boundary::{Boundary, BoundarySegment, RayHit};
+pub use boundary::{Boundary, RayHit};
+pub use segment::BoundarySegment;
+pub use vector::{norm, within_hypot};
 
 use geo::{Coord, Polygon};
 use thiserror::Error;
-
-/// Length of a vector: `√(x² + y²)`, without `hypot`'s care for overflow
-/// (which costs several times as much and which projected coordinates never
-/// need).
-#[inline]
-pub fn norm(d: Coord<f64>) -> f64 {
-    (d.x * d.x + d.y * d.y).sqrt()
-}
-
-/// `d.x.hypot(d.y) <= tol`, the same answer bit for bit, with `hypot` only
-/// when both components are within `tol`: `hypot` is never below the larger
-/// component (a faithfully rounded `√(x² + y²) ≥ max(|x|, |y|)` cannot
-/// round below that floating-point number), so a larger component decides
-/// alone — as it does for nearly every pair of points compared with a
-/// tolerance.
-#[inline]
-pub fn within_hypot(d: Coord<f64>, tol: f64) -> bool {
-    d.x.abs() <= tol && d.y.abs() <= tol && d.x.hypot(d.y) <= tol
-}
 
 /// Why a polygon cannot be prepared for skeletonisation.
 #[derive(Debug, Error, Clone, PartialEq)]

@@ -15,6 +15,7 @@
 //! towards the query point, and the side searches of a 200 000-vertex noisy
 //! circle's bars scored 446 boxes each with them, 140 with oriented ones.
 
+use super::tolerance::{BOUND_MARGIN, BOX_SLACK, SLAB_SLACK};
 use std::mem::MaybeUninit;
 use std::ops::ControlFlow;
 
@@ -34,11 +35,11 @@ const FEW_PAIRED: usize = 48;
 const STACK: usize = NODE_SIZE * 12;
 
 /// An axis-aligned box: `[min x, min y, max x, max y]`.
-pub type Bbox = [f64; 4];
+pub(crate) type Bbox = [f64; 4];
 
 /// The packed tree.
 #[derive(Debug, Clone, Default)]
-pub struct PackedTree {
+pub(crate) struct PackedTree {
     /// Item boxes (Hilbert order), then the nodes of each level up to the root.
     boxes: Vec<Bbox>,
     /// For an item position: the item's number; for a node: the position of
@@ -62,7 +63,7 @@ pub struct PackedTree {
 /// construction and every bound is shrunk by a relative 10⁻⁹), so a search
 /// gives the same answer with them as with axis-aligned boxes.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Obb {
+pub(crate) struct Obb {
     c: [f64; 2],
     u: [f64; 2],
     hl: f64,
@@ -107,7 +108,7 @@ impl Obb {
         let (hl, hw) = (0.5 * (hi[0] - lo[0]), 0.5 * (hi[1] - lo[1]));
         // Rounding in the projections above and in a query's: a relative
         // 10⁻¹² of the magnitudes involved is far beyond it.
-        let slack = 1e-12 * (c[0].abs() + c[1].abs() + hl + hw) + f64::MIN_POSITIVE;
+        let slack = BOX_SLACK * (c[0].abs() + c[1].abs() + hl + hw) + f64::MIN_POSITIVE;
         Self {
             c,
             u,
@@ -126,18 +127,18 @@ impl Obb {
     }
 
     /// A lower bound of the squared distance from `p` to anything in the box.
-    pub fn distance_2(&self, p: [f64; 2]) -> f64 {
+    pub(crate) fn distance_2(&self, p: [f64; 2]) -> f64 {
         let l = self.local(p);
         let a = (l[0].abs() - self.hl).max(0.0);
         let b = (l[1].abs() - self.hw).max(0.0);
-        (a * a + b * b) * (1.0 - 2e-9)
+        (a * a + b * b) * (1.0 - 2.0 * BOUND_MARGIN)
     }
 
     /// A lower bound of the distance from `q` to the part of the box in the
     /// closed half-planes `(x − q) · n ≥ 0` of every `n` in `normals`, or
     /// `None` when the box is out of one of them (never when a point of it
     /// is in all).
-    pub fn clipped_distance(&self, q: [f64; 2], normals: &[[f64; 2]]) -> Option<f64> {
+    pub(crate) fn clipped_distance(&self, q: [f64; 2], normals: &[[f64; 2]]) -> Option<f64> {
         let l = self.local(q);
         for n in normals {
             let nl = [
@@ -147,15 +148,16 @@ impl Obb {
             // The farthest reach of the box along n, from q.
             let reach =
                 -(l[0] * nl[0] + l[1] * nl[1]) + self.hl * nl[0].abs() + self.hw * nl[1].abs();
-            let room =
-                1e-9 * (l[0].abs() + l[1].abs() + self.hl + self.hw) * (nl[0].abs() + nl[1].abs());
+            let room = BOUND_MARGIN
+                * (l[0].abs() + l[1].abs() + self.hl + self.hw)
+                * (nl[0].abs() + nl[1].abs());
             if reach < -room {
                 return None;
             }
         }
         let a = (l[0].abs() - self.hl).max(0.0);
         let b = (l[1].abs() - self.hw).max(0.0);
-        Some(((a * a + b * b) * (1.0 - 2e-9)).sqrt())
+        Some(((a * a + b * b) * (1.0 - 2.0 * BOUND_MARGIN)).sqrt())
     }
 }
 
@@ -165,71 +167,19 @@ type Bound = Option<f64>;
 
 impl PackedTree {
     /// Packs `boxes` (item `i` has box `boxes[i]`).
-    pub fn new(boxes: &[Bbox]) -> Self {
+    pub(crate) fn new(boxes: &[Bbox]) -> Self {
         let n = boxes.len();
         if n == 0 {
             return Self::default();
         }
         if n <= NODE_SIZE {
-            // One node holds every item (or the item is the root): no order
-            // to find along the curve.
-            let mut tree_boxes = Vec::with_capacity(n + 1);
-            tree_boxes.extend_from_slice(boxes);
-            let mut ids: Vec<u32> = (0..n as u32).collect();
-            let mut level_ends = vec![n];
-            if n > 1 {
-                tree_boxes.push(boxes[1..].iter().fold(boxes[0], |acc, b| union(acc, *b)));
-                ids.push(0);
-                level_ends.push(n + 1);
-            }
-            return Self {
-                boxes: tree_boxes,
-                ids,
-                level_ends,
-                oriented: Vec::new(),
-            };
+            return Self::one_node(boxes);
         }
-        let mut all = [
-            f64::INFINITY,
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-            f64::NEG_INFINITY,
-        ];
-        for b in boxes {
-            all = union(all, *b);
-        }
-        let (w, h) = ((all[2] - all[0]).max(0.0), (all[3] - all[1]).max(0.0));
-        let max = f64::from(u16::MAX);
-        let key = |b: &Bbox| {
-            let cx = if w > 0.0 {
-                ((b[0] + b[2]) * 0.5 - all[0]) / w * max
-            } else {
-                0.0
-            };
-            let cy = if h > 0.0 {
-                ((b[1] + b[3]) * 0.5 - all[1]) / h * max
-            } else {
-                0.0
-            };
-            hilbert(cx as u32, cy as u32)
-        };
-        let mut order: Vec<(u32, u32)> = boxes
-            .iter()
-            .enumerate()
-            .map(|(i, b)| (key(b), i as u32))
-            .collect();
-        order.sort_unstable();
-        let mut level_ends = vec![n];
-        let mut count = n;
-        let mut total = n;
-        while count > 1 {
-            count = count.div_ceil(NODE_SIZE);
-            total += count;
-            level_ends.push(total);
-        }
+        let level_ends = level_ends(n);
+        let total = level_ends[level_ends.len() - 1];
         let mut tree_boxes = Vec::with_capacity(total);
         let mut ids = Vec::with_capacity(total);
-        for &(_, i) in &order {
+        for i in hilbert_order(boxes) {
             tree_boxes.push(boxes[i as usize]);
             ids.push(i);
         }
@@ -255,10 +205,31 @@ impl PackedTree {
         }
     }
 
+    /// The tree of at most [`NODE_SIZE`] boxes: one node holds every item
+    /// (or the item is the root), with no order to find along the curve.
+    fn one_node(boxes: &[Bbox]) -> Self {
+        let n = boxes.len();
+        let mut tree_boxes = Vec::with_capacity(n + 1);
+        tree_boxes.extend_from_slice(boxes);
+        let mut ids: Vec<u32> = (0..n as u32).collect();
+        let mut level_ends = vec![n];
+        if n > 1 {
+            tree_boxes.push(boxes[1..].iter().fold(boxes[0], |acc, b| union(acc, *b)));
+            ids.push(0);
+            level_ends.push(n + 1);
+        }
+        Self {
+            boxes: tree_boxes,
+            ids,
+            level_ends,
+            oriented: Vec::new(),
+        }
+    }
+
     /// Packs segments (item `i` runs from `ends[i][0]` to `ends[i][1]`),
     /// with an oriented box around every node when there are more than
     /// `ORIENTED_MIN` (64) of them.
-    pub fn of_segments(ends: &[[[f64; 2]; 2]]) -> Self {
+    pub(crate) fn of_segments(ends: &[[[f64; 2]; 2]]) -> Self {
         let boxes: Vec<Bbox> = ends
             .iter()
             .map(|[a, b]| {
@@ -299,13 +270,8 @@ impl PackedTree {
     }
 
     /// Number of items.
-    pub fn len(&self) -> usize {
+    pub(crate) fn len(&self) -> usize {
         self.level_ends.first().copied().unwrap_or(0)
-    }
-
-    /// True when there are no items.
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
     }
 
     /// The children positions of the node at `pos`.
@@ -323,7 +289,7 @@ impl PackedTree {
 
     /// Visits every item whose box `node` accepts (and whose every ancestor's
     /// box it accepts), in no particular order, until `item` breaks.
-    pub fn visit<B>(
+    pub(crate) fn visit<B>(
         &self,
         node: impl Fn(&Bbox) -> bool,
         mut item: impl FnMut(u32) -> ControlFlow<B>,
@@ -367,7 +333,7 @@ impl PackedTree {
     /// [`PackedTree::pairs`] of the tree over `boxes`, without building one
     /// for a few boxes: every pair is tested in turn (in order: `(0, 1)`,
     /// `(0, 2)`, …), which costs less than packing them.
-    pub fn pairs_of<B>(
+    pub(crate) fn pairs_of<B>(
         boxes: &[Bbox],
         mut pair: impl FnMut(u32, u32) -> ControlFlow<B>,
     ) -> Option<B> {
@@ -391,7 +357,7 @@ impl PackedTree {
     /// breaks. One descent pairs nodes with nodes (a self-join): a query per
     /// item would descend from the root once per item and meet every pair
     /// twice.
-    pub fn pairs<B>(&self, mut pair: impl FnMut(u32, u32) -> ControlFlow<B>) -> Option<B> {
+    pub(crate) fn pairs<B>(&self, mut pair: impl FnMut(u32, u32) -> ControlFlow<B>) -> Option<B> {
         let n = self.len();
         if n < 2 {
             return None;
@@ -428,7 +394,7 @@ impl PackedTree {
     /// scores an item exactly (`None`: it does not count). Returns the best
     /// item's score and number; ties go to the lower item number, so the
     /// answer does not depend on the tree's layout.
-    pub fn best(
+    pub(crate) fn best(
         &self,
         bound: impl Fn(&Bbox) -> Bound,
         oriented: Option<impl Fn(&Obb) -> Bound>,
@@ -438,7 +404,7 @@ impl PackedTree {
     }
 
     /// [`Self::best`] among the items scoring at most `limit`.
-    pub fn best_within(
+    pub(crate) fn best_within(
         &self,
         limit: f64,
         bound: impl Fn(&Bbox) -> Bound,
@@ -469,7 +435,7 @@ impl PackedTree {
     /// at first, then what `item` returns; equal bounds are still visited,
     /// for the tie rule). Every item that can beat or tie the answer is
     /// scored, so the answer is the one a best-first search gives.
-    pub fn branch_and_bound(
+    pub(crate) fn branch_and_bound(
         &self,
         limit: f64,
         bound: impl Fn(&Bbox) -> Bound,
@@ -483,12 +449,12 @@ impl PackedTree {
         // A node's bound: from its oriented box when the tree has them and
         // the query can use them.
         let oriented = oriented.filter(|_| !self.oriented.is_empty());
-        let node_bound = |pos: usize| match &oriented {
-            Some(f) if pos >= n => f(&self.oriented[pos - n]),
-            _ => bound(&self.boxes[pos]),
-        };
         let root = self.boxes.len() - 1;
-        let Some(rb) = node_bound(root).filter(|&b| b <= limit) else {
+        let root_bound = match &oriented {
+            Some(f) if root >= n => f(&self.oriented[root - n]),
+            _ => bound(&self.boxes[root]),
+        };
+        let Some(rb) = root_bound.filter(|&b| b <= limit) else {
             return;
         };
         if root < n {
@@ -499,20 +465,46 @@ impl PackedTree {
         if top.start < n {
             // One leaf (a small polygon): its items in order, as the heap
             // would visit them, without the heap.
-            let mut cut = limit;
-            for c in top {
-                if bound(&self.boxes[c]).is_some_and(|b| b <= cut) {
-                    cut = item(self.ids[c]);
-                }
-            }
+            self.score_items(top, limit, &bound, &mut item);
             return;
         }
-        // Depth first, each node's children nearest first: the same items
-        // are scored as best first would (every item whose bound is not
-        // above the cut-off when it is reached, and the answer's never is),
-        // with a fixed stack on the call stack instead of a heap.
+        self.depth_first((rb, root), limit, &bound, oriented.as_ref(), &mut item);
+    }
+
+    /// Scores the items at `positions` in order, each whose bound is not
+    /// above the cut-off (`cut` at first, then what `item` returns); returns
+    /// the last cut-off.
+    fn score_items(
+        &self,
+        positions: std::ops::Range<usize>,
+        mut cut: f64,
+        bound: &impl Fn(&Bbox) -> Bound,
+        item: &mut impl FnMut(u32) -> f64,
+    ) -> f64 {
+        for c in positions {
+            if bound(&self.boxes[c]).is_some_and(|b| b <= cut) {
+                cut = item(self.ids[c]);
+            }
+        }
+        cut
+    }
+
+    /// [`Self::branch_and_bound`] below the root (with its bound), whose
+    /// children are nodes: depth first, each node's children nearest first.
+    /// The same items are scored as best first would (every item whose
+    /// bound is not above the cut-off when it is reached, and the answer's
+    /// never is), with a fixed stack on the call stack instead of a heap.
+    fn depth_first(
+        &self,
+        root: (f64, usize),
+        limit: f64,
+        bound: &impl Fn(&Bbox) -> Bound,
+        oriented: Option<&impl Fn(&Obb) -> Bound>,
+        item: &mut impl FnMut(u32) -> f64,
+    ) {
+        let n = self.len();
         let mut stack = [MaybeUninit::<(f64, u32)>::uninit(); STACK];
-        stack[0] = MaybeUninit::new((rb, root as u32));
+        stack[0] = MaybeUninit::new((root.0, root.1 as u32));
         let mut top = 1;
         let mut cut = limit;
         while top > 0 {
@@ -525,46 +517,110 @@ impl PackedTree {
             let children = self.children(pos as usize);
             if children.start < n {
                 // Children are items: score every one that can still count.
-                for c in children {
-                    if bound(&self.boxes[c]).is_some_and(|b| b <= cut) {
-                        cut = item(self.ids[c]);
-                    }
-                }
+                cut = self.score_items(children, cut, bound, item);
                 continue;
             }
-            // The children that can still count, sorted so that the nearest
-            // is on top (insertion sort: at most NODE_SIZE of them); their
-            // bounds from their oriented or their axis-aligned boxes, each
-            // kind in its own loop.
-            let first = top;
-            let mut push = |b: f64, c: usize, top: &mut usize| {
-                let mut j = *top;
-                // SAFETY: entries first..top were written in this loop.
-                while j > first && unsafe { stack[j - 1].assume_init().0 } < b {
-                    stack[j] = stack[j - 1];
-                    j -= 1;
-                }
-                stack[j] = MaybeUninit::new((b, c as u32));
-                *top += 1;
+            // The children that can still count, their bounds from their
+            // oriented or their axis-aligned boxes, each kind in its own
+            // loop.
+            let mut sorted = Nearest {
+                stack: &mut stack,
+                first: top,
+                top,
             };
-            match &oriented {
+            match oriented {
                 Some(f) => {
                     for c in children {
                         if let Some(b) = f(&self.oriented[c - n]).filter(|&b| b <= cut) {
-                            push(b, c, &mut top);
+                            sorted.push(b, c);
                         }
                     }
                 }
                 None => {
                     for c in children {
                         if let Some(b) = bound(&self.boxes[c]).filter(|&b| b <= cut) {
-                            push(b, c, &mut top);
+                            sorted.push(b, c);
                         }
                     }
                 }
             }
+            top = sorted.top;
         }
     }
+}
+
+/// One node's children pushed on the depth-first stack above `first`,
+/// sorted so that the nearest is on top (insertion sort: at most
+/// [`NODE_SIZE`] of them).
+struct Nearest<'s> {
+    stack: &'s mut [MaybeUninit<(f64, u32)>; STACK],
+    first: usize,
+    top: usize,
+}
+
+impl Nearest<'_> {
+    /// Pushes node `c` with bound `b` in its place.
+    #[inline]
+    fn push(&mut self, b: f64, c: usize) {
+        let mut j = self.top;
+        // SAFETY: entries first..top were written in this loop.
+        while j > self.first && unsafe { self.stack[j - 1].assume_init().0 } < b {
+            self.stack[j] = self.stack[j - 1];
+            j -= 1;
+        }
+        self.stack[j] = MaybeUninit::new((b, c as u32));
+        self.top += 1;
+    }
+}
+
+/// The item numbers of `boxes` in the order of their centres along the
+/// Hilbert curve over their common box (ties by number).
+fn hilbert_order(boxes: &[Bbox]) -> Vec<u32> {
+    let mut all = [
+        f64::INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NEG_INFINITY,
+    ];
+    for b in boxes {
+        all = union(all, *b);
+    }
+    let (w, h) = ((all[2] - all[0]).max(0.0), (all[3] - all[1]).max(0.0));
+    let max = f64::from(u16::MAX);
+    let key = |b: &Bbox| {
+        let cx = if w > 0.0 {
+            ((b[0] + b[2]) * 0.5 - all[0]) / w * max
+        } else {
+            0.0
+        };
+        let cy = if h > 0.0 {
+            ((b[1] + b[3]) * 0.5 - all[1]) / h * max
+        } else {
+            0.0
+        };
+        hilbert(cx as u32, cy as u32)
+    };
+    let mut order: Vec<(u32, u32)> = boxes
+        .iter()
+        .enumerate()
+        .map(|(i, b)| (key(b), i as u32))
+        .collect();
+    order.sort_unstable();
+    order.into_iter().map(|(_, i)| i).collect()
+}
+
+/// End position of each level of a tree of `n` items (level 0 = the
+/// items), [`NODE_SIZE`] children a node, up to the root.
+fn level_ends(n: usize) -> Vec<usize> {
+    let mut level_ends = vec![n];
+    let mut count = n;
+    let mut total = n;
+    while count > 1 {
+        count = count.div_ceil(NODE_SIZE);
+        total += count;
+        level_ends.push(total);
+    }
+    level_ends
 }
 
 fn union(a: Bbox, b: Bbox) -> Bbox {
@@ -577,12 +633,12 @@ fn union(a: Bbox, b: Bbox) -> Bbox {
 }
 
 /// Whether two boxes meet (touching counts).
-pub fn boxes_meet(a: &Bbox, b: &Bbox) -> bool {
+pub(crate) fn boxes_meet(a: &Bbox, b: &Bbox) -> bool {
     a[0] <= b[2] && a[2] >= b[0] && a[1] <= b[3] && a[3] >= b[1]
 }
 
 /// Squared distance from `(x, y)` to the box (0 inside).
-pub fn box_distance_2(b: &Bbox, x: f64, y: f64) -> f64 {
+pub(crate) fn box_distance_2(b: &Bbox, x: f64, y: f64) -> f64 {
     let dx = (b[0] - x).max(0.0).max(x - b[2]);
     let dy = (b[1] - y).max(0.0).max(y - b[3]);
     dx * dx + dy * dy
@@ -590,7 +646,7 @@ pub fn box_distance_2(b: &Bbox, x: f64, y: f64) -> f64 {
 
 /// The parameter interval `[t0, t1]` over which the ray `o + t·d`,
 /// `0 ≤ t ≤ max_t`, is inside the box, or `None`.
-pub fn ray_box(b: &Bbox, o: [f64; 2], d: [f64; 2], max_t: f64) -> Option<(f64, f64)> {
+pub(crate) fn ray_box(b: &Bbox, o: [f64; 2], d: [f64; 2], max_t: f64) -> Option<(f64, f64)> {
     let mut t0 = 0.0f64;
     let mut t1 = max_t;
     for k in 0..2 {
@@ -616,23 +672,18 @@ pub fn ray_box(b: &Bbox, o: [f64; 2], d: [f64; 2], max_t: f64) -> Option<(f64, f
 
 /// A ray `o + t·d` prepared for many box tests ([`RaySlab::enter`]): the
 /// reciprocals of its direction computed once, so each test multiplies
-/// instead of dividing.
+/// instead of dividing (its interval widened by [`SLAB_SLACK`]).
 #[derive(Debug, Clone, Copy)]
-pub struct RaySlab {
+pub(crate) struct RaySlab {
     o: [f64; 2],
     d: [f64; 2],
     inv: [f64; 2],
     max_t: f64,
 }
 
-/// Relative widening of [`RaySlab::enter`]'s interval: a product by a
-/// rounded reciprocal is within two units in the last place of the quotient
-/// [`ray_box`] computes, so the widened interval holds the quotient's.
-const SLAB_SLACK: f64 = 4.0 * f64::EPSILON;
-
 impl RaySlab {
     /// The ray `o + t·d`, `0 ≤ t ≤ max_t`.
-    pub fn new(o: [f64; 2], d: [f64; 2], max_t: f64) -> Self {
+    pub(crate) fn new(o: [f64; 2], d: [f64; 2], max_t: f64) -> Self {
         Self {
             o,
             d,
@@ -646,7 +697,7 @@ impl RaySlab {
     /// than rounding. As a search bound it prunes a little less than
     /// [`ray_box`] would, never more.
     #[inline]
-    pub fn enter(&self, b: &Bbox) -> Option<f64> {
+    pub(crate) fn enter(&self, b: &Bbox) -> Option<f64> {
         let mut t0 = 0.0f64;
         let mut t1 = self.max_t;
         for k in 0..2 {
@@ -676,7 +727,7 @@ impl RaySlab {
 /// is on the corner farthest along `n`, and `(x − q) · n` computed in
 /// floating point never decreases as `x` moves towards that corner, so a
 /// point of the box that tests inside makes the corner test inside too.
-pub fn box_meets_half_plane(b: &Bbox, q: [f64; 2], n: [f64; 2]) -> bool {
+pub(crate) fn box_meets_half_plane(b: &Bbox, q: [f64; 2], n: [f64; 2]) -> bool {
     // The corner farthest along n.
     let x = if n[0] >= 0.0 { b[2] } else { b[0] };
     let y = if n[1] >= 0.0 { b[3] } else { b[1] };
@@ -934,7 +985,7 @@ mod tests {
                     let [a, b] = segs[i as usize];
                     let (ca, cb) = (Coord { x: a[0], y: a[1] }, Coord { x: b[0], y: b[1] });
                     let qc = Coord { x: q[0], y: q[1] };
-                    let c = crate::geometry::boundary::closest_on_segment(ca, cb, qc).0;
+                    let c = crate::geometry::segment::closest_on_segment(ca, cb, qc).0;
                     let d2 = (c.x - q[0]).hypot(c.y - q[1]);
                     assert!(o.distance_2(*q) <= d2 * d2, "node {pos}, item {i}");
                     let side = |p: [f64; 2]| (p[0] - q[0]) * normal[0] + (p[1] - q[1]) * normal[1];

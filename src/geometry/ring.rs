@@ -14,7 +14,7 @@ pub fn signed_area2(ring: &[Coord<f64>]) -> f64 {
     let mut s = 0.0;
     for w in ring.windows(2) {
         let (a, b) = (w[0] - o, w[1] - o);
-        s += a.x * b.y - a.y * b.x;
+        s += super::vector::cross(a, b);
     }
     s
 }

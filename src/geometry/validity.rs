@@ -9,18 +9,11 @@
 //! exterior ring or inside another hole. Each problem is reported with its
 //! position so that the user can find it.
 
-use super::boundary::{orient, BoundarySegment};
+use super::segment::{on_segment, orient, BoundarySegment};
+use super::vector::{cross, dot};
 use super::PreparedPolygon;
 use geo::Coord;
 use std::ops::ControlFlow;
-
-fn on_segment(a: Coord<f64>, b: Coord<f64>, p: Coord<f64>) -> bool {
-    orient(a, b, p) == 0.0
-        && p.x >= a.x.min(b.x)
-        && p.x <= a.x.max(b.x)
-        && p.y >= a.y.min(b.y)
-        && p.y <= a.y.max(b.y)
-}
 
 fn at(c: Coord<f64>) -> String {
     format!("({}, {})", c.x, c.y)
@@ -44,15 +37,16 @@ fn pair_problem(s: &BoundarySegment, t: &BoundarySegment) -> Option<String> {
         // Proper crossing: report the crossing point.
         let d = s.b - s.a;
         let e = t.b - t.a;
-        let den = d.x * e.y - d.y * e.x;
-        let u = ((t.a - s.a).x * e.y - (t.a - s.a).y * e.x) / den;
+        // Not `lines_meet`: the robust orientations decide the crossing,
+        // and a rounded denominator of zero still reports a point.
+        let u = cross(t.a - s.a, e) / cross(d, e);
         return Some(format!("{what} cross at {}", at(s.a + d * u)));
     }
     if o1 == 0.0 && o2 == 0.0 {
         // Collinear: an overlap of positive length is invalid.
         let d = s.b - s.a;
-        let proj = |p: Coord<f64>| (p - s.a).x * d.x + (p - s.a).y * d.y;
-        let l2 = d.x * d.x + d.y * d.y;
+        let proj = |p: Coord<f64>| dot(p - s.a, d);
+        let l2 = dot(d, d);
         let (lo, hi) = {
             let (x, y) = (proj(t.a), proj(t.b));
             (x.min(y), x.max(y))
@@ -117,9 +111,7 @@ pub fn problem(p: &PreparedPolygon) -> Option<String> {
             };
             let (u, v) = (far_s - shared, far_t - shared);
             let rings_of_3 = ring_len[s.ring as usize] < 3;
-            return (!rings_of_3
-                && orient(far_s, shared, far_t) == 0.0
-                && u.x * v.x + u.y * v.y > 0.0)
+            return (!rings_of_3 && orient(far_s, shared, far_t) == 0.0 && dot(u, v) > 0.0)
                 .then(|| format!("spike: the ring doubles back on itself at {}", at(shared)));
         }
         pair_problem(s, t)
@@ -169,7 +161,7 @@ pub fn problem(p: &PreparedPolygon) -> Option<String> {
 /// handles a shared vertex; a vertex in the middle of another ring's edge
 /// breaks triangulations).
 pub fn split_touches(polygon: &geo::Polygon<f64>) -> geo::Polygon<f64> {
-    use super::boundary::Boundary;
+    use super::Boundary;
     let rings: Vec<&geo::LineString<f64>> = std::iter::once(polygon.exterior())
         .chain(polygon.interiors())
         .collect();
@@ -200,7 +192,7 @@ pub fn split_touches(polygon: &geo::Polygon<f64>) -> geo::Polygon<f64> {
                 let d = w[1] - w[0];
                 let mut ps = ps.clone();
                 ps.sort_by(|p, q| {
-                    let t = |c: Coord<f64>| (c - w[0]).x * d.x + (c - w[0]).y * d.y;
+                    let t = |c: Coord<f64>| dot(c - w[0], d);
                     t(*p).total_cmp(&t(*q))
                 });
                 ps.dedup();

@@ -9,7 +9,8 @@
 //! [`MAX_GAP`] local radii and stays in P. Pieces farther apart are left as
 //! they are, and still counted in `components`.
 
-use super::{SkeletonGraph, UnionFind};
+use super::{NodeId, SkeletonGraph, UnionFind};
+use crate::geometry::vector::hypot;
 use crate::geometry::PreparedPolygon;
 use rstar::{primitives::GeomWithData, RTree};
 
@@ -48,7 +49,7 @@ pub fn bridge(graph: &SkeletonGraph, polygon: &PreparedPolygon) -> SkeletonGraph
                 continue;
             }
             let other = graph.nodes()[w];
-            let d = (other.pos - node.pos).x.hypot((other.pos - node.pos).y);
+            let d = hypot(other.pos - node.pos);
             if d > MAX_GAP * node.radius.max(other.radius) {
                 continue;
             }
@@ -75,7 +76,11 @@ pub fn bridge(graph: &SkeletonGraph, polygon: &PreparedPolygon) -> SkeletonGraph
             continue;
         }
         uf.union(v as usize, w as usize);
-        out.add_edge(super::NodeId(v), super::NodeId(w), Vec::new());
+        out.add_edge(
+            NodeId::from_index(v as usize),
+            NodeId::from_index(w as usize),
+            Vec::new(),
+        );
     }
     out
 }

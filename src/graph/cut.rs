@@ -34,7 +34,8 @@
 
 use super::line::point_at;
 use super::{Adjacency, EdgeId, NodeId, SkeletonGraph};
-use crate::geometry::boundary::closest_on_segment;
+use crate::geometry::segment::closest_on_segment;
+use crate::geometry::vector::{cross, dot, hypot};
 use crate::geometry::Boundary;
 use geo::Coord;
 
@@ -80,17 +81,17 @@ pub fn cut_ends(m: &SkeletonGraph, boundary: &Boundary, tol: f64) -> Vec<CutEnd>
         if edges.len() != 3 {
             continue;
         }
-        let jn = NodeId(j as u32);
+        let jn = NodeId::from_index(j);
         let legs: Vec<(EdgeId, NodeId)> = edges
             .iter()
             .map(|&e| (e, m.opposite(e, jn)))
-            .filter(|&(_, o)| o != jn && deg[o.0 as usize] == 1 && m.node(o).radius <= tol)
+            .filter(|&(_, o)| o != jn && deg[o.index()] == 1 && m.node(o).radius <= tol)
             .collect();
         let [(e1, c1), (e2, c2)] = legs[..] else {
             continue;
         };
         let (p1, p2) = (m.node(c1).pos, m.node(c2).pos);
-        let span = (p2 - p1).x.hypot((p2 - p1).y);
+        let span = hypot(p2 - p1);
         let rj = m.node(jn).radius;
         if span < MIN_SPAN * 2.0 * rj {
             continue;
@@ -114,18 +115,18 @@ pub fn cut_ends(m: &SkeletonGraph, boundary: &Boundary, tol: f64) -> Vec<CutEnd>
         }
         let course = c[0] - point_at(&c, (2.0 * rj).min(len));
         let foot = closest_on_segment(p1, p2, c[0]).0 - c[0];
-        let (lc, lf) = (course.x.hypot(course.y), foot.x.hypot(foot.y));
+        let (lc, lf) = (hypot(course), hypot(foot));
         if lc == 0.0 || lf == 0.0 {
             continue;
         }
-        if (course.x * foot.x + course.y * foot.y) / (lc * lf) < MAX_SLANT_DEG.to_radians().cos() {
+        if dot(course, foot) / (lc * lf) < MAX_SLANT_DEG.to_radians().cos() {
             continue;
         }
         if !rings.straight_between(boundary, p1, p2, span) {
             continue;
         }
         let (u1, u2) = (p1 - c[0], p2 - c[0]);
-        let (right, left) = if u1.x * u2.y - u1.y * u2.x > 0.0 {
+        let (right, left) = if cross(u1, u2) > 0.0 {
             (u1, u2)
         } else {
             (u2, u1)
@@ -167,9 +168,9 @@ fn course_line(
         }
         let is_leg = |e: EdgeId| {
             let o = m.opposite(e, at);
-            deg[o.0 as usize] == 1 && m.node(o).radius <= tol
+            deg[o.index()] == 1 && m.node(o).radius <= tol
         };
-        let onward: Vec<EdgeId> = adj[at.0 as usize]
+        let onward: Vec<EdgeId> = adj[at.index()]
             .iter()
             .copied()
             .filter(|&e| e != via && !is_leg(e))
@@ -204,8 +205,8 @@ impl RingIndex {
         let ring = s.ring as usize;
         let at = seg - self.start[ring];
         let n = self.start[ring + 1] - self.start[ring];
-        let da = (s.a - p).x.hypot((s.a - p).y);
-        let db = (s.b - p).x.hypot((s.b - p).y);
+        let da = hypot(s.a - p);
+        let db = hypot(s.b - p);
         Some((ring, if da <= db { at } else { (at + 1) % n }))
     }
 
@@ -232,8 +233,8 @@ impl RingIndex {
         (1..steps).all(|k| {
             let v = b.segments()[self.start[r1] + (from + k) % n].a;
             let w = v - p1;
-            let off = (w.x * d.y - w.y * d.x).abs() / span;
-            let t = (w.x * d.x + w.y * d.y) / (span * span);
+            let off = cross(w, d).abs() / span;
+            let t = dot(w, d) / (span * span);
             off <= MAX_BOW * span && (0.0..=1.0).contains(&t)
         })
     }

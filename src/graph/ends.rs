@@ -57,10 +57,10 @@
 use super::cut::{cut_ends, CutEnd};
 use super::line::{end_turn, point_at, HOOK_DEG};
 use super::{Adjacency, EdgeId, NodeId, SkeletonGraph};
+use crate::geometry::tolerance::ON_BOUNDARY_END;
+use crate::geometry::vector::{cross, dot, hypot};
 use crate::geometry::{Boundary, PreparedPolygon};
 use geo::Coord;
-
-pub use super::line::ON_BOUNDARY_END as END_ON_BOUNDARY;
 
 /// Largest angle between the line's course and a removed leg that the line
 /// follows.
@@ -91,7 +91,7 @@ pub fn centred(m: &SkeletonGraph, keep: Vec<bool>, polygon: &PreparedPolygon) ->
     let mut st = State::new(m, keep);
     let leaves: Vec<NodeId> = (0..m.nodes().len())
         .filter(|&n| st.kdeg[n] == 1)
-        .map(|n| NodeId(n as u32))
+        .map(NodeId::from_index)
         .collect();
     for leaf in leaves {
         let (start, tail) = e.end_zone(leaf, &st);
@@ -101,10 +101,10 @@ pub fn centred(m: &SkeletonGraph, keep: Vec<bool>, polygon: &PreparedPolygon) ->
         for &t in &tail {
             st.release(m, t);
         }
-        let Some(behind) = e.adj[start.0 as usize]
+        let Some(behind) = e.adj[start.index()]
             .iter()
             .copied()
-            .find(|x| st.keep[x.0 as usize])
+            .find(|x| st.keep[x.index()])
         else {
             continue;
         };
@@ -134,8 +134,8 @@ impl State {
         let mut kdeg = vec![0usize; m.nodes().len()];
         for (i, ed) in m.edges().iter().enumerate() {
             if keep[i] {
-                kdeg[ed.a.0 as usize] += 1;
-                kdeg[ed.b.0 as usize] += 1;
+                kdeg[ed.a.index()] += 1;
+                kdeg[ed.b.index()] += 1;
             }
         }
         Self {
@@ -149,24 +149,24 @@ impl State {
     /// Takes a kept edge out of the result and frees it for a descent.
     fn release(&mut self, m: &SkeletonGraph, e: EdgeId) {
         self.set(m, e, false);
-        self.taken[e.0 as usize] = false;
+        self.taken[e.index()] = false;
     }
 
     fn set(&mut self, m: &SkeletonGraph, e: EdgeId, on: bool) {
-        if self.keep[e.0 as usize] == on {
+        if self.keep[e.index()] == on {
             return;
         }
-        self.keep[e.0 as usize] = on;
+        self.keep[e.index()] = on;
         let ed = m.edge(e);
         for n in [ed.a, ed.b] {
             if on {
-                self.kdeg[n.0 as usize] += 1;
+                self.kdeg[n.index()] += 1;
             } else {
-                self.kdeg[n.0 as usize] -= 1;
+                self.kdeg[n.index()] -= 1;
             }
         }
         if on {
-            self.taken[e.0 as usize] = true;
+            self.taken[e.index()] = true;
         }
     }
 }
@@ -181,7 +181,7 @@ pub fn assemble(
     let mut g = SkeletonGraph::new();
     let mut map: Vec<Option<NodeId>> = vec![None; m.nodes().len()];
     let mut id = |g: &mut SkeletonGraph, n: NodeId| -> NodeId {
-        *map[n.0 as usize].get_or_insert_with(|| {
+        *map[n.index()].get_or_insert_with(|| {
             let nd = m.node(n);
             g.add_node(nd.pos, nd.radius, nd.time)
         })
@@ -258,23 +258,15 @@ impl Heights {
 }
 
 fn unit(v: Coord<f64>) -> Option<Coord<f64>> {
-    let n = v.x.hypot(v.y);
+    let n = hypot(v);
     (n > 0.0 && n.is_finite()).then(|| v / n)
-}
-
-fn dot(a: Coord<f64>, b: Coord<f64>) -> f64 {
-    a.x * b.x + a.y * b.y
-}
-
-fn cross(a: Coord<f64>, b: Coord<f64>) -> f64 {
-    a.x * b.y - a.y * b.x
 }
 
 impl<'a> Extender<'a> {
     fn new(m: &'a SkeletonGraph, polygon: &'a PreparedPolygon) -> Self {
         let boundary = polygon.boundary();
         let span = boundary.bbox_max() - boundary.bbox_min();
-        let tol = END_ON_BOUNDARY * polygon.extent();
+        let tol = ON_BOUNDARY_END * polygon.extent();
         Self {
             m,
             boundary,
@@ -284,10 +276,10 @@ impl<'a> Extender<'a> {
                 .collect(),
             adj: m.adjacency(),
             len: (0..m.edges().len())
-                .map(|i| m.edge_length(EdgeId(i as u32)))
+                .map(|i| m.edge_length(EdgeId::from_index(i)))
                 .collect(),
             tol,
-            max_t: 2.0 * span.x.hypot(span.y) + 1.0,
+            max_t: 2.0 * hypot(span) + 1.0,
             forest: m.edges().iter().all(|e| e.a != e.b)
                 && m.edges().len() + m.components() == m.nodes().len(),
             heights: std::cell::RefCell::new(Heights {
@@ -315,7 +307,7 @@ impl<'a> Extender<'a> {
     fn arrival(&self, e: EdgeId, at: NodeId) -> Coord<f64> {
         let c = self.m.oriented_coords(e, at);
         let r = self.radius(at);
-        let l = self.len[e.0 as usize];
+        let l = self.len[e.index()];
         let s = if r > self.tol { (2.0 * r).min(l) } else { l };
         unit(c[0] - point_at(&c, s)).unwrap_or(Coord { x: 1.0, y: 0.0 })
     }
@@ -325,7 +317,7 @@ impl<'a> Extender<'a> {
     fn departure(&self, e: EdgeId, from: NodeId) -> Option<Coord<f64>> {
         let c = self.m.oriented_coords(e, from);
         let r = self.radius(from);
-        let l = self.len[e.0 as usize];
+        let l = self.len[e.index()];
         let s = if r > self.tol { r.min(l) } else { l };
         unit(point_at(&c, s) - c[0])
     }
@@ -333,13 +325,13 @@ impl<'a> Extender<'a> {
     /// The removed edges at `v` that a descent may take: not kept, not yet
     /// used, not a loop, not leading back into the result.
     fn children(&self, v: NodeId, st: &State) -> Vec<EdgeId> {
-        self.adj[v.0 as usize]
+        self.adj[v.index()]
             .iter()
             .copied()
             .filter(|e| {
                 let ed = self.m.edge(*e);
                 let o = self.m.opposite(*e, v);
-                !st.taken[e.0 as usize] && ed.a != ed.b && st.kdeg[o.0 as usize] == 0
+                !st.taken[e.index()] && ed.a != ed.b && st.kdeg[o.index()] == 0
             })
             .collect()
     }
@@ -352,7 +344,7 @@ impl<'a> Extender<'a> {
             return self.height(v, e, taken).min(cap);
         }
         let mut best = 0.0f64;
-        let mut stack = vec![(self.m.opposite(e, v), e, self.len[e.0 as usize])];
+        let mut stack = vec![(self.m.opposite(e, v), e, self.len[e.index()])];
         let mut seen = std::collections::HashSet::new();
         seen.insert(v);
         while let Some((n, via, d)) = stack.pop() {
@@ -363,12 +355,12 @@ impl<'a> Extender<'a> {
                 continue;
             }
             let mut leaf = true;
-            for &f in &self.adj[n.0 as usize] {
-                if f != via && !taken[f.0 as usize] {
+            for &f in &self.adj[n.index()] {
+                if f != via && !taken[f.index()] {
                     let o = self.m.opposite(f, n);
                     if !seen.contains(&o) {
                         leaf = false;
-                        stack.push((o, f, d + self.len[f.0 as usize]));
+                        stack.push((o, f, d + self.len[f.index()]));
                     }
                 }
             }
@@ -385,8 +377,7 @@ impl<'a> Extender<'a> {
     /// the walk with a cap would measure the same subtree again at every
     /// step, quadratic on a long descent.
     fn height(&self, v: NodeId, e: EdgeId, taken: &[bool]) -> f64 {
-        let key =
-            |from: NodeId, e: EdgeId| 2 * e.0 as usize + usize::from(self.m.edge(e).a != from);
+        let key = |from: NodeId, e: EdgeId| 2 * e.index() + usize::from(self.m.edge(e).a != from);
         let mut h = self.heights.borrow_mut();
         let mut stack = vec![(v, e, false)];
         while let Some((from, e, ready)) = stack.pop() {
@@ -395,17 +386,17 @@ impl<'a> Extender<'a> {
                 continue;
             }
             let b = self.m.opposite(e, from);
-            let ahead = self.adj[b.0 as usize]
+            let ahead = self.adj[b.index()]
                 .iter()
                 .copied()
-                .filter(|&f| f != e && !taken[f.0 as usize]);
+                .filter(|&f| f != e && !taken[f.index()]);
             if ready {
                 let deepest = ahead
                     .map(|f| h.get(key(b, f)).expect("measured before"))
                     .reduce(f64::max);
                 h.set(
                     k,
-                    self.len[e.0 as usize] + deepest.unwrap_or_else(|| self.radius(b)),
+                    self.len[e.index()] + deepest.unwrap_or_else(|| self.radius(b)),
                 );
             } else {
                 stack.push((from, e, true));
@@ -560,7 +551,7 @@ impl<'a> Extender<'a> {
             st.set(self.m, c, true);
             rec.edges.push(c);
             let o = self.m.opposite(c, v);
-            walked += self.len[c.0 as usize];
+            walked += self.len[c.index()];
             if walked > zone {
                 d = self.arrival(c, o);
             }
@@ -668,10 +659,10 @@ impl<'a> Extender<'a> {
             };
             let c = self.m.oriented_coords(e, at);
             fwd.extend_from_slice(&c[1..]);
-            walked += self.len[e.0 as usize];
+            walked += self.len[e.index()];
             at = self.m.opposite(e, at);
             via = Some(e);
-            if walked > limit || st.kdeg[at.0 as usize] != 2 {
+            if walked > limit || st.kdeg[at.index()] != 2 {
                 break;
             }
         }
@@ -680,10 +671,10 @@ impl<'a> Extender<'a> {
 
     /// The kept edge at `at` other than `via`, walking along a kept line.
     fn next_kept(&self, at: NodeId, via: Option<EdgeId>, st: &State) -> Option<EdgeId> {
-        self.adj[at.0 as usize]
+        self.adj[at.index()]
             .iter()
             .copied()
-            .find(|&x| st.keep[x.0 as usize] && Some(x) != via)
+            .find(|&x| st.keep[x.index()] && Some(x) != via)
     }
 
     /// The start of `leaf`'s end zone: walking back along the kept line,
@@ -701,10 +692,10 @@ impl<'a> Extender<'a> {
                 break;
             };
             let o = self.m.opposite(e, at);
-            if st.kdeg[o.0 as usize] != 2 {
+            if st.kdeg[o.index()] != 2 {
                 break;
             }
-            s += self.len[e.0 as usize];
+            s += self.len[e.index()];
             tail.push(e);
             at = o;
             via = Some(e);
@@ -769,14 +760,14 @@ mod tests {
             let mut remembered = Vec::new();
             for (i, ed) in g.edges().iter().enumerate() {
                 for from in [ed.a, ed.b] {
-                    remembered.push(e.depth(from, EdgeId(i as u32), &taken, f64::INFINITY));
+                    remembered.push(e.depth(from, EdgeId::from_index(i), &taken, f64::INFINITY));
                 }
             }
             e.forest = false;
             let mut k = 0;
             for (i, ed) in g.edges().iter().enumerate() {
                 for from in [ed.a, ed.b] {
-                    let walked = e.depth(from, EdgeId(i as u32), &taken, f64::INFINITY);
+                    let walked = e.depth(from, EdgeId::from_index(i), &taken, f64::INFINITY);
                     let r = remembered[k];
                     assert!(
                         (walked - r).abs() <= 1e-12 * walked.max(1.0),
@@ -788,7 +779,7 @@ mod tests {
         }
         // A cycle: not a forest, so every depth is walked.
         let mut g = random_tree(10, 3);
-        g.add_edge(NodeId(0), NodeId(9), Vec::new());
+        g.add_edge(NodeId::from_index(0), NodeId::from_index(9), Vec::new());
         assert!(!Extender::new(&g, &polygon).forest);
     }
 }

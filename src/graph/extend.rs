@@ -46,6 +46,8 @@
 use super::line::point_at;
 use super::prune::{prune, prune_mask, PruneParams};
 use super::{polyline_length, SkeletonGraph};
+use crate::geometry::tolerance::SAME_POINT;
+use crate::geometry::vector::hypot;
 use crate::geometry::{Boundary, PreparedPolygon};
 use geo::Coord;
 use schemars::JsonSchema;
@@ -90,9 +92,6 @@ impl Default for ExtendParams {
     }
 }
 
-/// Relative tolerance (× polygon extent) below which a leaf is on ∂P.
-pub const ON_BOUNDARY: f64 = 1e-9;
-
 /// Extends the legs of `graph` to ∂P (see the module documentation).
 pub fn extend(
     graph: &SkeletonGraph,
@@ -109,7 +108,7 @@ pub fn extend(
         ExtendMode::Ray | ExtendMode::Nearest => {}
     }
     let boundary = polygon.boundary();
-    let tol = ON_BOUNDARY * polygon.extent();
+    let tol = SAME_POINT * polygon.extent();
     let deg = graph.degrees();
     let mut out = graph.clone();
     for b in graph.branches() {
@@ -117,7 +116,7 @@ pub fn extend(
             continue;
         }
         for (leaf, from_leaf) in [(b.start, false), (b.end, true)] {
-            if deg[leaf.0 as usize] != 1 {
+            if deg[leaf.index()] != 1 {
                 continue;
             }
             let p = graph.node(leaf).pos;
@@ -217,14 +216,14 @@ fn ray_target(boundary: &Boundary, leg: &[Coord<f64>], r: f64, tol: f64) -> Opti
     let p = leg[0];
     let q = point_at(leg, (2.0 * r).min(polyline_length(leg)));
     let d = p - q;
-    let norm = d.x.hypot(d.y);
+    let norm = hypot(d);
     if norm.is_nan() || norm <= 0.0 || !boundary.contains_with_tolerance(p, tol) {
         return None;
     }
     let dir = d / norm;
     // Any hit lies within the bounding box, so its diagonal bounds t.
     let span = boundary.bbox_max() - boundary.bbox_min();
-    let max_t = 2.0 * (span.x.hypot(span.y) + r);
+    let max_t = 2.0 * (hypot(span) + r);
     let hit = boundary.first_hit(p, dir, 0.0, max_t)?;
     let mid = (p + hit.point) * 0.5;
     if !boundary.reaches(p, hit.point) || !boundary.contains_with_tolerance(mid, tol) {

@@ -3,13 +3,9 @@
 //! width at an end, and how much an end turns.
 
 use super::{NodeId, SkeletonGraph};
+use crate::geometry::vector::{dot, hypot};
 use crate::geometry::PreparedPolygon;
 use geo::Coord;
-
-/// Relative tolerance (× polygon extent) within which a node lies on ∂P;
-/// above the coarsest coordinate resolution of any method (MA's grid,
-/// ≤ 1.5 × 10⁻⁸ × extent).
-pub const ON_BOUNDARY_END: f64 = 1e-7;
 
 /// A line end that turns by more than this (degrees) within its last local
 /// width is a hook.
@@ -69,11 +65,11 @@ impl<'a> Measured<'a> {
 
 /// The angle between two directions, in degrees (`None` for a zero vector).
 pub fn angle_deg(a: Coord<f64>, b: Coord<f64>) -> Option<f64> {
-    let (la, lb) = (a.x.hypot(a.y), b.x.hypot(b.y));
+    let (la, lb) = (hypot(a), hypot(b));
     if la == 0.0 || lb == 0.0 {
         return None;
     }
-    let c = ((a.x * b.x + a.y * b.y) / (la * lb)).clamp(-1.0, 1.0);
+    let c = (dot(a, b) / (la * lb)).clamp(-1.0, 1.0);
     Some(c.acos().to_degrees())
 }
 
@@ -191,7 +187,7 @@ pub fn end_turns(g: &SkeletonGraph, polygon: &PreparedPolygon) -> Vec<f64> {
         if adj[n].len() != 1 {
             continue;
         }
-        let coords = g.line_from(NodeId(n as u32), &adj);
+        let coords = g.line_from(NodeId::from_index(n), &adj);
         if let Some(t) = end_turn(&coords, polygon) {
             out.push(t);
         }

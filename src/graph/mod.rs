@@ -13,22 +13,18 @@ pub mod bridge;
 pub mod cut;
 pub mod ends;
 pub mod extend;
+mod handle;
 pub mod line;
 pub mod planar;
 pub mod prune;
 pub mod structure;
+pub mod widths;
+
+pub use handle::{EdgeId, NodeId};
 
 use crate::geometry::Boundary;
 use geo::{Coord, LineString, MultiLineString};
 use rustc_hash::FxHashMap as HashMap;
-
-/// Typed index of a node.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct NodeId(pub u32);
-
-/// Typed index of an edge.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct EdgeId(pub u32);
 
 /// A skeleton node.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -120,14 +116,14 @@ impl SkeletonGraph {
     /// Adds a node.
     pub fn add_node(&mut self, pos: Coord<f64>, radius: f64, time: Option<f64>) -> NodeId {
         self.nodes.push(Node { pos, radius, time });
-        NodeId(self.nodes.len() as u32 - 1)
+        NodeId::from_index(self.nodes.len() - 1)
     }
 
     /// Adds an edge between existing nodes.
     pub fn add_edge(&mut self, a: NodeId, b: NodeId, interior: Vec<Coord<f64>>) -> EdgeId {
-        debug_assert!((a.0 as usize) < self.nodes.len() && (b.0 as usize) < self.nodes.len());
+        debug_assert!((a.index()) < self.nodes.len() && (b.index()) < self.nodes.len());
         self.edges.push(Edge { a, b, interior });
-        EdgeId(self.edges.len() as u32 - 1)
+        EdgeId::from_index(self.edges.len() - 1)
     }
 
     /// All nodes.
@@ -147,12 +143,12 @@ impl SkeletonGraph {
 
     /// One node.
     pub fn node(&self, n: NodeId) -> &Node {
-        &self.nodes[n.0 as usize]
+        &self.nodes[n.index()]
     }
 
     /// One edge.
     pub fn edge(&self, e: EdgeId) -> &Edge {
-        &self.edges[e.0 as usize]
+        &self.edges[e.index()]
     }
 
     /// True when the graph has no edge.
@@ -188,7 +184,7 @@ impl SkeletonGraph {
     /// Total length of all edges.
     pub fn total_length(&self) -> f64 {
         (0..self.edges.len())
-            .map(|i| self.edge_length(EdgeId(i as u32)))
+            .map(|i| self.edge_length(EdgeId::from_index(i)))
             .sum()
     }
 
@@ -201,8 +197,8 @@ impl SkeletonGraph {
     pub fn degrees(&self) -> Vec<usize> {
         let mut d = vec![0; self.nodes.len()];
         for e in &self.edges {
-            d[e.a.0 as usize] += 1;
-            d[e.b.0 as usize] += 1;
+            d[e.a.index()] += 1;
+            d[e.b.index()] += 1;
         }
         d
     }
@@ -221,9 +217,9 @@ impl SkeletonGraph {
     pub fn components(&self) -> usize {
         let mut uf = UnionFind::new(self.nodes.len());
         for e in &self.edges {
-            uf.union(e.a.0 as usize, e.b.0 as usize);
+            uf.union(e.a.index(), e.b.index());
         }
-        let mut roots: Vec<usize> = self.edges.iter().map(|e| uf.find(e.a.0 as usize)).collect();
+        let mut roots: Vec<usize> = self.edges.iter().map(|e| uf.find(e.a.index())).collect();
         roots.sort_unstable();
         roots.dedup();
         roots.len()
@@ -233,7 +229,7 @@ impl SkeletonGraph {
     pub fn component_labels(&self) -> Vec<usize> {
         let mut uf = UnionFind::new(self.nodes.len());
         for e in &self.edges {
-            uf.union(e.a.0 as usize, e.b.0 as usize);
+            uf.union(e.a.index(), e.b.index());
         }
         (0..self.nodes.len()).map(|i| uf.find(i)).collect()
     }
@@ -274,15 +270,12 @@ impl SkeletonGraph {
         let mut walk = |start: NodeId, first: EdgeId, used: &mut Vec<bool>| {
             edges.clear();
             edges.push(first);
-            used[first.0 as usize] = true;
+            used[first.index()] = true;
             let mut cur = self.opposite(first, start);
-            while adj[cur.0 as usize].len() == 2 && cur != start {
-                let next = adj[cur.0 as usize]
-                    .iter()
-                    .copied()
-                    .find(|e| !used[e.0 as usize]);
+            while adj[cur.index()].len() == 2 && cur != start {
+                let next = adj[cur.index()].iter().copied().find(|e| !used[e.index()]);
                 let Some(next) = next else { break };
-                used[next.0 as usize] = true;
+                used[next.index()] = true;
                 edges.push(next);
                 cur = self.opposite(next, cur);
             }
@@ -294,8 +287,8 @@ impl SkeletonGraph {
                 continue;
             }
             for &e in a {
-                if !used[e.0 as usize] {
-                    walk(NodeId(n as u32), e, &mut used);
+                if !used[e.index()] {
+                    walk(NodeId::from_index(n), e, &mut used);
                 }
             }
         }
@@ -303,7 +296,7 @@ impl SkeletonGraph {
         for i in 0..self.edges.len() {
             if !used[i] {
                 let start = self.edges[i].a;
-                walk(start, EdgeId(i as u32), &mut used);
+                walk(start, EdgeId::from_index(i), &mut used);
             }
         }
     }
@@ -353,7 +346,7 @@ impl SkeletonGraph {
         let mut g = SkeletonGraph::new();
         let mut ids = NodeMap::new(self);
         for (i, e) in self.edges.iter().enumerate() {
-            if !keep(EdgeId(i as u32), e) {
+            if !keep(EdgeId::from_index(i), e) {
                 continue;
             }
             let a = ids.id(&mut g, e.a);
@@ -373,6 +366,17 @@ impl SkeletonGraph {
         )
     }
 
+    /// The graph of skeleton lines made by any tool: each line one edge,
+    /// end points shared bit for bit one node, radii 0 (see
+    /// [`GraphBuilder::polyline`] for the lines it leaves out).
+    pub fn from_lines(lines: &MultiLineString<f64>) -> SkeletonGraph {
+        let mut b = GraphBuilder::new();
+        for l in &lines.0 {
+            b.polyline(&l.0);
+        }
+        b.finish_raw()
+    }
+
     /// Recomputes every node's radius as its distance to ∂P.
     pub fn set_radii(&mut self, boundary: &Boundary) {
         for n in &mut self.nodes {
@@ -384,9 +388,9 @@ impl SkeletonGraph {
     /// degree ≠ 2 (for a leaf: its whole branch, starting at the leaf);
     /// `adj` is [`SkeletonGraph::adjacency`].
     pub fn line_from(&self, n: NodeId, adj: &Adjacency) -> Vec<Coord<f64>> {
-        let deg = |m: NodeId| adj[m.0 as usize].len();
+        let deg = |m: NodeId| adj[m.index()].len();
         let mut coords = vec![self.node(n).pos];
-        let Some(&first) = adj[n.0 as usize].first() else {
+        let Some(&first) = adj[n.index()].first() else {
             return coords;
         };
         let (mut at, mut via) = (n, first);
@@ -397,7 +401,7 @@ impl SkeletonGraph {
             if deg(at) != 2 || at == n {
                 break;
             }
-            let Some(&next) = adj[at.0 as usize].iter().find(|&&e| e != via) else {
+            let Some(&next) = adj[at.index()].iter().find(|&&e| e != via) else {
                 break;
             };
             via = next;
@@ -413,15 +417,15 @@ impl SkeletonGraph {
             .into_iter()
             .filter(|b| b.start != b.end)
             .filter_map(|mut b| {
-                if deg[b.start.0 as usize] != 1 {
-                    if deg[b.end.0 as usize] != 1 {
+                if deg[b.start.index()] != 1 {
+                    if deg[b.end.index()] != 1 {
                         return None;
                     }
                     std::mem::swap(&mut b.start, &mut b.end);
                     b.edges.reverse();
                     b.coords.reverse();
                 }
-                let junction = deg[b.end.0 as usize] >= 3;
+                let junction = deg[b.end.index()] >= 3;
                 Some(Leg {
                     branch: b,
                     junction,
@@ -436,9 +440,7 @@ impl SkeletonGraph {
         let deg = self.degrees();
         let mut n = 0;
         self.walk_branches(|start, _, end| {
-            n += usize::from(
-                start != end && (deg[start.0 as usize] == 1 || deg[end.0 as usize] == 1),
-            );
+            n += usize::from(start != end && (deg[start.index()] == 1 || deg[end.index()] == 1));
         });
         n
     }
@@ -447,7 +449,7 @@ impl SkeletonGraph {
     /// ([`SkeletonGraph::branches`]) when they are at hand: no second walk.
     pub fn leg_count_in(&self, branches: &[Branch]) -> usize {
         let deg = self.degrees();
-        let leaf = |n: NodeId| deg[n.0 as usize] == 1;
+        let leaf = |n: NodeId| deg[n.index()] == 1;
         branches
             .iter()
             .filter(|b| b.start != b.end && (leaf(b.start) || leaf(b.end)))
@@ -459,26 +461,24 @@ impl SkeletonGraph {
 /// are first met.
 struct NodeMap<'a> {
     from: &'a SkeletonGraph,
-    /// New number of every node of `from` (`u32::MAX`: not copied yet).
-    ids: Vec<u32>,
+    /// New handle of every node of `from` (`None`: not copied yet).
+    ids: Vec<Option<NodeId>>,
 }
 
 impl<'a> NodeMap<'a> {
     fn new(from: &'a SkeletonGraph) -> Self {
         Self {
             from,
-            ids: vec![u32::MAX; from.nodes.len()],
+            ids: vec![None; from.nodes.len()],
         }
     }
 
     /// Node `n`'s number in `g`, copied there the first time.
     fn id(&mut self, g: &mut SkeletonGraph, n: NodeId) -> NodeId {
-        let id = &mut self.ids[n.0 as usize];
-        if *id == u32::MAX {
+        *self.ids[n.index()].get_or_insert_with(|| {
             let nd = self.from.node(n);
-            *id = g.add_node(nd.pos, nd.radius, nd.time).0;
-        }
-        NodeId(*id)
+            g.add_node(nd.pos, nd.radius, nd.time)
+        })
     }
 }
 
@@ -500,9 +500,9 @@ impl Adjacency {
         let mut start = vec![0u32; g.nodes.len() + 1];
         let mut kept = 0;
         for (i, e) in g.edges.iter().enumerate() {
-            if keep(EdgeId(i as u32)) {
-                start[e.a.0 as usize + 1] += 1;
-                start[e.b.0 as usize + 1] += 1;
+            if keep(EdgeId::from_index(i)) {
+                start[e.a.index() + 1] += 1;
+                start[e.b.index() + 1] += 1;
                 kept += 2;
             }
         }
@@ -510,14 +510,14 @@ impl Adjacency {
             start[i] += start[i - 1];
         }
         let mut next = start.clone();
-        let mut edges = vec![EdgeId(0); kept];
+        let mut edges = vec![EdgeId::from_index(0); kept];
         for (i, e) in g.edges.iter().enumerate() {
-            if !keep(EdgeId(i as u32)) {
+            if !keep(EdgeId::from_index(i)) {
                 continue;
             }
             for n in [e.a, e.b] {
-                let at = &mut next[n.0 as usize];
-                edges[*at as usize] = EdgeId(i as u32);
+                let at = &mut next[n.index()];
+                edges[*at as usize] = EdgeId::from_index(i);
                 *at += 1;
             }
         }
@@ -585,7 +585,7 @@ impl GraphBuilder {
 
     /// Sets the event time of the node at `p` (straight skeleton).
     pub fn set_time(&mut self, n: NodeId, time: f64) {
-        self.graph.nodes[n.0 as usize].time = Some(time);
+        self.graph.nodes[n.index()].time = Some(time);
     }
 
     /// Adds the segment `pq` (ignored when degenerate).

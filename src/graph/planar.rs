@@ -8,8 +8,9 @@
 //! planar graph: two lines meet only at a node.
 
 use super::{Edge, SkeletonGraph};
-use crate::geometry::boundary::{orient, properly_cross};
 use crate::geometry::packed::{Bbox, PackedTree};
+use crate::geometry::segment::{crossing_point, properly_cross};
+use crate::geometry::vector::dot;
 use crate::geometry::Boundary;
 use geo::Coord;
 use std::ops::ControlFlow;
@@ -44,14 +45,6 @@ fn segments(g: &SkeletonGraph) -> Vec<Seg> {
     out
 }
 
-/// The crossing point of two properly crossing segments.
-fn intersection(p: Coord<f64>, q: Coord<f64>, a: Coord<f64>, b: Coord<f64>) -> Coord<f64> {
-    let oa = orient(p, q, a);
-    let ob = orient(p, q, b);
-    let t = oa / (oa - ob);
-    a + (b - a) * t
-}
-
 /// Every proper crossing of two segments of `g`: (segment i, segment j,
 /// point), i < j, as indices into the segments in edge order.
 fn find(segs: &[Seg]) -> Vec<(usize, usize, Coord<f64>)> {
@@ -70,7 +63,7 @@ fn find(segs: &[Seg]) -> Vec<(usize, usize, Coord<f64>)> {
     PackedTree::pairs_of(&boxes, |i, j| {
         let (s, t) = (&segs[i as usize], &segs[j as usize]);
         if properly_cross(s.a, s.b, t.a, t.b) {
-            out.push((i as usize, j as usize, intersection(s.a, s.b, t.a, t.b)));
+            out.push((i as usize, j as usize, crossing_point(s.a, s.b, t.a, t.b)));
         }
         ControlFlow::<()>::Continue(())
     });
@@ -106,14 +99,14 @@ pub fn node_crossings(g: SkeletonGraph, boundary: &Boundary) -> (SkeletonGraph, 
         cut_nodes.push(id);
         for s in [&segs[i], &segs[j]] {
             let d = s.b - s.a;
-            let t = ((p - s.a).x * d.x + (p - s.a).y * d.y) / (d.x * d.x + d.y * d.y);
+            let t = dot(p - s.a, d) / dot(d, d);
             cuts.entry((s.edge, s.index))
                 .or_default()
                 .push((t, cut_nodes.len() - 1));
         }
     }
     for (ei, e) in g.edges().iter().enumerate() {
-        let coords = g.edge_coords(super::EdgeId(ei as u32));
+        let coords = g.edge_coords(super::EdgeId::from_index(ei));
         let mut from = e.a;
         let mut interior: Vec<Coord<f64>> = Vec::new();
         // Walk the polyline segment by segment; the k-th segment runs from

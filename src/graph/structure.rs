@@ -38,10 +38,12 @@
 
 use super::bridge::bridge;
 use super::ends::assemble;
-use super::line::{end_radius, point_at, ON_BOUNDARY_END as END_ON_BOUNDARY};
+use super::line::{end_radius, point_at};
 use super::prune::trunk::shortest_path;
 use super::{EdgeId, NodeId, SkeletonGraph, UnionFind};
 use crate::geometry::packed::{box_distance_2, Bbox, PackedTree};
+use crate::geometry::tolerance::ON_BOUNDARY_END;
+use crate::geometry::vector::hypot;
 use crate::geometry::PreparedPolygon;
 use geo::Coord;
 use std::ops::ControlFlow;
@@ -76,15 +78,15 @@ pub struct Structure {
 impl Structure {
     /// The structure of a finished reference skeleton: its leaves.
     pub fn of(reference: &SkeletonGraph, polygon: &PreparedPolygon, trunk: bool) -> Self {
-        let tol = END_ON_BOUNDARY * polygon.extent();
+        let tol = ON_BOUNDARY_END * polygon.extent();
         let deg = reference.degrees();
         let labels = reference.component_labels();
         let adj = reference.adjacency();
         let contacts = (0..reference.nodes().len())
             .filter(|&n| deg[n] == 1)
             .map(|n| {
-                let node = reference.node(NodeId(n as u32));
-                let approach = reference.line_from(NodeId(n as u32), &adj);
+                let node = reference.node(NodeId::from_index(n));
+                let approach = reference.line_from(NodeId::from_index(n), &adj);
                 Contact {
                     point: node.pos,
                     radius: end_radius(&approach, polygon),
@@ -109,7 +111,7 @@ pub fn conform(
     if g.is_empty() {
         return g;
     }
-    let tol = END_ON_BOUNDARY * polygon.extent();
+    let tol = ON_BOUNDARY_END * polygon.extent();
     let tree = NodeIndex::new(&g);
     let served: Vec<Option<(NodeId, bool)>> = structure
         .contacts
@@ -125,7 +127,7 @@ pub fn conform(
     let terminals: Vec<Option<NodeId>> = served.iter().map(|t| t.map(|t| t.0)).collect();
     let mut is_terminal = vec![false; g.nodes().len()];
     for t in terminals.iter().flatten() {
-        is_terminal[t.0 as usize] = true;
+        is_terminal[t.index()] = true;
     }
     let mut keep = peel(&g, &is_terminal);
     if structure.trunk {
@@ -141,7 +143,7 @@ pub fn conform(
                 return None;
             }
             let p = g.node(t).pos;
-            let d = (p - c.point).x.hypot((p - c.point).y);
+            let d = hypot(p - c.point);
             (c.on_boundary && d > tol).then_some((t, c.point))
         })
         .collect();
@@ -276,8 +278,8 @@ fn best_seeing(
         let r2 = reach * reach;
         let mut keys: Vec<(f64, f64, u32)> = Vec::new();
         tree.within(q, r2, |n| {
-            let node = g.node(NodeId(n));
-            let d = (node.pos - q).x.hypot((node.pos - q).y);
+            let node = g.node(NodeId::from_index(n as usize));
+            let d = hypot(node.pos - q);
             keys.push((score(d, node.radius), d, n));
         });
         keys.sort_unstable_by(|a, b| {
@@ -286,11 +288,11 @@ fn best_seeing(
                 .then(a.2.cmp(&b.2))
         });
         let seen = keys.into_iter().find(|&(_, d, n)| {
-            let node = g.node(NodeId(n));
+            let node = g.node(NodeId::from_index(n as usize));
             d <= tol || ((on_boundary || node.radius > tol) && b.reaches(node.pos, q))
         });
         if let Some((_, _, n)) = seen {
-            return Some(NodeId(n));
+            return Some(NodeId::from_index(n as usize));
         }
         if reach >= limit {
             return None;
@@ -312,12 +314,12 @@ fn peel(g: &SkeletonGraph, is_terminal: &[bool]) -> Vec<bool> {
         if deg[n] != 1 || is_terminal[n] {
             continue;
         }
-        let Some(&e) = adj[n].iter().find(|e| keep[e.0 as usize]) else {
+        let Some(&e) = adj[n].iter().find(|e| keep[e.index()]) else {
             continue;
         };
-        keep[e.0 as usize] = false;
+        keep[e.index()] = false;
         deg[n] -= 1;
-        let o = g.opposite(e, NodeId(n as u32)).0 as usize;
+        let o = g.opposite(e, NodeId::from_index(n)).index();
         deg[o] -= 1;
         if deg[o] == 1 && !is_terminal[o] {
             stack.push(o);
@@ -337,7 +339,7 @@ fn trunk_paths(
     let mut uf = UnionFind::new(g.nodes().len());
     for (i, e) in g.edges().iter().enumerate() {
         if keep[i] {
-            uf.union(e.a.0 as usize, e.b.0 as usize);
+            uf.union(e.a.index(), e.b.index());
         }
     }
     let mut by_component: std::collections::BTreeMap<usize, Vec<NodeId>> = Default::default();
@@ -349,20 +351,20 @@ fn trunk_paths(
     let mut out = keep.clone();
     for ts in by_component.values() {
         let [a, b] = ts[..] else { continue };
-        let comp = uf.find(a.0 as usize);
-        if a == b || uf.find(b.0 as usize) != comp {
+        let comp = uf.find(a.index());
+        if a == b || uf.find(b.index()) != comp {
             continue;
         }
         let Some(path) = shortest_path(g, &keep, a, b) else {
             continue;
         };
         for (i, e) in g.edges().iter().enumerate() {
-            if keep[i] && uf.find(e.a.0 as usize) == comp {
+            if keep[i] && uf.find(e.a.index()) == comp {
                 out[i] = false;
             }
         }
         for e in path {
-            out[e.0 as usize] = true;
+            out[e.index()] = true;
         }
     }
     out
@@ -399,7 +401,7 @@ mod tests {
                 got.sort_unstable();
                 let want: Vec<u32> = (0..n as u32)
                     .filter(|&i| {
-                        let p = g.node(NodeId(i)).pos;
+                        let p = g.node(NodeId::from_index(i as usize)).pos;
                         (p.x - q.x).powi(2) + (p.y - q.y).powi(2) <= r2
                     })
                     .collect();

@@ -2,19 +2,21 @@
 //! (`skeleton.max_memory_mb`) — so that one pathological polygon cannot
 //! stall an unattended run or exhaust the machine.
 //!
-//! The per-feature path runs each method inside [`with_budget`]. A method
-//! with a long loop calls [`check`] in it (the straight skeleton does, on
-//! its event queue) and stops with [`MethodError::TimedOut`] once the
-//! deadline has passed. A method that cannot be interrupted is judged when
-//! it returns: its skeleton is dropped with the same error if it took too
-//! long. A method whose cost grows faster than its input (the straight
-//! skeleton) predicts its cost first and declines a polygon it cannot finish
-//! within the budget ([`MethodError::OverBudget`]), and keeps its memory
-//! under [`memory_limit`]. Either way only that method fails for that
-//! feature; the others still run.
+//! The per-feature path runs each method inside [`with_budget`], which
+//! starts the method's clock and hands it a [`MethodContext`]: the budget
+//! travels as an argument of [`super::SkeletonMethod::skeletonise`], not in
+//! global or thread-local state. A method with a long loop calls
+//! [`MethodContext::check`] in it (the straight skeleton does, on its event
+//! queue) and stops with [`MethodError::TimedOut`] once the deadline has
+//! passed. A method that cannot be interrupted is judged when it returns:
+//! its skeleton is dropped with the same error if it took too long. A method
+//! whose cost grows faster than its input (the straight skeleton) predicts
+//! its cost first and declines a polygon it cannot finish within the budget
+//! ([`MethodContext::afford`], [`MethodError::OverBudget`]), and keeps its
+//! memory under [`MethodContext::memory_limit`]. Either way only that method
+//! fails for that feature; the others still run.
 
 use super::{MethodError, MethodId};
-use std::cell::Cell;
 use std::time::{Duration, Instant};
 
 /// What one method may spend on one polygon part.
@@ -26,94 +28,97 @@ pub struct Budget {
     pub memory: Option<u64>,
 }
 
-#[derive(Clone, Copy)]
-struct Current {
-    id: MethodId,
-    deadline: Option<Instant>,
+/// The context of one method's run on one polygon part: its budget, with
+/// the clock started. [`MethodContext::default`] has no limits (every check
+/// passes), for a method called outside the per-feature path.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct MethodContext {
     budget: Budget,
+    deadline: Option<Instant>,
 }
 
-thread_local! {
-    static CURRENT: Cell<Option<Current>> = const { Cell::new(None) };
+impl MethodContext {
+    /// `budget`, its clock starting now.
+    pub fn start(budget: Budget) -> Self {
+        Self {
+            budget,
+            deadline: budget.time.map(|t| Instant::now() + t),
+        }
+    }
+
+    /// The budget.
+    pub fn budget(&self) -> Budget {
+        self.budget
+    }
+
+    /// Fails with [`MethodError::TimedOut`] (for `method`) when the deadline
+    /// has passed (free when no deadline is set).
+    pub fn check(&self, method: MethodId) -> Result<(), MethodError> {
+        match self.deadline {
+            Some(d) if Instant::now() > d => {
+                Err(timed_out(method, self.budget.time.unwrap_or_default()))
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// Time left before the deadline (`None`: no deadline).
+    pub fn remaining(&self) -> Option<Duration> {
+        self.deadline
+            .map(|d| d.saturating_duration_since(Instant::now()))
+    }
+
+    /// The memory budget in bytes (`None`: no limit).
+    pub fn memory_limit(&self) -> Option<u64> {
+        self.budget.memory
+    }
+
+    /// Declines the polygon (for `method`) when `seconds` (predicted)
+    /// exceeds the time left or `bytes` (predicted) the memory budget: the
+    /// reason names the prediction and the option to raise.
+    pub fn afford(&self, method: MethodId, seconds: f64, bytes: f64) -> Result<(), MethodError> {
+        if let Some(left) = self.remaining() {
+            if seconds > left.as_secs_f64() {
+                return Err(MethodError::OverBudget {
+                    method,
+                    reason: format!(
+                        "would need about {} s on this polygon, more than the {} s left of `skeleton.timeout_s`",
+                        seconds_text(seconds),
+                        seconds_text(left.as_secs_f64())
+                    ),
+                });
+            }
+        }
+        if let Some(max) = self.memory_limit() {
+            if bytes > max as f64 {
+                return Err(MethodError::OverBudget {
+                    method,
+                    reason: format!(
+                        "would need about {:.0} MB on this polygon, more than `skeleton.max_memory_mb` = {:.0}",
+                        bytes / 1e6,
+                        max as f64 / 1e6
+                    ),
+                });
+            }
+        }
+        Ok(())
+    }
 }
 
-/// Runs `f` (method `id`) under `budget` on this thread; a result that came
-/// after the deadline becomes [`MethodError::TimedOut`].
+/// Runs `f` (method `id`) with a [`MethodContext`] of `budget` started now;
+/// a result that came after the deadline becomes [`MethodError::TimedOut`].
 pub fn with_budget<T>(
     id: MethodId,
     budget: Budget,
-    f: impl FnOnce() -> Result<T, MethodError>,
+    f: impl FnOnce(&MethodContext) -> Result<T, MethodError>,
 ) -> Result<T, MethodError> {
-    let start = Instant::now();
-    let current = Current {
-        id,
-        deadline: budget.time.map(|t| start + t),
-        budget,
-    };
-    let before = CURRENT.with(|c| c.replace(Some(current)));
-    let r = f();
-    CURRENT.with(|c| c.set(before));
-    match (r, budget.time) {
-        (Ok(_), Some(t)) if start.elapsed() > t => Err(timed_out(id, t)),
-        (other, _) => other,
-    }
-}
-
-/// Fails with [`MethodError::TimedOut`] when the current method's deadline
-/// has passed (free when no deadline is set).
-pub fn check() -> Result<(), MethodError> {
-    match CURRENT.with(Cell::get) {
-        Some(Current {
-            id,
-            deadline: Some(d),
-            budget,
-        }) if Instant::now() > d => Err(timed_out(id, budget.time.unwrap_or_default())),
-        _ => Ok(()),
-    }
-}
-
-/// Time left before the current method's deadline (`None`: no deadline).
-pub fn remaining() -> Option<Duration> {
-    CURRENT
-        .with(Cell::get)
-        .and_then(|c| c.deadline)
-        .map(|d| d.saturating_duration_since(Instant::now()))
-}
-
-/// The current method's memory budget in bytes (`None`: no limit).
-pub fn memory_limit() -> Option<u64> {
-    CURRENT.with(Cell::get).and_then(|c| c.budget.memory)
-}
-
-/// Declines the current polygon when `seconds` (predicted) exceeds the time
-/// left or `bytes` (predicted) the memory budget: the reason names the
-/// prediction and the option to raise.
-pub fn afford(id: MethodId, seconds: f64, bytes: f64) -> Result<(), MethodError> {
-    if let Some(left) = remaining() {
-        if seconds > left.as_secs_f64() {
-            return Err(MethodError::OverBudget {
-                method: id,
-                reason: format!(
-                    "would need about {} s on this polygon, more than the {} s left of `skeleton.timeout_s`",
-                    seconds_text(seconds),
-                    seconds_text(left.as_secs_f64())
-                ),
-            });
+    let ctx = MethodContext::start(budget);
+    match f(&ctx) {
+        Ok(_) if ctx.deadline.is_some_and(|d| Instant::now() > d) => {
+            Err(timed_out(id, budget.time.unwrap_or_default()))
         }
+        other => other,
     }
-    if let Some(max) = memory_limit() {
-        if bytes > max as f64 {
-            return Err(MethodError::OverBudget {
-                method: id,
-                reason: format!(
-                    "would need about {:.0} MB on this polygon, more than `skeleton.max_memory_mb` = {:.0}",
-                    bytes / 1e6,
-                    max as f64 / 1e6
-                ),
-            });
-        }
-    }
-    Ok(())
 }
 
 /// Whole seconds from 10 s, tenths from 1 s, milliseconds below.
@@ -147,9 +152,9 @@ mod tests {
 
     #[test]
     fn a_method_past_its_deadline_stops_with_the_reason() {
-        let slow = || -> Result<(), MethodError> {
+        let slow = |ctx: &MethodContext| -> Result<(), MethodError> {
             loop {
-                check()?;
+                ctx.check(MethodId::STSK)?;
             }
         };
         let b = Budget {
@@ -159,18 +164,26 @@ mod tests {
         let e = with_budget(MethodId::STSK, b, slow).unwrap_err();
         assert!(e.to_string().contains("skeleton.timeout_s"), "{e}");
         // No budget: check is free and never fails.
-        assert!(check().is_ok());
+        assert!(MethodContext::default().check(MethodId::STSK).is_ok());
         assert_eq!(
-            with_budget(MethodId::MA, Budget::default(), || Ok(3)),
+            with_budget(MethodId::MA, Budget::default(), |_| Ok(3)),
             Ok(3)
+        );
+        // A method that cannot be interrupted is judged when it returns.
+        let late = with_budget(MethodId::CDT, b, |_| {
+            std::thread::sleep(Duration::from_millis(30));
+            Ok(())
+        });
+        assert!(
+            matches!(late, Err(MethodError::TimedOut { method, .. }) if method == MethodId::CDT)
         );
     }
 
     #[test]
     fn a_predicted_cost_over_the_budget_is_declined_with_the_reason() {
-        let r = with_budget(MethodId::STSK, seconds(60), || {
-            afford(MethodId::STSK, 5.0, 1e12)?;
-            afford(MethodId::STSK, 600.0, 0.0)
+        let r = with_budget(MethodId::STSK, seconds(60), |ctx| {
+            ctx.afford(MethodId::STSK, 5.0, 1e12)?;
+            ctx.afford(MethodId::STSK, 600.0, 0.0)
         });
         let e = r.unwrap_err().to_string();
         assert!(
@@ -181,11 +194,16 @@ mod tests {
             time: None,
             memory: Some(1_000_000),
         };
-        let e = with_budget(MethodId::STSK, mem, || afford(MethodId::STSK, 1e9, 5e6))
-            .unwrap_err()
-            .to_string();
+        let e = with_budget(MethodId::STSK, mem, |ctx| {
+            ctx.afford(MethodId::STSK, 1e9, 5e6)
+        })
+        .unwrap_err()
+        .to_string();
         assert!(e.contains("5 MB") && e.contains("max_memory_mb"), "{e}");
-        // Outside any budget everything is affordable.
-        assert!(afford(MethodId::STSK, 1e9, 1e18).is_ok());
+        // Without a budget everything is affordable.
+        assert!(MethodContext::default()
+            .afford(MethodId::STSK, 1e9, 1e18)
+            .is_ok());
+        assert_eq!(MethodContext::start(mem).memory_limit(), Some(1_000_000));
     }
 }

@@ -18,14 +18,16 @@
 //!
 //! ```
 //! use skeletonise::geometry::PreparedPolygon;
-//! use skeletonise::methods::{cdt::Cdt, SkeletonMethod};
+//! use skeletonise::methods::{cdt::Cdt, MethodContext, SkeletonMethod};
 //! use geo::polygon;
 //! let p = polygon![(x: 0., y: 0.), (x: 10., y: 0.), (x: 10., y: 2.), (x: 0., y: 2.)];
-//! let g = Cdt.skeletonise(&PreparedPolygon::new(&p).unwrap()).unwrap();
+//! let p = PreparedPolygon::new(&p).unwrap();
+//! let g = Cdt.skeletonise(&p, &MethodContext::default()).unwrap();
 //! assert!(g.edges().len() >= 2);
 //! ```
 
-use super::{MethodError, MethodId, SkeletonMethod};
+use super::{MethodContext, MethodError, MethodId, SkeletonMethod};
+use crate::geometry::vector::dot;
 use crate::geometry::PreparedPolygon;
 use crate::graph::{GraphBuilder, SkeletonGraph};
 use geo::Coord;
@@ -164,7 +166,11 @@ impl SkeletonMethod for Cdt {
         MethodId::CDT
     }
 
-    fn skeletonise(&self, polygon: &PreparedPolygon) -> Result<SkeletonGraph, MethodError> {
+    fn skeletonise(
+        &self,
+        polygon: &PreparedPolygon,
+        _ctx: &MethodContext,
+    ) -> Result<SkeletonGraph, MethodError> {
         let triangles = inside_triangles(polygon)?;
         let mut b = Nodes::default();
         for t in &triangles {
@@ -217,7 +223,7 @@ struct Nodes {
 impl Nodes {
     fn segment(&mut self, p: Coord<f64>, q: Coord<f64>, corners: &[Coord<f64>; 3]) {
         for x in [p, q] {
-            let id = self.graph.node(x).0 as usize;
+            let id = self.graph.node(x).index();
             if self.bound.len() <= id {
                 self.bound.resize(id + 1, f64::INFINITY);
             }
@@ -225,7 +231,7 @@ impl Nodes {
                 .iter()
                 .map(|&c| {
                     let d = x - c;
-                    d.x * d.x + d.y * d.y
+                    dot(d, d)
                 })
                 .fold(f64::INFINITY, f64::min);
             self.bound[id] = self.bound[id].min(d2.sqrt());
@@ -248,7 +254,11 @@ mod tests {
     use geo::polygon;
 
     fn run(p: geo::Polygon<f64>) -> SkeletonGraph {
-        Cdt.skeletonise(&PreparedPolygon::new(&p).unwrap()).unwrap()
+        Cdt.skeletonise(
+            &PreparedPolygon::new(&p).unwrap(),
+            &MethodContext::default(),
+        )
+        .unwrap()
     }
 
     #[test]
@@ -295,7 +305,10 @@ mod tests {
     #[test]
     fn self_intersecting_boundary_is_an_error_not_a_panic() {
         let p = polygon![(x: 0., y: 0.), (x: 4., y: 4.), (x: 4., y: 0.), (x: 0., y: 6.)];
-        let r = Cdt.skeletonise(&PreparedPolygon::new(&p).unwrap());
+        let r = Cdt.skeletonise(
+            &PreparedPolygon::new(&p).unwrap(),
+            &MethodContext::default(),
+        );
         assert!(r.is_err());
     }
 }

@@ -18,6 +18,8 @@ pub mod medial_axis;
 pub mod straight_skeleton;
 pub mod voronoi;
 
+pub use budget::MethodContext;
+
 use crate::geometry::PreparedPolygon;
 use crate::graph::SkeletonGraph;
 use schemars::JsonSchema;
@@ -283,8 +285,14 @@ impl Default for SkeletonParams {
 pub trait SkeletonMethod: Send + Sync {
     /// The method's identifier.
     fn id(&self) -> MethodId;
-    /// The raw skeleton of `polygon` (before pruning and extension).
-    fn skeletonise(&self, polygon: &PreparedPolygon) -> Result<SkeletonGraph, MethodError>;
+    /// The raw skeleton of `polygon` (before pruning and extension), within
+    /// the budget of `ctx` (a method with long loops checks it; see
+    /// [`budget`]). `&MethodContext::default()` sets no limit.
+    fn skeletonise(
+        &self,
+        polygon: &PreparedPolygon,
+        ctx: &MethodContext,
+    ) -> Result<SkeletonGraph, MethodError>;
 }
 
 /// One method as the registry knows it: its identifier, name, description

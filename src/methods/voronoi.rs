@@ -40,33 +40,35 @@
 //! ```
 //! use geo::polygon;
 //! use skeletonise::geometry::{densify::Density, PreparedPolygon};
-//! use skeletonise::methods::{voronoi::Voronoi, SkeletonMethod};
+//! use skeletonise::methods::{voronoi::Voronoi, MethodContext, SkeletonMethod};
 //!
 //! let p = polygon![(x: 0., y: 0.), (x: 10., y: 0.), (x: 10., y: 2.), (x: 0., y: 2.)];
 //! let p = PreparedPolygon::new(&p).unwrap();
 //! // Four cocircular corners: the Voronoi diagram is one point, no edge.
-//! assert!(Voronoi::plain().skeletonise(&p).unwrap().is_empty());
+//! let no_limit = MethodContext::default();
+//! assert!(Voronoi::plain().skeletonise(&p, &no_limit).unwrap().is_empty());
 //! // Densified to pieces of at most 0.5: the centre line y = 1 (where the
 //! // inscribed disc has the half width as radius) and short legs into the corners.
-//! let g = Voronoi::densified(Density::Spacing(0.5), 1_000_000).skeletonise(&p).unwrap();
+//! let g = Voronoi::densified(Density::Spacing(0.5), 1_000_000)
+//!     .skeletonise(&p, &no_limit)
+//!     .unwrap();
 //! assert_eq!(g.components(), 1);
 //! assert_eq!(g.leg_count(), 4);
 //! let on_centre_line = g.nodes().iter().filter(|n| n.pos.y == 1.0 && n.radius == 1.0);
 //! assert_eq!(on_centre_line.count(), 18);
 //! ```
 
-use super::{MethodError, MethodId, SkeletonMethod};
-use crate::geometry::{boundary::orient, densify, densify::Density, PreparedPolygon};
+use super::{MethodContext, MethodError, MethodId, SkeletonMethod};
+use crate::geometry::segment::orient;
+use crate::geometry::tolerance::{BOUND_MARGIN, SAME_POINT};
+use crate::geometry::vector::{hypot, norm, within_hypot};
+use crate::geometry::{densify, densify::Density, PreparedPolygon};
 use crate::graph::UnionFind;
 use crate::graph::{GraphBuilder, SkeletonGraph};
 use geo::{Coord, LineString};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use spade::{DelaunayTriangulation, InsertionError, Point2, Triangulation};
-
-/// Relative tolerance (× the polygon's extent) for "on ∂P" and for merging
-/// coincident Voronoi vertices (SPEC §3: points within 1e-9 × extent of P).
-pub const RELATIVE_TOLERANCE: f64 = 1e-9;
 
 /// Densification of the boundary for DVD.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
@@ -204,7 +206,7 @@ fn densified_count<'a>(
     for ring in rings {
         for l in ring.lines() {
             let d = l.end - l.start;
-            total = total.saturating_add(density.pieces(d.x.hypot(d.y)));
+            total = total.saturating_add(density.pieces(hypot(d)));
             if total > cap {
                 return total;
             }
@@ -222,9 +224,13 @@ impl SkeletonMethod for Voronoi {
         }
     }
 
-    fn skeletonise(&self, polygon: &PreparedPolygon) -> Result<SkeletonGraph, MethodError> {
+    fn skeletonise(
+        &self,
+        polygon: &PreparedPolygon,
+        _ctx: &MethodContext,
+    ) -> Result<SkeletonGraph, MethodError> {
         let sites = self.sites(polygon)?;
-        let tol = RELATIVE_TOLERANCE * polygon.extent();
+        let tol = SAME_POINT * polygon.extent();
         let vd = VoronoiDiagram::new(&sites, tol).map_err(|e| MethodError::Failed {
             method: self.id(),
             reason: format!("the boundary points cannot be triangulated: {e:?}"),
@@ -271,7 +277,7 @@ impl SkeletonMethod for Voronoi {
             for (k, r) in [(u, ru), (v, rv)] {
                 if node_of[k].is_none() {
                     let n = b.node(pos[k]);
-                    if n.0 as usize == radii.len() {
+                    if n.index() == radii.len() {
                         radii.push(r);
                     }
                     node_of[k] = Some(n);
@@ -315,7 +321,7 @@ impl<'a> Locator<'a> {
     /// `p` to a site (a point of ∂P up to rounding): it bounds the search
     /// (the same answer, fewer nodes queued).
     fn locate(&self, p: Coord<f64>, to_site: f64, tol: f64) -> Option<f64> {
-        let limit = to_site * (1.0 + 1e-9) + tol;
+        let limit = to_site * (1.0 + BOUND_MARGIN) + tol;
         let (_, k, d) = self
             .boundary
             .nearest_within(p, limit)
@@ -372,7 +378,7 @@ impl VoronoiDiagram {
             }
             let (f, g) = (f.fix().index(), g.fix().index());
             let (cf, cg) = (centre[f], centre[g]);
-            if crate::geometry::within_hypot(cf - cg, merge_tolerance) {
+            if within_hypot(cf - cg, merge_tolerance) {
                 uf.union(f, g);
             } else {
                 dual.push((f, g));
@@ -396,7 +402,7 @@ impl VoronoiDiagram {
                 vertices.push(centre[r]);
                 // A bound of the search for the nearest boundary point,
                 // which never changes its answer: no need for `hypot`.
-                site_distance.push(crate::geometry::norm(centre[r] - corner[r]));
+                site_distance.push(norm(centre[r] - corner[r]));
             }
             id[f] = id[r];
         }
@@ -423,10 +429,10 @@ impl VoronoiDiagram {
 fn circumcentre([a, b, c]: [Point2<f64>; 3]) -> Coord<f64> {
     let (bx, by) = (b.x - a.x, b.y - a.y);
     let (cx, cy) = (c.x - a.x, c.y - a.y);
-    let det = robust::orient2d(
-        robust::Coord { x: a.x, y: a.y },
-        robust::Coord { x: b.x, y: b.y },
-        robust::Coord { x: c.x, y: c.y },
+    let det = orient(
+        Coord { x: a.x, y: a.y },
+        Coord { x: b.x, y: b.y },
+        Coord { x: c.x, y: c.y },
     );
     let d = 2.0 * det;
     let (lb, lc) = (bx * bx + by * by, cx * cx + cy * cy);
@@ -464,7 +470,9 @@ mod tests {
     }
 
     fn vd(p: &PreparedPolygon) -> SkeletonGraph {
-        Voronoi::plain().skeletonise(p).unwrap()
+        Voronoi::plain()
+            .skeletonise(p, &MethodContext::default())
+            .unwrap()
     }
 
     /// Every edge as its two end points, sorted, for comparison with a known answer.
@@ -488,7 +496,7 @@ mod tests {
 
     /// Raw output invariants: points in P, no crossing, radius = distance to ∂P.
     fn assert_valid(p: &PreparedPolygon, g: &SkeletonGraph) {
-        let tol = RELATIVE_TOLERANCE * p.extent();
+        let tol = SAME_POINT * p.extent();
         for n in g.nodes() {
             assert!(
                 p.boundary().contains_with_tolerance(n.pos, tol),
@@ -527,7 +535,7 @@ mod tests {
         let p = prepared(Polygon::new(LineString(ring), vec![]));
         assert!(vd(&p).is_empty());
         let g = Voronoi::densified(Density::Factor(3), usize::MAX)
-            .skeletonise(&p)
+            .skeletonise(&p, &MethodContext::default())
             .unwrap();
         assert_valid(&p, &g);
         let deg = g.degrees();
@@ -666,7 +674,7 @@ mod tests {
             interiors: [[(x: 0.25, y: 0.25), (x: 0.25, y: 0.75), (x: 0.75, y: 0.75), (x: 0.75, y: 0.25)]],
         ));
         let loc = Locator::new(&p);
-        let tol = RELATIVE_TOLERANCE * p.extent();
+        let tol = SAME_POINT * p.extent();
         let mut inside = 0;
         for i in -10..=90 {
             for j in -10..=90 {
@@ -711,7 +719,7 @@ mod tests {
             VoronoiDiagram::new(&distinct, 1e-8).unwrap().edges.len()
         );
         let g = Voronoi::densified(Density::Factor(8), usize::MAX)
-            .skeletonise(&p)
+            .skeletonise(&p, &MethodContext::default())
             .unwrap();
         assert_valid(&p, &g);
         assert!(!g.is_empty());
@@ -725,7 +733,7 @@ mod tests {
             .unwrap();
         assert_eq!(ok.len(), 16);
         assert_eq!(
-            Voronoi::densified(Density::Factor(4), 15).skeletonise(&p),
+            Voronoi::densified(Density::Factor(4), 15).skeletonise(&p, &MethodContext::default()),
             Err(MethodError::TooManyPoints {
                 points: 16,
                 max: 15
@@ -733,7 +741,7 @@ mod tests {
         );
         // A spacing so small that the count would overflow `usize`.
         let e = Voronoi::densified(Density::Spacing(1e-300), 2_000_000)
-            .skeletonise(&p)
+            .skeletonise(&p, &MethodContext::default())
             .unwrap_err();
         assert!(
             matches!(e, MethodError::TooManyPoints { points, max: 2_000_000 } if points > 2_000_000),

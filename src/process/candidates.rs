@@ -6,9 +6,8 @@ use super::{part_reason, CandidateSkeleton, ProcessParams, StageTimes};
 use crate::clock::{CpuClock, Stage, Stages, Stopwatch};
 use crate::geometry::PreparedPolygon;
 use crate::graph::extend::prune_and_extend;
+use crate::graph::widths::medial_axis_transform;
 use crate::graph::SkeletonGraph;
-use crate::methods::medial_axis::medial_axis_transform;
-use crate::score::defects::graph_of;
 use crate::score::{metrics, BarRays};
 use geo::{LineString, MultiLineString};
 use std::time::Duration;
@@ -124,7 +123,7 @@ pub(super) fn given(
     lines: &MultiLineString<f64>,
     params: &ProcessParams,
 ) -> CandidateSkeleton {
-    let graph = graph_of(lines);
+    let graph = SkeletonGraph::from_lines(lines);
     let legs = graph.leg_count();
     let parts: Vec<PartSkeleton> = prepared
         .iter()
@@ -257,7 +256,7 @@ impl<'a> PartWork<'a> {
                             crate::methods::budget::with_budget(
                                 m,
                                 self.params.skeleton.budget(),
-                                || method.skeletonise(self.p),
+                                |ctx| method.skeletonise(self.p, ctx),
                             )
                             .map_err(|e| e.to_string())
                         })

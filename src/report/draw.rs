@@ -7,7 +7,7 @@
 //! geometry, the scores are computed on it, and the radii come from the
 //! full-resolution boundary.
 
-use crate::geometry::boundary::closest_on_segment;
+use crate::geometry::segment::closest_on_segment;
 use crate::geometry::Boundary;
 use crate::output::BarRow;
 use geo::{Coord, LineString};

@@ -2,25 +2,16 @@
 
 use super::{metrics, Bar, BarHit, Scores};
 use crate::clock::CpuClock;
-use crate::geometry::{boundary::orient, Boundary, BoundarySegment, PreparedPolygon};
-use crate::graph::{Branch, GraphBuilder, SkeletonGraph};
+use crate::geometry::segment::orient;
+use crate::geometry::tolerance::{BAR_ORIGIN, BOUND_MARGIN};
+use crate::geometry::vector::{dot, hypot, norm};
+use crate::geometry::{Boundary, BoundarySegment, PreparedPolygon};
+use crate::graph::{Branch, SkeletonGraph};
 use geo::{Coord, MultiLineString};
 use rayon::prelude::*;
 
 /// Bars per parallel task: a polygon with fewer is scored on one thread.
 pub(crate) const PAR_BARS: usize = 4096;
-
-/// Relative tolerance: hits closer than this × extent to the bar's origin are
-/// the origin itself (SPEC §6.2).
-const REL_EPS: f64 = 1e-6;
-
-fn dot(a: Coord<f64>, b: Coord<f64>) -> f64 {
-    a.x * b.x + a.y * b.y
-}
-
-fn norm(a: Coord<f64>) -> f64 {
-    crate::geometry::norm(a)
-}
 
 /// Left unit normal of the direction `d` (inward for a ring edge, since the
 /// interior lies on the left of every ring edge).
@@ -43,7 +34,7 @@ fn vertex_bar_valid(prev: Coord<f64>, v: Coord<f64>, next: Coord<f64>) -> bool {
     let left = orient(v, next, prev) >= 0.0;
     // A right angle computed with rounding (a rotated rectangle) must not
     // count as obtuse: its bar would run along the next edge.
-    let ahead = dot(a, b) >= -RIGHT_ANGLE_TOLERANCE * a.x.hypot(a.y) * b.x.hypot(b.y);
+    let ahead = dot(a, b) >= -RIGHT_ANGLE_TOLERANCE * hypot(a) * hypot(b);
     !(left && ahead)
 }
 
@@ -174,7 +165,7 @@ impl BarRays {
         // have enough of them to be split.
         let clock = (3 * polygon.vertex_count() > PAR_BARS).then(CpuClock::start);
         let boundary = polygon.boundary();
-        let eps = REL_EPS * polygon.extent();
+        let eps = BAR_ORIGIN * polygon.extent();
         // No ray stays inside P for longer than the bounding box's diagonal.
         let diagonal = norm(boundary.bbox_max() - boundary.bbox_min());
         let mut rays = Vec::with_capacity(3 * polygon.vertex_count());
@@ -274,7 +265,7 @@ impl BarRays {
         polygon: &PreparedPolygon,
         branches: &[Branch],
     ) -> (Vec<Bar>, Option<std::time::Duration>, usize) {
-        let eps = REL_EPS * polygon.extent();
+        let eps = BAR_ORIGIN * polygon.extent();
         let cast_all = |sk: &SkeletonIndex, bars: &mut [Bar], rays: &[Ray]| {
             let mut recent = [NOWHERE; 2];
             for (bar, r) in bars.iter_mut().zip(rays) {
@@ -341,7 +332,7 @@ fn cast(
             let seed = seeds
                 .into_iter()
                 .filter(|&c| dot(c - q, n) >= 0.0)
-                .map(|c| norm(c - q) * (1.0 + 1e-9))
+                .map(|c| norm(c - q) * (1.0 + BOUND_MARGIN))
                 .fold(f64::INFINITY, f64::min);
             boundary
                 .nearest_in_half_plane_within(q, n, seed)
@@ -377,11 +368,8 @@ pub fn score_skeleton(
     polygon: &PreparedPolygon,
     skeleton: &MultiLineString<f64>,
 ) -> (Scores, Vec<Bar>) {
-    let mut gb = GraphBuilder::new();
-    for line in &skeleton.0 {
-        gb.polyline(&line.0);
-    }
-    let graph = gb.finish(polygon.boundary());
+    let mut graph = SkeletonGraph::from_lines(skeleton);
+    graph.set_radii(polygon.boundary());
     let b = bars(polygon, &graph);
     (metrics(&b), b)
 }

@@ -16,21 +16,11 @@
 
 use crate::graph::line::angle_deg;
 pub use crate::graph::line::{end_turn, end_turns, HOOK_DEG};
-use crate::graph::{GraphBuilder, SkeletonGraph};
-use geo::{Coord, MultiLineString};
+use crate::graph::SkeletonGraph;
+use geo::Coord;
 
 /// A vertex where the line turns by more than this (degrees) is a sharp turn.
 pub const SHARP_DEG: f64 = 45.0;
-
-/// The graph of skeleton lines made by any tool (end points shared bit for
-/// bit become nodes).
-pub fn graph_of(lines: &MultiLineString<f64>) -> SkeletonGraph {
-    let mut b = GraphBuilder::new();
-    for l in &lines.0 {
-        b.polyline(&l.0);
-    }
-    b.finish_raw()
-}
 
 /// Vertices where the lines of `g` turn by more than [`SHARP_DEG`], and the
 /// total length of the lines.
@@ -64,6 +54,7 @@ mod tests {
     }
 
     use crate::geometry::PreparedPolygon;
+    use crate::graph::GraphBuilder;
 
     #[test]
     fn a_straight_end_does_not_turn_and_a_sideways_stub_is_a_hook() {

@@ -23,9 +23,11 @@
 //! (a polygon with holes) are removed down to the cycles.
 
 use super::{LegMeasure, PruneParams};
+use crate::geometry::tolerance::ON_BOUNDARY_END;
+use crate::geometry::vector::dot;
 use crate::geometry::Boundary;
 use crate::graph::cut::cut_ends;
-use crate::graph::line::{point_at, ON_BOUNDARY_END};
+use crate::graph::line::point_at;
 use crate::graph::{EdgeId, NodeId, SkeletonGraph};
 use geo::Coord;
 use std::cmp::{Ordering, Reverse};
@@ -36,25 +38,27 @@ use std::collections::BinaryHeap;
 /// O(1) however long the chain).
 #[derive(Debug, Clone, Copy)]
 struct Piece {
-    u: u32,
-    v: u32,
+    u: NodeId,
+    v: NodeId,
     len: f64,
     kind: Kind,
 }
 
 #[derive(Debug, Clone, Copy)]
 enum Kind {
-    Orig(u32),
+    Orig(EdgeId),
     /// Pieces `a` (from `u`) and `b` (to `v`) joined at node `at`.
     Join {
         a: u32,
         b: u32,
-        at: u32,
+        at: NodeId,
     },
 }
 
-/// Mutable multigraph over pieces. Invariant: `adj[n]` lists the alive pieces
-/// incident to n (a loop twice), and an alive piece's originals are kept.
+/// Mutable multigraph over pieces (numbered in the order made; piece `i`
+/// of the first `edges().len()` is edge `i`). Invariant: `adj[n]` lists the
+/// alive pieces incident to node n (a loop twice), and an alive piece's
+/// originals are kept.
 struct Work<'a> {
     graph: &'a SkeletonGraph,
     boundary: &'a Boundary,
@@ -106,26 +110,26 @@ impl<'a> Work<'a> {
             reach: graph.nodes().iter().map(|n| n.radius.max(0.0)).collect(),
         };
         for (i, e) in graph.edges().iter().enumerate() {
-            let len = graph.edge_length(EdgeId(i as u32));
-            w.push_piece(e.a.0, e.b.0, len, Kind::Orig(i as u32));
+            let len = graph.edge_length(EdgeId::from_index(i));
+            w.push_piece(e.a, e.b, len, Kind::Orig(EdgeId::from_index(i)));
         }
         w
     }
 
-    fn push_piece(&mut self, u: u32, v: u32, len: f64, kind: Kind) -> u32 {
+    fn push_piece(&mut self, u: NodeId, v: NodeId, len: f64, kind: Kind) -> u32 {
         let id = self.pieces.len() as u32;
         self.pieces.push(Piece { u, v, len, kind });
         self.alive.push(true);
-        self.adj[u as usize].push(id);
-        self.adj[v as usize].push(id);
+        self.adj[u.index()].push(id);
+        self.adj[v.index()].push(id);
         id
     }
 
-    fn deg(&self, n: u32) -> usize {
-        self.adj[n as usize].len()
+    fn deg(&self, n: NodeId) -> usize {
+        self.adj[n.index()].len()
     }
 
-    fn other(&self, p: u32, n: u32) -> u32 {
+    fn other(&self, p: u32, n: NodeId) -> NodeId {
         let pc = &self.pieces[p as usize];
         if pc.u == n {
             pc.v
@@ -135,7 +139,7 @@ impl<'a> Work<'a> {
     }
 
     /// `(leaf, junction)` when piece `p` is a leg at a junction of degree ≥ 3.
-    fn leg(&self, p: u32) -> Option<(u32, u32)> {
+    fn leg(&self, p: u32) -> Option<(NodeId, NodeId)> {
         let pc = &self.pieces[p as usize];
         if pc.u == pc.v {
             return None;
@@ -151,20 +155,20 @@ impl<'a> Work<'a> {
     fn remove(&mut self, p: u32) {
         self.alive[p as usize] = false;
         let Piece { u, v, .. } = self.pieces[p as usize];
-        self.adj[u as usize].retain(|&q| q != p);
-        self.adj[v as usize].retain(|&q| q != p);
+        self.adj[u.index()].retain(|&q| q != p);
+        self.adj[v.index()].retain(|&q| q != p);
         let mut stack = vec![p];
         while let Some(q) = stack.pop() {
             match self.pieces[q as usize].kind {
-                Kind::Orig(e) => self.keep[e as usize] = false,
+                Kind::Orig(e) => self.keep[e.index()] = false,
                 Kind::Join { a, b, .. } => stack.extend([a, b]),
             }
         }
     }
 
     /// Joins the two distinct pieces at degree-2 node `j` into one.
-    fn join(&mut self, j: u32) -> Option<u32> {
-        let (p1, p2) = (self.adj[j as usize][0], self.adj[j as usize][1]);
+    fn join(&mut self, j: NodeId) -> Option<u32> {
+        let (p1, p2) = (self.adj[j.index()][0], self.adj[j.index()][1]);
         if p1 == p2 {
             return None; // a loop: j anchors a pure cycle
         }
@@ -184,9 +188,9 @@ impl<'a> Work<'a> {
         self.alive.push(true);
         self.alive[p1 as usize] = false;
         self.alive[p2 as usize] = false;
-        self.adj[j as usize].clear();
+        self.adj[j.index()].clear();
         for (n, old) in [(u, p1), (v, p2)] {
-            let slot = self.adj[n as usize]
+            let slot = self.adj[n.index()]
                 .iter_mut()
                 .find(|q| **q == old)
                 .expect("adjacency lists every alive piece");
@@ -197,13 +201,13 @@ impl<'a> Work<'a> {
 
     /// Extent of leg `p` seen from its junction: its length plus the reach
     /// of its leaf.
-    fn extent(&self, p: u32, leaf: u32) -> f64 {
-        self.pieces[p as usize].len + self.reach[leaf as usize]
+    fn extent(&self, p: u32, leaf: NodeId) -> f64 {
+        self.pieces[p as usize].len + self.reach[leaf.index()]
     }
 
     /// Piece `p` is a leg whose leaf is not `j` and which is insignificant
     /// when judged at `j` (radius r_j).
-    fn insignificant_at(&self, p: u32, j: u32, params: &PruneParams) -> bool {
+    fn insignificant_at(&self, p: u32, j: NodeId, params: &PruneParams) -> bool {
         let o = self.other(p, j);
         o != j && self.deg(o) == 1 && params.is_insignificant(&self.measure(p, o, j))
     }
@@ -211,7 +215,7 @@ impl<'a> Work<'a> {
     /// The leg `p` from junction `j` to leaf `leaf` as the rules see it. The
     /// mouth radius (a boundary query) is only measured when the radius rule
     /// alone would remove the leg.
-    fn measure(&self, p: u32, leaf: u32, j: u32) -> LegMeasure {
+    fn measure(&self, p: u32, leaf: NodeId, j: NodeId) -> LegMeasure {
         let rj = self.radius(j);
         let mut leg = LegMeasure {
             extent: self.extent(p, leaf),
@@ -223,20 +227,20 @@ impl<'a> Work<'a> {
             leg.r_mouth = if len > rj {
                 self.boundary.distance(self.point_at(p, j, rj))
             } else {
-                self.radius(leaf).max(self.reach[leaf as usize])
+                self.radius(leaf).max(self.reach[leaf.index()])
             };
         }
         leg
     }
 
     /// The point at arc length `s` along piece `p` walked from its end `from`.
-    fn point_at(&self, p: u32, from: u32, s: f64) -> Coord<f64> {
+    fn point_at(&self, p: u32, from: NodeId, s: f64) -> Coord<f64> {
         let (mut p, mut from, mut s) = (p, from, s);
         loop {
             let pc = self.pieces[p as usize];
             match pc.kind {
                 Kind::Orig(e) => {
-                    let coords = self.graph.oriented_coords(EdgeId(e), NodeId(from));
+                    let coords = self.graph.oriented_coords(e, from);
                     return point_at(&coords, s);
                 }
                 Kind::Join { a, b, at } => {
@@ -255,8 +259,8 @@ impl<'a> Work<'a> {
         }
     }
 
-    fn radius(&self, n: u32) -> f64 {
-        self.graph.nodes()[n as usize].radius
+    fn radius(&self, n: NodeId) -> f64 {
+        self.graph.node(n).radius
     }
 
     fn entry(&self, p: u32, params: &PruneParams) -> Option<Entry> {
@@ -265,7 +269,7 @@ impl<'a> Work<'a> {
         if !params.is_insignificant(&leg) {
             return None;
         }
-        let pos = self.graph.nodes()[leaf as usize].pos;
+        let pos = self.graph.node(leaf).pos;
         Some(Entry {
             key: params.key(&leg),
             leaf: (pos.x, pos.y),
@@ -285,14 +289,15 @@ pub fn mask(m: &SkeletonGraph, params: &PruneParams, boundary: &Boundary) -> Vec
     if params.mode == super::PruneMode::Significance {
         for cut in cut_ends(m, boundary, tol) {
             for leg in cut.legs {
-                if w.alive[leg.0 as usize] {
-                    w.remove(leg.0);
+                // Piece `i` of the first ones is edge `i`.
+                if w.alive[leg.index()] {
+                    w.remove(leg.index() as u32);
                 }
             }
-            w.reach[cut.junction.0 as usize] = f64::INFINITY;
+            w.reach[cut.junction.index()] = f64::INFINITY;
         }
     }
-    let mut collapsed: Vec<u32> = Vec::new();
+    let mut collapsed: Vec<NodeId> = Vec::new();
     let mut heap: BinaryHeap<Reverse<Entry>> = (0..w.pieces.len() as u32)
         .filter_map(|p| w.entry(p, params).map(Reverse))
         .collect();
@@ -310,7 +315,7 @@ pub fn mask(m: &SkeletonGraph, params: &PruneParams, boundary: &Boundary) -> Vec
         if w.deg(j) != 2 {
             continue;
         }
-        let (a, b) = (w.adj[j as usize][0], w.adj[j as usize][1]);
+        let (a, b) = (w.adj[j.index()][0], w.adj[j.index()][1]);
         let (ia, ib) = (
             w.insignificant_at(a, j, params),
             w.insignificant_at(b, j, params),
@@ -322,7 +327,7 @@ pub fn mask(m: &SkeletonGraph, params: &PruneParams, boundary: &Boundary) -> Vec
             let gone_leaf = w.other(gone, j);
             // j keeps the reach of what was cut behind it, so that a long
             // arm is not eroded junction by junction.
-            w.reach[j as usize] = removed_extent.max(w.extent(gone, gone_leaf));
+            w.reach[j.index()] = removed_extent.max(w.extent(gone, gone_leaf));
             w.remove(gone);
             Some(stays)
         } else {
@@ -342,7 +347,7 @@ pub fn mask(m: &SkeletonGraph, params: &PruneParams, boundary: &Boundary) -> Vec
         // component keeps its main axis instead.
         let labels = m.component_labels();
         let flagged: std::collections::BTreeSet<usize> =
-            collapsed.iter().map(|&j| labels[j as usize]).collect();
+            collapsed.iter().map(|&j| labels[j.index()]).collect();
         for c in flagged {
             main_axis(m, &labels, c, &mut keep);
         }
@@ -362,13 +367,9 @@ fn main_axis(m: &SkeletonGraph, labels: &[usize], c: usize, keep: &mut [bool]) {
     let deg = m.degrees();
     let leaves: Vec<NodeId> = (0..m.nodes().len())
         .filter(|&n| labels[n] == c && deg[n] == 1)
-        .map(|n| NodeId(n as u32))
+        .map(NodeId::from_index)
         .collect();
-    let in_c: Vec<bool> = m
-        .edges()
-        .iter()
-        .map(|e| labels[e.a.0 as usize] == c)
-        .collect();
+    let in_c: Vec<bool> = m.edges().iter().map(|e| labels[e.a.index()] == c).collect();
     let pair = if leaves.len() > MAX_AXIS_LEAVES {
         None
     } else {
@@ -376,7 +377,7 @@ fn main_axis(m: &SkeletonGraph, labels: &[usize], c: usize, keep: &mut [bool]) {
         for (i, &a) in leaves.iter().enumerate() {
             for &b in &leaves[i + 1..] {
                 let d = m.node(a).pos - m.node(b).pos;
-                let d2 = d.x * d.x + d.y * d.y;
+                let d2 = dot(d, d);
                 if best.is_none_or(|(bd, _, _)| d2 > bd) {
                     best = Some((d2, a, b));
                 }
@@ -393,7 +394,7 @@ fn main_axis(m: &SkeletonGraph, labels: &[usize], c: usize, keep: &mut [bool]) {
                 }
             }
             for e in path {
-                keep[e.0 as usize] = true;
+                keep[e.index()] = true;
             }
         }
         None => {

@@ -227,7 +227,7 @@ pub fn prune(graph: &SkeletonGraph, params: &PruneParams, boundary: &Boundary) -
     }
     let m = graph.merged();
     let keep = prune_mask(&m, params, boundary);
-    m.filter_edges(|e, _| keep[e.0 as usize]).merged()
+    m.filter_edges(|e, _| keep[e.index()]).merged()
 }
 
 /// Legs of `graph` that are insignificant under `params` at a junction of

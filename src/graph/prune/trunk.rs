@@ -17,7 +17,7 @@ use std::collections::BinaryHeap;
 struct Sweep {
     dist: Vec<f64>,
     pred: Vec<Option<EdgeId>>,
-    touched: Vec<u32>,
+    touched: Vec<NodeId>,
 }
 
 impl Sweep {
@@ -39,32 +39,32 @@ impl Sweep {
         s: NodeId,
     ) -> (NodeId, f64) {
         for &t in &self.touched {
-            self.dist[t as usize] = f64::INFINITY;
-            self.pred[t as usize] = None;
+            self.dist[t.index()] = f64::INFINITY;
+            self.pred[t.index()] = None;
         }
         self.touched.clear();
         let mut heap = BinaryHeap::new();
-        self.dist[s.0 as usize] = 0.0;
-        self.touched.push(s.0);
-        heap.push(Reverse((OrdF(0.0), s.0)));
+        self.dist[s.index()] = 0.0;
+        self.touched.push(s);
+        heap.push(Reverse((OrdF(0.0), s)));
         let mut best = (s, 0.0);
         while let Some(Reverse((OrdF(d), n))) = heap.pop() {
-            if d > self.dist[n as usize] {
+            if d > self.dist[n.index()] {
                 continue;
             }
-            if deg[n as usize] == 1 && (d > best.1 || (d == best.1 && n < best.0 .0 && d > 0.0)) {
-                best = (NodeId(n), d);
+            if deg[n.index()] == 1 && (d > best.1 || (d == best.1 && n < best.0 && d > 0.0)) {
+                best = (n, d);
             }
-            for &e in &adj[n as usize] {
-                let o = g.opposite(e, NodeId(n));
-                let nd = d + len[e.0 as usize];
-                if nd < self.dist[o.0 as usize] {
-                    if self.dist[o.0 as usize].is_infinite() {
-                        self.touched.push(o.0);
+            for &e in &adj[n.index()] {
+                let o = g.opposite(e, n);
+                let nd = d + len[e.index()];
+                if nd < self.dist[o.index()] {
+                    if self.dist[o.index()].is_infinite() {
+                        self.touched.push(o);
                     }
-                    self.dist[o.0 as usize] = nd;
-                    self.pred[o.0 as usize] = Some(e);
-                    heap.push(Reverse((OrdF(nd), o.0)));
+                    self.dist[o.index()] = nd;
+                    self.pred[o.index()] = Some(e);
+                    heap.push(Reverse((OrdF(nd), o)));
                 }
             }
         }
@@ -96,20 +96,20 @@ pub fn mask(m: &SkeletonGraph) -> Vec<bool> {
     let adj = m.adjacency();
     let deg = m.degrees();
     let len: Vec<f64> = (0..m.edges().len())
-        .map(|i| m.edge_length(EdgeId(i as u32)))
+        .map(|i| m.edge_length(EdgeId::from_index(i)))
         .collect();
     let labels = m.component_labels();
     let mut leaves_of: Vec<Vec<NodeId>> = vec![Vec::new(); m.nodes().len()];
     for (n, &d) in deg.iter().enumerate() {
         if d == 1 {
-            leaves_of[labels[n]].push(NodeId(n as u32));
+            leaves_of[labels[n]].push(NodeId::from_index(n));
         }
     }
     let mut keep = vec![false; m.edges().len()];
     let mut sweep = Sweep::new(m.nodes().len());
     let mut done = vec![false; m.nodes().len()];
     for e in m.edges() {
-        let c = labels[e.a.0 as usize];
+        let c = labels[e.a.index()];
         if done[c] {
             continue;
         }
@@ -119,16 +119,16 @@ pub fn mask(m: &SkeletonGraph) -> Vec<bool> {
             0 => {
                 // A ring: keep the whole component.
                 for (k, f) in m.edges().iter().enumerate() {
-                    if labels[f.a.0 as usize] == c {
+                    if labels[f.a.index()] == c {
                         keep[k] = true;
                     }
                 }
             }
             1 => {
                 // Cycles and one leg: keep the cycles.
-                let leg = adj[leaves[0].0 as usize][0];
+                let leg = adj[leaves[0].index()][0];
                 for (k, f) in m.edges().iter().enumerate() {
-                    if labels[f.a.0 as usize] == c && EdgeId(k as u32) != leg {
+                    if labels[f.a.index()] == c && EdgeId::from_index(k) != leg {
                         keep[k] = true;
                     }
                 }
@@ -148,8 +148,8 @@ pub fn mask(m: &SkeletonGraph) -> Vec<bool> {
                 // Walk back from b to a along the predecessors of the sweep from a.
                 let mut n = b;
                 while n != a {
-                    let e = sweep.pred[n.0 as usize].expect("b is reachable from a");
-                    keep[e.0 as usize] = true;
+                    let e = sweep.pred[n.index()].expect("b is reachable from a");
+                    keep[e.index()] = true;
                     n = m.opposite(e, n);
                 }
             }
@@ -167,20 +167,20 @@ pub(crate) fn shortest_path(
     from: NodeId,
     to: NodeId,
 ) -> Option<Vec<EdgeId>> {
-    let adj = Adjacency::of(g, |e| usable[e.0 as usize]);
+    let adj = Adjacency::of(g, |e| usable[e.index()]);
     let len: Vec<f64> = (0..g.edges().len())
-        .map(|i| g.edge_length(EdgeId(i as u32)))
+        .map(|i| g.edge_length(EdgeId::from_index(i)))
         .collect();
     let deg: Vec<usize> = adj.iter().map(<[EdgeId]>::len).collect();
     let mut sweep = Sweep::new(g.nodes().len());
     sweep.run(g, &adj, &len, &deg, from);
-    if from != to && sweep.pred[to.0 as usize].is_none() {
+    if from != to && sweep.pred[to.index()].is_none() {
         return None;
     }
     let mut path = Vec::new();
     let mut n = to;
     while n != from {
-        let e = sweep.pred[n.0 as usize]?;
+        let e = sweep.pred[n.index()]?;
         path.push(e);
         n = g.opposite(e, n);
     }

@@ -7,8 +7,8 @@
 //! concave (reflex) vertices — in the segment Voronoi diagram those are
 //! exactly the *secondary* edges, between a segment and its own endpoint.
 //! Every node carries its disc radius, so the graph with its radii is the
-//! Medial Axis Transform; [`medial_axis_transform`] lists it segment by
-//! segment with the local width.
+//! Medial Axis Transform; [`crate::graph::widths::medial_axis_transform`]
+//! lists it segment by segment with the local width.
 //!
 //! # How
 //!
@@ -45,11 +45,11 @@
 //! use geo::polygon;
 //! use skeletonise::geometry::PreparedPolygon;
 //! use skeletonise::methods::medial_axis::{ArcTolerance, MedialAxis};
-//! use skeletonise::methods::SkeletonMethod;
+//! use skeletonise::methods::{MethodContext, SkeletonMethod};
 //! // A 10 × 4 rectangle: centre segment plus four 45° corner legs.
 //! let p = polygon![(x: 0., y: 0.), (x: 10., y: 0.), (x: 10., y: 4.), (x: 0., y: 4.)];
 //! let g = MedialAxis::new(ArcTolerance::default())
-//!     .skeletonise(&PreparedPolygon::new(&p).unwrap())
+//!     .skeletonise(&PreparedPolygon::new(&p).unwrap(), &MethodContext::default())
 //!     .unwrap();
 //! assert_eq!(g.edges().len(), 5);
 //! assert_eq!(g.leg_count(), 4);
@@ -60,12 +60,16 @@
 mod arc;
 mod quantise;
 
-use super::{MethodError, MethodId, SkeletonMethod};
-use crate::geometry::{Boundary, PreparedPolygon};
+use super::{MethodContext, MethodError, MethodId, SkeletonMethod};
+use crate::geometry::PreparedPolygon;
+/// The Medial Axis Transform's pieces, at their old path for the
+/// per-feature path (`process`), which imports them from here; their home
+/// is [`crate::graph::widths`].
+#[doc(no_inline)]
+pub use crate::graph::widths::MatSegment;
 use crate::graph::{NodeId, SkeletonGraph};
 use arc::Parabola;
 use boostvoronoi::prelude::{Builder, Cell, Diagram, SourceCategory, VertexIndex};
-use geo::Line;
 use quantise::{orient, Grid, Pt, Seg};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -179,7 +183,11 @@ impl SkeletonMethod for MedialAxis {
         MethodId::MA
     }
 
-    fn skeletonise(&self, polygon: &PreparedPolygon) -> Result<SkeletonGraph, MethodError> {
+    fn skeletonise(
+        &self,
+        polygon: &PreparedPolygon,
+        _ctx: &MethodContext,
+    ) -> Result<SkeletonGraph, MethodError> {
         self.tolerance.validate().map_err(fail)?;
         let grid = Grid::new(polygon.origin(), polygon.extent()).ok_or_else(|| {
             fail(format!(
@@ -501,85 +509,4 @@ impl<'a> Extractor<'a> {
         }
         self.graph.add_edge(prev, n1, Vec::new());
     }
-}
-
-/// One straight piece of a Medial Axis Transform: a skeleton segment and the
-/// disc radius (local half-width of P) at each end.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct MatSegment {
-    /// The segment, in the direction of its edge.
-    pub line: Line<f64>,
-    /// Disc radius at `line.start`.
-    pub r_start: f64,
-    /// Disc radius at `line.end`.
-    pub r_end: f64,
-}
-
-impl MatSegment {
-    /// Local width of P (2 × radius) at the start.
-    pub fn width_start(&self) -> f64 {
-        2.0 * self.r_start
-    }
-
-    /// Local width of P (2 × radius) at the end.
-    pub fn width_end(&self) -> f64 {
-        2.0 * self.r_end
-    }
-
-    /// Mean width along the segment (radius varies linearly to first order).
-    pub fn mean_width(&self) -> f64 {
-        self.r_start + self.r_end
-    }
-}
-
-/// The Medial Axis Transform of a skeleton, segment by segment: every
-/// straight piece of every edge with the disc radius at both ends — what a
-/// writer needs for a `width` attribute or M values, and what a cartographer
-/// uses to decide what is narrow enough to collapse.
-///
-/// End nodes carry their radius. Interior polyline vertices (edges merged by
-/// pruning, for instance) get their distance to ∂P from `boundary` when given
-/// (exact on the medial axis), otherwise a radius interpolated linearly by
-/// length between the edge's end nodes. On MA's raw output every polyline
-/// vertex is a node, so no boundary is needed.
-pub fn medial_axis_transform(
-    graph: &SkeletonGraph,
-    boundary: Option<&Boundary>,
-) -> Vec<MatSegment> {
-    let mut out = Vec::new();
-    for (i, e) in graph.edges().iter().enumerate() {
-        let coords = graph.edge_coords(crate::graph::EdgeId(i as u32));
-        let (ra, rb) = (graph.node(e.a).radius, graph.node(e.b).radius);
-        let radii: Vec<f64> = match boundary {
-            Some(b) => {
-                let mut r: Vec<f64> = coords.iter().map(|&c| b.distance(c)).collect();
-                let n = r.len();
-                r[0] = ra;
-                r[n - 1] = rb;
-                r
-            }
-            None => {
-                let total = crate::graph::polyline_length(&coords);
-                let mut acc = 0.0;
-                let mut r = Vec::with_capacity(coords.len());
-                for (k, c) in coords.iter().enumerate() {
-                    if k > 0 {
-                        let d = *c - coords[k - 1];
-                        acc += d.x.hypot(d.y);
-                    }
-                    let t = if total > 0.0 { acc / total } else { 0.0 };
-                    r.push(ra + (rb - ra) * t);
-                }
-                r
-            }
-        };
-        for k in 1..coords.len() {
-            out.push(MatSegment {
-                line: Line::new(coords[k - 1], coords[k]),
-                r_start: radii[k - 1],
-                r_end: radii[k],
-            });
-        }
-    }
-    out
 }

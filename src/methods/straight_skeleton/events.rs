@@ -13,7 +13,8 @@
 //! first, then creation order, for determinism); stale events (a named
 //! vertex is no longer active) are dropped when popped.
 
-use super::wavefront::{dot, LineId, VertexId, Wavefront};
+use super::wavefront::{LineId, VertexId, Wavefront};
+use crate::geometry::vector::dot;
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 

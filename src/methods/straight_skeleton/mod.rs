@@ -75,10 +75,11 @@
 //!
 //! ```
 //! use skeletonise::geometry::PreparedPolygon;
-//! use skeletonise::methods::{straight_skeleton::StraightSkeleton, SkeletonMethod};
+//! use skeletonise::methods::{straight_skeleton::StraightSkeleton, MethodContext, SkeletonMethod};
 //! use geo::polygon;
 //! let p = polygon![(x: 0., y: 0.), (x: 10., y: 0.), (x: 10., y: 2.), (x: 0., y: 2.)];
-//! let g = StraightSkeleton.skeletonise(&PreparedPolygon::new(&p).unwrap()).unwrap();
+//! let p = PreparedPolygon::new(&p).unwrap();
+//! let g = StraightSkeleton.skeletonise(&p, &MethodContext::default()).unwrap();
 //! // The centre segment from (1, 1) to (9, 1) and four legs to the corners.
 //! assert_eq!(g.leg_count(), 4);
 //! assert!(g.nodes().iter().all(|n| n.time.is_some()));
@@ -87,21 +88,21 @@
 pub mod events;
 pub mod wavefront;
 
-use super::{MethodError, MethodId, SkeletonMethod};
+use super::{MethodContext, MethodError, MethodId, SkeletonMethod};
 use crate::geometry::packed::{boxes_meet, Bbox, PackedTree};
+use crate::geometry::segment::{lines_meet, properly_cross};
+use crate::geometry::tolerance::{SAME_POINT, TRACE_CROSSING};
+use crate::geometry::vector::{cross, dot, hypot, within_hypot};
 use crate::geometry::{Boundary, PreparedPolygon};
 use crate::graph::{GraphBuilder, SkeletonGraph};
 use events::{edge_collapse_time, split_candidates, EventKind, EventQueue, SplitCandidate};
 use geo::Coord;
 use std::ops::ControlFlow;
-use wavefront::{dot, Line, LineId, VertexId, Wavefront};
+use wavefront::{Line, LineId, VertexId, Wavefront};
 
 /// The straight-skeleton method.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct StraightSkeleton;
-
-/// Relative tolerance: `tol = REL_TOL · extent` (see the module doc).
-pub const REL_TOL: f64 = 1e-9;
 
 /// Counts of one propagation, for tests and benchmarks.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -175,6 +176,8 @@ enum Search {
 const SEARCH_PASSES: [Search; 3] = [Search::Near(2.0), Search::Near(16.0), Search::All];
 
 struct Propagation<'a> {
+    /// The method's budget: its deadline is checked on the event queue.
+    ctx: &'a MethodContext,
     w: Wavefront,
     q: EventQueue,
     /// The original edges, item `i` being `LineId(i)`.
@@ -197,7 +200,7 @@ struct Propagation<'a> {
 }
 
 impl<'a> Propagation<'a> {
-    fn new(polygon: &'a PreparedPolygon, search: Search) -> Self {
+    fn new(polygon: &'a PreparedPolygon, search: Search, ctx: &'a MethodContext) -> Self {
         let origin = polygon.origin();
         let n = polygon.vertex_count();
         let extent = polygon.extent().max(f64::MIN_POSITIVE);
@@ -217,19 +220,20 @@ impl<'a> Propagation<'a> {
             }
             let first = w.vertices.len();
             for i in 0..m {
-                let left = LineId((base + (i + m - 1) % m) as u32);
-                let right = LineId((base + i) as u32);
+                let left = LineId::from_index(base + (i + m - 1) % m);
+                let right = LineId::from_index(base + i);
                 let id = w.add_vertex(pts[i], 0.0, left, right, Some(abs[i]));
                 work.push(id);
             }
             for i in 0..m {
-                let a = VertexId((first + i) as u32);
-                let b = VertexId((first + (i + 1) % m) as u32);
+                let a = VertexId::from_index(first + i);
+                let b = VertexId::from_index(first + (i + 1) % m);
                 w.link(a, b);
             }
         }
         work.reverse();
         Self {
+            ctx,
             candidates: vec![Vec::new(); w.vertices.len()],
             w,
             q: EventQueue::default(),
@@ -240,10 +244,11 @@ impl<'a> Propagation<'a> {
             arcs: Vec::with_capacity(2 * n),
             work,
             now: 0.0,
-            tol: REL_TOL * extent,
+            tol: SAME_POINT * extent,
             extent,
             max_pops: 1000 * n + 10_000,
-            max_candidates: crate::methods::budget::memory_limit()
+            max_candidates: ctx
+                .memory_limit()
                 .map_or(usize::MAX, |b| (b / CANDIDATE_BYTES as u64) as usize),
             max_vertices: 16 * n + 64,
             stats: Stats {
@@ -307,7 +312,7 @@ impl<'a> Propagation<'a> {
         while let Some(ev) = self.q.pop() {
             self.stats.pops += 1;
             if self.stats.pops.is_multiple_of(4096) {
-                crate::methods::budget::check()?;
+                self.ctx.check(MethodId::STSK)?;
                 self.stats.max_queue = self.stats.max_queue.max(self.q.len());
             }
             if self.stats.pops > self.max_pops {
@@ -328,7 +333,7 @@ impl<'a> Propagation<'a> {
                         continue;
                     }
                     self.now = self.now.max(ev.t);
-                    let c = self.candidates[v.0 as usize][candidate as usize];
+                    let c = self.candidates[v.index()][candidate as usize];
                     if self.find_piece(v, c.line).is_none() {
                         self.push_candidate(v, candidate + 1);
                         self.drain_work()?;
@@ -362,9 +367,9 @@ impl<'a> Propagation<'a> {
 
     /// Whether vertex `v` is at `p` now, within `tol · (1 + speed)`.
     fn at(&self, v: VertexId, p: Coord<f64>) -> bool {
-        let speed = self.w.v(v).vel.map_or(0.0, |s| s.x.hypot(s.y));
+        let speed = self.w.v(v).vel.map_or(0.0, hypot);
         let d = self.w.pos(v, self.now) - p;
-        crate::geometry::within_hypot(d, self.tol * (1.0 + speed))
+        within_hypot(d, self.tol * (1.0 + speed))
     }
 
     /// Handles the valid event `ev` (popped at time `now`) together with
@@ -415,7 +420,7 @@ impl<'a> Propagation<'a> {
         match ev.kind {
             EventKind::Edge { x, y } => self.edge_event(x, y),
             EventKind::Split { v, candidate } => {
-                let c = self.candidates[v.0 as usize][candidate as usize];
+                let c = self.candidates[v.index()][candidate as usize];
                 match self.find_piece(v, c.line) {
                     Some(x) => self.split_event(v, x, c.line),
                     None => {
@@ -478,7 +483,7 @@ impl<'a> Propagation<'a> {
                 EventKind::Split { v, candidate } => {
                     let mut i = candidate as usize;
                     let mut hit = false;
-                    while let Some(&c) = self.candidates[v.0 as usize].get(i) {
+                    while let Some(&c) = self.candidates[v.index()].get(i) {
                         if i > candidate as usize && c.t > t0 + self.tol {
                             break;
                         }
@@ -670,8 +675,8 @@ impl<'a> Propagation<'a> {
         let t = self.now;
         let pz = self.w.pos(z, t);
         let (pw, pu) = (self.w.pos(w, t), self.w.pos(u, t));
-        let dw = (pw - pz).x.hypot((pw - pz).y);
-        let du = (pu - pz).x.hypot((pu - pz).y);
+        let dw = hypot(pw - pz);
+        let du = hypot(pu - pz);
         let (zl, zr) = (self.w.v(z).left, self.w.v(z).right);
         if (dw - du).abs() <= self.tol {
             let (before, after) = (self.w.v(w).prev, self.w.v(u).next);
@@ -731,7 +736,7 @@ impl<'a> Propagation<'a> {
         let l = *self.w.line(line);
         let sp = dot(l.dir, p);
         let w = &mut self.w;
-        let mut pieces = std::mem::take(&mut w.pieces[line.0 as usize]);
+        let mut pieces = std::mem::take(&mut w.pieces[line.index()]);
         pieces.retain(|&x| w.v(x).active);
         let tol = self.tol;
         let found = pieces.iter().copied().find(|&x| {
@@ -741,8 +746,8 @@ impl<'a> Propagation<'a> {
             }
             let (px, py) = (w.pos(x, t), w.pos(y, t));
             let (sx, sy) = (dot(l.dir, px), dot(l.dir, py));
-            let at_x = crate::geometry::within_hypot(px - p, tol);
-            let at_y = crate::geometry::within_hypot(py - p, tol);
+            let at_x = within_hypot(px - p, tol);
+            let at_y = within_hypot(py - p, tol);
             // Touching a zero-length piece, or a piece end that already
             // carries one of v's own lines, changes nothing: not a split.
             // A vertex made by an event touching a piece end at once: the
@@ -759,7 +764,7 @@ impl<'a> Propagation<'a> {
             }
             sx - tol <= sp && sp <= sy + tol
         });
-        w.pieces[line.0 as usize] = pieces;
+        w.pieces[line.index()] = pieces;
         found
     }
 
@@ -785,7 +790,7 @@ impl<'a> Propagation<'a> {
     fn candidate_lines(&self, z: VertexId) -> Option<(Vec<LineId>, f64)> {
         let vx = *self.w.v(z);
         let s = vx.vel?;
-        let speed = s.x.hypot(s.y);
+        let speed = hypot(s);
         let dir = s / speed;
         let start = vx.start + self.origin;
         let reach = self
@@ -810,13 +815,13 @@ impl<'a> Propagation<'a> {
                 self.tree.visit(
                     |b| boxes_meet(b, &env),
                     |i| {
-                        lines.push(LineId(i));
+                        lines.push(LineId::from_index(i as usize));
                         ControlFlow::<()>::Continue(())
                     },
                 );
                 lines
             }
-            Search::All => (0..self.w.lines.len() as u32).map(LineId).collect(),
+            Search::All => (0..self.w.lines.len()).map(LineId::from_index).collect(),
         };
         Some((lines, t_max))
     }
@@ -831,7 +836,7 @@ impl<'a> Propagation<'a> {
         self.stats.tried += lines.len();
         let c = split_candidates(&self.w, z, lines.into_iter(), t_max, self.tol);
         self.stats.candidates += c.len();
-        self.candidates[z.0 as usize] = c;
+        self.candidates[z.index()] = c;
         if self.stats.candidates > self.max_candidates {
             return Err(MethodError::OverBudget {
                 method: MethodId::STSK,
@@ -851,8 +856,8 @@ impl<'a> Propagation<'a> {
     /// budget), that estimate is returned without the rest — on a huge
     /// polygon each sampled vertex can cost a scan of every edge.
     fn predict(&self, hopeless: impl Fn((f64, f64)) -> bool) -> (f64, f64) {
-        let reflex: Vec<VertexId> = (0..self.w.vertices.len() as u32)
-            .map(VertexId)
+        let reflex: Vec<VertexId> = (0..self.w.vertices.len())
+            .map(VertexId::from_index)
             .filter(|&v| self.w.v(v).reflex)
             .collect();
         if reflex.is_empty() {
@@ -890,7 +895,7 @@ impl<'a> Propagation<'a> {
     }
 
     fn push_candidate(&mut self, v: VertexId, i: u32) {
-        if let Some(c) = self.candidates[v.0 as usize].get(i as usize) {
+        if let Some(c) = self.candidates[v.index()].get(i as usize) {
             let t = c.t.max(self.now);
             self.q.push(t, EventKind::Split { v, candidate: i });
         }
@@ -898,20 +903,24 @@ impl<'a> Propagation<'a> {
 }
 
 /// One propagation with the given split-candidate search, verified.
-fn propagate(polygon: &PreparedPolygon, search: Search) -> Result<(Vec<Arc>, Stats), MethodError> {
+fn propagate(
+    polygon: &PreparedPolygon,
+    search: Search,
+    ctx: &MethodContext,
+) -> Result<(Vec<Arc>, Stats), MethodError> {
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        let p = Propagation::new(polygon, search);
+        let p = Propagation::new(polygon, search, ctx);
         // Declined after the first eighth of the sample when that already
         // predicts four times the budget.
         let predicted = p.predict(|(tries, kept)| {
-            crate::methods::budget::afford(
+            ctx.afford(
                 MethodId::STSK,
                 tries * SECONDS_PER_TRY / 4.0,
                 kept * CANDIDATE_BYTES as f64 / 4.0,
             )
             .is_err()
         });
-        crate::methods::budget::afford(
+        ctx.afford(
             MethodId::STSK,
             predicted.0 * SECONDS_PER_TRY,
             predicted.1 * CANDIDATE_BYTES as f64,
@@ -934,7 +943,7 @@ fn propagate(polygon: &PreparedPolygon, search: Search) -> Result<(Vec<Arc>, Sta
 /// the traces bounding that face or leaves P). Crossings closer than
 /// `1e-6 · extent` to an end of either trace are rounding, not misses.
 fn verify(polygon: &PreparedPolygon, arcs: &[Arc]) -> Result<(), MethodError> {
-    let tol = 1e-6 * polygon.extent();
+    let tol = TRACE_CROSSING * polygon.extent();
     if let Some(a) = arcs
         .iter()
         .find(|a| !polygon.boundary().contains_with_tolerance(a.to, tol))
@@ -984,30 +993,27 @@ fn crossing(
     b: Coord<f64>,
     tol: f64,
 ) -> Option<Coord<f64>> {
-    if !crate::geometry::boundary::properly_cross(p, q, a, b) {
+    if !properly_cross(p, q, a, b) {
         return None;
     }
-    let (d, e) = (q - p, b - a);
-    let den = wavefront::cross(d, e);
-    if den == 0.0 {
-        return None;
-    }
-    let s = wavefront::cross(a - p, e) / den;
+    let d = q - p;
+    let (s, _) = lines_meet(p, d, a, b)?;
     let x = p + d * s;
     let far = |c: Coord<f64>| {
         // `hypot > tol`, the hypot only when no component alone decides.
         let d = c - x;
-        d.x.abs() > tol || d.y.abs() > tol || d.x.hypot(d.y) > tol
+        d.x.abs() > tol || d.y.abs() > tol || hypot(d) > tol
     };
     let off = |u: Coord<f64>, v: Coord<f64>, c: Coord<f64>| {
         let w = v - u;
-        wavefront::cross(w, c - u).abs() / w.x.hypot(w.y)
+        cross(w, c - u).abs() / hypot(w)
     };
     let apart = off(p, q, a).max(off(p, q, b)) > tol && off(a, b, p).max(off(a, b, q)) > tol;
     (apart && far(p) && far(q) && far(a) && far(b)).then_some(x)
 }
 
-/// The straight skeleton of `polygon` and the propagation's counts.
+/// The straight skeleton of `polygon` and the propagation's counts, within
+/// the budget of `ctx`.
 ///
 /// The first pass takes split candidates from edges near each reflex
 /// vertex's path; when its result fails verification (no collapse,
@@ -1015,10 +1021,11 @@ fn crossing(
 /// one exhaustive.
 pub fn straight_skeleton_with_stats(
     polygon: &PreparedPolygon,
+    ctx: &MethodContext,
 ) -> Result<(SkeletonGraph, Stats), MethodError> {
     let mut result = Err(fail("no search pass"));
     for search in SEARCH_PASSES {
-        result = propagate(polygon, search);
+        result = propagate(polygon, search, ctx);
         if result.is_ok() {
             break;
         }
@@ -1040,8 +1047,12 @@ impl SkeletonMethod for StraightSkeleton {
         MethodId::STSK
     }
 
-    fn skeletonise(&self, polygon: &PreparedPolygon) -> Result<SkeletonGraph, MethodError> {
-        straight_skeleton_with_stats(polygon).map(|(g, _)| g)
+    fn skeletonise(
+        &self,
+        polygon: &PreparedPolygon,
+        ctx: &MethodContext,
+    ) -> Result<SkeletonGraph, MethodError> {
+        straight_skeleton_with_stats(polygon, ctx).map(|(g, _)| g)
     }
 }
 
@@ -1052,7 +1063,10 @@ mod tests {
 
     fn run(p: geo::Polygon<f64>) -> SkeletonGraph {
         StraightSkeleton
-            .skeletonise(&PreparedPolygon::new(&p).unwrap())
+            .skeletonise(
+                &PreparedPolygon::new(&p).unwrap(),
+                &MethodContext::default(),
+            )
             .unwrap()
     }
 
@@ -1075,7 +1089,8 @@ mod tests {
             })
             .collect();
         let pp = PreparedPolygon::new(&geo::Polygon::new(ring.into(), vec![])).unwrap();
-        let p = Propagation::new(&pp, Search::Near(1.0));
+        let ctx = MethodContext::default();
+        let p = Propagation::new(&pp, Search::Near(1.0), &ctx);
         let full = p.predict(|_| false);
         let early = p.predict(|_| true);
         assert!(full.0 > 0.0 && full.1 > 0.0, "{full:?}");

@@ -8,20 +8,60 @@
 //! when that vertex is still active (lazy invalidation, no version counter
 //! needed).
 
+use crate::geometry::vector::{cross, dot, hypot};
 use geo::Coord;
 
-/// Index of a supporting line (one per original boundary edge).
-///
-/// Invariant: `LineId(i)` indexes [`Wavefront::lines`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct LineId(pub u32);
+pub use handle::{LineId, VertexId};
 
-/// Index of a wavefront vertex.
-///
-/// Invariant: `VertexId(i)` indexes [`Wavefront::vertices`]; vertices are
-/// never removed, only deactivated.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct VertexId(pub u32);
+/// The handles, in a module of their own so that their number is read and
+/// made only through `index` and `from_index`.
+mod handle {
+    #[cfg(doc)]
+    use super::Wavefront;
+
+    /// Index of a supporting line (one per original boundary edge).
+    ///
+    /// Invariant: `LineId::from_index(i)` indexes [`Wavefront::lines`].
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+    pub struct LineId(u32);
+
+    /// Index of a wavefront vertex.
+    ///
+    /// Invariant: `VertexId::from_index(i)` indexes [`Wavefront::vertices`];
+    /// vertices are never removed, only deactivated.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+    pub struct VertexId(u32);
+
+    impl LineId {
+        /// The handle of the line at position `i` (below 2³²).
+        #[inline]
+        pub fn from_index(i: usize) -> Self {
+            debug_assert!(u32::try_from(i).is_ok(), "line index {i}");
+            Self(i as u32)
+        }
+
+        /// Its position in [`Wavefront::lines`].
+        #[inline]
+        pub fn index(self) -> usize {
+            self.0 as usize
+        }
+    }
+
+    impl VertexId {
+        /// The handle of the vertex at position `i` (below 2³²).
+        #[inline]
+        pub fn from_index(i: usize) -> Self {
+            debug_assert!(u32::try_from(i).is_ok(), "vertex index {i}");
+            Self(i as u32)
+        }
+
+        /// Its position in [`Wavefront::vertices`].
+        #[inline]
+        pub fn index(self) -> usize {
+            self.0 as usize
+        }
+    }
+}
 
 /// The supporting line of one original edge and its motion: at time `t` the
 /// wavefront edge lies on `normal · x = c + t`.
@@ -46,7 +86,7 @@ impl Line {
     /// The line through the edge `a → b` (which must have non-zero length).
     pub fn new(a: Coord<f64>, b: Coord<f64>) -> Self {
         let d = b - a;
-        let len = d.x.hypot(d.y);
+        let len = hypot(d);
         let dir = Coord {
             x: d.x / len,
             y: d.y / len,
@@ -107,16 +147,6 @@ pub struct Vertex {
 /// them up as a fold would end traces off their offset lines.
 pub const FOLD_EPS: f64 = 1e-12;
 
-/// `a · b`.
-pub fn dot(a: Coord<f64>, b: Coord<f64>) -> f64 {
-    a.x * b.x + a.y * b.y
-}
-
-/// `a × b` (z component).
-pub fn cross(a: Coord<f64>, b: Coord<f64>) -> f64 {
-    a.x * b.y - a.y * b.x
-}
-
 /// Velocity of the intersection of two lines moving along their unit
 /// normals at unit speed: `(n1 + n2) / (1 + n1·n2)`, `None` for a fold.
 pub fn velocity(l1: &Line, l2: &Line) -> Option<Coord<f64>> {
@@ -145,17 +175,17 @@ pub struct Wavefront {
 impl Wavefront {
     /// One vertex.
     pub fn v(&self, id: VertexId) -> &Vertex {
-        &self.vertices[id.0 as usize]
+        &self.vertices[id.index()]
     }
 
     /// One vertex, mutable.
     pub fn v_mut(&mut self, id: VertexId) -> &mut Vertex {
-        &mut self.vertices[id.0 as usize]
+        &mut self.vertices[id.index()]
     }
 
     /// One line.
     pub fn line(&self, id: LineId) -> &Line {
-        &self.lines[id.0 as usize]
+        &self.lines[id.index()]
     }
 
     /// Position of vertex `id` at time `t`.
@@ -180,7 +210,7 @@ impl Wavefront {
         let (l1, l2) = (*self.line(left), *self.line(right));
         let vel = velocity(&l1, &l2);
         let reflex = vel.is_some() && cross(l1.dir, l2.dir) < 0.0;
-        let id = VertexId(self.vertices.len() as u32);
+        let id = VertexId::from_index(self.vertices.len());
         self.vertices.push(Vertex {
             start,
             t0,
@@ -193,7 +223,7 @@ impl Wavefront {
             reflex,
             exact,
         });
-        self.pieces[right.0 as usize].push(id);
+        self.pieces[right.index()].push(id);
         id
     }
 
