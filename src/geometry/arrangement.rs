@@ -123,7 +123,35 @@ pub enum SplitError {
 /// `1e-9 × extent`) and whose other points lie inside P; chords may share
 /// points (exactly equal coordinates) but must not cross each other or ∂P.
 pub fn split(p: &PreparedPolygon, chords: &[LineString<f64>]) -> Result<Vec<Face>, SplitError> {
+    split_with(p, chords, false)
+}
+
+/// [`split`] by a network of chords: a chord may also end inside P, on a
+/// point (exactly equal coordinates) where another chord passes or ends —
+/// the junctions of a partition's boundaries. An end that is on neither
+/// ∂P nor another chord is [`SplitError::Detached`].
+pub fn split_network(
+    p: &PreparedPolygon,
+    chords: &[LineString<f64>],
+) -> Result<Vec<Face>, SplitError> {
+    split_with(p, chords, true)
+}
+
+fn split_with(
+    p: &PreparedPolygon,
+    chords: &[LineString<f64>],
+    network: bool,
+) -> Result<Vec<Face>, SplitError> {
     let rings: Vec<&LineString<f64>> = p.rings().collect();
+    // Every point of every chord, for the ends that meet another chord.
+    let mut on_chords: FxHashMap<(u64, u64), u32> = FxHashMap::default();
+    if network {
+        for c in chords {
+            for q in &c.0 {
+                *on_chords.entry((q.x.to_bits(), q.y.to_bits())).or_default() += 1;
+            }
+        }
+    }
     // The points to insert into each ring edge, and the chords with their
     // ends moved onto ∂P exactly.
     let mut inserts: FxHashMap<(u32, u32), Vec<Coord<f64>>> = FxHashMap::default();
@@ -131,12 +159,22 @@ pub fn split(p: &PreparedPolygon, chords: &[LineString<f64>]) -> Result<Vec<Face
     for (k, chord) in chords.iter().enumerate() {
         let mut pts = chord.0.clone();
         if pts.len() < 2 {
+            lines.push(Vec::new());
             continue;
         }
         for end in [0, pts.len() - 1] {
-            let (edge, at) = attach(p, pts[end]).ok_or(SplitError::Detached(k))?;
-            pts[end] = at;
-            inserts.entry(edge).or_default().push(at);
+            let q = pts[end];
+            let shared = on_chords
+                .get(&(q.x.to_bits(), q.y.to_bits()))
+                .is_some_and(|&n| n > 1);
+            match attach(p, q) {
+                Some((edge, at)) => {
+                    pts[end] = at;
+                    inserts.entry(edge).or_default().push(at);
+                }
+                None if shared => {}
+                None => return Err(SplitError::Detached(k)),
+            }
         }
         lines.push(pts);
     }
@@ -169,6 +207,48 @@ pub fn split(p: &PreparedPolygon, chords: &[LineString<f64>]) -> Result<Vec<Face
     Ok(faces(&g))
 }
 
+/// The union of polygons that form a coverage (no overlap; where two meet,
+/// their edges have the same vertices): every edge two of them share is
+/// dropped, and the rest is walked into rings, exactly — no vertex moves,
+/// none is added. (River reaches cut from one river, a neighbour grown by
+/// the pieces of a partition.)
+pub fn coverage_union(polygons: &[Polygon<f64>]) -> Vec<Polygon<f64>> {
+    let mut g = Graph {
+        pos: Vec::new(),
+        ids: FxHashMap::default(),
+        half: Vec::new(),
+    };
+    // Directed edges with their multiplicity: an edge met in both directions
+    // is between two of the polygons.
+    let mut count: FxHashMap<(VertexId, VertexId), i64> = FxHashMap::default();
+    for p in polygons {
+        let p = super::ring::normalise_polygon(p).unwrap_or_else(|_| p.clone());
+        for ring in std::iter::once(p.exterior()).chain(p.interiors()) {
+            for w in ring.0.windows(2) {
+                let (u, v) = (g.vertex(w[0]), g.vertex(w[1]));
+                if u != v {
+                    *count.entry((u, v)).or_default() += 1;
+                }
+            }
+        }
+    }
+    let mut edges: Vec<(VertexId, VertexId)> = count
+        .iter()
+        .filter(|&(&(u, v), &n)| n > count.get(&(v, u)).copied().unwrap_or(0))
+        .map(|(&e, _)| e)
+        .collect();
+    edges.sort_unstable();
+    for (u, v) in edges {
+        g.half.push(HalfEdge {
+            from: u,
+            to: v,
+            chord: None,
+            outside: false,
+        });
+    }
+    faces(&g).into_iter().map(|f| f.polygon).collect()
+}
+
 /// The cycles of half-edges with P on their left, as faces.
 fn faces(g: &Graph) -> Vec<Face> {
     let n = g.pos.len();
@@ -184,18 +264,14 @@ fn faces(g: &Graph) -> Vec<Face> {
     for list in &mut out {
         list.sort_by(|&a, &b| angle_order(dir(a), dir(b)));
     }
-    // Where each half-edge sits in its origin's list.
-    let mut slot = vec![0u32; g.half.len()];
-    for list in &out {
-        for (i, &h) in list.iter().enumerate() {
-            slot[h as usize] = i as u32;
-        }
-    }
-    let twin = |h: u32| h ^ 1;
+    // The next half-edge of a cycle: at the end of `h`, the first outgoing
+    // one clockwise from the way back (the twin, when there is one, is
+    // skipped: it lies exactly on the way back).
     let next = |h: u32| {
-        let t = twin(h);
-        let list = &out[g.half[t as usize].from as usize];
-        let i = slot[t as usize] as usize;
+        let e = g.half[h as usize];
+        let list = &out[e.to as usize];
+        let back = g.pos[e.from as usize] - g.pos[e.to as usize];
+        let i = list.partition_point(|&x| angle_order(dir(x), back) == std::cmp::Ordering::Less);
         list[(i + list.len() - 1) % list.len()]
     };
     let mut seen = vec![false; g.half.len()];
@@ -326,9 +402,7 @@ fn signed_area(c: &[Coord<f64>]) -> f64 {
     let n = c.len();
     let o = c[0];
     (1..n.saturating_sub(1))
-        .map(|i| {
-            cross(c[i] - o, c[i + 1] - o)
-        })
+        .map(|i| cross(c[i] - o, c[i + 1] - o))
         .sum()
 }
 
@@ -452,6 +526,44 @@ mod tests {
             area(&f),
             p.unsigned_area()
         );
+    }
+
+    #[test]
+    fn a_network_of_chords_with_a_junction_splits_into_three_faces() {
+        let r = polygon![(x: 0., y: 0.), (x: 20., y: 0.), (x: 20., y: 10.), (x: 0., y: 10.)];
+        let p = PreparedPolygon::new(&r).unwrap();
+        let j = (8., 5.);
+        let chords = [
+            LineString::from(vec![(0., 5.), j]),
+            LineString::from(vec![j, (20., 5.)]),
+            LineString::from(vec![j, (8., 10.)]),
+        ];
+        let f = split_network(&p, &chords).unwrap();
+        assert_eq!(f.len(), 3);
+        assert!((area(&f) - 200.0).abs() < 1e-9);
+        // Not a network: an end inside P that no other chord meets.
+        let e = split_network(&p, &[LineString::from(vec![(0., 5.), (8., 5.)])]).unwrap_err();
+        assert_eq!(e, SplitError::Detached(0));
+    }
+
+    #[test]
+    fn the_union_of_a_coverage_drops_shared_edges_and_keeps_every_vertex() {
+        use geo::Validation;
+        let sq = |x: f64, y: f64| polygon![(x: x, y: y), (x: x + 1., y: y), (x: x + 1., y: y + 1.), (x: x, y: y + 1.)];
+        let u = coverage_union(&[sq(0., 0.), sq(1., 0.)]);
+        assert_eq!(u.len(), 1);
+        assert_eq!(u[0].exterior().0.len(), 7, "{:?}", u[0]);
+        assert!((u[0].unsigned_area() - 2.0).abs() < 1e-12);
+        // Eight squares around a ninth: a shell and a hole.
+        let ring: Vec<Polygon<f64>> = (0..3)
+            .flat_map(|i| (0..3).map(move |j| (f64::from(i), f64::from(j))))
+            .filter(|&(i, j)| (i, j) != (1., 1.))
+            .map(|(i, j)| sq(i, j))
+            .collect();
+        let u = coverage_union(&ring);
+        assert_eq!(u.len(), 1);
+        assert_eq!(u[0].interiors().len(), 1);
+        assert!(u[0].is_valid() && (u[0].unsigned_area() - 8.0).abs() < 1e-12);
     }
 
     #[test]

@@ -58,6 +58,7 @@
 //! ```
 
 mod arc;
+pub mod cells;
 mod quantise;
 
 use super::{MethodContext, MethodError, MethodId, SkeletonMethod};
@@ -189,27 +190,38 @@ impl SkeletonMethod for MedialAxis {
         _ctx: &MethodContext,
     ) -> Result<SkeletonGraph, MethodError> {
         self.tolerance.validate().map_err(fail)?;
-        let grid = Grid::new(polygon.origin(), polygon.extent()).ok_or_else(|| {
-            fail(format!(
-                "the polygon's extent {} cannot be quantised",
-                polygon.extent()
-            ))
-        })?;
-        let segs = quantise::segments(&grid, polygon.rings()).map_err(|c| {
-            let w = grid.world(c.at[0] as f64, c.at[1] as f64);
-            fail(format!(
-                "the boundary intersects itself near ({}, {}) at the method's resolution of {:e} CRS units; repair the polygon (`prepare: {{ make_valid: true }}`)",
-                w.x,
-                w.y,
-                grid.resolution()
-            ))
-        })?;
-        if segs.len() < 3 {
-            return Ok(SkeletonGraph::new());
+        match quantised(polygon)? {
+            Some((grid, segs, diagram)) => {
+                Extractor::new(&diagram, &segs, &grid, self.tolerance).run()
+            }
+            None => Ok(SkeletonGraph::new()),
         }
-        let diagram = voronoi(&segs)?;
-        Extractor::new(&diagram, &segs, &grid, self.tolerance).run()
     }
+}
+
+/// ∂P on its grid and the Voronoi diagram of its segments (`None` for a
+/// boundary of fewer than three segments on the grid).
+fn quantised(polygon: &PreparedPolygon) -> Result<Option<(Grid, Vec<Seg>, Diagram)>, MethodError> {
+    let grid = Grid::new(polygon.origin(), polygon.extent()).ok_or_else(|| {
+        fail(format!(
+            "the polygon's extent {} cannot be quantised",
+            polygon.extent()
+        ))
+    })?;
+    let segs = quantise::segments(&grid, polygon.rings()).map_err(|c| {
+        let w = grid.world(c.at[0] as f64, c.at[1] as f64);
+        fail(format!(
+            "the boundary intersects itself near ({}, {}) at the method's resolution of {:e} CRS units; repair the polygon (`prepare: {{ make_valid: true }}`)",
+            w.x,
+            w.y,
+            grid.resolution()
+        ))
+    })?;
+    if segs.len() < 3 {
+        return Ok(None);
+    }
+    let diagram = voronoi(&segs)?;
+    Ok(Some((grid, segs, diagram)))
 }
 
 /// The segment Voronoi diagram; boostvoronoi's errors and panics become a
@@ -290,6 +302,15 @@ struct Kept {
     curved: bool,
 }
 
+/// The root of `x` in the union-find forest `rep` (paths halved).
+fn find(rep: &mut [usize], mut x: usize) -> usize {
+    while rep[x] != x {
+        rep[x] = rep[rep[x]];
+        x = rep[x];
+    }
+    x
+}
+
 /// Walks the diagram once and builds the skeleton graph.
 struct Extractor<'a> {
     diagram: &'a Diagram,
@@ -337,28 +358,8 @@ impl<'a> Extractor<'a> {
     }
 
     fn run(mut self) -> Result<SkeletonGraph, MethodError> {
-        let kept = self.medial_edges()?;
-        // Contract edges shorter than the grid can resolve (the several
-        // Voronoi vertices a near-regular junction splits into), never moving
-        // a vertex more than CONTRACT from its cluster's representative.
-        let mut rep: Vec<usize> = (0..self.diagram.vertices().len()).collect();
-        fn find(rep: &mut [usize], mut x: usize) -> usize {
-            while rep[x] != x {
-                rep[x] = rep[rep[x]];
-                x = rep[x];
-            }
-            x
-        }
-        for k in &kept {
-            let (a, b) = (find(&mut rep, k.v0.usize()), find(&mut rep, k.v1.usize()));
-            if a != b {
-                let (pa, pb) = (self.vertex_at(a), self.vertex_at(b));
-                if (pa[0] - pb[0]).hypot(pa[1] - pb[1]) < CONTRACT {
-                    let (lo, hi) = if a < b { (a, b) } else { (b, a) };
-                    rep[hi] = lo;
-                }
-            }
-        }
+        let kept = self.inside_edges(false)?;
+        let mut rep = self.representatives(&kept);
         for k in &kept {
             let (r0, r1) = (find(&mut rep, k.v0.usize()), find(&mut rep, k.v1.usize()));
             if r0 == r1 {
@@ -376,8 +377,31 @@ impl<'a> Extractor<'a> {
         Ok(self.graph)
     }
 
-    /// The finite primary edges inside P, once each.
-    fn medial_edges(&mut self) -> Result<Vec<Kept>, MethodError> {
+    /// The representative of every Voronoi vertex after contracting the
+    /// edges shorter than the grid can resolve (the several Voronoi
+    /// vertices a near-regular junction splits into), never moving a vertex
+    /// more than [`CONTRACT`] from its cluster's representative: a union-find
+    /// forest to [`find`] in.
+    fn representatives(&self, kept: &[Kept]) -> Vec<usize> {
+        let mut rep: Vec<usize> = (0..self.diagram.vertices().len()).collect();
+        for k in kept {
+            let (a, b) = (find(&mut rep, k.v0.usize()), find(&mut rep, k.v1.usize()));
+            if a != b {
+                let (pa, pb) = (self.vertex_at(a), self.vertex_at(b));
+                if (pa[0] - pb[0]).hypot(pa[1] - pb[1]) < CONTRACT {
+                    let (lo, hi) = if a < b { (a, b) } else { (b, a) };
+                    rep[hi] = lo;
+                }
+            }
+        }
+        rep
+    }
+
+    /// The finite edges inside P, once each: the primary ones that are
+    /// medial, or with `all` every one (secondary edges, between a segment
+    /// and its endpoint, and the normals at straight-angle vertices too:
+    /// the boundaries of every site's cell).
+    fn inside_edges(&mut self, all: bool) -> Result<Vec<Kept>, MethodError> {
         let d = self.diagram;
         let edges = d.edges();
         let mut kept = Vec::new();
@@ -385,7 +409,7 @@ impl<'a> Extractor<'a> {
             let twin = e
                 .twin()
                 .map_err(|err| fail(format!("malformed Voronoi diagram: {err}")))?;
-            if twin.usize() < i || !e.is_primary() {
+            if twin.usize() < i || !(all || e.is_primary()) {
                 continue;
             }
             let (Some(v0), Some(v1)) = (e.vertex0(), edges[twin.usize()].vertex0()) else {
@@ -408,7 +432,7 @@ impl<'a> Extractor<'a> {
             if !inside {
                 continue;
             }
-            if let (Site::Segment(a), Site::Segment(b)) = (s0, s1) {
+            if let (false, Site::Segment(a), Site::Segment(b)) = (all, s0, s1) {
                 if self.straight_angle(a, b) {
                     continue;
                 }
@@ -465,11 +489,9 @@ impl<'a> Extractor<'a> {
         verdict
     }
 
-    /// The graph node of Voronoi vertex `v`, whose disc touches `site`.
-    fn node(&mut self, v: usize, site: Site) -> NodeId {
-        if let Some(n) = self.node_of[v] {
-            return n;
-        }
+    /// Where Voronoi vertex `v`, whose disc touches `site`, lies in world
+    /// coordinates, and its disc radius (grid units).
+    fn position(&self, v: usize, site: Site) -> (geo::Coord<f64>, f64) {
         let p = self.vertex_at(v);
         let r = site_distance(site, self.segs, p);
         let pos = match (r == 0.0, site) {
@@ -478,6 +500,15 @@ impl<'a> Extractor<'a> {
             (true, Site::Segment(s)) if p == fpt(self.segs[s].b) => self.segs[s].wb,
             _ => self.grid.world(p[0], p[1]),
         };
+        (pos, r)
+    }
+
+    /// The graph node of Voronoi vertex `v`, whose disc touches `site`.
+    fn node(&mut self, v: usize, site: Site) -> NodeId {
+        if let Some(n) = self.node_of[v] {
+            return n;
+        }
+        let (pos, r) = self.position(v, site);
         let n = self.graph.add_node(pos, self.grid.length(r), None);
         self.node_of[v] = Some(n);
         n

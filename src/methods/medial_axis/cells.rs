@@ -1,0 +1,221 @@
+//! The cells of the segment Voronoi diagram of ∂P inside P: every edge of
+//! the diagram that lies in P — the medial axis, the edges MA leaves out
+//! (between a segment and its own endpoint, the normal at a straight-angle
+//! vertex) — with the two sites whose cells it separates. Each point of P
+//! lies in the cell of the boundary site nearest to it, so the union of the
+//! cells of the sites owned by one neighbour is the part of P nearest to
+//! that neighbour's bank: the `partition` step is made of these edges.
+
+use super::{fail, fpt, quantised, ArcTolerance, Extractor, Site as GridSite};
+use crate::geometry::PreparedPolygon;
+use crate::methods::MethodError;
+use geo::Coord;
+
+/// A site of the diagram: a boundary segment or a boundary vertex, in the
+/// input's coordinates (its vertices bit for bit).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum CellSite {
+    /// The segment from `.0` to `.1` (P on its left).
+    Segment(Coord<f64>, Coord<f64>),
+    /// A vertex (its cell lies in P when it is a reflex vertex).
+    Vertex(Coord<f64>),
+}
+
+/// One edge of the diagram inside P.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CellEdge {
+    /// The sites whose cells it separates: `[left, right]` walking `line`
+    /// from its first point to its last.
+    pub sites: [CellSite; 2],
+    /// The edge (a parabolic one as a polyline within the tolerance); its
+    /// end points are shared exactly with the edges that meet there.
+    pub line: Vec<Coord<f64>>,
+}
+
+/// Every edge of the segment Voronoi diagram of `polygon`'s boundary that
+/// lies inside it (arcs within `tolerance`).
+pub fn cell_edges(
+    polygon: &PreparedPolygon,
+    tolerance: ArcTolerance,
+) -> Result<Vec<CellEdge>, MethodError> {
+    tolerance.validate().map_err(fail)?;
+    let Some((grid, segs, diagram)) = quantised(polygon)? else {
+        return Ok(Vec::new());
+    };
+    Extractor::new(&diagram, &segs, &grid, tolerance).cells()
+}
+
+impl Extractor<'_> {
+    /// The site in world coordinates.
+    fn world_site(&self, s: GridSite) -> CellSite {
+        match s {
+            GridSite::Segment(i) => CellSite::Segment(self.segs[i].wa, self.segs[i].wb),
+            GridSite::Point(p) => {
+                let w = self
+                    .segs
+                    .iter()
+                    .find(|s| s.a == p)
+                    .map_or_else(|| self.grid.world(p[0] as f64, p[1] as f64), |s| s.wa);
+                CellSite::Vertex(w)
+            }
+        }
+    }
+
+    /// Every inside edge with its sites (see [`cell_edges`]).
+    fn cells(mut self) -> Result<Vec<CellEdge>, MethodError> {
+        let kept = self.inside_edges(true)?;
+        let mut rep = self.representatives(&kept);
+        let mut out = Vec::with_capacity(kept.len());
+        for k in &kept {
+            let (r0, r1) = (
+                super::find(&mut rep, k.v0.usize()),
+                super::find(&mut rep, k.v1.usize()),
+            );
+            if r0 == r1 {
+                continue;
+            }
+            let (w0, _) = self.position(r0, k.s0);
+            let (w1, _) = self.position(r1, k.s0);
+            let mut line = vec![w0];
+            if k.curved {
+                let (p0, p1) = (self.vertex_at(r0), self.vertex_at(r1));
+                line.extend(self.arc_points(p0, p1, k.s0, k.s1));
+            }
+            line.push(w1);
+            out.push(CellEdge {
+                sites: [self.world_site(k.s0), self.world_site(k.s1)],
+                line,
+            });
+        }
+        out.extend(self.normals_through_vertices(&mut rep));
+        Ok(out)
+    }
+
+    /// The secondary edges that pass through their vertex site (the normal
+    /// at a straight-angle vertex, where the vertex's own cell has no area):
+    /// the diagram holds them as rays from infinity through the vertex to a
+    /// Voronoi vertex; their part in P runs from the vertex to that Voronoi
+    /// vertex.
+    fn normals_through_vertices(&self, rep: &mut [usize]) -> Vec<CellEdge> {
+        let d = self.diagram;
+        let edges = d.edges();
+        let mut out = Vec::new();
+        for e in edges.iter() {
+            let Ok(twin) = e.twin() else { continue };
+            let t = &edges[twin.usize()];
+            // One half-edge of each pair: the one that starts at infinity.
+            let (None, Some(v)) = (e.vertex0(), t.vertex0()) else {
+                continue;
+            };
+            if e.is_primary() {
+                continue;
+            }
+            let (Ok(c0), Ok(c1)) = (e.cell(), t.cell()) else {
+                continue;
+            };
+            let (s0, s1) = (
+                self.site(&d.cells()[c0.usize()]),
+                self.site(&d.cells()[c1.usize()]),
+            );
+            let (q, seg) = match (s0, s1) {
+                (GridSite::Point(q), GridSite::Segment(s))
+                | (GridSite::Segment(s), GridSite::Point(q)) => (q, s),
+                _ => continue,
+            };
+            let pv = self.vertex(v);
+            let mid = [0.5 * (pv[0] + q[0] as f64), 0.5 * (pv[1] + q[1] as f64)];
+            if fpt(q) == pv || super::side(&self.segs[seg], mid) <= 0.0 {
+                continue;
+            }
+            let r = super::find(rep, v.usize());
+            let (w, _) = self.position(r, s0);
+            let CellSite::Vertex(wq) = self.world_site(GridSite::Point(q)) else {
+                continue;
+            };
+            out.push(CellEdge {
+                sites: [self.world_site(s0), self.world_site(s1)],
+                line: vec![wq, w],
+            });
+        }
+        out
+    }
+
+    /// The inner points of a parabolic edge from `p0` to `p1` (grid
+    /// coordinates) between a point and a segment site, in world
+    /// coordinates.
+    fn arc_points(
+        &self,
+        p0: [f64; 2],
+        p1: [f64; 2],
+        s0: GridSite,
+        s1: GridSite,
+    ) -> Vec<Coord<f64>> {
+        let (point, seg) = match (s0, s1) {
+            (GridSite::Point(p), GridSite::Segment(s))
+            | (GridSite::Segment(s), GridSite::Point(p)) => (p, s),
+            _ => return Vec::new(),
+        };
+        let s = self.segs[seg];
+        let Some(par) = super::arc::Parabola::new(fpt(point), fpt(s.a), fpt(s.b)) else {
+            return Vec::new();
+        };
+        let (grid, tol) = (*self.grid, self.tolerance);
+        par.samples(par.abscissa(p0), par.abscissa(p1), |r| tol.at(r, &grid))
+            .into_iter()
+            .map(|smp| grid.world(smp.x, smp.y))
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use geo::polygon;
+
+    #[test]
+    fn a_rectangles_cells_meet_on_its_medial_axis_and_its_corner_bisectors() {
+        let r = polygon![(x: 0., y: 0.), (x: 10., y: 0.), (x: 10., y: 4.), (x: 0., y: 4.)];
+        let p = PreparedPolygon::new(&r).unwrap();
+        let edges = cell_edges(&p, ArcTolerance::default()).unwrap();
+        // The medial axis (5 edges): no reflex vertex, no straight angle.
+        assert_eq!(edges.len(), 5, "{edges:#?}");
+        // The centre line separates the bottom from the top side, the
+        // bottom (P on its left, walking east) on the right of a line
+        // walked east, or on its left walked west.
+        let centre = edges
+            .iter()
+            .find(|e| e.line.iter().all(|c| (c.y - 2.0).abs() < 1e-9))
+            .expect("the centre line");
+        let bottom = CellSite::Segment(Coord { x: 0., y: 0. }, Coord { x: 10., y: 0. });
+        let east = centre.line[centre.line.len() - 1].x > centre.line[0].x;
+        assert_eq!(centre.sites[usize::from(east)], bottom, "{centre:?}");
+    }
+
+    #[test]
+    fn a_straight_angle_vertex_and_a_reflex_vertex_bound_cells() {
+        // An L with a vertex in the middle of its bottom side.
+        let l = polygon![
+            (x: 0., y: 0.), (x: 20., y: 0.), (x: 40., y: 0.), (x: 40., y: 6.), (x: 6., y: 6.),
+            (x: 6., y: 30.), (x: 0., y: 30.)
+        ];
+        let p = PreparedPolygon::new(&l).unwrap();
+        let edges = cell_edges(&p, ArcTolerance::default()).unwrap();
+        let normal_at_20 = edges.iter().any(|e| {
+            e.line.iter().any(|c| *c == Coord { x: 20., y: 0. })
+                && e.line.iter().all(|c| (c.x - 20.0).abs() < 1e-6)
+        });
+        assert!(
+            normal_at_20,
+            "the normal at the straight-angle vertex bounds two cells"
+        );
+        let reflex = Coord { x: 6., y: 6. };
+        let at_reflex = edges
+            .iter()
+            .filter(|e| e.sites.contains(&CellSite::Vertex(reflex)))
+            .count();
+        assert!(
+            at_reflex >= 3,
+            "the reflex vertex's cell: its two normals and the arc"
+        );
+    }
+}
