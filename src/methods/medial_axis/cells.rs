@@ -201,7 +201,7 @@ mod tests {
         let p = PreparedPolygon::new(&l).unwrap();
         let edges = cell_edges(&p, ArcTolerance::default()).unwrap();
         let normal_at_20 = edges.iter().any(|e| {
-            e.line.iter().any(|c| *c == Coord { x: 20., y: 0. })
+            e.line.contains(&Coord { x: 20., y: 0. })
                 && e.line.iter().all(|c| (c.x - 20.0).abs() < 1e-6)
         });
         assert!(
