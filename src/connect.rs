@@ -9,7 +9,7 @@
 
 use crate::geometry::PreparedPolygon;
 use crate::graph::{GraphBuilder, SkeletonGraph};
-use crate::layer::{col, fid, ColumnType, GeometryKind, LayerDef, Shape, When};
+use crate::layer::{col, fid, Attributes, ColumnType, GeometryKind, LayerDef, Shape, When};
 use geo::{BoundingRect, Coord, Geometry, LineString, Rect};
 
 /// The lines of a geometry, appended to `out` (other kinds are skipped).
@@ -267,7 +267,7 @@ pub const CONNECTIONS: LayerDef<ConnectionRow> = LayerDef {
     when: When::Connect,
     geometry: GeometryKind::LineString,
     shape: |r| Some(Shape::Line(r.geometry.clone())),
-    attributes: None,
+    attributes: Attributes::None,
     columns: &[
         col("src_fid", ColumnType::Int64, |r| fid(r.src_fid)),
         col("line_fid", ColumnType::Int64, |r| fid(r.line_fid)),

@@ -44,6 +44,8 @@ pub enum GeometryKind {
     LineString,
     /// POLYGON.
     Polygon,
+    /// MULTIPOLYGON.
+    MultiPolygon,
     /// Any geometry (the `rejected` layer keeps the input's).
     Unknown,
     /// An attribute table.
@@ -59,6 +61,8 @@ pub enum Shape<'a> {
     Line(geo::LineString<f64>),
     /// One polygon.
     Polygon(&'a geo::Polygon<f64>),
+    /// Polygons.
+    MultiPolygon(&'a geo::MultiPolygon<f64>),
     /// Lines with an M value per vertex (line by line).
     LinesM(&'a geo::MultiLineString<f64>, &'a [Vec<f64>]),
     /// A geometry as WKB.
@@ -89,6 +93,10 @@ pub enum When {
     Widths,
     /// With `output.measures: width` (the skeleton layer's lines carry M).
     Measures,
+    /// When the pipeline has a `partition` step.
+    Partition,
+    /// When the pipeline has kept areas: a `collapse` or `partition` step.
+    Areas,
     /// When the pipeline has the step of this name (a registered step's
     /// own layers and columns).
     Step(&'static str),
@@ -139,6 +147,52 @@ impl<R> Clone for Column<R> {
 
 impl<R> Copy for Column<R> {}
 
+/// Where a layer's source fields come from, and a row's values of them.
+pub enum Attributes<R: 'static> {
+    /// The layer has no source fields.
+    None,
+    /// The input's fields.
+    Input(fn(&R) -> &[Value]),
+    /// The fields of `input.neighbours` (the units of a partition).
+    Neighbours(fn(&R) -> &[Value]),
+}
+
+impl<R> Clone for Attributes<R> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<R> Copy for Attributes<R> {}
+
+/// The source whose fields a layer carries.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Fields {
+    /// The input's.
+    Input,
+    /// `input.neighbours`'.
+    Neighbours,
+}
+
+impl<R> Attributes<R> {
+    /// Whose fields, if any.
+    pub fn fields(&self) -> Option<Fields> {
+        match self {
+            Attributes::None => None,
+            Attributes::Input(_) => Some(Fields::Input),
+            Attributes::Neighbours(_) => Some(Fields::Neighbours),
+        }
+    }
+
+    /// A row's values of them (none when the layer has no fields).
+    pub fn of<'r>(&self, r: &'r R) -> &'r [Value] {
+        match self {
+            Attributes::None => &[],
+            Attributes::Input(f) | Attributes::Neighbours(f) => f(r),
+        }
+    }
+}
+
 /// One output layer.
 pub struct LayerDef<R: 'static> {
     /// Layer name (the skeleton layer's is configurable: `output.layer`).
@@ -149,9 +203,10 @@ pub struct LayerDef<R: 'static> {
     pub geometry: GeometryKind,
     /// The row's geometry.
     pub shape: for<'a> fn(&'a R) -> Option<Shape<'a>>,
-    /// The source feature's attributes, written first under the source's
-    /// field names (the skeleton layer).
-    pub attributes: Option<fn(&R) -> &[Value]>,
+    /// Source fields written first, under their own names: none, the
+    /// input's (the skeleton layer) or the neighbours' (the partitioned
+    /// coverage).
+    pub attributes: Attributes<R>,
     /// The tool's columns.
     pub columns: &'static [Column<R>],
 }

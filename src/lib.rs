@@ -58,6 +58,7 @@ pub mod io;
 pub mod layer;
 pub mod methods;
 pub mod output;
+pub mod partition;
 #[cfg(feature = "gdal")]
 pub mod pipeline;
 pub mod process;

@@ -163,6 +163,7 @@ impl ScoreArgs {
             merge_adjacent: false,
             merge_by: None,
             connect: None,
+            neighbours: None,
         };
         ScoreJob {
             polygons: spec(&self.polygons, &self.polygons_layer),
@@ -269,6 +270,7 @@ impl ReportArgs {
             merge_adjacent: false,
             merge_by: None,
             connect: None,
+            neighbours: None,
         });
         Ok(skeletonise::reporting::ReportJob {
             html: self

@@ -305,6 +305,7 @@ fn polygon_spec(file: &OutputFile, job: &ReportJob) -> Result<InputSpec, ReportE
         merge_adjacent: false,
         merge_by: None,
         connect: None,
+        neighbours: None,
     })
 }
 

@@ -29,6 +29,7 @@ fn reads_every_training_layer_with_its_fields() {
         merge_adjacent: false,
         merge_by: None,
         connect: None,
+        neighbours: None,
     })
     .unwrap();
     let names: Vec<_> = r.info().fields.iter().map(|f| f.name.as_str()).collect();

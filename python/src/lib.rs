@@ -196,7 +196,7 @@ fn columns(layer: &str, explode: bool) -> PyResult<(Vec<(&'static str, &'static 
         .into_iter()
         .map(|(_, name, ty)| (name, type_name(ty)))
         .collect();
-    Ok((cols, layer.has_attributes()))
+    Ok((cols, layer.fields().is_some()))
 }
 
 pub(crate) fn type_name(t: ColumnType) -> &'static str {

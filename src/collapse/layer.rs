@@ -2,7 +2,8 @@
 
 use crate::feature::Value;
 use crate::layer::{
-    col, col_when, fid, int, text, Cell, ColumnType, GeometryKind, LayerDef, Shape, When,
+    col, col_when, fid, int, text, Attributes, Cell, ColumnType, GeometryKind, LayerDef, Shape,
+    When,
 };
 
 /// One row of the `areas` layer: a piece of a polygon kept as an area by
@@ -17,19 +18,23 @@ pub struct AreaRow {
     pub attributes: Vec<Value>,
     /// The piece.
     pub geometry: geo::Polygon<f64>,
-    /// Cuts on its boundary, where collapsed lines meet it.
+    /// Cuts on its boundary, where collapsed lines meet it (0 in a
+    /// partition).
     pub cuts: usize,
     /// With `input.merge_adjacent`: the source FIDs dissolved, comma-separated.
     pub members: Option<String>,
+    /// With a `partition` step: `wide` (a part wider than `width`) or
+    /// `unowned` (nearest to bank no unit owns).
+    pub kind: Option<&'static str>,
 }
 
 /// The `areas` layer (with a `collapse` step).
 pub const AREAS: LayerDef<AreaRow> = LayerDef {
     name: "areas",
-    when: When::Collapse,
+    when: When::Areas,
     geometry: GeometryKind::Polygon,
     shape: |r| Some(Shape::Polygon(&r.geometry)),
-    attributes: Some(|r| &r.attributes),
+    attributes: Attributes::Input(|r| &r.attributes),
     columns: &[
         col("src_fid", ColumnType::Int64, |r| fid(r.src_fid)),
         col_when(When::Explode, "polygon_part", ColumnType::Int32, |r| {
@@ -38,6 +43,9 @@ pub const AREAS: LayerDef<AreaRow> = LayerDef {
         col("cuts", ColumnType::Int32, |r| int(r.cuts)),
         col_when(When::Merge, "members", ColumnType::Text, |r| {
             r.members.as_deref().map_or(Cell::Null, text)
+        }),
+        col_when(When::Partition, "kind", ColumnType::Text, |r| {
+            r.kind.map_or(Cell::Null, text)
         }),
     ],
 };

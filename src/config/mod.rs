@@ -20,7 +20,9 @@ mod sections;
 mod validate;
 
 pub use describe::{describe, describe_with, json_schema};
-pub use sections::{ConnectSpec, InputSpec, LayerRef, Measures, OutputSpec, ReportSpec};
+pub use sections::{
+    ConnectSpec, InputSpec, LayerRef, Measures, NeighboursSpec, OutputSpec, ReportSpec,
+};
 
 use crate::process::step::{Extra, StepRegistry};
 use parse::parse;
@@ -62,6 +64,8 @@ pub enum Step {
     Extend(ExtendParams),
     /// Partial collapse for map production: the chosen skeleton replaces the polygon where its local width 2r is below `width` (lines in the skeleton layer with `collapsed = 1`), the wider pieces stay areas (layer `areas`), cut across the polygon where the lines meet them.
     Collapse(CollapseParams),
+    /// The polygon's area given to the units of `input.neighbours` around it: every point to the unit whose bank is nearest, the new boundaries (layer `boundaries`) running down the middle; the units grown by what they received (layer `coverage`), the areas given (layer `given`).
+    Partition(crate::partition::PartitionParams),
     /// The paper's metrics.
     Score(ScoreParams),
     /// A registered step (`process::step`), parsed by its own entry.
@@ -81,6 +85,7 @@ impl Step {
             Step::Prune(_) => "prune",
             Step::Extend(_) => "extend",
             Step::Collapse(_) => "collapse",
+            Step::Partition(_) => "partition",
             Step::Score(_) => "score",
             Step::Select(_) => "select",
             Step::Extra(e) => e.entry.name,
@@ -94,14 +99,22 @@ impl Step {
             Step::Skeleton(p) => p.validate(),
             Step::Prune(p) => p.validate(),
             Step::Collapse(p) => p.validate(),
+            Step::Partition(p) => p.validate(),
             Step::Extend(_) | Step::Score(_) | Step::Extra(_) => Ok(()),
             Step::Select(p) => p.validate(),
         }
     }
 
     /// Steps in the only order they may appear in.
-    pub const ORDER: [&'static str; 7] = [
-        "prepare", "skeleton", "prune", "extend", "collapse", "score", "select",
+    pub const ORDER: [&'static str; 8] = [
+        "prepare",
+        "skeleton",
+        "prune",
+        "extend",
+        "collapse",
+        "partition",
+        "score",
+        "select",
     ];
 }
 
@@ -114,7 +127,7 @@ pub struct PipelineFile {
     pub name: Option<String>,
     /// Where the polygons come from.
     pub input: InputSpec,
-    /// Steps, in the order prepare → skeleton → prune → extend → collapse → score → select; only `skeleton` is required.
+    /// Steps, in the order prepare → skeleton → prune → extend → collapse → partition → score → select; only `skeleton` is required.
     pub steps: Vec<Step>,
     /// Where the GeoPackage goes.
     pub output: OutputSpec,
@@ -147,6 +160,7 @@ pub fn process_params(steps: &[Step], plan: &crate::output::Plan) -> ProcessPara
             Step::Prune(x) => p.prune = Some(*x),
             Step::Extend(x) => p.extend = Some(*x),
             Step::Collapse(x) => p.collapse = Some(*x),
+            Step::Partition(x) => p.partition = Some(*x),
             Step::Score(x) => p.score = Some(*x),
             Step::Select(x) => p.select = Some(*x),
             Step::Extra(e) => p.extra.push(e.clone()),
@@ -179,11 +193,15 @@ pub fn plan_of(
     flag(output.bars, When::Bars);
     flag(output.widths, When::Widths);
     flag(output.measures == Measures::Width, When::Measures);
+    let collapse = steps.iter().any(|s| matches!(s, Step::Collapse(_)));
+    let partition = steps.iter().any(|s| matches!(s, Step::Partition(_)));
+    flag(collapse, When::Collapse);
+    flag(partition, When::Partition);
+    flag(collapse || partition, When::Areas);
     flag(
-        steps.iter().any(|s| matches!(s, Step::Collapse(_))),
-        When::Collapse,
+        input.is_some_and(|i| i.merge_adjacent) || partition,
+        When::Merge,
     );
-    flag(input.is_some_and(|i| i.merge_adjacent), When::Merge);
     flag(input.is_some_and(|i| i.connect.is_some()), When::Connect);
     let mut layers = Vec::new();
     for s in steps {
@@ -215,7 +233,7 @@ pub struct StepsFile {
     /// Ignored (the caller brings the data).
     #[serde(default)]
     pub input: Option<InputSpec>,
-    /// Steps, in the order prepare → skeleton → prune → extend → collapse → score → select (`Step::ORDER`); only `skeleton` is required.
+    /// Steps, in the order prepare → skeleton → prune → extend → collapse → partition → score → select (`Step::ORDER`); only `skeleton` is required.
     pub steps: Vec<Step>,
     /// Only `explode` is used (the caller writes the data).
     #[serde(default)]

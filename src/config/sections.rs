@@ -51,6 +51,41 @@ pub struct InputSpec {
     /// A line network (any OGR source and layer of lines, e.g. the rivers) to continue through the polygons: where a line touches or crosses a polygon's boundary (or ends within `snap` of it) the skeleton gets a leg to that point (layer `connections`).
     #[serde(default)]
     pub connect: Option<ConnectSpec>,
+    /// The coverage whose units take the polygons' area (the `partition` step): any OGR source and layer of polygons, reprojected to the polygons' CRS; only the units that pass its `where` are read, written and own anything.
+    #[serde(default)]
+    pub neighbours: Option<NeighboursSpec>,
+}
+
+/// The `input.neighbours` section: the coverage a `partition` gives area to.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct NeighboursSpec {
+    /// Any OGR data source string of polygons (may be the same file as `input.source`).
+    pub source: String,
+    /// Layer name or zero-based index; default the first layer.
+    #[serde(default)]
+    pub layer: Option<LayerRef>,
+    /// OGR SQL attribute filter: only these units are read, written and own bank.
+    #[serde(default, rename = "where")]
+    pub where_: Option<String>,
+}
+
+impl NeighboursSpec {
+    /// The coverage as an input of its own, reprojected to `crs` (the CRS
+    /// the polygons are handed out in, as WKT; `None` when they have none).
+    pub fn input(&self, crs: Option<&str>) -> InputSpec {
+        InputSpec {
+            source: self.source.clone(),
+            layer: self.layer.clone(),
+            where_: self.where_.clone(),
+            bbox: None,
+            reproject: crs.map(str::to_string),
+            merge_adjacent: false,
+            merge_by: None,
+            connect: None,
+            neighbours: None,
+        }
+    }
 }
 
 /// The `input.connect` section: the line network.
@@ -81,6 +116,7 @@ impl ConnectSpec {
             merge_adjacent: false,
             merge_by: None,
             connect: None,
+            neighbours: None,
         }
     }
 }
@@ -107,6 +143,14 @@ impl InputSpec {
             }
             if !(c.snap.is_finite() && c.snap >= 0.0) {
                 return Err(("connect.snap".into(), "snap must be ≥ 0 (CRS units)".into()));
+            }
+        }
+        if let Some(n) = &self.neighbours {
+            if n.source.trim().is_empty() {
+                return Err((
+                    "neighbours.source".into(),
+                    "give the coverage's data source".into(),
+                ));
             }
         }
         if let Some([x0, y0, x1, y1]) = self.bbox {
@@ -138,6 +182,7 @@ impl InputSpec {
             merge_adjacent: false,
             merge_by: None,
             connect: None,
+            neighbours: None,
         }
     }
 }

@@ -6,6 +6,7 @@ use crate::process::step::StepRegistry;
 
 pub(super) fn validate(f: &PipelineFile) -> Result<(), (String, String)> {
     validate_steps(&f.steps)?;
+    partition_needs_neighbours(f)?;
     f.input
         .validate()
         .map_err(|(k, m)| (format!("input.{k}"), m))?;
@@ -182,4 +183,25 @@ fn order_of(steps: &[Step]) -> Vec<&'static str> {
         .collect();
     names.sort_by_key(|(r, _)| *r);
     names.into_iter().map(|(_, n)| n).collect()
+}
+
+/// `partition` gives area to the units of `input.neighbours`: one needs the
+/// other; and a polygon is either partitioned or collapsed.
+fn partition_needs_neighbours(f: &PipelineFile) -> Result<(), (String, String)> {
+    let at = |name: &str| f.steps.iter().position(|s| s.name() == name);
+    match (at("partition"), at("collapse"), &f.input.neighbours) {
+        (Some(p), Some(_), _) => Err((
+            format!("steps[{p}].partition"),
+            "a pipeline has `partition` (the area given to the neighbours) or `collapse` (lines and kept areas), not both: remove one".into(),
+        )),
+        (Some(p), None, None) => Err((
+            format!("steps[{p}].partition"),
+            "`partition` gives the polygons' area to the units of a coverage: add `input.neighbours: { source: …, layer: … }`".into(),
+        )),
+        (None, _, Some(_)) => Err((
+            "input.neighbours".into(),
+            "`input.neighbours` is the coverage a `partition` step gives area to: add `- partition: {}` to the steps, or remove it".into(),
+        )),
+        _ => Ok(()),
+    }
 }

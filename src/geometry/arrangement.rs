@@ -51,6 +51,8 @@ struct Graph {
     pos: Vec<Coord<f64>>,
     ids: FxHashMap<(u64, u64), VertexId>,
     half: Vec<HalfEdge>,
+    /// The edges made, each once (a chord laid twice on the same points).
+    made: rustc_hash::FxHashSet<(VertexId, VertexId)>,
 }
 
 impl Graph {
@@ -68,7 +70,7 @@ impl Graph {
     /// Both half-edges of the edge `a`–`b` (nothing for a zero-length one).
     fn edge(&mut self, a: Coord<f64>, b: Coord<f64>, chord: Option<u32>, ring: bool) {
         let (u, v) = (self.vertex(a), self.vertex(b));
-        if u == v {
+        if u == v || !self.made.insert((u.min(v), u.max(v))) {
             return;
         }
         self.half.push(HalfEdge {
@@ -182,6 +184,7 @@ fn split_with(
         pos: Vec::new(),
         ids: FxHashMap::default(),
         half: Vec::new(),
+        made: Default::default(),
     };
     for (r, ring) in rings.iter().enumerate() {
         for (i, w) in ring.0.windows(2).enumerate() {
@@ -217,6 +220,7 @@ pub fn coverage_union(polygons: &[Polygon<f64>]) -> Vec<Polygon<f64>> {
         pos: Vec::new(),
         ids: FxHashMap::default(),
         half: Vec::new(),
+        made: Default::default(),
     };
     // Directed edges with their multiplicity: an edge met in both directions
     // is between two of the polygons.

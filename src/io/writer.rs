@@ -14,6 +14,7 @@ use super::guard::{Kind, Protected, Target};
 use super::reader::{FieldInfo, SourceInfo};
 use super::{signals, IoError};
 use crate::feature::Value;
+use crate::layer::Fields;
 use crate::output::{
     Cell, ColumnType, GeometryKind, Layer, Plan, Rows, RunRecord, Shape, SKELETONS,
 };
@@ -36,6 +37,8 @@ pub struct Writer {
     /// The layers and columns to write.
     plan: Plan,
     source_fields: Vec<(String, FieldInfo)>,
+    /// The fields of `input.neighbours` (the partitioned coverage's layer).
+    neighbour_fields: Vec<(String, FieldInfo)>,
     /// Rows written in the open transaction (`None`: none open).
     in_transaction: Option<usize>,
 }
@@ -88,6 +91,7 @@ fn ogr_geometry(g: GeometryKind) -> u32 {
         GeometryKind::MultiLineString => OGRwkbGeometryType::wkbMultiLineString,
         GeometryKind::LineString => OGRwkbGeometryType::wkbLineString,
         GeometryKind::Polygon => OGRwkbGeometryType::wkbPolygon,
+        GeometryKind::MultiPolygon => OGRwkbGeometryType::wkbMultiPolygon,
         GeometryKind::Unknown => OGRwkbGeometryType::wkbUnknown,
         GeometryKind::None => OGRwkbGeometryType::wkbNone,
     }
@@ -134,6 +138,7 @@ fn shape_to_gdal(s: Shape<'_>) -> Result<Geometry, IoError> {
         Shape::Lines(l) => to_gdal(l),
         Shape::Line(l) => to_gdal(&l),
         Shape::Polygon(p) => to_gdal(p),
+        Shape::MultiPolygon(p) => to_gdal(p),
         Shape::LinesM(lines, m) => lines_m(lines, m),
         Shape::Wkb(w) => {
             Geometry::from_wkb(w).map_err(|e| IoError::gdal("reading a WKB geometry", e))
@@ -164,11 +169,13 @@ fn to_gdal<G: ToGdal>(g: &G) -> Result<Geometry, IoError> {
 impl Writer {
     /// Creates the temporary GeoPackage and the layers of `plan`. Fails,
     /// touching nothing, when the output is refused by [`check_output`]
-    /// (`protected`: the data sources the run reads).
+    /// (`protected`: the data sources the run reads). `neighbours`: what
+    /// `input.neighbours` holds, when the run partitions.
     pub fn create(
         plan: &Plan,
         spec: &OutputSpec,
         source: &SourceInfo,
+        neighbours: Option<&SourceInfo>,
         protected: &[Protected<'_>],
     ) -> Result<Self, IoError> {
         let target = output_target(spec, protected);
@@ -196,6 +203,7 @@ impl Writer {
             spec: spec.clone(),
             plan: plan.clone(),
             source_fields: source_fields(source),
+            neighbour_fields: neighbours.map(source_fields).unwrap_or_default(),
             in_transaction: None,
         };
         let r = plan
@@ -238,15 +246,13 @@ impl Writer {
                 options: spatial.then_some(&["SPATIAL_INDEX=NO"][..]),
             })
             .map_err(|e| IoError::gdal(format!("creating layer `{name}`"), e))?;
-        if layer.has_attributes() {
-            for (fname, f) in &self.source_fields {
-                let d = FieldDefn::new(fname, f.kind)
-                    .map_err(|e| IoError::gdal("copying a field", e))?;
-                d.set_width(f.width);
-                d.set_precision(f.precision);
-                d.add_to_layer(&l)
-                    .map_err(|e| IoError::gdal(format!("copying field `{fname}`"), e))?;
-            }
+        for (fname, f) in self.fields_of(layer) {
+            let d =
+                FieldDefn::new(fname, f.kind).map_err(|e| IoError::gdal("copying a field", e))?;
+            d.set_width(f.width);
+            d.set_precision(f.precision);
+            d.add_to_layer(&l)
+                .map_err(|e| IoError::gdal(format!("copying field `{fname}`"), e))?;
         }
         for (_, cname, ty) in self.plan.columns(layer) {
             field(&l, cname, ogr_type(ty))?;
@@ -269,6 +275,15 @@ impl Writer {
         Ok(())
     }
 
+    /// The source fields `layer` carries first.
+    fn fields_of(&self, layer: &dyn Layer) -> &[(String, FieldInfo)] {
+        match layer.fields() {
+            None => &[],
+            Some(Fields::Input) => &self.source_fields,
+            Some(Fields::Neighbours) => &self.neighbour_fields,
+        }
+    }
+
     /// Writes the rows of `layer` in `rows`.
     fn write_rows(&self, ds: &Dataset, layer: &dyn Layer, rows: &Rows) -> Result<(), IoError> {
         let n = layer.count(rows);
@@ -279,11 +294,7 @@ impl Writer {
         let l = ds
             .layer_by_name(name)
             .map_err(|e| IoError::gdal(format!("opening layer `{name}`"), e))?;
-        let n_source = if layer.has_attributes() {
-            self.source_fields.len()
-        } else {
-            0
-        };
+        let n_source = self.fields_of(layer).len();
         let columns = self.plan.columns(layer);
         for i in 0..n {
             let mut f =

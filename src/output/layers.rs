@@ -9,8 +9,8 @@
 
 use crate::feature::Value;
 use crate::layer::{
-    col, col_when, fid, int, real, text, Cell, Column, ColumnType, GeometryKind, LayerDef, Shape,
-    When,
+    col, col_when, fid, int, real, text, Attributes, Cell, Column, ColumnType, GeometryKind,
+    LayerDef, Shape, When,
 };
 use crate::score::Scores;
 use ColumnType::{Int32, Int64, Real, Text};
@@ -230,7 +230,7 @@ pub const SKELETONS: LayerDef<SkeletonRow> = LayerDef {
             None => Shape::Lines(&r.geometry),
         })
     },
-    attributes: Some(|r| &r.attributes),
+    attributes: Attributes::Input(|r| &r.attributes),
     columns: columns!(SkeletonRow;
         [
             col(name::SRC_FID, Int64, |r: &SkeletonRow| fid(r.src_fid)),
@@ -286,7 +286,7 @@ pub const CANDIDATES: LayerDef<CandidateRow> = LayerDef {
     when: When::Candidates,
     geometry: GeometryKind::MultiLineString,
     shape: |r| r.geometry.as_ref().map(Shape::Lines),
-    attributes: None,
+    attributes: Attributes::None,
     columns: columns!(CandidateRow;
         [
             col(name::SRC_FID, Int64, |r: &CandidateRow| fid(r.src_fid)),
@@ -331,7 +331,7 @@ pub const BARS: LayerDef<BarRow> = LayerDef {
     when: When::Bars,
     geometry: GeometryKind::LineString,
     shape: |r| Some(Shape::Line(r.geometry.clone())),
-    attributes: None,
+    attributes: Attributes::None,
     columns: &[
         col(name::SRC_FID, Int64, |r| fid(r.src_fid)),
         col(name::METHOD, Text, |r| text(&r.method)),
@@ -370,7 +370,7 @@ pub const WIDTHS: LayerDef<WidthRow> = LayerDef {
             r.geometry.end,
         ])))
     },
-    attributes: None,
+    attributes: Attributes::None,
     columns: &[
         col(name::SRC_FID, Int64, |r| fid(r.src_fid)),
         col(name::METHOD, Text, |r| text(&r.method)),
@@ -399,7 +399,7 @@ pub const REJECTED: LayerDef<RejectedRow> = LayerDef {
     when: When::Always,
     geometry: GeometryKind::Unknown,
     shape: |r| r.wkb.as_deref().map(Shape::Wkb),
-    attributes: None,
+    attributes: Attributes::None,
     columns: &[
         col(name::SRC_FID, Int64, |r| fid(r.src_fid)),
         col("reason", Text, |r| text(&r.reason)),
@@ -454,7 +454,7 @@ pub const RUNS: LayerDef<RunRecord> = LayerDef {
     when: When::Always,
     geometry: GeometryKind::None,
     shape: |_| None,
-    attributes: None,
+    attributes: Attributes::None,
     columns: &[
         col(name::run::NAME, Text, |r| text(&r.name)),
         col(name::run::STARTED_UTC, Text, |r| text(&r.started_utc)),

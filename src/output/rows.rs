@@ -10,6 +10,7 @@ use crate::collapse::{AreaRow, AREAS};
 use crate::connect::{ConnectionRow, CONNECTIONS};
 use crate::feature::Value;
 use crate::layer::{Cell, ColumnType, GeometryKind, LayerDef, Shape, StepLayer, StepRow, When};
+use crate::partition::{BoundaryRow, CoverageRow, GivenRow, BOUNDARIES, COVERAGE, GIVEN};
 
 /// A row of a registered step's layer, with what the per-feature path
 /// knows of its feature.
@@ -38,6 +39,15 @@ pub struct Rows {
     pub areas: Vec<AreaRow>,
     /// `connections` rows.
     pub connections: Vec<ConnectionRow>,
+    /// `boundaries` rows (a partition's new boundaries).
+    pub boundaries: Vec<BoundaryRow>,
+    /// `given` rows (a partition's areas given).
+    pub given: Vec<GivenRow>,
+    /// `coverage` rows (the units, grown: written once, after the features).
+    pub coverage: Vec<CoverageRow>,
+    /// The pieces given to each unit (its FID): not a layer, but what the
+    /// `coverage` rows are made of at the end of a run.
+    pub grown: Vec<(Option<u64>, geo::Polygon<f64>)>,
     /// `rejected` rows.
     pub rejected: Vec<RejectedRow>,
     /// Rows of registered steps' layers, by layer name.
@@ -55,6 +65,10 @@ impl Rows {
         self.widths.append(&mut other.widths);
         self.areas.append(&mut other.areas);
         self.connections.append(&mut other.connections);
+        self.boundaries.append(&mut other.boundaries);
+        self.given.append(&mut other.given);
+        self.coverage.append(&mut other.coverage);
+        self.grown.append(&mut other.grown);
         self.rejected.append(&mut other.rejected);
         for (layer, mut rows) in other.extra {
             self.extra.entry(layer).or_default().append(&mut rows);
@@ -70,6 +84,9 @@ impl Rows {
             + self.widths.len()
             + self.areas.len()
             + self.connections.len()
+            + self.boundaries.len()
+            + self.given.len()
+            + self.coverage.len()
             + self.rejected.len()
             + self.extra.values().map(Vec::len).sum::<usize>()
             + self.runs.len()
@@ -101,8 +118,8 @@ pub trait Layer: Sync {
     fn when(&self) -> When;
     /// Its geometry type.
     fn geometry(&self) -> GeometryKind;
-    /// Whether the source feature's fields come first.
-    fn has_attributes(&self) -> bool;
+    /// Whose source fields come first, if any.
+    fn fields(&self) -> Option<crate::layer::Fields>;
     /// The tool's columns, in order.
     fn columns(&self) -> Vec<ColumnInfo>;
     /// How many rows of this layer `rows` holds.
@@ -134,8 +151,8 @@ impl<R: Sync + 'static> Layer for Builtin<R> {
     fn geometry(&self) -> GeometryKind {
         self.def.geometry
     }
-    fn has_attributes(&self) -> bool {
-        self.def.attributes.is_some()
+    fn fields(&self) -> Option<crate::layer::Fields> {
+        self.def.attributes.fields()
     }
     fn columns(&self) -> Vec<ColumnInfo> {
         self.def
@@ -155,10 +172,7 @@ impl<R: Sync + 'static> Layer for Builtin<R> {
         (self.def.shape)(&(self.rows)(rows)[i])
     }
     fn attributes<'r>(&self, rows: &'r Rows, i: usize) -> &'r [Value] {
-        match self.def.attributes {
-            Some(a) => a(&(self.rows)(rows)[i]),
-            None => &[],
-        }
+        self.def.attributes.of(&(self.rows)(rows)[i])
     }
     fn cell(&self, rows: &Rows, i: usize, column: usize) -> Cell {
         (self.def.columns[column].get)(&(self.rows)(rows)[i])
@@ -181,8 +195,8 @@ impl Layer for StepLayer {
     fn geometry(&self) -> GeometryKind {
         self.geometry
     }
-    fn has_attributes(&self) -> bool {
-        self.attributes
+    fn fields(&self) -> Option<crate::layer::Fields> {
+        self.attributes.then_some(crate::layer::Fields::Input)
     }
     fn columns(&self) -> Vec<ColumnInfo> {
         std::iter::once(("src_fid", ColumnType::Int64))
@@ -234,7 +248,7 @@ pub static CANDIDATE_LAYER: Builtin<CandidateRow> = Builtin {
 
 /// Every built-in layer, in the order they are created (the run record,
 /// written once at the end of a run, last).
-pub static BUILTIN: [&dyn Layer; 8] = [
+pub static BUILTIN: [&dyn Layer; 11] = [
     &SKELETON_LAYER,
     &CANDIDATE_LAYER,
     &Builtin {
@@ -252,6 +266,18 @@ pub static BUILTIN: [&dyn Layer; 8] = [
     &Builtin {
         def: &CONNECTIONS,
         rows: |r| &r.connections,
+    },
+    &Builtin {
+        def: &COVERAGE,
+        rows: |r| &r.coverage,
+    },
+    &Builtin {
+        def: &BOUNDARIES,
+        rows: |r| &r.boundaries,
+    },
+    &Builtin {
+        def: &GIVEN,
+        rows: |r| &r.given,
     },
     &Builtin {
         def: &REJECTED,

@@ -27,7 +27,10 @@ use order::in_order;
 use progress::Progress;
 use rayon::prelude::*;
 use record::{finish_run, Counts};
-use source::{connect_error, merge_field, no_lines, read_batches, read_network, reader_gone};
+use source::{
+    connect_error, merge_field, no_lines, read_batches, read_neighbours, read_network, reader_gone,
+    Merge,
+};
 use std::collections::HashMap;
 use std::sync::mpsc;
 use std::time::Instant;
@@ -134,6 +137,11 @@ pub fn validate(p: &Pipeline) -> Result<crate::io::SourceInfo, RunError> {
             return Err(no_lines(c, lines.info(), 0));
         }
     }
+    if let Some(n) = &input.neighbours {
+        let mut units = Reader::open(&n.input(reader.info().srs_wkt.as_deref()))
+            .map_err(|e| connect_error_of("neighbours", &n.source, e))?;
+        units.probe()?;
+    }
     let job = Job::of(p);
     check_output(&p.file.output, &job.protected())?;
     check_report_path(&job)?;
@@ -197,6 +205,9 @@ impl<'a> Job<'a> {
         if let Some(c) = &self.input.connect {
             p.push(Protected::new("the connect source", &c.source));
         }
+        if let Some(n) = &self.input.neighbours {
+            p.push(Protected::new("the neighbours source", &n.source));
+        }
         p.extend(
             self.other_inputs
                 .iter()
@@ -233,6 +244,14 @@ pub fn run(p: &Pipeline, opts: &RunOptions) -> Result<RunSummary, RunError> {
         })?);
     }
     Ok(summary)
+}
+
+/// An error opening the source of `input.<what>`, said to be about it.
+fn connect_error_of(what: &str, source: &str, e: IoError) -> RunError {
+    RunError::Io(IoError::Read {
+        source_name: source.to_string(),
+        reason: format!("`input.{what}`: {e}"),
+    })
 }
 
 /// Checks the path of the report a job writes after its run (if any):
@@ -290,8 +309,15 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
         // the thread that made them) and reports what it found first.
         let (info_tx, info_rx) = mpsc::sync_channel::<Result<SourceInfo, IoError>>(1);
         let (batch_tx, batch_rx) = mpsc::sync_channel::<Batch>(QUEUE);
-        let reader =
-            scope.spawn(move || read_batches(job.input, batch, make_valid, info_tx, batch_tx));
+        let merge = if job.params.partition.is_some() {
+            Merge::Exactly
+        } else if job.input.merge_adjacent {
+            Merge::Dissolve
+        } else {
+            Merge::None
+        };
+        let reader = scope
+            .spawn(move || read_batches(job.input, merge, batch, make_valid, info_tx, batch_tx));
         let info = match info_rx.recv() {
             Ok(Ok(info)) => info,
             Ok(Err(e)) => return Err(e.into()),
@@ -301,8 +327,20 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
         if let Some(c) = &job.input.connect {
             params.connect = Some(std::sync::Arc::new(read_network(c, &info)?));
         }
+        let mut neighbours = None;
+        if let Some(n) = &job.input.neighbours {
+            let (coverage, source) = read_neighbours(n, &info)?;
+            params.neighbours = Some(std::sync::Arc::new(coverage));
+            neighbours = Some(source);
+        }
         let params = &params;
-        let writer = Writer::create(&job.plan, job.output, &info, &job.protected())?;
+        let writer = Writer::create(
+            &job.plan,
+            job.output,
+            &info,
+            neighbours.as_ref(),
+            &job.protected(),
+        )?;
         tracing::info!(
             pipeline = %job.name,
             source = %info.source,
@@ -325,8 +363,24 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
             pool: &pool,
             row_opts,
         };
-        let result = workers.compute(&batch_rx, &rows_tx, &mut counts, &mut progress);
+        let mut grown = Vec::new();
+        let mut result =
+            workers.compute(&batch_rx, &rows_tx, &mut counts, &mut progress, &mut grown);
         progress.finish();
+        // The partitioned coverage: every unit, grown by what it received.
+        if let (Ok(()), Some(cov)) = (&result, &params.neighbours) {
+            let coverage = crate::partition::assemble(cov.units(), grown);
+            counts.units = Some(coverage.len() as u64);
+            if rows_tx
+                .send(Rows {
+                    coverage,
+                    ..Rows::default()
+                })
+                .is_err()
+            {
+                result = Ok(());
+            }
+        }
         // Stop the reader (if still reading) and let the writer drain.
         drop(batch_rx);
         drop(rows_tx);
@@ -372,6 +426,7 @@ impl Workers<'_> {
         rows_tx: &mpsc::SyncSender<Rows>,
         counts: &mut Counts,
         progress: &mut Progress,
+        grown: &mut Vec<(Option<u64>, geo::Polygon<f64>)>,
     ) -> Result<(), RunError> {
         let (job, params, row_opts) = (self.job, self.params, self.row_opts);
         let next = || batches.recv().ok().map(|b| b.map_err(RunError::from));
@@ -388,6 +443,7 @@ impl Workers<'_> {
                 counts.add(f, &r, job.on_error)?;
                 rows.append(r.rows);
             }
+            grown.append(&mut rows.grown);
             // A closed channel: the writer stopped on an error; it says
             // which after the workers.
             let more = rows_tx.send(rows).is_ok();

@@ -25,6 +25,8 @@ pub(super) struct Counts {
     lines_used: std::collections::BTreeSet<Option<u64>>,
     /// Lines of `input.connect`, when the run has a network.
     pub(super) network: Option<u64>,
+    /// Units of the partitioned coverage written, when the run partitions.
+    pub(super) units: Option<u64>,
 }
 
 impl Counts {

@@ -13,6 +13,7 @@ use std::sync::mpsc;
 /// listens any more.
 pub(super) fn read_batches(
     input: &InputSpec,
+    merge: Merge,
     batch: usize,
     make_valid: bool,
     info_tx: mpsc::SyncSender<Result<SourceInfo, IoError>>,
@@ -28,8 +29,8 @@ pub(super) fn read_batches(
     if info_tx.send(Ok(reader.info().clone())).is_err() {
         return;
     }
-    if input.merge_adjacent {
-        return read_merged(&mut reader, input, batch, make_valid, batch_tx);
+    if merge != Merge::None {
+        return read_merged(&mut reader, input, merge, (batch, make_valid), batch_tx);
     }
     let r = reader.read::<Stop>(batch, make_valid, |features| {
         batch_tx.send(Ok(features)).map_err(|_| Stop::Gone)
@@ -118,8 +119,8 @@ pub(super) fn no_lines(
 fn read_merged(
     reader: &mut Reader,
     input: &InputSpec,
-    batch: usize,
-    make_valid: bool,
+    merge: Merge,
+    (batch, make_valid): (usize, bool),
     batch_tx: mpsc::SyncSender<Batch>,
 ) {
     let by = match merge_field(input, reader.info()) {
@@ -138,12 +139,80 @@ fn read_merged(
         let _ = batch_tx.send(Err(e));
         return;
     }
-    let merged = crate::process::merge::merge_adjacent(all, by);
+    let merged = match merge {
+        Merge::Exactly => crate::process::merge::merge_adjacent_exactly(all, by),
+        _ => crate::process::merge::merge_adjacent(all, by),
+    };
     for chunk in merged.chunks(batch) {
         if batch_tx.send(Ok(chunk.to_vec())).is_err() {
             return;
         }
     }
+}
+
+/// How the reader thread merges adjacent polygons.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Merge {
+    /// Not at all.
+    None,
+    /// `input.merge_adjacent`: dissolved.
+    Dissolve,
+    /// A partition's collapsed polygons: their union made exactly.
+    Exactly,
+}
+
+/// The coverage of `input.neighbours`, reprojected to the CRS the polygons
+/// are handed out in (`polygons`), and what its source holds.
+pub(super) fn read_neighbours(
+    n: &crate::config::NeighboursSpec,
+    polygons: &SourceInfo,
+) -> Result<(crate::partition::Coverage, SourceInfo), RunError> {
+    use crate::partition::{Coverage, Unit};
+    let error = |reason: String| {
+        RunError::Io(IoError::Read {
+            source_name: n.source.clone(),
+            reason,
+        })
+    };
+    let mut reader = Reader::open(&n.input(polygons.srs_wkt.as_deref()))
+        .map_err(|e| error(format!("`input.neighbours`: {e}")))?;
+    let mut units = Vec::new();
+    let mut bad = None;
+    reader.read::<IoError>(1024, false, |batch| {
+        for f in batch {
+            let geometry = match &f.geometry {
+                None => geo::MultiPolygon(Vec::new()),
+                Some(geo::Geometry::Polygon(p)) => geo::MultiPolygon(vec![p.clone()]),
+                Some(geo::Geometry::MultiPolygon(m)) => m.clone(),
+                Some(_) => {
+                    bad.get_or_insert(f.fid);
+                    continue;
+                }
+            };
+            units.push(Unit {
+                fid: f.fid,
+                geometry,
+                attributes: f.attributes,
+            });
+        }
+        Ok(())
+    })?;
+    if let Some(fid) = bad {
+        return Err(error(format!(
+            "`input.neighbours`: feature {} of layer `{}` is not a polygon; the coverage is a layer of polygons (filter it with `input.neighbours.where`)",
+            fid.map_or_else(|| "(no fid)".into(), |f| f.to_string()),
+            reader.info().layer
+        )));
+    }
+    if units.is_empty() {
+        return Err(error(format!(
+            "`input.neighbours`: layer `{}` has no units (after its `where`); give the coverage whose units take the area",
+            reader.info().layer
+        )));
+    }
+    units.sort_by_key(|u| u.fid);
+    tracing::info!(source = %n.source, layer = %reader.info().layer, units = units.len(), "partition: coverage read");
+    Ok((Coverage::new(units), reader.info().clone()))
 }
 
 /// Why the reader thread stops before the end of the source.

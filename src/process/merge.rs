@@ -26,6 +26,23 @@ pub const SNAP: f64 = 1e-6;
 /// in the order of each group's first member; `by`: merge only features
 /// whose attribute at this index has the same value.
 pub fn merge_adjacent(features: Vec<Feature>, by: Option<usize>) -> Vec<Feature> {
+    merge_with(features, by, dissolve)
+}
+
+/// [`merge_adjacent`] with each group's union made exactly
+/// ([`crate::geometry::arrangement::coverage_union`]: the shared edges
+/// dropped, every other vertex kept bit for bit), for polygons that share
+/// their edges vertex for vertex (reaches cut from one river) — what a
+/// partition needs, whose pieces must keep the source's vertices.
+pub fn merge_adjacent_exactly(features: Vec<Feature>, by: Option<usize>) -> Vec<Feature> {
+    merge_with(features, by, dissolve_exactly)
+}
+
+fn merge_with(
+    features: Vec<Feature>,
+    by: Option<usize>,
+    dissolve: fn(Vec<Feature>) -> Feature,
+) -> Vec<Feature> {
     let n = features.len();
     let mut uf = UnionFind::new(n);
     // Each edge (quantised, unordered) → the first feature seen with it, per group key.
@@ -130,6 +147,27 @@ pub fn dissolve(mut group: Vec<Feature>) -> Feature {
         .filter(|s| !s.is_empty())
         .map(|s| Polygon::new(closed(&s[0]), s[1..].iter().map(closed).collect()))
         .collect();
+    let members: Vec<u64> = group.iter().filter_map(|f| f.fid).collect();
+    let repaired = group.iter().any(|f| f.repaired);
+    let mut first = group.swap_remove(0);
+    first.geometry = Some(match merged.len() {
+        1 => Geometry::Polygon(merged.into_iter().next().expect("one")),
+        _ => Geometry::MultiPolygon(MultiPolygon(merged)),
+    });
+    first.source_wkb = None;
+    first.repaired = repaired;
+    first.members = members;
+    first
+}
+
+/// [`dissolve`] with the union made exactly.
+fn dissolve_exactly(mut group: Vec<Feature>) -> Feature {
+    group.sort_by_key(|f| f.fid);
+    let parts: Vec<Polygon<f64>> = group
+        .iter()
+        .flat_map(|f| polygons(f).unwrap_or_default())
+        .collect();
+    let merged = crate::geometry::arrangement::coverage_union(&parts);
     let members: Vec<u64> = group.iter().filter_map(|f| f.fid).collect();
     let repaired = group.iter().any(|f| f.repaired);
     let mut first = group.swap_remove(0);

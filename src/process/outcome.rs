@@ -43,6 +43,22 @@ pub fn process(geom: Option<&Geometry<f64>>, params: &ProcessParams) -> Processe
     if let (true, Processed::Done(o)) = (params.keep_measures, &mut processed) {
         measure(o, &prepared);
     }
+    if let (Some(pp), Some(cov), Processed::Done(o)) =
+        (&params.partition, &params.neighbours, &mut processed)
+    {
+        let parts: Result<Vec<_>, String> = prepared
+            .iter()
+            .enumerate()
+            .map(|(i, p)| {
+                crate::partition::partition(p, cov, pp)
+                    .map_err(|e| super::part_reason(i, prepared.len(), &e))
+            })
+            .collect();
+        match parts {
+            Ok(parts) => o.partition = Some(parts),
+            Err(reason) => return Processed::Rejected(reason),
+        }
+    }
     if let Processed::Done(o) = &mut processed {
         for e in &params.extra {
             let rows = e.step.rows(&step::StepInput {
@@ -203,6 +219,7 @@ fn choose(candidates: Vec<Candidate>, parts: usize, params: &ProcessParams) -> P
             connections: Vec::new(),
             measures: None,
             extra: Vec::new(),
+            partition: None,
         }),
         None => Processed::Rejected(rejection(&candidates)),
     }

@@ -269,6 +269,9 @@ fn outcome_rows(
         }));
     }
     candidate_rows(f, part, o, &name, opts, rows);
+    if let Some(parts) = &o.partition {
+        partition_rows(f, part, parts, rows);
+    }
     for (layer, row) in &o.extra {
         rows.extra
             .entry(layer)
@@ -329,6 +332,54 @@ fn collapse_rows(
             geometry: a.polygon.clone(),
             cuts: a.cuts,
             members: members.clone(),
+            kind: None,
+        }));
+}
+
+/// The rows of a partitioned feature: its new boundaries, the area given
+/// to each unit, what no unit takes (an `areas` row, `kind = unowned`), and
+/// the pieces the units grow by.
+fn partition_rows(
+    f: &Feature,
+    part: Option<usize>,
+    parts: &[crate::partition::PartPartition],
+    rows: &mut Rows,
+) {
+    use crate::partition::{BoundaryRow, GivenRow};
+    use geo::{Euclidean, Length};
+    let mut given: std::collections::BTreeMap<Option<u64>, f64> = Default::default();
+    for p in parts {
+        for b in &p.boundaries {
+            rows.boundaries.push(BoundaryRow {
+                src_fid: f.fid,
+                left_fid: b.fids[0],
+                right_fid: b.fids[1],
+                length: b.lines.0.iter().map(|l| Euclidean.length(l)).sum(),
+                geometry: b.lines.clone(),
+            });
+        }
+        for (unit, area) in crate::partition::given_area(p) {
+            let fid = p.given.iter().find(|g| g.unit == unit).and_then(|g| g.fid);
+            *given.entry(fid).or_default() += area;
+        }
+        rows.grown
+            .extend(p.given.iter().map(|g| (g.fid, g.polygon.clone())));
+        rows.areas
+            .extend(p.remainders.iter().map(|polygon| AreaRow {
+                src_fid: f.fid,
+                polygon_part: part,
+                attributes: f.attributes.clone(),
+                geometry: polygon.clone(),
+                cuts: 0,
+                members: members_text(f),
+                kind: Some("unowned"),
+            }));
+    }
+    rows.given
+        .extend(given.into_iter().map(|(unit_fid, area)| GivenRow {
+            src_fid: f.fid,
+            unit_fid,
+            area,
         }));
 }
 

@@ -30,6 +30,10 @@ pub struct ProcessParams {
     pub collapse: Option<CollapseParams>,
     /// `input.connect`: the line network the chosen skeleton gets legs to.
     pub connect: Option<std::sync::Arc<connect::Network>>,
+    /// `partition` step, when present.
+    pub partition: Option<crate::partition::PartitionParams>,
+    /// `input.neighbours`: the coverage a partition gives area to.
+    pub neighbours: Option<std::sync::Arc<crate::partition::Coverage>>,
     /// `score` step, when present.
     pub score: Option<ScoreParams>,
     /// `select` step, when present.
@@ -118,6 +122,8 @@ pub struct FeatureOutcome {
     pub measures: Option<Vec<Vec<f64>>>,
     /// Rows of the registered steps' layers, each with its layer's name.
     pub extra: Vec<(&'static str, crate::layer::StepRow)>,
+    /// The partition of every polygon part, when the pipeline partitions.
+    pub partition: Option<Vec<crate::partition::PartPartition>>,
 }
 
 impl FeatureOutcome {

@@ -498,6 +498,11 @@ impl<'a> Extractor<'a> {
             // On ∂P (a convex corner): the input vertex itself, not its rounding.
             (true, Site::Segment(s)) if p == fpt(self.segs[s].a) => self.segs[s].wa,
             (true, Site::Segment(s)) if p == fpt(self.segs[s].b) => self.segs[s].wb,
+            (true, Site::Point(q)) if p == fpt(q) => self
+                .segs
+                .iter()
+                .find(|s| s.a == q)
+                .map_or_else(|| self.grid.world(p[0], p[1]), |s| s.wa),
             _ => self.grid.world(p[0], p[1]),
         };
         (pos, r)

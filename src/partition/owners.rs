@@ -1,0 +1,303 @@
+//! Who owns each edge of a collapsed polygon: the coverage's units indexed
+//! by their boundary segments, a unit vertex that lies on one of the
+//! polygon's edges (a T-junction) inserted there, every edge of the polygon
+//! given to the unit whose boundary it lies on (or to none: unowned bank),
+//! and a polygon that overlaps a unit's interior refused.
+
+use crate::feature::Value;
+use crate::geometry::segment::{closest_on_segment, properly_cross};
+use crate::geometry::vector::norm;
+use crate::geometry::{Boundary, PreparedPolygon};
+use geo::{BoundingRect, Coord, LineString, MultiPolygon, Polygon};
+use rstar::primitives::{GeomWithData, Line};
+use rstar::{RTree, AABB};
+use rustc_hash::FxHashMap;
+
+/// One unit of the neighbours' coverage.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Unit {
+    /// Its FID in the coverage's source.
+    pub fid: Option<u64>,
+    /// Its geometry, as read.
+    pub geometry: MultiPolygon<f64>,
+    /// Its fields, in the source's order.
+    pub attributes: Vec<Value>,
+}
+
+/// A unit's boundary segment in the index: the unit and its two ends.
+type Indexed = GeomWithData<Line<[f64; 2]>, u32>;
+
+/// The neighbours' coverage, indexed by the units' boundary segments.
+#[derive(Debug)]
+pub struct Coverage {
+    units: Vec<Unit>,
+    segments: RTree<Indexed>,
+}
+
+impl PartialEq for Coverage {
+    fn eq(&self, other: &Self) -> bool {
+        self.units == other.units
+    }
+}
+
+impl Coverage {
+    /// The coverage of `units`.
+    pub fn new(units: Vec<Unit>) -> Self {
+        let mut segs = Vec::new();
+        for (k, u) in units.iter().enumerate() {
+            for p in &u.geometry.0 {
+                for r in std::iter::once(p.exterior()).chain(p.interiors()) {
+                    for w in r.0.windows(2) {
+                        if w[0] != w[1] {
+                            segs.push(GeomWithData::new(
+                                Line::new([w[0].x, w[0].y], [w[1].x, w[1].y]),
+                                k as u32,
+                            ));
+                        }
+                    }
+                }
+            }
+        }
+        Self {
+            units,
+            segments: RTree::bulk_load(segs),
+        }
+    }
+
+    /// The units, in the order given.
+    pub fn units(&self) -> &[Unit] {
+        &self.units
+    }
+
+    /// The units' segments whose box meets the box around `a`–`b` grown by
+    /// `tol`.
+    fn near(&self, a: Coord<f64>, b: Coord<f64>, tol: f64) -> impl Iterator<Item = &Indexed> {
+        let env = AABB::from_corners(
+            [a.x.min(b.x) - tol, a.y.min(b.y) - tol],
+            [a.x.max(b.x) + tol, a.y.max(b.y) + tol],
+        );
+        self.segments.locate_in_envelope_intersecting(&env)
+    }
+}
+
+/// A collapsed polygon with its owners: the polygon with every T-junction
+/// inserted, and the unit (an index into the coverage) that owns each of
+/// its edges, by the edge's two ends.
+#[derive(Debug, Clone)]
+pub struct Owned {
+    /// The polygon, its rings normalised, the units' vertices on its edges
+    /// inserted.
+    pub polygon: Polygon<f64>,
+    owner: FxHashMap<((u64, u64), (u64, u64)), Option<u32>>,
+}
+
+fn key(c: Coord<f64>) -> (u64, u64) {
+    (c.x.to_bits(), c.y.to_bits())
+}
+
+impl Owned {
+    /// The owner of the polygon's edge from `a` to `b` (`None`: unowned or
+    /// no such edge).
+    pub fn owner(&self, a: Coord<f64>, b: Coord<f64>) -> Option<u32> {
+        self.owner.get(&(key(a), key(b))).copied().flatten()
+    }
+
+    /// Whether `a`–`b` is an edge of the polygon.
+    pub fn is_edge(&self, a: Coord<f64>, b: Coord<f64>) -> bool {
+        self.owner.contains_key(&(key(a), key(b)))
+    }
+
+    /// The owners of the edges into and out of every vertex.
+    pub fn at_vertices(&self) -> FxHashMap<(u64, u64), VertexOwners> {
+        let mut out = FxHashMap::default();
+        for r in std::iter::once(self.polygon.exterior()).chain(self.polygon.interiors()) {
+            let n = r.0.len() - 1;
+            for i in 0..n {
+                let (u, v, w) = (r.0[(i + n - 1) % n], r.0[i], r.0[i + 1]);
+                out.insert(
+                    key(v),
+                    VertexOwners {
+                        before: self.owner(u, v),
+                        after: self.owner(v, w),
+                        into: v - u,
+                        out_of: w - v,
+                    },
+                );
+            }
+        }
+        out
+    }
+}
+
+/// The owners of the two edges at a vertex, and their directions.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VertexOwners {
+    /// The edge that ends at the vertex.
+    pub before: Option<u32>,
+    /// The edge that starts there.
+    pub after: Option<u32>,
+    /// The direction of the edge before.
+    pub into: Coord<f64>,
+    /// The direction of the edge after.
+    pub out_of: Coord<f64>,
+}
+
+/// `p` with its owners in `cov`, or why it cannot be partitioned: it
+/// overlaps a unit's interior (more than `tol`).
+pub fn owned(p: &PreparedPolygon, cov: &Coverage, tol: f64) -> Result<Owned, String> {
+    let polygon = with_t_junctions(p, cov, tol);
+    overlaps(p, &polygon, cov, tol)?;
+    let mut owner = FxHashMap::default();
+    for r in std::iter::once(polygon.exterior()).chain(polygon.interiors()) {
+        for w in r.0.windows(2) {
+            owner.insert((key(w[0]), key(w[1])), owner_of(cov, w[0], w[1], tol));
+        }
+    }
+    Ok(Owned { polygon, owner })
+}
+
+/// The unit whose boundary holds the edge `a`–`b` (both ends within `tol`
+/// of one of its segments).
+fn owner_of(cov: &Coverage, a: Coord<f64>, b: Coord<f64>, tol: f64) -> Option<u32> {
+    let on = |s: &Indexed, c: Coord<f64>| {
+        let (f, t) = (s.geom().from, s.geom().to);
+        let (q, _) = closest_on_segment(Coord { x: f[0], y: f[1] }, Coord { x: t[0], y: t[1] }, c);
+        norm(q - c) <= tol
+    };
+    cov.near(a, b, tol)
+        .filter(|s| on(s, a) && on(s, b))
+        .map(|s| s.data)
+        .min()
+}
+
+/// `p`'s rings with every unit vertex that lies on one of its edges (within
+/// `tol`, not at its ends) inserted there, and every vertex of `p` within
+/// `tol` of a unit vertex moved onto it, with the unit's coordinates: where
+/// they meet, the polygon and the units then share their vertices exactly
+/// (the units keep theirs bit for bit).
+fn with_t_junctions(p: &PreparedPolygon, cov: &Coverage, tol: f64) -> Polygon<f64> {
+    let b = p.boundary();
+    let (lo, hi) = (b.bbox_min(), b.bbox_max());
+    let mut inserts: FxHashMap<(u32, u32), Vec<Coord<f64>>> = FxHashMap::default();
+    let mut moves: FxHashMap<(u64, u64), Coord<f64>> = FxHashMap::default();
+    for s in cov.near(lo, hi, tol) {
+        let v = Coord {
+            x: s.geom().from[0],
+            y: s.geom().from[1],
+        };
+        let Some((_, i, d)) = b.nearest_within(v, tol) else {
+            continue;
+        };
+        let seg = &b.segments()[i];
+        if d > tol {
+            continue;
+        }
+        match [seg.a, seg.b].into_iter().find(|&e| norm(v - e) <= tol) {
+            Some(e) if e != v => {
+                moves.insert(key(e), v);
+            }
+            Some(_) => {}
+            None => inserts.entry((seg.ring, seg.index)).or_default().push(v),
+        }
+    }
+    for extra in inserts.values_mut() {
+        extra.dedup();
+    }
+    let ring = |r: usize, l: &LineString<f64>| {
+        let mut out = Vec::with_capacity(l.0.len());
+        let moved = |c: Coord<f64>| moves.get(&key(c)).copied().unwrap_or(c);
+        for (i, w) in l.0.windows(2).enumerate() {
+            out.push(moved(w[0]));
+            if let Some(extra) = inserts.get(&(r as u32, i as u32)) {
+                let d = w[1] - w[0];
+                let t = |c: &Coord<f64>| (c.x - w[0].x) * d.x + (c.y - w[0].y) * d.y;
+                let mut extra = extra.clone();
+                extra.sort_by(|a, b| t(a).total_cmp(&t(b)));
+                extra.dedup();
+                out.extend(extra);
+            }
+        }
+        out.push(moved(l.0[l.0.len() - 1]));
+        LineString(out)
+    };
+    let poly = p.polygon();
+    Polygon::new(
+        ring(0, poly.exterior()),
+        poly.interiors()
+            .iter()
+            .enumerate()
+            .map(|(k, r)| ring(k + 1, r))
+            .collect(),
+    )
+}
+
+/// An error when a unit near `p` overlaps its interior: a vertex of one
+/// farther than `tol` inside the other, or edges that cross.
+fn overlaps(
+    p: &PreparedPolygon,
+    polygon: &Polygon<f64>,
+    cov: &Coverage,
+    tol: f64,
+) -> Result<(), String> {
+    let b = p.boundary();
+    let Some(bbox) = polygon.bounding_rect() else {
+        return Ok(());
+    };
+    let mut near: Vec<u32> = cov
+        .near(bbox.min(), bbox.max(), tol)
+        .map(|s| s.data)
+        .collect();
+    near.sort_unstable();
+    near.dedup();
+    let inside_p = |v: Coord<f64>| b.contains(v) && b.distance(v) > tol;
+    for &k in &near {
+        let unit = &cov.units[k as usize];
+        let ub = Boundary::from_rings(
+            unit.geometry
+                .0
+                .iter()
+                .flat_map(|q| std::iter::once(q.exterior()).chain(q.interiors())),
+        );
+        let inside_u = |v: Coord<f64>| ub.contains(v) && ub.distance(v) > tol;
+        let vertex_in = unit
+            .geometry
+            .0
+            .iter()
+            .flat_map(|q| std::iter::once(q.exterior()).chain(q.interiors()))
+            .flat_map(|r| r.0.iter())
+            .find(|&&v| inside_p(v))
+            .or_else(|| {
+                std::iter::once(polygon.exterior())
+                    .chain(polygon.interiors())
+                    .flat_map(|r| r.0.iter())
+                    .find(|&&v| inside_u(v))
+            });
+        let crossing = || {
+            ub.segments().iter().find_map(|s| {
+                b.segments_near(s.a, s.b)
+                    .map(|i| &b.segments()[i])
+                    .find(|t| {
+                        properly_cross(s.a, s.b, t.a, t.b) && far_from_ends(s.a, s.b, t.a, t.b, tol)
+                    })
+                    .map(|t| crate::geometry::segment::crossing_point(s.a, s.b, t.a, t.b))
+            })
+        };
+        if let Some(at) = vertex_in.copied().or_else(crossing) {
+            let fid = unit
+                .fid
+                .map_or_else(|| "(no fid)".into(), |f| f.to_string());
+            return Err(format!(
+                "the polygon overlaps the interior of unit {fid} of `input.neighbours` near ({:.3}, {:.3}); the units must meet the collapsed polygons along their boundaries, not cover them: remove the overlap from the coverage (e.g. cut the polygons out of it) and run again",
+                at.x, at.y
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Whether two crossing segments cross farther than `tol` from all four
+/// ends (a crossing at a shared vertex, within rounding, is a touch).
+fn far_from_ends(a: Coord<f64>, b: Coord<f64>, c: Coord<f64>, d: Coord<f64>, tol: f64) -> bool {
+    let x = crate::geometry::segment::crossing_point(a, b, c, d);
+    [a, b, c, d].iter().all(|&e| norm(x - e) > tol)
+}
