@@ -254,11 +254,14 @@ mod tests {
     use geo::polygon;
 
     fn run(p: geo::Polygon<f64>) -> SkeletonGraph {
-        Cdt.skeletonise(
-            &PreparedPolygon::new(&p).unwrap(),
-            &MethodContext::default(),
-        )
-        .unwrap()
+        let g = Cdt
+            .skeletonise(
+                &PreparedPolygon::new(&p).unwrap(),
+                &MethodContext::default(),
+            )
+            .unwrap();
+        g.check_invariants().unwrap();
+        g
     }
 
     #[test]

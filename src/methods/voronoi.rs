@@ -470,9 +470,11 @@ mod tests {
     }
 
     fn vd(p: &PreparedPolygon) -> SkeletonGraph {
-        Voronoi::plain()
+        let g = Voronoi::plain()
             .skeletonise(p, &MethodContext::default())
-            .unwrap()
+            .unwrap();
+        g.check_invariants().unwrap();
+        g
     }
 
     /// Every edge as its two end points, sorted, for comparison with a known answer.
@@ -494,8 +496,10 @@ mod tests {
         v
     }
 
-    /// Raw output invariants: points in P, no crossing, radius = distance to ∂P.
+    /// Raw output invariants: the graph's, points in P, no crossing,
+    /// radius = distance to ∂P.
     fn assert_valid(p: &PreparedPolygon, g: &SkeletonGraph) {
+        g.check_invariants().unwrap();
         let tol = SAME_POINT * p.extent();
         for n in g.nodes() {
             assert!(

@@ -1062,12 +1062,14 @@ mod tests {
     use geo::polygon;
 
     fn run(p: geo::Polygon<f64>) -> SkeletonGraph {
-        StraightSkeleton
+        let g = StraightSkeleton
             .skeletonise(
                 &PreparedPolygon::new(&p).unwrap(),
                 &MethodContext::default(),
             )
-            .unwrap()
+            .unwrap();
+        g.check_invariants().unwrap();
+        g
     }
 
     /// The early estimate (the first eighth of the sample, spread over the
