@@ -13,16 +13,16 @@
 //!
 //! Everything here works on owned [`geo`] types; nothing touches GDAL.
 
-pub mod arrangement;
+pub(crate) mod arrangement;
 pub mod boundary;
 pub mod densify;
 pub(crate) mod lanes;
 pub(crate) mod packed;
-pub mod ring;
+pub(crate) mod ring;
 pub(crate) mod scan;
 pub mod segment;
 pub mod tolerance;
-pub mod validity;
+pub(crate) mod validity;
 pub mod vector;
 
 pub use boundary::{Boundary, RayHit};

@@ -9,16 +9,16 @@
 //! [`SkeletonGraph`]. Graphs are values: pruning and extension build new
 //! graphs.
 
-pub mod bridge;
-pub mod cut;
-pub mod ends;
+pub(crate) mod bridge;
+pub(crate) mod cut;
+pub(crate) mod ends;
 pub mod extend;
 mod handle;
 mod invariants;
-pub mod line;
+pub(crate) mod line;
 pub mod planar;
 pub mod prune;
-pub mod structure;
+pub(crate) mod structure;
 pub mod widths;
 
 pub use handle::{EdgeId, NodeId};

@@ -80,7 +80,7 @@ pub fn crossings(g: &SkeletonGraph) -> usize {
 /// `g` with a node at every proper crossing (both edges split there; the new
 /// node's radius is its distance to ∂P). Returns the graph and the number of
 /// crossings noded.
-pub fn node_crossings(g: SkeletonGraph, boundary: &Boundary) -> (SkeletonGraph, usize) {
+pub(crate) fn node_crossings(g: SkeletonGraph, boundary: &Boundary) -> (SkeletonGraph, usize) {
     let segs = segments(&g);
     let found = find(&segs);
     if found.is_empty() {

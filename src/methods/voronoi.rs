@@ -343,7 +343,7 @@ impl<'a> Locator<'a> {
 /// Invariant: every edge joins two distinct vertices (`u < v`), no edge
 /// appears twice, and the order of both lists depends only on the input.
 #[derive(Debug, Clone, Default, PartialEq)]
-pub struct VoronoiDiagram {
+pub(crate) struct VoronoiDiagram {
     /// Voronoi vertices (circumcentres of Delaunay triangles), in the sites'
     /// coordinates.
     pub vertices: Vec<Coord<f64>>,

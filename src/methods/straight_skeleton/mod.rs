@@ -85,8 +85,8 @@
 //! assert!(g.nodes().iter().all(|n| n.time.is_some()));
 //! ```
 
-pub mod events;
-pub mod wavefront;
+pub(crate) mod events;
+pub(crate) mod wavefront;
 
 use super::{MethodContext, MethodError, MethodId, SkeletonMethod};
 use crate::geometry::packed::{boxes_meet, Bbox, PackedTree};
