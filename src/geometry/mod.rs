@@ -8,8 +8,9 @@
 //! ([`vector`]), segment predicates and their tie rules ([`segment`]) and
 //! the table of tolerances ([`tolerance`]). The boundary index is a façade
 //! ([`Boundary`]) over three backends: the packed R-tree (`packed`), the
-//! scalar passes over few segments (`scan`) and the same passes four
-//! segments at a time (`lanes`); those three import only the ground floor.
+//! scalar passes over few segments (in `boundary`) and the same passes four
+//! segments at a time (`lanes`); `packed` and `lanes` import only the
+//! ground floor.
 //!
 //! Everything here works on owned [`geo`] types; nothing touches GDAL.
 
@@ -19,7 +20,6 @@ pub mod densify;
 pub(crate) mod lanes;
 pub(crate) mod packed;
 pub(crate) mod ring;
-pub(crate) mod scan;
 pub mod segment;
 pub mod tolerance;
 pub(crate) mod validity;

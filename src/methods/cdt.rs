@@ -256,14 +256,7 @@ mod tests {
     use geo::polygon;
 
     fn run(p: geo::Polygon<f64>) -> SkeletonGraph {
-        let g = Cdt
-            .skeletonise(
-                &PreparedPolygon::new(&p).unwrap(),
-                &MethodContext::default(),
-            )
-            .unwrap();
-        g.check_invariants().unwrap();
-        g
+        crate::methods::checked_skeleton(&Cdt, &PreparedPolygon::new(&p).unwrap())
     }
 
     #[test]

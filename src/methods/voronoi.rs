@@ -470,11 +470,7 @@ mod tests {
     }
 
     fn vd(p: &PreparedPolygon) -> SkeletonGraph {
-        let g = Voronoi::plain()
-            .skeletonise(p, &MethodContext::default())
-            .unwrap();
-        g.check_invariants().unwrap();
-        g
+        crate::methods::checked_skeleton(&Voronoi::plain(), p)
     }
 
     /// Every edge as its two end points, sorted, for comparison with a known answer.

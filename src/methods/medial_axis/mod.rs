@@ -525,10 +525,7 @@ mod tests {
             interiors: [[(x: 4., y: 2.), (x: 4., y: 4.), (x: 6., y: 4.), (x: 6., y: 2.)]],
         );
         let pp = PreparedPolygon::new(&p).unwrap();
-        let g = MedialAxis::default()
-            .skeletonise(&pp, &MethodContext::default())
-            .unwrap();
-        g.check_invariants().unwrap();
+        let g = crate::methods::checked_skeleton(&MedialAxis::default(), &pp);
         assert!(!g.is_empty());
         let tol = 4.0 * resolution(&pp);
         for n in g.nodes() {

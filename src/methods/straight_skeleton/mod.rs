@@ -1062,14 +1062,7 @@ mod tests {
     use geo::polygon;
 
     fn run(p: geo::Polygon<f64>) -> SkeletonGraph {
-        let g = StraightSkeleton
-            .skeletonise(
-                &PreparedPolygon::new(&p).unwrap(),
-                &MethodContext::default(),
-            )
-            .unwrap();
-        g.check_invariants().unwrap();
-        g
+        crate::methods::checked_skeleton(&StraightSkeleton, &PreparedPolygon::new(&p).unwrap())
     }
 
     /// The early estimate (the first eighth of the sample, spread over the
