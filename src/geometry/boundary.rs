@@ -12,11 +12,11 @@
 //! besides a tree search (nearest segment, first hit of a ray, nearest point
 //! on both sides of a line):
 //!
-//! * the lane passes ([`super::lanes`]): a boundary of at most 64 segments,
-//!   on a processor with AVX2, and a query within [`super::lanes::TAME`];
+//! * the lane passes (`geometry::lanes`): a boundary of at most 64 segments,
+//!   on a processor with AVX2, and a query within `lanes::TAME`;
 //! * the scalar passes (`Scan`): a boundary of at most 64 segments
 //!   otherwise;
-//! * the packed R-tree ([`super::packed`]): a larger boundary, built on the
+//! * the packed R-tree (`geometry::packed`): a larger boundary, built on the
 //!   first query that needs it.
 //!
 //! All three give the same answers bit for bit, ties included (tested

@@ -1,5 +1,5 @@
 //! Geometry helpers shared by every method and step: ring normalisation
-//! ([`ring`]), boundary densification ([`densify`]) and the spatial index of the
+//! (`ring`), boundary densification ([`densify`]) and the spatial index of the
 //! boundary ([`boundary`]) used for radii, containment, crossing tests, ray casts
 //! and nearest-point queries.
 //!

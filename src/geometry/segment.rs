@@ -18,12 +18,12 @@
 //! * [`crosses_rightward`]: the half-open rule on vertices (an end counts
 //!   when the other end is strictly above the ray), so a ray through a
 //!   vertex counts it once.
-//! * [`closest_on_segment`], [`closest_point`], [`segment_distance_2`]: an
+//! * [`closest_on_segment`], `closest_point`, `segment_distance_2`: an
 //!   end wins when the foot of the perpendicular is at or beyond it; a
 //!   zero-length segment is its start.
-//! * [`nearer_2`]: distances compared as their roots, so that squares whose
+//! * `nearer_2`: distances compared as their roots, so that squares whose
 //!   roots are equal tie (the first found stays).
-//! * [`clip_by_sides`] and [`clip_to_half_plane`]: closed half-planes (a
+//! * `clip_by_sides` and [`clip_to_half_plane`]: closed half-planes (a
 //!   point on the line is in).
 
 use super::tolerance::ROOT_MARGIN;

@@ -4,7 +4,7 @@
 //! (end segments, bridges across necks, straight rays) can cross a line of
 //! the skeleton. [`crossings`] finds every proper crossing of two segments
 //! (a packed R-tree over the segments' boxes, O(n log n) on real data), and
-//! [`node_crossings`] splits both edges there, so the written skeleton is a
+//! `node_crossings` splits both edges there, so the written skeleton is a
 //! planar graph: two lines meet only at a node.
 
 use super::{Edge, SkeletonGraph};

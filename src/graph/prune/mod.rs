@@ -28,17 +28,17 @@
 //! Modes:
 //!
 //! * `significance` (default) and `length` (only the `min_length` rule):
-//!   see [`legs`] — least significant leg first, junctions that become
+//!   see `legs` — least significant leg first, junctions that become
 //!   leaves keep the reach of what was cut behind them, never below a simple
 //!   path.
 //! * `trunk`: keep only the longest leaf-to-leaf path of each component, one
-//!   centreline per part (see [`trunk`]).
+//!   centreline per part (see `trunk`).
 //! * `none`: the graph unchanged.
 //!
 //! Pruning works on the *merged* raw graph (one edge per branch, see
 //! [`SkeletonGraph::merged`]) and decides per edge whether it is kept
-//! ([`prune_mask`]), so that the extension step can follow the removed edges
-//! back to ∂P ([`crate::graph::ends`]). [`prune`] returns the kept graph.
+//! (`prune_mask`), so that the extension step can follow the removed edges
+//! back to ∂P (`crate::graph::ends`). [`prune`] returns the kept graph.
 //! Everything is sequential and ordered by node and edge indices and
 //! coordinates, so the output is the same for any thread count.
 //!

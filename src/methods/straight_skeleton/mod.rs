@@ -8,7 +8,7 @@
 //!
 //! # Algorithm
 //!
-//! Event-driven wavefront propagation ([`wavefront`], [`events`]):
+//! Event-driven wavefront propagation (`wavefront`, `events`):
 //!
 //! * Every ring becomes a circular list of wavefront vertices (exterior
 //!   counter-clockwise, holes clockwise, so P is always on the left). A
