@@ -14,10 +14,11 @@ mod common;
 use geo::{Coord, Geometry, LineString, Polygon};
 use proptest::prelude::*;
 use skeletonise::geometry::PreparedPolygon;
-use skeletonise::graph::extend::{ExtendMode, ExtendParams};
+use skeletonise::graph::extend::{prune_and_extend, ExtendMode, ExtendParams};
 use skeletonise::graph::planar::crossings;
 use skeletonise::graph::prune::{PruneMode, PruneParams, Structure};
 use skeletonise::graph::SkeletonGraph;
+use skeletonise::methods::{build, MethodContext, MethodId};
 use skeletonise::process::{process, ProcessParams, Processed};
 
 /// The steps in one of their modes.
@@ -69,6 +70,7 @@ fn check(geom: &Geometry<f64>, p: &ProcessParams) -> Result<(), String> {
                 return Ok(());
             };
             let pp = PreparedPolygon::new(poly).map_err(|e| e.to_string())?;
+            check_graphs(&pp, p)?;
             let tol = 1e-6 * pp.extent();
             for c in &o.candidates {
                 let s = match &c.result {
@@ -83,7 +85,11 @@ fn check(geom: &Geometry<f64>, p: &ProcessParams) -> Result<(), String> {
                         }
                     }
                 }
-                if crossings(&SkeletonGraph::from_lines(&s.geometry)) > 0 {
+                let lines = SkeletonGraph::from_lines(&s.geometry);
+                lines
+                    .check_invariants()
+                    .map_err(|e| format!("{}'s lines: {e}", c.method))?;
+                if crossings(&lines) > 0 {
                     return Err(format!("{}: pieces cross", c.method));
                 }
                 if let Some(sc) = s.scores {
@@ -95,6 +101,25 @@ fn check(geom: &Geometry<f64>, p: &ProcessParams) -> Result<(), String> {
             Ok(())
         }
     }
+}
+
+/// Every built-in method's raw skeleton of `pp`, and that skeleton pruned
+/// and extended as `p` asks, keep the graph's invariants.
+fn check_graphs(pp: &PreparedPolygon, p: &ProcessParams) -> Result<(), String> {
+    for id in MethodId::builtin() {
+        let method = build(id, &p.skeleton);
+        let raw = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            method.skeletonise(pp, &MethodContext::default())
+        }))
+        .map_err(|_| format!("{id} panicked"))?;
+        let Ok(raw) = raw else { continue };
+        raw.check_invariants()
+            .map_err(|e| format!("{id}'s raw skeleton: {e}"))?;
+        let g = prune_and_extend(&raw, pp, p.prune.as_ref(), p.extend.as_ref());
+        g.check_invariants()
+            .map_err(|e| format!("{id}'s pruned and extended skeleton: {e}"))?;
+    }
+    Ok(())
 }
 
 /// A star polygon around `centre` with radii `radii` (a spike where a

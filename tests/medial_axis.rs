@@ -23,6 +23,7 @@ fn ma_with(p: &Polygon<f64>, tol: ArcTolerance) -> (PreparedPolygon, SkeletonGra
     let g = MedialAxis::new(tol)
         .skeletonise(&pp, &MethodContext::default())
         .unwrap();
+    g.check_invariants().unwrap();
     (pp, g)
 }
 
@@ -34,9 +35,11 @@ fn dist(a: Coord<f64>, b: Coord<f64>) -> f64 {
     (a - b).x.hypot((a - b).y)
 }
 
-/// SPEC §3 invariants: radius = distance to ∂P, every point in P, no edge
-/// crossing ∂P. Tolerance: a few grid spacings (MA quantises ∂P).
+/// The graph's invariants ([`SkeletonGraph::check_invariants`]) and SPEC
+/// §3's: radius = distance to ∂P, every point in P, no edge crossing ∂P.
+/// Tolerance: a few grid spacings (MA quantises ∂P).
 fn check_invariants(pp: &PreparedPolygon, g: &SkeletonGraph) {
+    g.check_invariants().unwrap();
     let b = pp.boundary();
     let res = resolution(pp);
     assert!(res > 0.0 && res < 1.5e-8 * pp.extent());

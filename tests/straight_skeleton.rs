@@ -42,6 +42,7 @@ fn line_distances(pp: &PreparedPolygon, p: Coord<f64>) -> Vec<f64> {
 fn check(p: &Polygon<f64>) -> (SkeletonGraph, PreparedPolygon) {
     let pp = PreparedPolygon::new(p).unwrap();
     let (g, stats) = straight_skeleton_with_stats(&pp, &MethodContext::default()).unwrap();
+    g.check_invariants().unwrap();
     // Positions and times: 1e-7 of the extent; the line-support check
     // allows 1e-5, since near-simultaneous events (many vertices on one
     // circle) are resolved one after another with rounding in between.
@@ -367,6 +368,9 @@ fn every_training_layer() {
                 let pp = PreparedPolygon::new(p).ok()?;
                 match StraightSkeleton.skeletonise(&pp, &MethodContext::default()) {
                     Ok(g) => {
+                        if let Err(e) = g.check_invariants() {
+                            return Some(format!("{layer}: {e}"));
+                        }
                         let crossing = g
                             .edges()
                             .iter()
@@ -412,6 +416,7 @@ fn largest_lena_reach() {
     let pp = PreparedPolygon::new(&p).unwrap();
     assert!(pp.vertex_count() > 10_000);
     let (g, stats) = straight_skeleton_with_stats(&pp, &MethodContext::default()).unwrap();
+    g.check_invariants().unwrap();
     assert!(stats.pops <= 1000 * stats.input_vertices + 10_000);
     let tol = 1e-6 * pp.extent();
     for n in g.nodes() {
@@ -500,6 +505,7 @@ fn a_polygon_beyond_the_budget_is_declined_up_front_with_the_reason() {
             StraightSkeleton.skeletonise(&small, ctx)
         })
         .unwrap();
+        g.check_invariants().unwrap();
         assert!(g.edges().len() > 400);
     }
 }

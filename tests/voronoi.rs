@@ -47,6 +47,9 @@ fn run_with_threads(
 #[cfg(feature = "gdal")]
 /// SPEC §3 invariants of a raw skeleton, and radius = distance to ∂P.
 fn assert_valid(layer: &str, p: &PreparedPolygon, g: &SkeletonGraph) {
+    if let Err(e) = g.check_invariants() {
+        panic!("{layer}: {e}");
+    }
     let b = p.boundary();
     let tol = 1e-9 * p.extent();
     for n in g.nodes() {
@@ -104,6 +107,7 @@ fn densified_skeleton_of_a_real_river_is_connected() {
     let g = Voronoi::densified(Density::Factor(4), 2_000_000)
         .skeletonise(p, &MethodContext::default())
         .unwrap();
+    g.check_invariants().unwrap();
     assert_eq!(g.components(), 1);
 }
 
@@ -150,6 +154,7 @@ fn dvd_converges_to_the_medial_axis() {
             let g = Voronoi::densified(Density::Factor(k), 1_000_000)
                 .skeletonise(&p, &MethodContext::default())
                 .unwrap();
+            g.check_invariants().unwrap();
             g.nodes().iter().map(|n| dist(n.pos)).sum::<f64>() / g.nodes().len() as f64
         })
         .collect();

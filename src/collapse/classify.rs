@@ -3,6 +3,7 @@
 //! documentation).
 
 use super::CollapseParams;
+use crate::geometry::vector::norm;
 use crate::geometry::PreparedPolygon;
 use crate::graph::{EdgeId, NodeId, SkeletonGraph, UnionFind};
 use geo::Coord;
@@ -40,6 +41,92 @@ pub(super) struct Samples {
     follows: Vec<(u32, u32)>,
 }
 
+/// The samples of [`Samples::of`] as they are made: the graph's nodes
+/// (same numbers), then the points inserted along its edges, edge by edge.
+struct Sampling {
+    pos: Vec<Coord<f64>>,
+    inserted: Vec<bool>,
+    segments: Vec<(u32, u32)>,
+    follows: Vec<(u32, u32)>,
+}
+
+/// The sample of node `n`: its own number.
+fn sample(n: NodeId) -> u32 {
+    n.index() as u32
+}
+
+impl Sampling {
+    /// Starts with the nodes of `g`.
+    fn of_nodes(g: &SkeletonGraph) -> Self {
+        let pos: Vec<Coord<f64>> = g.nodes().iter().map(|n| n.pos).collect();
+        Self {
+            inserted: vec![false; pos.len()],
+            pos,
+            segments: Vec::new(),
+            follows: Vec::new(),
+        }
+    }
+
+    /// A new sample at `c`; `inserted` when the sampling made it.
+    fn push(&mut self, c: Coord<f64>, inserted: bool) -> u32 {
+        self.pos.push(c);
+        self.inserted.push(inserted);
+        self.pos.len() as u32 - 1
+    }
+
+    /// Samples edge `id` of `g` at most `step` apart (its own vertices
+    /// kept); when it is one of the connection `legs`, its samples follow
+    /// the end where it leaves the skeleton.
+    fn edge(
+        &mut self,
+        g: &SkeletonGraph,
+        id: EdgeId,
+        step: f64,
+        legs: &[(Coord<f64>, Coord<f64>)],
+    ) {
+        let edge = g.edge(id);
+        let coords = g.edge_coords(id);
+        let (first, last) = (coords[0], coords[coords.len() - 1]);
+        let attachment = legs.iter().find_map(|&(s, c)| {
+            if (first, last) == (s, c) {
+                Some(sample(edge.a))
+            } else if (first, last) == (c, s) {
+                Some(sample(edge.b))
+            } else {
+                None
+            }
+        });
+        let before = self.pos.len();
+        let mut prev = sample(edge.a);
+        for k in 1..coords.len() {
+            let (a, b) = (coords[k - 1], coords[k]);
+            let n = (norm(b - a) / step).ceil().max(1.0) as usize;
+            for j in 1..n {
+                let cur = self.push(super::lerp(a, b, j as f64 / n as f64), true);
+                self.segments.push((prev, cur));
+                prev = cur;
+            }
+            let cur = if k == coords.len() - 1 {
+                sample(edge.b)
+            } else {
+                self.push(b, false)
+            };
+            self.segments.push((prev, cur));
+            prev = cur;
+        }
+        if let Some(a) = attachment {
+            let end = if a == sample(edge.a) {
+                sample(edge.b)
+            } else {
+                sample(edge.a)
+            };
+            let made = before as u32..self.pos.len() as u32;
+            self.follows.extend(made.map(|i| (i, a)));
+            self.follows.push((end, a));
+        }
+    }
+}
+
 impl Samples {
     /// Samples every edge of `g` at most `width / 4` apart; `legs` are the
     /// connection legs added to `g` (from the skeleton to the boundary).
@@ -53,67 +140,21 @@ impl Samples {
         let step = (width / 4.0)
             .max(total / MAX_SAMPLES)
             .max(MIN_STEP * p.extent());
-        let mut pos: Vec<Coord<f64>> = g.nodes().iter().map(|n| n.pos).collect();
-        let mut inserted = vec![false; pos.len()];
-        let mut segments = Vec::new();
-        let mut follows = Vec::new();
-        // Sample points: the graph's nodes (same numbers), then the points
-        // inserted along its edges.
-        let sample = |n: NodeId| n.index() as u32;
+        let mut s = Sampling::of_nodes(g);
         for e in 0..g.edges().len() {
-            let id = EdgeId::from_index(e);
-            let edge = g.edge(id);
-            let coords = g.edge_coords(id);
-            let (first, last) = (coords[0], coords[coords.len() - 1]);
-            let attachment = legs.iter().find_map(|&(s, c)| {
-                if (first, last) == (s, c) {
-                    Some(sample(edge.a))
-                } else if (first, last) == (c, s) {
-                    Some(sample(edge.b))
-                } else {
-                    None
-                }
-            });
-            let before = pos.len();
-            let mut prev = sample(edge.a);
-            for k in 1..coords.len() {
-                let (a, b) = (coords[k - 1], coords[k]);
-                let n = (crate::geometry::norm(b - a) / step).ceil().max(1.0) as usize;
-                for j in 1..n {
-                    pos.push(super::lerp(a, b, j as f64 / n as f64));
-                    inserted.push(true);
-                    let cur = pos.len() as u32 - 1;
-                    segments.push((prev, cur));
-                    prev = cur;
-                }
-                let cur = if k == coords.len() - 1 {
-                    sample(edge.b)
-                } else {
-                    pos.push(b);
-                    inserted.push(false);
-                    pos.len() as u32 - 1
-                };
-                segments.push((prev, cur));
-                prev = cur;
-            }
-            if let Some(a) = attachment {
-                let end = if a == sample(edge.a) {
-                    sample(edge.b)
-                } else {
-                    sample(edge.a)
-                };
-                follows.extend((before as u32..pos.len() as u32).map(|i| (i, a)));
-                follows.push((end, a));
-            }
+            s.edge(g, EdgeId::from_index(e), step, legs);
         }
+        let Sampling {
+            pos,
+            inserted,
+            segments,
+            follows,
+        } = s;
         let boundary = p.boundary();
         let r: Vec<f64> = pos.iter().map(|&c| boundary.distance(c)).collect();
         let segments: Vec<(u32, u32, f64)> = segments
             .into_iter()
-            .map(|(a, b)| {
-                let l = crate::geometry::norm(pos[b as usize] - pos[a as usize]);
-                (a, b, l)
-            })
+            .map(|(a, b)| (a, b, norm(pos[b as usize] - pos[a as usize])))
             .collect();
         let mut adj = vec![Vec::new(); pos.len()];
         for (i, &(a, b, _)) in segments.iter().enumerate() {

@@ -27,7 +27,7 @@
 //!    skeleton (the inscribed disc's contacts; each is visible from p, so the
 //!    cut lies inside P; a contact within `1e-9 × extent` of a vertex is that
 //!    vertex). The polygon is split exactly along the cuts
-//!    ([`crate::geometry::arrangement`]): its own vertices keep their
+//!    (`crate::geometry::arrangement`): its own vertices keep their
 //!    coordinates, a cut's ends are inserted into the edges they meet, rings
 //!    touching at a vertex give valid pieces. A piece holding a wide stretch
 //!    (or none) is kept; kept pieces that share a cut are one area. The

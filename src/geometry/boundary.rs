@@ -12,11 +12,11 @@
 //! besides a tree search (nearest segment, first hit of a ray, nearest point
 //! on both sides of a line):
 //!
-//! * the lane passes ([`super::lanes`]): a boundary of at most 64 segments,
-//!   on a processor with AVX2, and a query within [`super::lanes::TAME`];
-//! * the scalar passes ([`super::scan`]): a boundary of at most 64 segments
+//! * the lane passes (`geometry::lanes`): a boundary of at most 64 segments,
+//!   on a processor with AVX2, and a query within `lanes::TAME`;
+//! * the scalar passes (`Scan`): a boundary of at most 64 segments
 //!   otherwise;
-//! * the packed R-tree ([`super::packed`]): a larger boundary, built on the
+//! * the packed R-tree (`geometry::packed`): a larger boundary, built on the
 //!   first query that needs it.
 //!
 //! All three give the same answers bit for bit, ties included (tested
@@ -27,13 +27,12 @@ use super::lanes::{self, Columns};
 use super::packed::{
     box_distance_2, box_meets_half_plane, boxes_meet, ray_box, Bbox, Obb, PackedTree, RaySlab,
 };
-use super::scan::Scan;
 use super::segment::{
-    clip_to_half_plane, crosses_rightward, properly_cross, ray_segment, segment_distance_2,
-    BoundarySegment,
+    clip_by_sides, clip_to_half_plane, closest_point, crosses_rightward, nearer_2, properly_cross,
+    ray_segment, segment_distance_2, BoundarySegment,
 };
 use super::tolerance::{BOUND_MARGIN, SHORT_OF_END};
-use super::vector::norm;
+use super::vector::{dot, norm};
 use geo::{Coord, LineString, Polygon};
 use std::cell::Cell;
 use std::ops::ControlFlow;
@@ -118,23 +117,74 @@ impl Backend for Columns {
     }
 }
 
+/// The scalar passes over every segment, one at a time: how a boundary of
+/// few segments answers without building or walking a tree (and what the
+/// lane passes must agree with bit for bit), and how any boundary answers
+/// its two-sided query. Each keeps the tree search's answer, ties included
+/// (segments in index order, the first of equal values stays).
+#[derive(Debug, Clone, Copy)]
+struct Scan<'a>(&'a [BoundarySegment]);
+
 impl Backend for Scan<'_> {
     fn nearest_2(&self, p: Coord<f64>, limit2: f64) -> Option<(f64, u32)> {
-        Scan::nearest_2(self, p, limit2)
+        let mut best: Option<(f64, u32)> = None;
+        for (i, s) in self.0.iter().enumerate() {
+            let d2 = segment_distance_2(s.a, s.b, p);
+            if d2 <= limit2 && best.is_none_or(|(bd, _)| d2 < bd) {
+                best = Some((d2, i as u32));
+            }
+        }
+        best
     }
 
     fn first_param(
         &self,
-        o: Coord<f64>,
-        d: Coord<f64>,
+        origin: Coord<f64>,
+        dir: Coord<f64>,
         min_t: f64,
         max_t: f64,
     ) -> Option<(f64, usize)> {
-        Scan::first_param(self, o, d, min_t, max_t)
+        let mut best: Option<(f64, usize)> = None;
+        for (i, s) in self.0.iter().enumerate() {
+            let hit = ray_segment(origin, dir, s.a, s.b)
+                .map(|(t, _)| t)
+                .filter(|&t| t > min_t && t <= max_t);
+            if let Some(t) = hit {
+                if best.is_none_or(|(bt, _)| t < bt) {
+                    best = Some((t, i));
+                }
+            }
+        }
+        best
     }
 
     fn both_sides(&self, q: Coord<f64>, normal: Coord<f64>) -> [Option<(Coord<f64>, f64)>; 2] {
-        Scan::both_sides(self, q, normal)
+        // The nearest point on each side so far and its squared distance.
+        let mut best: [Option<(Coord<f64>, f64)>; 2] = [None, None];
+        let side = |c: Coord<f64>| dot(c - q, normal);
+        for s in self.0 {
+            let (fa, fb) = (side(s.a), side(s.b));
+            // The segment clipped to each closed half-plane, as
+            // `clip_to_half_plane` clips it (the opposite side's values are
+            // the negated ones, exactly).
+            let parts = [
+                clip_by_sides(s.a, s.b, fa, fb),
+                clip_by_sides(s.a, s.b, -fa, -fb),
+            ];
+            for (k, part) in parts.into_iter().enumerate() {
+                let Some((a, b)) = part else { continue };
+                let c = closest_point(a, b, q);
+                let d2 = dot(c - q, c - q);
+                // Segments in index order: the first of equal distances
+                // stays, distances compared as roots (as the tree search
+                // compares them): see `nearer_2`. The root of the winner is
+                // the caller's to take: the same answer.
+                if best[k].is_none_or(|(_, bd2)| nearer_2(d2, bd2)) {
+                    best[k] = Some((c, d2));
+                }
+            }
+        }
+        best
     }
 }
 

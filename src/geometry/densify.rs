@@ -25,7 +25,7 @@ impl Density {
 }
 
 /// Number of points a densified closed ring will have (without the closing point).
-pub fn densified_len(ring: &LineString<f64>, density: Density) -> usize {
+pub(crate) fn densified_len(ring: &LineString<f64>, density: Density) -> usize {
     ring.lines()
         .map(|l| density.pieces(hypot(l.end - l.start)))
         .fold(0usize, usize::saturating_add)
@@ -33,7 +33,7 @@ pub fn densified_len(ring: &LineString<f64>, density: Density) -> usize {
 
 /// The ring's points with pseudo-nodes inserted, not closed: each original
 /// vertex followed by the pseudo-nodes of the edge that starts there.
-pub fn densify_ring(ring: &LineString<f64>, density: Density) -> Vec<Coord<f64>> {
+pub(crate) fn densify_ring(ring: &LineString<f64>, density: Density) -> Vec<Coord<f64>> {
     let mut out = Vec::with_capacity(densified_len(ring, density));
     for l in ring.lines() {
         let d = l.end - l.start;

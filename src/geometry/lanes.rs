@@ -112,7 +112,7 @@ impl Columns {
 
     /// The segment nearest `p` (tame) among those within squared distance
     /// `limit2`, and its squared distance: the scalar pass
-    /// ([`super::scan::Scan::nearest_2`]: `segment_distance_2` per segment,
+    /// (the boundary's `Scan`: `segment_distance_2` per segment,
     /// the least within the limit, ties to the lower index).
     pub(crate) fn nearest_2(&self, p: Coord<f64>, limit2: f64) -> Option<(f64, u32)> {
         #[cfg(target_arch = "x86_64")]
@@ -124,7 +124,7 @@ impl Columns {
 
     /// The least ray parameter `t`, `min_t < t ≤ max_t`, at which
     /// `origin + t · dir` (both tame) meets a segment, and the segment:
-    /// the scalar pass ([`super::scan::Scan::first_param`]: `ray_segment`
+    /// the scalar pass (the boundary's `Scan`: `ray_segment`
     /// per segment, ties to the lower index). A segment parallel to the ray is decided by
     /// `ray_segment` itself.
     pub(crate) fn first_param(
@@ -144,7 +144,7 @@ impl Columns {
     /// The point nearest `q` (tame) in each closed half-plane of the line
     /// through `q` across `normal` (tame) — `(x − q) · normal ≥ 0`, then
     /// `≤ 0` — and its squared distance: the scalar two-sided pass
-    /// ([`super::scan::Scan::both_sides`]: each segment cut by
+    /// (the boundary's `Scan`: each segment cut by
     /// `clip_by_sides`, its nearest point by `closest_point`, compared by
     /// `nearer_2` in index order).
     pub(crate) fn both_sides(

@@ -1,5 +1,5 @@
 //! Geometry helpers shared by every method and step: ring normalisation
-//! ([`ring`]), boundary densification ([`densify`]) and the spatial index of the
+//! (`ring`), boundary densification ([`densify`]) and the spatial index of the
 //! boundary ([`boundary`]) used for radii, containment, crossing tests, ray casts
 //! and nearest-point queries.
 //!
@@ -8,21 +8,21 @@
 //! ([`vector`]), segment predicates and their tie rules ([`segment`]) and
 //! the table of tolerances ([`tolerance`]). The boundary index is a façade
 //! ([`Boundary`]) over three backends: the packed R-tree (`packed`), the
-//! scalar passes over few segments (`scan`) and the same passes four
-//! segments at a time (`lanes`); those three import only the ground floor.
+//! scalar passes over few segments (in `boundary`) and the same passes four
+//! segments at a time (`lanes`); `packed` and `lanes` import only the
+//! ground floor.
 //!
 //! Everything here works on owned [`geo`] types; nothing touches GDAL.
 
-pub mod arrangement;
+pub(crate) mod arrangement;
 pub mod boundary;
 pub mod densify;
 pub(crate) mod lanes;
 pub(crate) mod packed;
-pub mod ring;
-pub(crate) mod scan;
+pub(crate) mod ring;
 pub mod segment;
 pub mod tolerance;
-pub mod validity;
+pub(crate) mod validity;
 pub mod vector;
 
 pub use boundary::{Boundary, RayHit};

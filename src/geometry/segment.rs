@@ -18,12 +18,12 @@
 //! * [`crosses_rightward`]: the half-open rule on vertices (an end counts
 //!   when the other end is strictly above the ray), so a ray through a
 //!   vertex counts it once.
-//! * [`closest_on_segment`], [`closest_point`], [`segment_distance_2`]: an
+//! * [`closest_on_segment`], `closest_point`, `segment_distance_2`: an
 //!   end wins when the foot of the perpendicular is at or beyond it; a
 //!   zero-length segment is its start.
-//! * [`nearer_2`]: distances compared as their roots, so that squares whose
+//! * `nearer_2`: distances compared as their roots, so that squares whose
 //!   roots are equal tie (the first found stays).
-//! * [`clip_by_sides`] and [`clip_to_half_plane`]: closed half-planes (a
+//! * `clip_by_sides` and [`clip_to_half_plane`]: closed half-planes (a
 //!   point on the line is in).
 
 use super::tolerance::ROOT_MARGIN;
@@ -222,7 +222,7 @@ pub fn closest_on_segment(a: Coord<f64>, b: Coord<f64>, p: Coord<f64>) -> (Coord
 /// [`closest_on_segment`]'s point without its parameter, dividing only when
 /// the foot is interior (see [`segment_distance_2`]: the same point, but
 /// for the sign of a zero coordinate).
-pub fn closest_point(a: Coord<f64>, b: Coord<f64>, p: Coord<f64>) -> Coord<f64> {
+pub(crate) fn closest_point(a: Coord<f64>, b: Coord<f64>, p: Coord<f64>) -> Coord<f64> {
     let d = b - a;
     let along = dot(p - a, d);
     let l2 = dot(d, d);
@@ -246,7 +246,7 @@ pub fn closest_point(a: Coord<f64>, b: Coord<f64>, p: Coord<f64>) -> Coord<f64> 
 /// most 1 − 2⁻⁵³), so `dot/l2 < 1` exactly when `dot < l2`. The same
 /// distance, bit for bit, as dividing first; most segments of a pass have
 /// their nearest point at an end.
-pub fn segment_distance_2(a: Coord<f64>, b: Coord<f64>, p: Coord<f64>) -> f64 {
+pub(crate) fn segment_distance_2(a: Coord<f64>, b: Coord<f64>, p: Coord<f64>) -> f64 {
     let dir = b - a;
     let along = dot(p - a, dir);
     let l2 = dot(dir, dir);
@@ -267,13 +267,13 @@ pub fn segment_distance_2(a: Coord<f64>, b: Coord<f64>, p: Coord<f64>) -> f64 {
 /// when its square is smaller by more than the roots' rounding (a relative
 /// 2⁻⁵³ each), so only squares closer than that need their roots.
 #[inline]
-pub fn nearer_2(d2: f64, best2: f64) -> bool {
+pub(crate) fn nearer_2(d2: f64, best2: f64) -> bool {
     d2 < best2 && (d2 < best2 * (1.0 - ROOT_MARGIN) || d2.sqrt() < best2.sqrt())
 }
 
 /// Segment `ab` cut down to where a linear function with values `fa` at `a`
 /// and `fb` at `b` is ≥ 0, or `None` when it is negative at both ends.
-pub fn clip_by_sides(
+pub(crate) fn clip_by_sides(
     a: Coord<f64>,
     b: Coord<f64>,
     fa: f64,

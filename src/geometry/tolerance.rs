@@ -58,11 +58,11 @@ pub const TRACE_CROSSING: f64 = 1e-6;
 /// bit for bit).
 pub const VERTEX_SNAP: f64 = 1e-12;
 
-/// Relative margin of a distance bound computed in floating point: lower
-/// bounds of the boundary index (a box, an oriented box, a box's part in a
-/// half-plane) are shrunk by it, and known upper bounds (a seed distance, a
-/// radius bound) widened by it, so that rounding never makes a bound cut an
-/// answer off.
+/// Relative margin of a bound computed in floating point: lower bounds of
+/// the boundary index (a box, an oriented box, a box's part in a
+/// half-plane) and the stretch a line end's width search may skip are
+/// shrunk by it, and known upper bounds (a seed distance, a radius bound)
+/// widened by it, so that rounding never makes a bound cut an answer off.
 pub const BOUND_MARGIN: f64 = 1e-9;
 
 /// Relative widening of an oriented box's extents at construction: rounding

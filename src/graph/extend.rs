@@ -7,7 +7,7 @@
 //! leaf lies on ∂P.
 //!
 //! * `centred` (default): along the method's own removed legs, or between
-//!   them where they fork symmetrically — see [`crate::graph::ends`]. It
+//!   them where they fork symmetrically — see `crate::graph::ends`. It
 //!   needs what pruning removed, so it runs in [`prune_and_extend`]; on an
 //!   already pruned graph ([`extend`]) only its straight rays from leaves
 //!   inside P and its cut-end rule at leaves on ∂P apply.

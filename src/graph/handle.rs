@@ -21,7 +21,7 @@ impl NodeId {
         Self(i as u32)
     }
 
-    /// Its position in [`SkeletonGraph::nodes`].
+    /// Its position in [`super::SkeletonGraph::nodes`].
     #[inline]
     pub fn index(self) -> usize {
         self.0 as usize
@@ -36,7 +36,7 @@ impl EdgeId {
         Self(i as u32)
     }
 
-    /// Its position in [`SkeletonGraph::edges`].
+    /// Its position in [`super::SkeletonGraph::edges`].
     #[inline]
     pub fn index(self) -> usize {
         self.0 as usize

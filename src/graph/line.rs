@@ -3,7 +3,8 @@
 //! width at an end, and how much an end turns.
 
 use super::{NodeId, SkeletonGraph};
-use crate::geometry::vector::{dot, hypot};
+use crate::geometry::tolerance::BOUND_MARGIN;
+use crate::geometry::vector::{dot, hypot, norm};
 use crate::geometry::PreparedPolygon;
 use geo::Coord;
 
@@ -13,11 +14,7 @@ pub const HOOK_DEG: f64 = 60.0;
 
 /// The point at arc length `s` along `line` (its end when `s` ≥ its length).
 pub fn point_at(line: &[Coord<f64>], s: f64) -> Coord<f64> {
-    walk_to(
-        line,
-        line.windows(2).map(|w| crate::geometry::norm(w[1] - w[0])),
-        s,
-    )
+    walk_to(line, line.windows(2).map(|w| norm(w[1] - w[0])), s)
 }
 
 /// [`point_at`] with the segments' lengths given in order (measured as
@@ -45,10 +42,7 @@ struct Measured<'a> {
 
 impl<'a> Measured<'a> {
     fn new(line: &'a [Coord<f64>]) -> Self {
-        let lengths: Vec<f64> = line
-            .windows(2)
-            .map(|w| crate::geometry::norm(w[1] - w[0]))
-            .collect();
+        let lengths: Vec<f64> = line.windows(2).map(|w| norm(w[1] - w[0])).collect();
         let total = lengths.iter().sum();
         Self {
             line,
@@ -105,7 +99,7 @@ fn measured_end_width_point(line: &Measured, polygon: &PreparedPolygon) -> (f64,
     let radius = |s: f64| {
         let p = line.point_at(s);
         let r = match last.get() {
-            Some((q, rq)) => b.distance_within(p, rq + crate::geometry::norm(p - q)),
+            Some((q, rq)) => b.distance_within(p, rq + norm(p - q)),
             None => b.distance(p),
         };
         last.set(Some((p, r)));
@@ -121,7 +115,7 @@ fn measured_end_width_point(line: &Measured, polygon: &PreparedPolygon) -> (f64,
             continue;
         }
         let v = f(s);
-        negative_below = s - v / 3.0 * (1.0 - 1e-9);
+        negative_below = s - v / 3.0 * (1.0 - BOUND_MARGIN);
         if v >= 0.0 {
             let hi = first_crossing(&f, (lo, f(lo)), (s, v), total * 2f64.powi(-36));
             return (hi, radius(hi));

@@ -5,19 +5,20 @@
 //! straight skeleton, the event time. Edges are polylines between two nodes.
 //!
 //! Handles are typed indices ([`NodeId`], [`EdgeId`]), never pointers.
-//! Invariant kept by every operation: each edge's end nodes exist, and an
-//! edge's polyline runs from `nodes[a].pos` through `interior` to
-//! `nodes[b].pos`. Graphs are values: pruning and extension build new graphs.
+//! The invariants every operation keeps are written above
+//! [`SkeletonGraph`]. Graphs are values: pruning and extension build new
+//! graphs.
 
-pub mod bridge;
-pub mod cut;
-pub mod ends;
+pub(crate) mod bridge;
+pub(crate) mod cut;
+pub(crate) mod ends;
 pub mod extend;
 mod handle;
-pub mod line;
+mod invariants;
+pub(crate) mod line;
 pub mod planar;
 pub mod prune;
-pub mod structure;
+pub(crate) mod structure;
 pub mod widths;
 
 pub use handle::{EdgeId, NodeId};
@@ -101,6 +102,18 @@ pub fn polyline_length(c: &[Coord<f64>]) -> f64 {
 }
 
 /// The skeleton of one polygon: nodes and polyline edges.
+///
+/// Invariants, kept by every method and step (and checked by
+/// [`SkeletonGraph::check_invariants`] in the tests):
+///
+/// * each edge's end nodes exist, and its polyline runs from `nodes[a].pos`
+///   through `interior` to `nodes[b].pos`;
+/// * no edge has zero length: its polyline has two distinct points at least
+///   ([`GraphBuilder`] leaves degenerate segments and polylines out);
+/// * every position is finite, every radius finite and ≥ 0 (the distance to
+///   ∂P once set, 0 before), every event time finite and ≥ 0;
+/// * a node's degree ([`SkeletonGraph::degrees`]) is the number of edge ends
+///   at it, as [`SkeletonGraph::adjacency`] lists them (a loop twice).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct SkeletonGraph {
     nodes: Vec<Node>,

@@ -4,7 +4,7 @@
 //! (end segments, bridges across necks, straight rays) can cross a line of
 //! the skeleton. [`crossings`] finds every proper crossing of two segments
 //! (a packed R-tree over the segments' boxes, O(n log n) on real data), and
-//! [`node_crossings`] splits both edges there, so the written skeleton is a
+//! `node_crossings` splits both edges there, so the written skeleton is a
 //! planar graph: two lines meet only at a node.
 
 use super::{Edge, SkeletonGraph};
@@ -80,7 +80,7 @@ pub fn crossings(g: &SkeletonGraph) -> usize {
 /// `g` with a node at every proper crossing (both edges split there; the new
 /// node's radius is its distance to ∂P). Returns the graph and the number of
 /// crossings noded.
-pub fn node_crossings(g: SkeletonGraph, boundary: &Boundary) -> (SkeletonGraph, usize) {
+pub(crate) fn node_crossings(g: SkeletonGraph, boundary: &Boundary) -> (SkeletonGraph, usize) {
     let segs = segments(&g);
     let found = find(&segs);
     if found.is_empty() {

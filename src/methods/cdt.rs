@@ -48,7 +48,7 @@ fn fail(reason: impl Into<String>) -> MethodError {
 /// A triangle of the CDT that lies inside P: its corners and, per edge
 /// `i` (from corner `i` to corner `i+1`), whether the edge lies on ∂P.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct InsideTriangle {
+pub(crate) struct InsideTriangle {
     /// Corners (counter-clockwise), in polygon coordinates.
     pub corners: [Coord<f64>; 3],
     /// `on_boundary[i]`: the edge `corners[i]` → `corners[(i + 1) % 3]` lies on ∂P.
@@ -57,7 +57,9 @@ pub struct InsideTriangle {
 
 /// The triangles of the constrained Delaunay triangulation of ∂P that lie
 /// inside P (holes excluded).
-pub fn inside_triangles(polygon: &PreparedPolygon) -> Result<Vec<InsideTriangle>, MethodError> {
+pub(crate) fn inside_triangles(
+    polygon: &PreparedPolygon,
+) -> Result<Vec<InsideTriangle>, MethodError> {
     let origin = polygon.origin();
     // Bulk loading is several times faster than inserting vertex by vertex;
     // duplicate vertices (rings touching at a point) are merged by spade.
@@ -254,11 +256,7 @@ mod tests {
     use geo::polygon;
 
     fn run(p: geo::Polygon<f64>) -> SkeletonGraph {
-        Cdt.skeletonise(
-            &PreparedPolygon::new(&p).unwrap(),
-            &MethodContext::default(),
-        )
-        .unwrap()
+        crate::methods::checked_skeleton(&Cdt, &PreparedPolygon::new(&p).unwrap())
     }
 
     #[test]

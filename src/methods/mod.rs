@@ -438,6 +438,22 @@ pub fn build(id: MethodId, params: &SkeletonParams) -> Box<dyn SkeletonMethod> {
         .expect("a built-in method")
 }
 
+/// `method`'s skeleton of `polygon` without a budget, its graph's
+/// invariants checked: how the methods' unit tests run a method.
+#[cfg(test)]
+pub(crate) fn checked_skeleton(
+    method: &dyn SkeletonMethod,
+    polygon: &PreparedPolygon,
+) -> SkeletonGraph {
+    let g = method
+        .skeletonise(polygon, &MethodContext::default())
+        .unwrap_or_else(|e| panic!("{}: {e}", method.id()));
+    if let Err(e) = g.check_invariants() {
+        panic!("{}: {e}", method.id());
+    }
+    g
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

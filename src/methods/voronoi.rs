@@ -343,7 +343,7 @@ impl<'a> Locator<'a> {
 /// Invariant: every edge joins two distinct vertices (`u < v`), no edge
 /// appears twice, and the order of both lists depends only on the input.
 #[derive(Debug, Clone, Default, PartialEq)]
-pub struct VoronoiDiagram {
+pub(crate) struct VoronoiDiagram {
     /// Voronoi vertices (circumcentres of Delaunay triangles), in the sites'
     /// coordinates.
     pub vertices: Vec<Coord<f64>>,
@@ -470,9 +470,7 @@ mod tests {
     }
 
     fn vd(p: &PreparedPolygon) -> SkeletonGraph {
-        Voronoi::plain()
-            .skeletonise(p, &MethodContext::default())
-            .unwrap()
+        crate::methods::checked_skeleton(&Voronoi::plain(), p)
     }
 
     /// Every edge as its two end points, sorted, for comparison with a known answer.
@@ -494,8 +492,10 @@ mod tests {
         v
     }
 
-    /// Raw output invariants: points in P, no crossing, radius = distance to ∂P.
+    /// Raw output invariants: the graph's, points in P, no crossing,
+    /// radius = distance to ∂P.
     fn assert_valid(p: &PreparedPolygon, g: &SkeletonGraph) {
+        g.check_invariants().unwrap();
         let tol = SAME_POINT * p.extent();
         for n in g.nodes() {
             assert!(

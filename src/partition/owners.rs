@@ -88,8 +88,11 @@ pub struct Owned {
     /// The polygon, its rings normalised, the units' vertices on its edges
     /// inserted.
     pub polygon: Polygon<f64>,
-    owner: FxHashMap<((u64, u64), (u64, u64)), Option<u32>>,
+    owner: FxHashMap<EdgeKey, Option<u32>>,
 }
+
+/// An edge by the bits of its two ends.
+type EdgeKey = ((u64, u64), (u64, u64));
 
 fn key(c: Coord<f64>) -> (u64, u64) {
     (c.x.to_bits(), c.y.to_bits())

@@ -57,9 +57,7 @@ impl Vertices {
     /// cell is split along the bisector of the normals), or at a straight
     /// angle (a cell with no area: the normal) the owner of the edge after.
     fn owner_at(&self, v: Coord<f64>, x: Coord<f64>) -> Owner {
-        let Some(o) = self.0.get(&key(v)) else {
-            return None;
-        };
+        let o = self.0.get(&key(v))?;
         if o.before == o.after {
             return o.before;
         }

@@ -250,7 +250,7 @@ impl BarRays {
     /// counts them (a clock reading per small polygon saved). Also the
     /// number of the skeleton's branches (`skeleton.branches().len()`, which
     /// [`BarHit::part`] indexes).
-    pub fn cast_timed(
+    pub(crate) fn cast_timed(
         &self,
         polygon: &PreparedPolygon,
         skeleton: &SkeletonGraph,
@@ -260,7 +260,7 @@ impl BarRays {
 
     /// [`BarRays::cast_timed`] on a skeleton's branches
     /// ([`SkeletonGraph::branches`], which the caller may need as well).
-    pub fn cast_on_branches(
+    pub(crate) fn cast_on_branches(
         &self,
         polygon: &PreparedPolygon,
         branches: &[Branch],

@@ -5,7 +5,7 @@
 //!   running on into the polygon's end. Walking back from the end e, w is
 //!   the arc length of the first point whose distance to ∂P is half the
 //!   arc length walked (one local width back,
-//!   [`crate::graph::line::end_width_point`]); the end's turn is the
+//!   `crate::graph::line::end_width_point`); the end's turn is the
 //!   angle between the line's course entering that stretch (from 1.5 w to
 //!   w back) and its last segment. A turn above [`HOOK_DEG`] is a hook.
 //! * **Crossing**: two segments of the skeleton that cross without a node

@@ -416,6 +416,8 @@ fn params_may_need_mouth(leg: &LegMeasure) -> bool {
 
 /// Distance to ∂P where the leg `coords` (starting at its junction of radius
 /// `r_j`) leaves the junction's disc; at its far end when it is shorter.
-pub fn mouth_radius(coords: &[Coord<f64>], r_j: f64, boundary: &Boundary) -> f64 {
+/// What the pruning worker measures piece by piece, for the tests.
+#[cfg(test)]
+pub(crate) fn mouth_radius(coords: &[Coord<f64>], r_j: f64, boundary: &Boundary) -> f64 {
     boundary.distance(point_at(coords, r_j))
 }

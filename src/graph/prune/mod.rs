@@ -28,17 +28,17 @@
 //! Modes:
 //!
 //! * `significance` (default) and `length` (only the `min_length` rule):
-//!   see [`legs`] — least significant leg first, junctions that become
+//!   see `legs` — least significant leg first, junctions that become
 //!   leaves keep the reach of what was cut behind them, never below a simple
 //!   path.
 //! * `trunk`: keep only the longest leaf-to-leaf path of each component, one
-//!   centreline per part (see [`trunk`]).
+//!   centreline per part (see `trunk`).
 //! * `none`: the graph unchanged.
 //!
 //! Pruning works on the *merged* raw graph (one edge per branch, see
 //! [`SkeletonGraph::merged`]) and decides per edge whether it is kept
-//! ([`prune_mask`]), so that the extension step can follow the removed edges
-//! back to ∂P ([`crate::graph::ends`]). [`prune`] returns the kept graph.
+//! (`prune_mask`), so that the extension step can follow the removed edges
+//! back to ∂P (`crate::graph::ends`). [`prune`] returns the kept graph.
 //! Everything is sequential and ordered by node and edge indices and
 //! coordinates, so the output is the same for any thread count.
 //!
@@ -62,10 +62,10 @@
 //! assert_eq!(pruned.total_length(), 6.0);
 //! ```
 
-pub mod legs;
-pub mod trunk;
+pub(crate) mod legs;
+pub(crate) mod trunk;
 
-use super::{NodeId, SkeletonGraph};
+use super::SkeletonGraph;
 use crate::geometry::Boundary;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -133,7 +133,7 @@ impl Default for PruneParams {
 /// A leg as the rules see it: its extent, its junction's radius and its
 /// width at the mouth.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct LegMeasure {
+pub(crate) struct LegMeasure {
     /// Length plus the reach of its leaf.
     pub extent: f64,
     /// Radius r_j of its junction.
@@ -145,7 +145,7 @@ pub struct LegMeasure {
 impl PruneParams {
     /// True when a leg is insignificant under this mode (always false for
     /// `trunk` and `none`).
-    pub fn is_insignificant(&self, leg: &LegMeasure) -> bool {
+    pub(crate) fn is_insignificant(&self, leg: &LegMeasure) -> bool {
         let LegMeasure {
             extent,
             r_junction: rj,
@@ -194,14 +194,14 @@ impl PruneParams {
     }
 
     /// True for the modes that remove legs one by one.
-    pub fn removes_legs(&self) -> bool {
+    pub(crate) fn removes_legs(&self) -> bool {
         matches!(self.mode, PruneMode::Significance | PruneMode::Length)
     }
 }
 
 /// Significance of a leg, `(length − r_j) / r_j`: how many local radii it
 /// protrudes beyond the inscribed disc at its junction (+∞ when `r_j ≤ 0`).
-pub fn significance(length: f64, r_j: f64) -> f64 {
+pub(crate) fn significance(length: f64, r_j: f64) -> f64 {
     if r_j > 0.0 {
         (length - r_j) / r_j
     } else {
@@ -211,7 +211,11 @@ pub fn significance(length: f64, r_j: f64) -> f64 {
 
 /// Which edges of `merged` (a graph whose degree-2 chains are merged, see
 /// [`SkeletonGraph::merged`]) pruning keeps, indexed by edge.
-pub fn prune_mask(merged: &SkeletonGraph, params: &PruneParams, boundary: &Boundary) -> Vec<bool> {
+pub(crate) fn prune_mask(
+    merged: &SkeletonGraph,
+    params: &PruneParams,
+    boundary: &Boundary,
+) -> Vec<bool> {
     match params.mode {
         PruneMode::None => vec![true; merged.edges().len()],
         PruneMode::Significance | PruneMode::Length => legs::mask(merged, params, boundary),
@@ -230,38 +234,39 @@ pub fn prune(graph: &SkeletonGraph, params: &PruneParams, boundary: &Boundary) -
     m.filter_edges(|e, _| keep[e.index()]).merged()
 }
 
-/// Legs of `graph` that are insignificant under `params` at a junction of
-/// degree ≥ 3, as `(leaf, junction, length)`. Empty after [`prune`] with the
-/// same parameters; legs of components that are simple paths never count.
-pub fn insignificant_legs(
-    graph: &SkeletonGraph,
-    params: &PruneParams,
-    boundary: &Boundary,
-) -> Vec<(NodeId, NodeId, f64)> {
-    graph
-        .legs()
-        .into_iter()
-        .filter(|l| l.junction)
-        .filter_map(|l| {
-            let len = l.branch.length();
-            let rj = graph.node(l.other()).radius;
-            // The mouth is measured from the junction.
-            let from_junction: Vec<_> = l.branch.coords.iter().rev().copied().collect();
-            let leg = LegMeasure {
-                extent: len,
-                r_junction: rj,
-                r_mouth: legs::mouth_radius(&from_junction, rj, boundary),
-            };
-            params
-                .is_insignificant(&leg)
-                .then_some((l.leaf(), l.other(), len))
-        })
-        .collect()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::graph::NodeId;
+
+    /// Legs of `graph` that are insignificant under `params` at a junction of
+    /// degree ≥ 3, as `(leaf, junction, length)`. Empty after [`prune`] with the
+    /// same parameters; legs of components that are simple paths never count.
+    fn insignificant_legs(
+        graph: &SkeletonGraph,
+        params: &PruneParams,
+        boundary: &Boundary,
+    ) -> Vec<(NodeId, NodeId, f64)> {
+        graph
+            .legs()
+            .into_iter()
+            .filter(|l| l.junction)
+            .filter_map(|l| {
+                let len = l.branch.length();
+                let rj = graph.node(l.other()).radius;
+                // The mouth is measured from the junction.
+                let from_junction: Vec<_> = l.branch.coords.iter().rev().copied().collect();
+                let leg = LegMeasure {
+                    extent: len,
+                    r_junction: rj,
+                    r_mouth: legs::mouth_radius(&from_junction, rj, boundary),
+                };
+                params
+                    .is_insignificant(&leg)
+                    .then_some((l.leaf(), l.other(), len))
+            })
+            .collect()
+    }
     use crate::geometry::PreparedPolygon;
     use crate::graph::GraphBuilder;
     use geo::{polygon, Coord};

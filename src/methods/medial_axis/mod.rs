@@ -546,3 +546,29 @@ impl<'a> Extractor<'a> {
         self.graph.add_edge(prev, n1, Vec::new());
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use geo::polygon;
+
+    /// A rectangle with a hole: the graph's invariants, and every node's
+    /// radius is its disc's (its distance to ∂P, within the grid).
+    #[test]
+    fn a_rectangle_with_a_hole_keeps_the_graphs_invariants() {
+        let p = polygon!(
+            exterior: [(x: 0., y: 0.), (x: 10., y: 0.), (x: 10., y: 6.), (x: 0., y: 6.)],
+            interiors: [[(x: 4., y: 2.), (x: 4., y: 4.), (x: 6., y: 4.), (x: 6., y: 2.)]],
+        );
+        let pp = PreparedPolygon::new(&p).unwrap();
+        let g = crate::methods::checked_skeleton(&MedialAxis::default(), &pp);
+        assert!(!g.is_empty());
+        let tol = 4.0 * resolution(&pp);
+        for n in g.nodes() {
+            assert!(
+                (n.radius - pp.boundary().distance(n.pos)).abs() <= tol,
+                "{n:?}"
+            );
+        }
+    }
+}

@@ -102,11 +102,6 @@ impl EventQueue {
         self.heap.len()
     }
 
-    /// True when no event is queued.
-    pub fn is_empty(&self) -> bool {
-        self.heap.is_empty()
-    }
-
     /// Time of the earliest event, without removing it.
     pub fn peek_time(&self) -> Option<f64> {
         self.heap.peek().map(|e| e.t)

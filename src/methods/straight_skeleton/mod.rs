@@ -8,7 +8,7 @@
 //!
 //! # Algorithm
 //!
-//! Event-driven wavefront propagation ([`wavefront`], [`events`]):
+//! Event-driven wavefront propagation (`wavefront`, `events`):
 //!
 //! * Every ring becomes a circular list of wavefront vertices (exterior
 //!   counter-clockwise, holes clockwise, so P is always on the left). A
@@ -85,8 +85,8 @@
 //! assert!(g.nodes().iter().all(|n| n.time.is_some()));
 //! ```
 
-pub mod events;
-pub mod wavefront;
+pub(crate) mod events;
+pub(crate) mod wavefront;
 
 use super::{MethodContext, MethodError, MethodId, SkeletonMethod};
 use crate::geometry::packed::{boxes_meet, Bbox, PackedTree};
@@ -1062,12 +1062,7 @@ mod tests {
     use geo::polygon;
 
     fn run(p: geo::Polygon<f64>) -> SkeletonGraph {
-        StraightSkeleton
-            .skeletonise(
-                &PreparedPolygon::new(&p).unwrap(),
-                &MethodContext::default(),
-            )
-            .unwrap()
+        crate::methods::checked_skeleton(&StraightSkeleton, &PreparedPolygon::new(&p).unwrap())
     }
 
     /// The early estimate (the first eighth of the sample, spread over the
