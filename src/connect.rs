@@ -131,7 +131,7 @@ impl Network {
 /// The intersection point of segments `pq` and `ab`, when they meet (not
 /// parallel).
 fn intersection(p: Coord<f64>, q: Coord<f64>, a: Coord<f64>, b: Coord<f64>) -> Option<Coord<f64>> {
-    crate::geometry::boundary::segment_parameter(p, q, a, b).map(|t| p + (q - p) * t)
+    crate::geometry::segment::segment_parameter(p, q, a, b).map(|t| p + (q - p) * t)
 }
 
 /// `g` with a leg to every connection point: straight from the nearest
@@ -237,7 +237,7 @@ fn nearest_visible(
                 continue;
             }
             let (pa, pz) = (a + (z - a) * t0, a + (z - a) * t1);
-            let (q, _) = crate::geometry::boundary::closest_on_segment(pa, pz, c);
+            let (q, _) = crate::geometry::segment::closest_on_segment(pa, pz, c);
             candidates.push((crate::geometry::norm(q - c), k, i, q));
         }
     }

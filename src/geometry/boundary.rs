@@ -28,8 +28,8 @@ use super::packed::{
     box_distance_2, box_meets_half_plane, boxes_meet, ray_box, Bbox, Obb, PackedTree, RaySlab,
 };
 use super::segment::{
-    clip_by_sides, clip_to_half_plane, closest_point, crosses_rightward, nearer_2, properly_cross,
-    ray_segment, segment_distance_2, BoundarySegment,
+    clip_by_sides, clip_to_half_plane, closest_on_segment, closest_point, crosses_rightward,
+    nearer_2, properly_cross, ray_segment, segment_distance_2, BoundarySegment,
 };
 use super::tolerance::{BOUND_MARGIN, SHORT_OF_END};
 use super::vector::{dot, norm};
@@ -37,11 +37,6 @@ use geo::{Coord, LineString, Polygon};
 use std::cell::Cell;
 use std::ops::ControlFlow;
 use std::sync::OnceLock;
-
-/// Kept at their old paths for the per-feature path (`process`), which
-/// imports them from here; their home is [`super::segment`].
-#[doc(no_inline)]
-pub use super::segment::{closest_on_segment, segment_parameter};
 
 /// The first boundary point met by a ray.
 #[derive(Debug, Clone, Copy, PartialEq)]

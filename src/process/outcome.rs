@@ -179,7 +179,7 @@ fn length_outside(lines: &MultiLineString<f64>, parts: &[PreparedPolygon]) -> (f
             let bd = p.boundary();
             for i in bd.segments_near(a, b) {
                 let s = &bd.segments()[i];
-                if let Some(t) = crate::geometry::boundary::segment_parameter(a, b, s.a, s.b) {
+                if let Some(t) = crate::geometry::segment::segment_parameter(a, b, s.a, s.b) {
                     ts.push(t);
                 }
             }

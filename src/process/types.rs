@@ -6,7 +6,7 @@ use crate::collapse::{CollapseParams, PartCollapse};
 use crate::connect;
 use crate::graph::extend::ExtendParams;
 use crate::graph::prune::PruneParams;
-use crate::methods::medial_axis::MatSegment;
+use crate::graph::widths::MatSegment;
 use crate::methods::{MethodId, Registry, SkeletonParams};
 use crate::score::select::SelectParams;
 use crate::score::{Bar, ScoreParams, Scores};

@@ -67,7 +67,6 @@ use crate::geometry::PreparedPolygon;
 /// per-feature path (`process`), which imports them from here; their home
 /// is [`crate::graph::widths`].
 #[doc(no_inline)]
-pub use crate::graph::widths::MatSegment;
 use crate::graph::{NodeId, SkeletonGraph};
 use arc::Parabola;
 use boostvoronoi::prelude::{Builder, Cell, Diagram, SourceCategory, VertexIndex};
