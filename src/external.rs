@@ -275,10 +275,7 @@ fn join_by_key(
         .filter_map(|(i, f)| key_text(f, pf).map(|k| (k, i)))
         .collect();
     for s in skeletons {
-        let mut ls = Vec::new();
-        if let Some(g) = &s.geometry {
-            lines_of(g, &mut ls);
-        }
+        let ls = feature_lines(s);
         if ls.is_empty() {
             unjoined.not_lines += 1;
             continue;
@@ -296,6 +293,15 @@ fn join_by_key(
         }
     }
     Ok(assigned)
+}
+
+/// The lines of a skeleton feature (none when it has no line geometry).
+fn feature_lines(s: &Feature) -> Vec<LineString<f64>> {
+    let mut ls = Vec::new();
+    if let Some(g) = &s.geometry {
+        lines_of(g, &mut ls);
+    }
+    ls
 }
 
 fn join_by_location(
@@ -329,10 +335,7 @@ fn join_by_location(
         .collect();
     let tree = RTree::bulk_load(boxes);
     for s in skeletons {
-        let mut ls = Vec::new();
-        if let Some(g) = &s.geometry {
-            lines_of(g, &mut ls);
-        }
+        let ls = feature_lines(s);
         if ls.is_empty() {
             unjoined.not_lines += 1;
         }

@@ -7,11 +7,11 @@
 //! written as it was read, bit for bit.
 
 use super::layer::CoverageRow;
-use super::owners::Unit;
+use super::owners::{with_inserted, Inserts, Unit};
 use crate::geometry::tolerance::SAME_POINT;
 use crate::geometry::vector::norm;
 use crate::geometry::Boundary;
-use geo::{Area, BoundingRect, Coord, LineString, MultiPolygon, Polygon};
+use geo::{Area, BoundingRect, Coord, MultiPolygon, Polygon};
 use rustc_hash::FxHashMap;
 
 /// The `coverage` rows: every unit, in the order given, grown by the pieces
@@ -67,7 +67,7 @@ fn grow(unit: &MultiPolygon<f64>, pieces: &[Polygon<f64>]) -> MultiPolygon<f64> 
 /// `tol`, not at its ends) inserted there.
 fn with_vertices(p: &Polygon<f64>, vertices: &[Coord<f64>], tol: f64) -> Polygon<f64> {
     let b = Boundary::new(p);
-    let mut inserts: FxHashMap<(u32, u32), Vec<Coord<f64>>> = FxHashMap::default();
+    let mut inserts = Inserts::default();
     for &v in vertices {
         let Some((_, i, d)) = b.nearest_within(v, tol) else {
             continue;
@@ -80,28 +80,5 @@ fn with_vertices(p: &Polygon<f64>, vertices: &[Coord<f64>], tol: f64) -> Polygon
     if inserts.is_empty() {
         return p.clone();
     }
-    let ring = |r: usize, l: &LineString<f64>| {
-        let mut out = Vec::with_capacity(l.0.len());
-        for (i, w) in l.0.windows(2).enumerate() {
-            out.push(w[0]);
-            if let Some(extra) = inserts.get(&(r as u32, i as u32)) {
-                let d = w[1] - w[0];
-                let t = |c: &Coord<f64>| (c.x - w[0].x) * d.x + (c.y - w[0].y) * d.y;
-                let mut extra = extra.clone();
-                extra.sort_by(|a, b| t(a).total_cmp(&t(b)));
-                extra.dedup();
-                out.extend(extra);
-            }
-        }
-        out.push(l.0[l.0.len() - 1]);
-        LineString(out)
-    };
-    Polygon::new(
-        ring(0, p.exterior()),
-        p.interiors()
-            .iter()
-            .enumerate()
-            .map(|(k, r)| ring(k + 1, r))
-            .collect(),
-    )
+    with_inserted(p, &inserts, |c| c)
 }

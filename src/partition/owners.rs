@@ -181,7 +181,7 @@ fn owner_of(cov: &Coverage, a: Coord<f64>, b: Coord<f64>, tol: f64) -> Option<u3
 fn with_t_junctions(p: &PreparedPolygon, cov: &Coverage, tol: f64) -> Polygon<f64> {
     let b = p.boundary();
     let (lo, hi) = (b.bbox_min(), b.bbox_max());
-    let mut inserts: FxHashMap<(u32, u32), Vec<Coord<f64>>> = FxHashMap::default();
+    let mut inserts = Inserts::default();
     let mut moves: FxHashMap<(u64, u64), Coord<f64>> = FxHashMap::default();
     for s in cov.near(lo, hi, tol) {
         let v = Coord {
@@ -203,12 +203,23 @@ fn with_t_junctions(p: &PreparedPolygon, cov: &Coverage, tol: f64) -> Polygon<f6
             None => inserts.entry((seg.ring, seg.index)).or_default().push(v),
         }
     }
-    for extra in inserts.values_mut() {
-        extra.dedup();
-    }
+    let moved = |c: Coord<f64>| moves.get(&key(c)).copied().unwrap_or(c);
+    with_inserted(p.polygon(), &inserts, moved)
+}
+
+/// Where points go into a polygon's edges: by (ring, edge index), ring 0
+/// the exterior.
+pub(super) type Inserts = FxHashMap<(u32, u32), Vec<Coord<f64>>>;
+
+/// `p` with the points of `inserts` put into their edges, in order along
+/// each edge (repeats once), and every vertex of `p` taken through `moved`.
+pub(super) fn with_inserted(
+    p: &Polygon<f64>,
+    inserts: &Inserts,
+    moved: impl Fn(Coord<f64>) -> Coord<f64>,
+) -> Polygon<f64> {
     let ring = |r: usize, l: &LineString<f64>| {
         let mut out = Vec::with_capacity(l.0.len());
-        let moved = |c: Coord<f64>| moves.get(&key(c)).copied().unwrap_or(c);
         for (i, w) in l.0.windows(2).enumerate() {
             out.push(moved(w[0]));
             if let Some(extra) = inserts.get(&(r as u32, i as u32)) {
@@ -223,10 +234,9 @@ fn with_t_junctions(p: &PreparedPolygon, cov: &Coverage, tol: f64) -> Polygon<f6
         out.push(moved(l.0[l.0.len() - 1]));
         LineString(out)
     };
-    let poly = p.polygon();
     Polygon::new(
-        ring(0, poly.exterior()),
-        poly.interiors()
+        ring(0, p.exterior()),
+        p.interiors()
             .iter()
             .enumerate()
             .map(|(k, r)| ring(k + 1, r))

@@ -147,6 +147,12 @@ pub fn dissolve(mut group: Vec<Feature>) -> Feature {
         .filter(|s| !s.is_empty())
         .map(|s| Polygon::new(closed(&s[0]), s[1..].iter().map(closed).collect()))
         .collect();
+    merged_feature(group, merged)
+}
+
+/// The group's first feature (by FID) standing for all of it: `merged` its
+/// geometry, the members' FIDs listed, repaired if any member was.
+fn merged_feature(mut group: Vec<Feature>, merged: Vec<Polygon<f64>>) -> Feature {
     let members: Vec<u64> = group.iter().filter_map(|f| f.fid).collect();
     let repaired = group.iter().any(|f| f.repaired);
     let mut first = group.swap_remove(0);
@@ -168,17 +174,7 @@ fn dissolve_exactly(mut group: Vec<Feature>) -> Feature {
         .flat_map(|f| polygons(f).unwrap_or_default())
         .collect();
     let merged = crate::geometry::arrangement::coverage_union(&parts);
-    let members: Vec<u64> = group.iter().filter_map(|f| f.fid).collect();
-    let repaired = group.iter().any(|f| f.repaired);
-    let mut first = group.swap_remove(0);
-    first.geometry = Some(match merged.len() {
-        1 => Geometry::Polygon(merged.into_iter().next().expect("one")),
-        _ => Geometry::MultiPolygon(MultiPolygon(merged)),
-    });
-    first.source_wkb = None;
-    first.repaired = repaired;
-    first.members = members;
-    first
+    merged_feature(group, merged)
 }
 
 #[cfg(test)]
