@@ -9,10 +9,11 @@ the river on one bank, on both (a cell across the river gives a two-part
 unit), or not at all.
 
     scripts/make_coverage.py SRC.gpkg LAYER OUT.gpkg [--seeds N] [--buffer M]
-        [--grid G] [--seed S] [--reaches K] [--fids F,...]
+        [--grid G] [--seed S] [--reaches K] [--fids F,...] [--name NAME]
 
 writes the layers `rivers` (fields: id, name) and `units` (fields: id,
-landuse) to OUT.gpkg in the source's CRS. With --reaches K each river is cut
+landuse) to OUT.gpkg in the source's CRS (with --name, `rivers_NAME` and
+`units_NAME`, added to OUT.gpkg beside the layers it holds). With --reaches K each river is cut
 into K reaches across its length (polygons that share edges, as a river
 network's reaches do).
 """
@@ -21,6 +22,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 
 import geopandas as gpd
 import numpy as np
@@ -109,6 +111,7 @@ def main(argv=None):
     a.add_argument("--seed", type=int, default=1, help="random seed")
     a.add_argument("--reaches", type=int, default=1, help="reaches per river")
     a.add_argument("--fids", default=None, help="only these source FIDs, comma-separated")
+    a.add_argument("--name", default=None, help="layers rivers_NAME and units_NAME, added to OUT")
     o = a.parse_args(argv)
     src = pyogrio.read_dataframe(o.src, layer=o.layer, fid_as_index=True)
     if o.fids:
@@ -136,8 +139,11 @@ def main(argv=None):
     if not shapely.coverage_is_valid(allg):
         sys.exit("the generated coverage is not valid")
     # GeoPackage 1.2: what the GDAL of Debian stable reads without a warning.
-    pyogrio.write_dataframe(rg, o.out, layer="rivers", driver="GPKG", dataset_options={"VERSION": "1.2"})
-    pyogrio.write_dataframe(ug, o.out, layer="units", driver="GPKG", append=False)
+    suffix = f"_{o.name}" if o.name else ""
+    new_file = not o.name or not Path(o.out).exists()
+    options = {"dataset_options": {"VERSION": "1.2"}} if new_file else {}
+    pyogrio.write_dataframe(rg, o.out, layer="rivers" + suffix, driver="GPKG", **options)
+    pyogrio.write_dataframe(ug, o.out, layer="units" + suffix, driver="GPKG")
     print(f"{o.out}: {len(rg)} river polygons, {len(ug)} units")
 
 

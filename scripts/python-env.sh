@@ -21,7 +21,7 @@ if ! command -v "$py" >/dev/null 2>&1 || ! "$py" -c 'import venv, ensurepip' 2>/
 fi
 [ -x "$venv/bin/python" ] || "$py" -m venv "$venv"
 "$venv/bin/python" -m pip install -q --upgrade pip
-"$venv/bin/python" -m pip install -q maturin pytest geopandas dask distributed dask-geopandas pyarrow shapely pyogrio
+"$venv/bin/python" -m pip install -q maturin pytest geopandas dask distributed dask-geopandas pyarrow "shapely>=2.2" pyogrio
 rm -rf target/wheels
 "$venv/bin/maturin" build --profile "${SKELETONISE_WHEEL_PROFILE:-release}" --quiet -m python/Cargo.toml \
   -i "$venv/bin/python" -o target/wheels

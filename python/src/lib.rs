@@ -66,8 +66,17 @@ fn pipeline_error(e: ConfigError) -> PyErr {
 
 impl Pipeline {
     /// The steps, unless they need what only the command line writes: the
-    /// `collapse` step's kept areas are a second layer beside the lines.
+    /// `collapse` step's kept areas are a second layer beside the lines, and
+    /// the `partition` step reads a second source (`input.neighbours`) and
+    /// writes the grown coverage once every polygon is done.
     fn supported(steps: config::Steps) -> PyResult<Self> {
+        if steps.process_params().partition.is_some() {
+            return Err(PipelineError::new_err(
+                "the `partition` step reads the coverage of `input.neighbours` and writes it grown once every \
+                 polygon is done, so it runs from the command line only (`skeletonise run`); leave it out \
+                 of the pipeline given to Python",
+            ));
+        }
         if steps.process_params().collapse.is_some() {
             return Err(PipelineError::new_err(
                 "the `collapse` step writes kept areas beside the lines and runs from the command line only \

@@ -125,6 +125,13 @@ def test_a_collapse_pipeline_is_refused_with_the_reason():
     assert "`collapse` step" in str(e.value) and "skeletonise run" in str(e.value), str(e.value)
 
 
+def test_a_partition_pipeline_is_refused_with_the_reason():
+    # The partition step reads a second source and writes the grown coverage at the end of a run.
+    with pytest.raises(skeletonise.PipelineError) as e:
+        skeletonise.apply(gpd.GeoDataFrame(geometry=[RIVER]), ROOT / "pipelines" / "partition-rivers.yaml")
+    assert "`partition` step" in str(e.value) and "skeletonise run" in str(e.value), str(e.value)
+
+
 def test_step_options_reach_the_steps():
     wavy = shapely.buffer(shapely.LineString([(0, 0), (50, 20), (100, 0), (150, 20)]), 5)
     trunk = skeletonise.skeletonise([wavy], prune="trunk", methods=["CDT", "MA"])

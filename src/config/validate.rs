@@ -106,7 +106,8 @@ pub(super) fn validate_steps(steps: &[Step]) -> Result<(), (String, String)> {
         s.validate()
             .map_err(|(k, m)| (format!("steps[{i}].{}.{k}", s.name()), m))?;
     }
-    collapse_on_ma(steps)
+    collapse_on_ma(steps)?;
+    partition_width_on_ma(steps)
 }
 
 /// `collapse` cuts the polygon by the medial axis's inscribed discs and
@@ -123,6 +124,27 @@ fn collapse_on_ma(steps: &[Step]) -> Result<(), (String, String)> {
         Some((i, p)) if collapses && p.methods != [crate::methods::MethodId::MA] => Err((
             format!("steps[{i}].skeleton.methods"),
             "`collapse` cuts the polygon where the medial axis's inscribed discs meet the collapse width and draws the medial axis: list MA alone (`skeleton: { methods: [MA] }`); other methods' lines are not centred on those discs, so their collapsed lines would cross the kept areas".into(),
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// A partition with `width` decides what is narrow on the medial axis's
+/// discs, as `collapse` does: MA must be among the methods (whichever
+/// `select` chooses for the skeleton layer).
+fn partition_width_on_ma(steps: &[Step]) -> Result<(), (String, String)> {
+    let width = steps.iter().enumerate().find_map(|(i, s)| match s {
+        Step::Partition(p) if p.width.is_some() => Some(i),
+        _ => None,
+    });
+    let has_ma = steps.iter().any(|s| match s {
+        Step::Skeleton(p) => p.methods.contains(&crate::methods::MethodId::MA),
+        _ => false,
+    });
+    match width {
+        Some(i) if !has_ma => Err((
+            format!("steps[{i}].partition.width"),
+            "`width` gives away only the narrow parts, measured by the medial axis's inscribed discs: add MA to `skeleton.methods` (any method may still be chosen for the skeleton layer)".into(),
         )),
         _ => Ok(()),
     }

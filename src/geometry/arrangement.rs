@@ -279,7 +279,7 @@ fn faces(g: &Graph) -> Vec<Face> {
         list[(i + list.len() - 1) % list.len()]
     };
     let mut seen = vec![false; g.half.len()];
-    let mut shells: Vec<(Vec<Coord<f64>>, Vec<u32>)> = Vec::new();
+    let mut shells: Vec<Shell> = Vec::new();
     let mut holes: Vec<Hole> = Vec::new();
     for start in 0..g.half.len() as u32 {
         if seen[start as usize] {
@@ -307,22 +307,32 @@ fn faces(g: &Graph) -> Vec<Face> {
                 .filter_map(|&h| g.half[h as usize].chord)
                 .collect();
             if signed_area(&coords) > 0.0 {
-                shells.push((coords, chords));
+                let edges = part
+                    .iter()
+                    .map(|&h| (g.half[h as usize].from, g.half[h as usize].to))
+                    .collect();
+                shells.push(Shell {
+                    coords,
+                    chords,
+                    edges,
+                });
             } else {
                 // A hole of the face: a ring, or rings joined by chords. It
                 // is placed by the middle of a ring edge, which no other
-                // face has on its boundary.
-                let h = part
+                // face has on its boundary; a hole of chords alone (a loop
+                // of boundaries around an island) by the middle of a chord,
+                // which the face inside the loop has on its boundary too.
+                let ring_edge = part
                     .iter()
                     .copied()
-                    .find(|&h| g.half[h as usize].chord.is_none())
-                    .unwrap_or(part[0]);
-                let e = g.half[h as usize];
+                    .find(|&h| g.half[h as usize].chord.is_none());
+                let e = g.half[ring_edge.unwrap_or(part[0]) as usize];
                 let probe = (g.pos[e.from as usize] + g.pos[e.to as usize]) * 0.5;
                 holes.push(Hole {
                     coords,
                     chords,
                     probe,
+                    on_chord: ring_edge.is_none().then_some((e.from, e.to)),
                 });
             }
         }
@@ -335,8 +345,19 @@ fn faces(g: &Graph) -> Vec<Face> {
 struct Hole {
     coords: Vec<Coord<f64>>,
     chords: Vec<u32>,
-    /// A point on it that lies on no other face's boundary.
+    /// A point on it that lies on no other face's boundary, or (a hole of
+    /// chords alone) on that of the face inside it only.
     probe: Coord<f64>,
+    /// The half-edge the probe is on, when it is a chord's.
+    on_chord: Option<(VertexId, VertexId)>,
+}
+
+/// A cycle with P on its left that turns counter-clockwise: the shell of a
+/// face, its chords and its half-edges.
+struct Shell {
+    coords: Vec<Coord<f64>>,
+    chords: Vec<u32>,
+    edges: rustc_hash::FxHashSet<(VertexId, VertexId)>,
 }
 
 /// A cycle of half-edges split at the vertices it passes more than once
@@ -366,26 +387,34 @@ fn simple_cycles(g: &Graph, cycle: &[u32]) -> Vec<Vec<u32>> {
 
 /// Shells with the holes that lie in them (each hole in the smallest shell
 /// that contains it).
-fn assemble(mut shells: Vec<(Vec<Coord<f64>>, Vec<u32>)>, holes: Vec<Hole>) -> Vec<Face> {
-    let areas: Vec<f64> = shells.iter().map(|(c, _)| signed_area(c)).collect();
+fn assemble(shells: Vec<Shell>, holes: Vec<Hole>) -> Vec<Face> {
+    let areas: Vec<f64> = shells.iter().map(|s| signed_area(&s.coords)).collect();
     let mut inner: Vec<Vec<LineString<f64>>> = vec![Vec::new(); shells.len()];
+    let mut chords: Vec<Vec<u32>> = shells.iter().map(|s| s.chords.clone()).collect();
     for hole in holes {
+        // Not the face inside a loop of chords: it has the probe's chord,
+        // the other way round.
+        let inside = |k: usize| {
+            hole.on_chord
+                .is_some_and(|(a, b)| shells[k].edges.contains(&(b, a)))
+        };
         let owner = (0..shells.len())
-            .filter(|&k| contains(&shells[k].0, hole.probe))
+            .filter(|&k| !inside(k) && contains(&shells[k].coords, hole.probe))
             .min_by(|&a, &b| areas[a].total_cmp(&areas[b]));
         if let Some(k) = owner {
             inner[k].push(closed(hole.coords));
-            shells[k].1.extend(hole.chords);
+            chords[k].extend(hole.chords);
         }
     }
     shells
         .into_iter()
         .zip(inner)
-        .map(|((coords, mut chords), interiors)| {
+        .zip(chords)
+        .map(|((shell, interiors), mut chords)| {
             chords.sort_unstable();
             chords.dedup();
             Face {
-                polygon: Polygon::new(closed(coords), interiors),
+                polygon: Polygon::new(closed(shell.coords), interiors),
                 chords: chords.into_iter().map(|c| c as usize).collect(),
             }
         })
@@ -548,6 +577,44 @@ mod tests {
         // Not a network: an end inside P that no other chord meets.
         let e = split_network(&p, &[LineString::from(vec![(0., 5.), (8., 5.)])]).unwrap_err();
         assert_eq!(e, SplitError::Detached(0));
+    }
+
+    #[test]
+    fn a_loop_of_chords_around_a_hole_is_the_hole_of_the_face_outside_it() {
+        // A 10 × 10 square with a 2 × 2 hole, and a closed chord around the
+        // hole touching nothing: the face inside the loop has the hole, the
+        // one outside has the loop as its hole (not the face inside it).
+        let r = Polygon::new(
+            LineString::from(vec![(0., 0.), (10., 0.), (10., 10.), (0., 10.), (0., 0.)]),
+            vec![LineString::from(vec![
+                (4., 4.),
+                (4., 6.),
+                (6., 6.),
+                (6., 4.),
+                (4., 4.),
+            ])],
+        );
+        let p = PreparedPolygon::new(&r).unwrap();
+        let lp = LineString::from(vec![(2., 2.), (8., 2.), (8., 8.), (2., 8.), (2., 2.)]);
+        let mut f = split_network(&p, &[lp]).unwrap();
+        f.sort_by(|a, b| {
+            a.polygon
+                .unsigned_area()
+                .total_cmp(&b.polygon.unsigned_area())
+        });
+        assert_eq!(f.len(), 2);
+        assert_eq!(f[0].polygon.interiors().len(), 1);
+        assert!(
+            (f[0].polygon.unsigned_area() - 32.0).abs() < 1e-12,
+            "{:?}",
+            f[0]
+        );
+        assert_eq!(f[1].polygon.interiors().len(), 1);
+        assert!(
+            (f[1].polygon.unsigned_area() - 64.0).abs() < 1e-12,
+            "{:?}",
+            f[1]
+        );
     }
 
     #[test]

@@ -25,6 +25,7 @@
 
 mod assemble;
 mod layer;
+mod narrow;
 mod owners;
 mod split;
 
@@ -33,9 +34,13 @@ pub use layer::{BoundaryRow, CoverageRow, GivenRow, BOUNDARIES, COVERAGE, GIVEN}
 pub use owners::{Coverage, Unit};
 pub use split::Owner;
 
+use crate::collapse::CollapseParams;
+use crate::geometry::vector::norm;
 use crate::geometry::{tolerance::SAME_POINT, PreparedPolygon};
+use crate::graph::SkeletonGraph;
 use crate::methods::medial_axis::{cells::cell_edges, ArcTolerance};
-use geo::{Area, LineString, MultiLineString, Polygon};
+use geo::{Area, Coord, LineString, MultiLineString, Polygon};
+use rustc_hash::FxHashMap;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
@@ -46,20 +51,71 @@ pub enum Unowned {
     /// A remainder polygon of its own (`areas`, `kind = unowned`).
     #[default]
     Keep,
+    /// The owned part it borders along the longest stretch takes it.
+    Nearest,
 }
 
 /// Options of the `partition` step.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize, JsonSchema)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct PartitionParams {
-    /// What happens to area nearest to bank no unit owns (the sea, the coverage's edge, holes that are no unit): `keep` (default) makes it a remainder polygon in `areas` (`kind = unowned`).
+    /// What happens to area nearest to bank no unit owns (the sea, the coverage's edge, holes that are no unit): `keep` (default) makes it a remainder polygon in `areas` (`kind = unowned`); `nearest` gives it to the owned part it borders along the longest stretch.
     #[serde(default)]
     pub unowned: Unowned,
+    /// Give away only the narrow parts (CRS units, as `collapse`'s `width`): where the medial axis's local width 2r is above it the polygon stays a polygon of its own (`areas`, `kind = wide`), cut across where it meets the given parts. Needs MA among `skeleton.methods`. Default: the whole polygon is given away.
+    #[serde(default)]
+    pub width: Option<f64>,
+    /// With `width`: the band around it as a fraction of it (default 0.2), as in `collapse`.
+    #[serde(default = "default_tolerance")]
+    pub tolerance: f64,
+    /// With `width`: the shortest narrow or wide stretch of the medial axis (CRS units; default `width`), as in `collapse`.
+    #[serde(default)]
+    pub min_length: Option<f64>,
+}
+
+fn default_tolerance() -> f64 {
+    0.2
+}
+
+impl Default for PartitionParams {
+    fn default() -> Self {
+        Self {
+            unowned: Unowned::Keep,
+            width: None,
+            tolerance: default_tolerance(),
+            min_length: None,
+        }
+    }
 }
 
 impl PartitionParams {
+    /// The `collapse` options that decide what is narrow, with `width`.
+    pub fn narrow(&self) -> Option<CollapseParams> {
+        self.width.map(|width| CollapseParams {
+            width,
+            tolerance: self.tolerance,
+            min_length: self.min_length,
+            mode: crate::collapse::CollapseMode::Partial,
+        })
+    }
+
     /// Checks the options: `(key, message)` of the first that is wrong.
     pub fn validate(&self) -> Result<(), (String, String)> {
+        let c = CollapseParams {
+            width: self.width.unwrap_or(1.0),
+            tolerance: self.tolerance,
+            min_length: self.min_length,
+            mode: crate::collapse::CollapseMode::Partial,
+        };
+        c.validate()?;
+        if self.width.is_none()
+            && (self.min_length.is_some() || self.tolerance != default_tolerance())
+        {
+            return Err((
+                "width".into(),
+                "`tolerance` and `min_length` say which parts are narrow: give `width` too, or remove them".into(),
+            ));
+        }
         Ok(())
     }
 }
@@ -97,38 +153,227 @@ pub struct PartPartition {
     pub boundaries: Vec<NewBoundary>,
     /// What no unit takes (`unowned: keep`).
     pub remainders: Vec<Polygon<f64>>,
+    /// With `width`: the wide parts, kept as polygons, each with the number
+    /// of cuts on its boundary.
+    pub wide: Vec<(Polygon<f64>, usize)>,
+}
+
+/// Where a face of the partitioned polygon goes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+enum Side {
+    /// To a unit, or to none (unowned).
+    To(Owner),
+    /// It stays: a wide part.
+    Wide,
 }
 
 /// Partitions polygon part `p` between the units of `cov` (see the module
-/// documentation), or says why it cannot be.
+/// documentation), or says why it cannot be. With `width`, `ma` is the
+/// part's medial axis (its discs say what is narrow).
 pub fn partition(
     p: &PreparedPolygon,
     cov: &Coverage,
-    _params: &PartitionParams,
+    params: &PartitionParams,
+    ma: Option<&SkeletonGraph>,
 ) -> Result<PartPartition, String> {
     let tol = SAME_POINT * p.extent();
-    let owned = owners::owned(p, cov, tol)?;
-    let prepared = PreparedPolygon::new(&owned.polygon).map_err(|e| e.to_string())?;
-    let edges = cell_edges(&prepared, ArcTolerance::default()).map_err(|e| e.to_string())?;
-    let pieces = split::pieces(&owned, edges);
-    let faces = split::faces(&owned, &pieces)?;
-    let mut out = PartPartition::default();
-    let fid = |o: Owner| o.and_then(|u| cov.units()[u as usize].fid);
-    for f in faces {
-        match f.owner {
-            Some(unit) => out.given.push(Given {
-                unit,
-                fid: fid(Some(unit)),
-                polygon: f.face.polygon,
-            }),
-            None => out.remainders.push(f.face.polygon),
+    let mut owned = owners::owned(p, cov, tol)?;
+    let mut cuts: Vec<Vec<Coord<f64>>> = Vec::new();
+    let mut wide_parts: Vec<Polygon<f64>> = Vec::new();
+    if let Some(c) = params.narrow() {
+        let ma = ma.ok_or("a partition with `width` needs the part's medial axis")?;
+        let n = crate::collapse::collapse(ma, p, &c, &[]);
+        if n.collapsed.is_empty() {
+            // Wide everywhere: nothing is given away.
+            return Ok(PartPartition {
+                wide: vec![(owned.polygon, 0)],
+                ..PartPartition::default()
+            });
+        }
+        wide_parts = n.areas.into_iter().map(|a| a.polygon).collect();
+        let ends: Vec<Coord<f64>> = n
+            .cuts
+            .iter()
+            .flat_map(|l| [l.0[0], l.0[l.0.len() - 1]])
+            .collect();
+        let (with_ends, at) = owned.with_points(&ends, tol);
+        owned = with_ends;
+        for (k, l) in n.cuts.iter().enumerate() {
+            let mut line = l.0.clone();
+            let last = line.len() - 1;
+            line[0] = at[2 * k].unwrap_or(line[0]);
+            line[last] = at[2 * k + 1].unwrap_or(line[last]);
+            cuts.push(line);
         }
     }
-    out.boundaries = boundaries(pieces);
+    let prepared = PreparedPolygon::new(&owned.polygon).map_err(|e| e.to_string())?;
+    let edges = cell_edges(&prepared, ArcTolerance::default()).map_err(|e| e.to_string())?;
+    let (pieces, vertices) = split::pieces(&owned, edges);
+    let mut lines: Vec<Vec<Coord<f64>>> = pieces.into_iter().map(|q| q.line).collect();
+    narrow::node(&mut cuts, &mut lines, tol);
+    let chords: Vec<LineString<f64>> = lines
+        .into_iter()
+        .chain(cuts.iter().cloned())
+        .map(LineString)
+        .collect();
+    let faces = split::faces(&owned, &vertices, &chords)?;
+    let mut sides: Vec<Side> = faces
+        .iter()
+        .map(|f| match narrow::is_wide(&f.face.polygon, &wide_parts) {
+            true => Side::Wide,
+            false => Side::To(f.owner),
+        })
+        .collect();
+    let adjacency = Adjacency::of(&faces);
+    if params.unowned == Unowned::Nearest {
+        adjacency.give_unowned(&mut sides);
+    }
+    Ok(assemble_part(cov, faces, &sides, &adjacency, &cuts))
+}
+
+/// The partition of a part from its faces and where each goes.
+fn assemble_part(
+    cov: &Coverage,
+    faces: Vec<split::OwnedFace>,
+    sides: &[Side],
+    adjacency: &Adjacency,
+    cuts: &[Vec<Coord<f64>>],
+) -> PartPartition {
+    let fid = |o: Owner| o.and_then(|u| cov.units()[u as usize].fid);
+    let mut out = PartPartition {
+        boundaries: boundaries(adjacency.pieces(sides)),
+        ..PartPartition::default()
+    };
     for b in &mut out.boundaries {
         b.fids = [fid(b.left), fid(b.right)];
     }
-    Ok(out)
+    let (mut unowned, mut wide) = (Vec::new(), Vec::new());
+    for (f, side) in faces.into_iter().zip(sides) {
+        match side {
+            Side::To(Some(unit)) => out.given.push(Given {
+                unit: *unit,
+                fid: fid(Some(*unit)),
+                polygon: f.face.polygon,
+            }),
+            Side::To(None) => unowned.push(f.face.polygon),
+            Side::Wide => wide.push(f.face.polygon),
+        }
+    }
+    out.remainders = crate::geometry::arrangement::coverage_union(&unowned);
+    let cut_ends: rustc_hash::FxHashSet<(u64, u64)> = cuts
+        .iter()
+        .flat_map(|l| [l[0], l[l.len() - 1]])
+        .map(|c| (c.x.to_bits(), c.y.to_bits()))
+        .collect();
+    out.wide = crate::geometry::arrangement::coverage_union(&wide)
+        .into_iter()
+        .map(|w| {
+            let n = w
+                .exterior()
+                .0
+                .iter()
+                .chain(w.interiors().iter().flat_map(|r| &r.0))
+                .filter(|c| cut_ends.contains(&(c.x.to_bits(), c.y.to_bits())))
+                .count();
+            (w, n / 2)
+        })
+        .collect();
+    out
+}
+
+/// An edge by the bits of its two ends.
+type EdgeKey = ((u64, u64), (u64, u64));
+
+/// Which faces meet along which chord edges: every directed edge of a
+/// face's rings (the face on its left) whose reverse is another face's.
+struct Adjacency {
+    /// `(edge from, edge to, face on its left, face on its right)`.
+    shared: Vec<(Coord<f64>, Coord<f64>, usize, usize)>,
+}
+
+impl Adjacency {
+    fn of(faces: &[split::OwnedFace]) -> Self {
+        let key = |c: Coord<f64>| (c.x.to_bits(), c.y.to_bits());
+        let mut by_edge: FxHashMap<EdgeKey, usize> = FxHashMap::default();
+        let rings = |f: &split::OwnedFace| {
+            let p = &f.face.polygon;
+            std::iter::once(p.exterior().clone())
+                .chain(p.interiors().iter().cloned())
+                .collect::<Vec<_>>()
+        };
+        for (i, f) in faces.iter().enumerate() {
+            for r in rings(f) {
+                for w in r.0.windows(2) {
+                    by_edge.insert((key(w[0]), key(w[1])), i);
+                }
+            }
+        }
+        let mut shared = Vec::new();
+        for (i, f) in faces.iter().enumerate() {
+            for r in rings(f) {
+                for w in r.0.windows(2) {
+                    if let Some(&j) = by_edge.get(&(key(w[1]), key(w[0]))) {
+                        if j != i {
+                            shared.push((w[0], w[1], i, j));
+                        }
+                    }
+                }
+            }
+        }
+        Self { shared }
+    }
+
+    /// `unowned: nearest`: every unowned face given to the owned face it
+    /// borders along the longest stretch, until none borders one.
+    fn give_unowned(&self, sides: &mut [Side]) {
+        loop {
+            let mut border: FxHashMap<(usize, Owner), f64> = FxHashMap::default();
+            for &(a, b, i, j) in &self.shared {
+                if let (Side::To(None), Side::To(Some(u))) = (sides[i], sides[j]) {
+                    *border.entry((i, Some(u))).or_default() += norm(b - a);
+                }
+            }
+            if border.is_empty() {
+                return;
+            }
+            let mut best: FxHashMap<usize, (Owner, f64)> = FxHashMap::default();
+            for ((i, o), l) in border {
+                let e = best.entry(i).or_insert((o, l));
+                if l > e.1 || (l == e.1 && o < e.0) {
+                    *e = (o, l);
+                }
+            }
+            for (i, (o, _)) in best {
+                sides[i] = Side::To(o);
+            }
+        }
+    }
+
+    /// The new boundaries: the edges between faces that go to different
+    /// owners (a wide part's edges are none), each once, the owner of the
+    /// face on its left and of the one on its right.
+    fn pieces(&self, sides: &[Side]) -> Vec<split::Piece> {
+        let mut out: Vec<split::Piece> = Vec::new();
+        for &(a, b, i, j) in &self.shared {
+            let (Side::To(left), Side::To(right)) = (sides[i], sides[j]) else {
+                continue;
+            };
+            if left == right || i > j {
+                continue;
+            }
+            match out.last_mut() {
+                Some(p) if p.left == left && p.right == right && p.line.last() == Some(&a) => {
+                    p.line.push(b)
+                }
+                _ => out.push(split::Piece {
+                    line: vec![a, b],
+                    left,
+                    right,
+                }),
+            }
+        }
+        out
+    }
 }
 
 /// The pieces grouped by pair of owners (each oriented with the smaller
@@ -258,7 +503,7 @@ mod tests {
     #[test]
     fn a_canal_between_two_units_is_split_on_its_centre_line() {
         let (p, cov) = canal();
-        let r = partition(&p, &cov, &PartitionParams::default()).unwrap();
+        let r = partition(&p, &cov, &PartitionParams::default(), None).unwrap();
         let areas = given_area(&r);
         assert_eq!(areas.len(), 4, "{areas:?}");
         for (unit, area) in areas {
@@ -298,7 +543,7 @@ mod tests {
             ),
         ]);
         let p = PreparedPolygon::new(&c).unwrap();
-        let r = partition(&p, &cov, &PartitionParams::default()).unwrap();
+        let r = partition(&p, &cov, &PartitionParams::default(), None).unwrap();
         let normal = r
             .boundaries
             .iter()
@@ -325,7 +570,7 @@ mod tests {
             9,
             polygon![(x: 50., y: 2.), (x: 60., y: 2.), (x: 60., y: 20.), (x: 50., y: 20.)],
         )]);
-        let e = partition(&p, &cov, &PartitionParams::default()).unwrap_err();
+        let e = partition(&p, &cov, &PartitionParams::default(), None).unwrap_err();
         assert!(e.contains("overlaps the interior of unit 9"), "{e}");
     }
 }

@@ -110,6 +110,49 @@ impl Owned {
         self.owner.contains_key(&(key(a), key(b)))
     }
 
+    /// The polygon with `points` (each within `tol` of its boundary) put
+    /// into the edges they lie on — or, within `tol` of a vertex, that
+    /// vertex — the new edges owned as the edge they split; and each point
+    /// as it now is in the polygon (`None`: not on its boundary).
+    pub fn with_points(&self, points: &[Coord<f64>], tol: f64) -> (Owned, Vec<Option<Coord<f64>>>) {
+        let b = Boundary::new(&self.polygon);
+        let mut inserts = Inserts::default();
+        let mut at = Vec::with_capacity(points.len());
+        for &v in points {
+            let on = b.nearest_within(v, tol).and_then(|(_, i, d)| {
+                let s = &b.segments()[i];
+                if norm(v - s.a) <= tol {
+                    Some(s.a)
+                } else if norm(v - s.b) <= tol {
+                    Some(s.b)
+                } else if d <= tol {
+                    inserts.entry((s.ring, s.index)).or_default().push(v);
+                    Some(v)
+                } else {
+                    None
+                }
+            });
+            at.push(on);
+        }
+        let polygon = with_inserted(&self.polygon, &inserts, |c| c);
+        let old_rings = std::iter::once(self.polygon.exterior()).chain(self.polygon.interiors());
+        let new_rings = std::iter::once(polygon.exterior()).chain(polygon.interiors());
+        let mut owner = FxHashMap::default();
+        for (old, new) in old_rings.zip(new_rings) {
+            // Each new edge lies in the old edge from the last old vertex
+            // passed: the points were put between the old vertices.
+            let mut k = 0;
+            for w in new.0.windows(2) {
+                let o = self.owner(old.0[k], old.0[k + 1]);
+                owner.insert((key(w[0]), key(w[1])), o);
+                if w[1] == old.0[k + 1] {
+                    k += 1;
+                }
+            }
+        }
+        (Owned { polygon, owner }, at)
+    }
+
     /// The owners of the edges into and out of every vertex.
     pub fn at_vertices(&self) -> FxHashMap<(u64, u64), VertexOwners> {
         let mut out = FxHashMap::default();

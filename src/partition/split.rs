@@ -46,40 +46,40 @@ fn key(c: Coord<f64>) -> (u64, u64) {
     (c.x.to_bits(), c.y.to_bits())
 }
 
-/// The owners at every vertex, and which side of a mixed reflex vertex's
-/// cell a point is on.
-struct Vertices(FxHashMap<(u64, u64), VertexOwners>);
+/// The owners at every vertex, and how the cells of the vertices where two
+/// units meet are split.
+pub struct Vertices {
+    owners: FxHashMap<(u64, u64), VertexOwners>,
+    /// The split of a vertex's cell: the direction from the vertex along
+    /// which it is split, and one towards the side of the edge before.
+    splits: FxHashMap<(u64, u64), (Coord<f64>, Coord<f64>)>,
+}
 
 impl Vertices {
     /// The owner of the cell of vertex `v` at point `x` of it: the unit of
-    /// its edges when both have one; at a vertex where two units meet, the
-    /// one whose edge's inward normal is nearer in angle to `x − v` (the
-    /// cell is split along the bisector of the normals), or at a straight
-    /// angle (a cell with no area: the normal) the owner of the edge after.
+    /// its edges when both have one; where two units meet and the cell has
+    /// area, the side of its split `x` is on; otherwise (a convex or
+    /// straight vertex, whose cell has no area) the one whose edge's inward
+    /// normal is nearer in angle to `x − v`, or at a straight angle the
+    /// owner of the edge after.
     fn owner_at(&self, v: Coord<f64>, x: Coord<f64>) -> Owner {
-        let o = self.0.get(&key(v))?;
+        let o = self.owners.get(&key(v))?;
         if o.before == o.after {
             return o.before;
         }
-        let (na, nb) = (left_normal(o.into), left_normal(o.out_of));
-        if cross(o.into, o.out_of) == 0.0 {
-            return o.after;
-        }
-        let bisector = na + nb;
-        let d = x - v;
-        if cross(bisector, d) * cross(bisector, na) >= 0.0 {
+        let (split, before) = match self.splits.get(&key(v)) {
+            Some(&s) => s,
+            None if cross(o.into, o.out_of) == 0.0 => return o.after,
+            None => {
+                let na = left_normal(o.into);
+                (na + left_normal(o.out_of), na)
+            }
+        };
+        if cross(split, x - v) * cross(split, before) >= 0.0 {
             o.before
         } else {
             o.after
         }
-    }
-
-    /// The bisector direction of a vertex where two units meet at a reflex
-    /// angle (its cell lies in P and is split), if `v` is one.
-    fn split_direction(&self, v: Coord<f64>) -> Option<Coord<f64>> {
-        let o = self.0.get(&key(v))?;
-        let reflex = cross(o.into, o.out_of) < 0.0;
-        (o.before != o.after && reflex).then(|| left_normal(o.into) + left_normal(o.out_of))
     }
 }
 
@@ -99,13 +99,16 @@ fn site_owner(owned: &Owned, vertices: &Vertices, site: CellSite, x: Coord<f64>)
     }
 }
 
-/// The new boundaries of `owned` from the edges of its cells: every piece
-/// of an edge with different owners on its sides, and the bisectors that
-/// split the cells of reflex vertices where two units meet.
-pub fn pieces(owned: &Owned, mut edges: Vec<CellEdge>) -> Vec<Piece> {
-    let vertices = Vertices(owned.at_vertices());
-    let bisectors = split_cells(&vertices, &mut edges);
-    let mut out = bisectors;
+/// The new boundaries of `owned` from the edges of its cells — every piece
+/// of an edge with different owners on its sides, and the splits of the
+/// cells of vertices where two units meet — and the owners at the
+/// vertices.
+pub fn pieces(owned: &Owned, mut edges: Vec<CellEdge>) -> (Vec<Piece>, Vertices) {
+    let mut vertices = Vertices {
+        owners: owned.at_vertices(),
+        splits: FxHashMap::default(),
+    };
+    let mut out = split_cells(&mut vertices, &mut edges);
     for e in &edges {
         for w in e.line.windows(2) {
             let m = (w[0] + w[1]) * 0.5;
@@ -127,13 +130,18 @@ pub fn pieces(owned: &Owned, mut edges: Vec<CellEdge>) -> Vec<Piece> {
             }
         }
     }
-    out
+    (out, vertices)
 }
 
-/// The bisectors of the cells of reflex vertices where two units meet:
-/// each from its vertex to where it leaves the cell, that point inserted
-/// into the cell edge it crosses (so both share it exactly).
-fn split_cells(vertices: &Vertices, edges: &mut [CellEdge]) -> Vec<Piece> {
+/// The splits of the cells of vertices where two units meet, where the
+/// diagram gives the vertex a cell with area (a reflex vertex — as the
+/// diagram sees it: a vertex within the coordinates' rounding of straight
+/// may be either): each along the bisector of the cell's two normal edges,
+/// from the vertex to where it leaves the cell — that point put into the
+/// cell edge it meets, so that both share it (where the cell is too thin
+/// for the ray to meet one exactly, the vertex of its far edges nearest in
+/// angle).
+fn split_cells(vertices: &mut Vertices, edges: &mut [CellEdge]) -> Vec<Piece> {
     let mut by_vertex: FxHashMap<(u64, u64), Vec<usize>> = FxHashMap::default();
     for (k, e) in edges.iter().enumerate() {
         for s in e.sites {
@@ -142,49 +150,119 @@ fn split_cells(vertices: &Vertices, edges: &mut [CellEdge]) -> Vec<Piece> {
             }
         }
     }
+    let mut by_vertex: Vec<_> = by_vertex.into_iter().collect();
+    by_vertex.sort_unstable_by_key(|(k, _)| *k);
     let mut out = Vec::new();
     for (vk, ks) in by_vertex {
+        let Some(o) = vertices.owners.get(&vk).copied() else {
+            continue;
+        };
         let v = Coord {
             x: f64::from_bits(vk.0),
             y: f64::from_bits(vk.1),
         };
-        let Some(dir) = vertices.split_direction(v) else {
+        if o.before == o.after {
+            continue;
+        }
+        let Some((dir, before)) = normals(v, &ks, edges) else {
             continue;
         };
-        // The nearest crossing of the ray from v with the cell's other edges.
-        let mut best: Option<(f64, usize, usize, Coord<f64>)> = None;
-        for &k in &ks {
-            for (j, w) in edges[k].line.windows(2).enumerate() {
-                if w[0] == v || w[1] == v {
-                    continue;
-                }
-                if let Some((t, x)) = ray_hit(v, dir, w[0], w[1]) {
-                    if best.is_none_or(|b| t < b.0) {
-                        best = Some((t, k, j, x));
-                    }
-                }
-            }
-        }
-        let Some((_, k, j, x)) = best else { continue };
-        let line = &mut edges[k].line;
-        let x = if norm(x - line[j]) == 0.0 {
-            line[j]
-        } else if norm(x - line[j + 1]) == 0.0 {
-            line[j + 1]
-        } else {
-            line.insert(j + 1, x);
-            x
+        let Some(x) = cell_exit(v, dir, &ks, edges) else {
+            continue;
         };
-        let o = vertices.0[&vk];
-        // Walking from v along the bisector, the edge before (whose normal
-        // turns left of the bisector) is on the left.
+        vertices.splits.insert(vk, (x - v, before));
+        // Walking from v along the split, the edge before is on the left
+        // when its side is to the left of the split.
+        let (left, right) = if cross(x - v, before) > 0.0 {
+            (o.before, o.after)
+        } else {
+            (o.after, o.before)
+        };
         out.push(Piece {
             line: vec![v, x],
-            left: o.before,
-            right: o.after,
+            left,
+            right,
         });
     }
     out
+}
+
+/// The bisector of the two normal edges of vertex `v`'s cell (the edges
+/// between it and the cells of its two polygon edges, which start at `v`),
+/// and the direction of the one on the side of the edge before; `None`
+/// where the cell has no far edge (no area).
+fn normals(v: Coord<f64>, ks: &[usize], edges: &[CellEdge]) -> Option<(Coord<f64>, Coord<f64>)> {
+    let mut into = None;
+    let mut out_of = None;
+    let mut far = false;
+    for &k in ks {
+        let e = &edges[k];
+        let (first, last) = (e.line[0], e.line[e.line.len() - 1]);
+        let end = if first == v {
+            last
+        } else if last == v {
+            first
+        } else {
+            far = true;
+            continue;
+        };
+        for s in e.sites {
+            match s {
+                CellSite::Segment(_, b) if b == v => into = Some(end - v),
+                CellSite::Segment(a, _) if a == v => out_of = Some(end - v),
+                _ => {}
+            }
+        }
+    }
+    let (a, b) = (into?, out_of?);
+    let unit = |d: Coord<f64>| d / norm(d);
+    (far && norm(a) > 0.0 && norm(b) > 0.0).then(|| (unit(a) + unit(b), a))
+}
+
+/// Where the ray from `v` along `dir` leaves the cell (its first crossing
+/// with a far edge, put into that edge), or the far edges' vertex nearest
+/// to it in angle.
+fn cell_exit(
+    v: Coord<f64>,
+    dir: Coord<f64>,
+    ks: &[usize],
+    edges: &mut [CellEdge],
+) -> Option<Coord<f64>> {
+    let mut best: Option<(f64, usize, usize, Coord<f64>)> = None;
+    let mut nearest: Option<(f64, Coord<f64>)> = None;
+    let unit = dir / norm(dir);
+    for &k in ks {
+        for (j, w) in edges[k].line.windows(2).enumerate() {
+            if w[0] == v || w[1] == v {
+                continue;
+            }
+            if let Some((t, x)) = ray_hit(v, dir, w[0], w[1]) {
+                if best.is_none_or(|b| t < b.0) {
+                    best = Some((t, k, j, x));
+                }
+            }
+            for q in [w[0], w[1]] {
+                let d = q - v;
+                let off = cross(unit, d).abs() / norm(d);
+                if crate::geometry::vector::dot(unit, d) > 0.0 && nearest.is_none_or(|n| off < n.0)
+                {
+                    nearest = Some((off, q));
+                }
+            }
+        }
+    }
+    let Some((_, k, j, x)) = best else {
+        return nearest.map(|n| n.1);
+    };
+    let line = &mut edges[k].line;
+    Some(if x == line[j] {
+        line[j]
+    } else if x == line[j + 1] {
+        line[j + 1]
+    } else {
+        line.insert(j + 1, x);
+        x
+    })
 }
 
 /// Where the ray `o + t·d` (t > 0) crosses segment `a`–`b`: `(t, point)`.
@@ -205,31 +283,55 @@ fn ray_hit(
     (t > 0.0 && (0.0..=1.0).contains(&u)).then(|| (t, a + s * u))
 }
 
-/// The polygon split along `pieces`, each face with its owner (the owner of
-/// the most of its bank by length; every bank edge of a face has the same
-/// owner unless the boundaries are broken).
-pub fn faces(owned: &Owned, pieces: &[Piece]) -> Result<Vec<OwnedFace>, String> {
+/// The polygon split along `chords` (the new boundaries, and the cuts of
+/// a partial partition), each face with its owner: the owner of the most
+/// of its bank by length (every bank edge of a face has the same owner
+/// unless the boundaries are broken); a face with no bank edge (a cut
+/// through the cell of a reflex vertex leaves two) takes the owner of the
+/// vertex's cell where the face lies.
+pub fn faces(
+    owned: &Owned,
+    vertices: &Vertices,
+    chords: &[LineString<f64>],
+) -> Result<Vec<OwnedFace>, String> {
     let p = PreparedPolygon::new(&owned.polygon).map_err(|e| e.to_string())?;
-    let chords: Vec<LineString<f64>> = pieces.iter().map(|q| LineString(q.line.clone())).collect();
-    let faces = split_network(&p, &chords).map_err(|e| {
+    let faces = split_network(&p, chords).map_err(|e| {
         format!("the new boundaries do not split the polygon ({e}); please report this feature")
     })?;
     Ok(faces
         .into_iter()
         .map(|face| {
-            let mut length: FxHashMap<Owner, f64> = FxHashMap::default();
-            for r in std::iter::once(face.polygon.exterior()).chain(face.polygon.interiors()) {
-                for w in r.0.windows(2) {
-                    if owned.is_edge(w[0], w[1]) {
-                        *length.entry(owned.owner(w[0], w[1])).or_default() += norm(w[1] - w[0]);
-                    }
-                }
-            }
-            let owner = length
-                .into_iter()
-                .max_by(|a, b| a.1.total_cmp(&b.1).then(b.0.cmp(&a.0)))
-                .and_then(|(o, _)| o);
+            let owner = bank_owner(owned, &face).unwrap_or_else(|| vertex_owner(vertices, &face));
             OwnedFace { face, owner }
         })
         .collect())
+}
+
+/// The owner of the most of `face`'s bank by length (`None`: it has none).
+fn bank_owner(owned: &Owned, face: &Face) -> Option<Owner> {
+    let mut length: FxHashMap<Owner, f64> = FxHashMap::default();
+    for r in std::iter::once(face.polygon.exterior()).chain(face.polygon.interiors()) {
+        for w in r.0.windows(2) {
+            if owned.is_edge(w[0], w[1]) {
+                *length.entry(owned.owner(w[0], w[1])).or_default() += norm(w[1] - w[0]);
+            }
+        }
+    }
+    length
+        .into_iter()
+        .max_by(|a, b| a.1.total_cmp(&b.1).then(b.0.cmp(&a.0)))
+        .map(|(o, _)| o)
+}
+
+/// The owner of a face without bank edges: that of the cell of a polygon
+/// vertex on it, at the face's inner point.
+fn vertex_owner(vertices: &Vertices, face: &Face) -> Owner {
+    use geo::InteriorPoint;
+    let inner = face.polygon.interior_point().map(|p| p.0);
+    face.polygon
+        .exterior()
+        .0
+        .iter()
+        .find(|v| vertices.owners.contains_key(&key(**v)))
+        .and_then(|&v| vertices.owner_at(v, inner?))
 }

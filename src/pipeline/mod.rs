@@ -371,6 +371,20 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
         if let (Ok(()), Some(cov)) = (&result, &params.neighbours) {
             let coverage = crate::partition::assemble(cov.units(), grown);
             counts.units = Some(coverage.len() as u64);
+            let grew: Vec<f64> = coverage
+                .iter()
+                .map(|c| c.received)
+                .filter(|&a| a > 0.0)
+                .collect();
+            tracing::info!(
+                units = coverage.len(),
+                grown = grew.len(),
+                area_given = grew.iter().sum::<f64>(),
+                "partition: {} of {} units grew by {:.6e} (CRS units²), the others are written unchanged",
+                grew.len(),
+                coverage.len(),
+                grew.iter().sum::<f64>()
+            );
             if rows_tx
                 .send(Rows {
                     coverage,

@@ -412,7 +412,10 @@ fn finish(
         if params.keep_widths {
             widths.extend(medial_axis_transform(g, Some(p.boundary())));
         }
-        if params.collapse.is_some() || params.connect.is_some() {
+        if params.collapse.is_some()
+            || params.connect.is_some()
+            || params.partition.is_some_and(|p| p.width.is_some())
+        {
             graphs.push(g.clone());
         }
         // The branches as lines (`SkeletonGraph::to_multilinestring`).

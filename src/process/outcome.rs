@@ -46,11 +46,18 @@ pub fn process(geom: Option<&Geometry<f64>>, params: &ProcessParams) -> Processe
     if let (Some(pp), Some(cov), Processed::Done(o)) =
         (&params.partition, &params.neighbours, &mut processed)
     {
+        // With `width`, the medial axis's discs say what is narrow.
+        let ma = o
+            .candidates
+            .iter()
+            .find(|c| c.method == crate::methods::MethodId::MA)
+            .and_then(|c| c.result.as_ref().ok());
         let parts: Result<Vec<_>, String> = prepared
             .iter()
             .enumerate()
             .map(|(i, p)| {
-                crate::partition::partition(p, cov, pp)
+                let g = ma.and_then(|m| m.graphs.get(i));
+                crate::partition::partition(p, cov, pp, g)
                     .map_err(|e| super::part_reason(i, prepared.len(), &e))
             })
             .collect();

@@ -337,7 +337,8 @@ fn collapse_rows(
 }
 
 /// The rows of a partitioned feature: its new boundaries, the area given
-/// to each unit, what no unit takes (an `areas` row, `kind = unowned`), and
+/// to each unit, the wide parts kept (`areas`, `kind = wide`) and what no
+/// unit takes (`kind = unowned`), and
 /// the pieces the units grow by.
 fn partition_rows(
     f: &Feature,
@@ -364,15 +365,17 @@ fn partition_rows(
         }
         rows.grown
             .extend(p.given.iter().map(|g| (g.fid, g.polygon.clone())));
+        let kept = p.wide.iter().map(|(w, cuts)| (w, *cuts, "wide"));
+        let remainders = p.remainders.iter().map(|r| (r, 0, "unowned"));
         rows.areas
-            .extend(p.remainders.iter().map(|polygon| AreaRow {
+            .extend(kept.chain(remainders).map(|(polygon, cuts, kind)| AreaRow {
                 src_fid: f.fid,
                 polygon_part: part,
                 attributes: f.attributes.clone(),
                 geometry: polygon.clone(),
-                cuts: 0,
+                cuts,
                 members: members_text(f),
-                kind: Some("unowned"),
+                kind: Some(kind),
             }));
     }
     rows.given

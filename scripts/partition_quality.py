@@ -1,0 +1,234 @@
+#!/usr/bin/env python3
+"""Measures a partition (the `partition` step's output) against its input, and
+the same measures for the peer, GEOS CoverageCleaner (shapely.coverage_clean:
+every gap merged into the neighbour it shares the longest border with), on the
+same data:
+
+- coverage: the output units and areas form a valid coverage (shapely
+  coverage_is_valid), every geometry is valid;
+- area: |Σ out − Σ in| / Σ in (units and collapsed polygons in, units and
+  areas out);
+- unchanged: units that received nothing are bit for bit the input's;
+- shrunk: units that lost area (more than 1e-9 of theirs);
+- nearest: the share of random points of the collapsed polygons that lie in
+  the unit whose bank is nearest (ties within the arc tolerance, 0.2 % of the
+  distance, count as right; points nearest to unowned bank are left out);
+- z: the paper's distortion of the new boundaries against the two units'
+  banks, z = |d_l − d_r| / (d_l + d_r) at 49 points evenly spread along
+  each line, mean over the points.
+
+    scripts/partition_quality.py IN.gpkg RIVERS UNITS OUT.gpkg [--peer]
+
+prints one line of measures (JSON); with --peer a second for CoverageCleaner.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import warnings
+
+import numpy as np
+import pyogrio
+import shapely
+
+warnings.filterwarnings("ignore", category=RuntimeWarning)
+
+
+def read(path, layer, **kw):
+    return pyogrio.read_dataframe(path, layer=layer, fid_as_index=True, **kw)
+
+
+def as_multi(geoms):
+    """Polygons as one-part multipolygons (the `coverage` layer's type), the
+    coordinates untouched."""
+    return np.array([shapely.MultiPolygon([g]) if g.geom_type == "Polygon" else g for g in geoms])
+
+
+def banks(rivers, units):
+    """Each unit's bank: the part of the collapsed polygons' boundary that lies
+    on its boundary (shared edges have identical vertices, so it is exact)."""
+    edge = shapely.union_all(rivers.geometry.boundary.values)
+    shapely.prepare(edge)
+    out = {}
+    for fid, g in zip(units.index, units.geometry):
+        if shapely.intersects(edge, g):
+            b = shapely.line_merge(shapely.intersection(edge, g.boundary))
+            if not b.is_empty and b.length > 0:
+                out[fid] = b
+    return out
+
+
+def sample_points(rivers, n, seed=1):
+    """n random points inside the collapsed polygons, spread by area."""
+    rng = np.random.default_rng(seed)
+    geoms = rivers.geometry.values
+    areas = shapely.area(geoms)
+    counts = rng.multinomial(n, areas / areas.sum())
+    pts = []
+    for g, k in zip(geoms, counts):
+        shapely.prepare(g)
+        minx, miny, maxx, maxy = g.bounds
+        got = []
+        while sum(len(x) for x in got) < k:
+            xy = rng.uniform((minx, miny), (maxx, maxy), size=(max(64, 4 * k), 2))
+            cand = shapely.points(xy)
+            got.append(cand[shapely.contains(g, cand)])
+        pts.append(np.concatenate(got)[:k])
+    return np.concatenate(pts)
+
+
+def nearest_share(points, polys, fids, bank):
+    """The share of `points` in the polygon (of `polys`, unit `fids`) whose
+    bank is nearest, ties within 0.2 % of the distance counting as right."""
+    bank_fids = list(bank)
+    bank_geoms = np.array([bank[f] for f in bank_fids])
+    tree = shapely.STRtree(bank_geoms)
+    (pi, bi), d_near = tree.query_nearest(points, return_distance=True, all_matches=False)
+    near = np.full(len(points), -1, dtype=np.int64)
+    dist = np.full(len(points), np.inf)
+    near[pi] = np.array(bank_fids)[bi]
+    dist[pi] = d_near
+    ptree = shapely.STRtree(polys)
+    qi, ui = ptree.query(points, predicate="within")
+    holder = np.full(len(points), -1, dtype=np.int64)
+    holder[qi] = np.asarray(fids)[ui]
+    ok = holder == near
+    for i in np.nonzero(~ok)[0]:
+        own = bank.get(holder[i])
+        if own is not None and shapely.distance(points[i], own) - dist[i] <= 0.002 * dist[i] + 1e-9:
+            ok[i] = True
+    return float(ok.mean())
+
+
+def boundary_z(lines, left, right, bank):
+    """Mean z of `lines` (between units `left` and `right`) against the two
+    units' banks, and the number of points it is taken at."""
+    zs = []
+    for line, lf, rf in zip(lines, left, right):
+        if lf not in bank or rf not in bank or line is None or line.is_empty:
+            continue
+        for part in shapely.get_parts(line):
+            pts = shapely.line_interpolate_point(part, np.linspace(0, 1, 51)[1:-1], normalized=True)
+            dl = shapely.distance(pts, bank[lf])
+            dr = shapely.distance(pts, bank[rf])
+            s = dl + dr
+            keep = s > 0
+            zs.append(np.abs(dl - dr)[keep] / s[keep])
+    z = np.concatenate(zs) if zs else np.array([])
+    return (float(z.mean()) if len(z) else float("nan")), int(len(z))
+
+
+def measure_ours(src, rivers_layer, units_layer, out, samples=20000):
+    units = read(src, units_layer)
+    rivers = read(src, rivers_layer)
+    cov = pyogrio.read_dataframe(out, layer="coverage")
+    layers = {n for n, _ in pyogrio.list_layers(out)}
+    areas = pyogrio.read_dataframe(out, layer="areas") if "areas" in layers else None
+    given = pyogrio.read_dataframe(out, layer="given", read_geometry=False) if "given" in layers else None
+    bnd = pyogrio.read_dataframe(out, layer="boundaries") if "boundaries" in layers else None
+    out_geoms = cov.geometry.values
+    everything = np.concatenate([out_geoms, areas.geometry.values]) if areas is not None else out_geoms
+    a_in = shapely.area(units.geometry.values).sum() + shapely.area(rivers.geometry.values).sum()
+    a_out = shapely.area(everything).sum()
+    received = set(given.unit_fid) if given is not None else set()
+    orig = as_multi(units.geometry.loc[cov.src_fid].values)
+    same = shapely.equals_exact(orig, out_geoms, tolerance=0)
+    unchanged_ok = bool(all(s for s, f in zip(same, cov.src_fid) if f not in received))
+    lost = shapely.area(shapely.difference(orig, out_geoms))
+    shrunk = int((lost > 1e-9 * np.maximum(shapely.area(orig), 1.0)).sum())
+    bank = banks(rivers, units)
+    m = {
+        "units": len(cov),
+        "grown": int((~same).sum()),
+        "coverage_valid": bool(shapely.coverage_is_valid(everything)),
+        "all_valid": bool(shapely.is_valid(everything).all()),
+        "area_rel": float(abs(a_out - a_in) / a_in),
+        "unchanged_bit_for_bit": unchanged_ok,
+        "shrunk": shrunk,
+        "same_order": list(cov.src_fid) == sorted(cov.src_fid),
+    }
+    if given is not None:
+        gained = shapely.area(out_geoms) - shapely.area(orig)
+        by = given.groupby("unit_fid")["area"].sum()
+        want = np.array([by.get(f, 0.0) for f in cov.src_fid])
+        m["given_rel"] = float(np.abs(gained - want).max() / a_in)
+    if samples:
+        pts = sample_points(rivers, samples)
+        # Points nearest to bank no unit owns are not judged.
+        edge = shapely.union_all(rivers.geometry.values).boundary
+        owned = shapely.union_all(list(bank.values()))
+        free = shapely.difference(edge, owned)
+        judged = pts
+        if not free.is_empty and free.length > 0:
+            d_free = shapely.distance(pts, free)
+            d_owned = shapely.distance(pts, owned)
+            judged = pts[d_owned < d_free]
+        polys = np.concatenate([out_geoms, areas.geometry.values]) if areas is not None else out_geoms
+        fids = list(cov.src_fid) + ([-2] * len(areas) if areas is not None else [])
+        m["nearest"] = nearest_share(judged, polys, fids, bank)
+        m["nearest_points"] = int(len(judged))
+    if bnd is not None and len(bnd):
+        m["z_mean"], m["z_points"] = boundary_z(
+            bnd.geometry.values, bnd.left_fid.fillna(-1).astype(int), bnd.right_fid.fillna(-1).astype(int), bank
+        )
+    return m
+
+
+def measure_peer(src, rivers_layer, units_layer):
+    """CoverageCleaner on the units alone (each collapsed polygon a gap, merged
+    into the neighbour with the longest shared border), measured as ours."""
+    units = read(src, units_layer)
+    rivers = read(src, rivers_layer)
+    width = max(max(g.bounds[2] - g.bounds[0], g.bounds[3] - g.bounds[1]) for g in rivers.geometry)
+    cleaned = shapely.coverage_clean(units.geometry.values, gap_width=width)
+    bank = banks(rivers, units)
+    everything = cleaned
+    a_in = shapely.area(units.geometry.values).sum() + shapely.area(rivers.geometry.values).sum()
+    river = shapely.union_all(rivers.geometry.values)
+    shapely.prepare(river)
+    # New boundaries: what two cleaned units share now and did not before,
+    # in or on the collapsed polygons (along a bank, where one unit took the
+    # whole polygon).
+    tree = shapely.STRtree(cleaned)
+    a, b = tree.query(cleaned, predicate="touches")
+    lines, left, right = [], [], []
+    fids = list(units.index)
+    before = units.geometry.values
+    for i, j in zip(a, b):
+        if i >= j:
+            continue
+        shared = shapely.intersection(cleaned[i].boundary, cleaned[j].boundary)
+        new = shapely.difference(shared, shapely.intersection(before[i].boundary, before[j].boundary))
+        new = shapely.intersection(new, river)
+        if new.is_empty or new.length == 0:
+            continue
+        lines.append(new)
+        left.append(fids[i])
+        right.append(fids[j])
+    pts = sample_points(rivers, 20000)
+    m = {
+        "coverage_valid": bool(shapely.coverage_is_valid(everything)),
+        "area_rel": float(abs(shapely.area(everything).sum() - a_in) / a_in),
+        "nearest": nearest_share(pts, cleaned, fids, bank),
+    }
+    m["z_mean"], m["z_points"] = boundary_z(lines, left, right, bank)
+    return m
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("src")
+    p.add_argument("rivers")
+    p.add_argument("units")
+    p.add_argument("out")
+    p.add_argument("--peer", action="store_true")
+    p.add_argument("--samples", type=int, default=20000, help="random points (0: no nearest-bank measure)")
+    o = p.parse_args()
+    print(json.dumps({"tool": "skeletonise", **measure_ours(o.src, o.rivers, o.units, o.out, o.samples)}))
+    if o.peer:
+        print(json.dumps({"tool": "CoverageCleaner", **measure_peer(o.src, o.rivers, o.units)}))
+
+
+if __name__ == "__main__":
+    main()
