@@ -18,7 +18,14 @@
 //! their two edges' normals.
 //!
 //! With `unowned: keep` (the default) the area nearest to unowned bank is a
-//! remainder polygon of its own (an `areas` row, `kind = unowned`).
+//! remainder polygon of its own (an `areas` row, `kind = unowned`); with
+//! `nearest` each such piece goes to the owned piece it borders along the
+//! longest stretch. With `width` only the narrow parts are given away:
+//! what is narrow is decided on the medial axis's discs as `collapse`
+//! decides it (`narrow`), its cuts are noded with the new boundaries, and
+//! the faces in the wide parts stay polygons (`kind = wide`). The new
+//! boundaries written are the edges between faces that go to different
+//! owners.
 //! Weights (a unit's "attractiveness", as SPLITAREA has it) are left out:
 //! a weighted distance makes the boundaries curves that are neither the
 //! medial axis nor exactly shared, and the step would no longer be exact.
