@@ -5,9 +5,11 @@
 # (scripts/make_partition_bench.py; 1 000 polygons, 10 000 units by default), through
 #   A: MA with prune and extend (the centrelines), and
 #   B: the same with `partition`;
-# wall time, CPU time and peak RSS from /usr/bin/time -v of each whole process. The step's cost
-# is B's CPU time less A's; the MA skeleton's is its thread CPU time from A's run record
-# (skeletonise_runs.stage_seconds). Then GEOS CoverageCleaner (shapely.coverage_clean, longest
+# wall time, CPU time and peak RSS from /usr/bin/time -v of each whole process. The step's own
+# cost is its thread CPU time in B's run record (skeletonise_runs.stage_seconds: "partition", the
+# polygons and the coverage assembled at the end); the MA skeleton's is its thread CPU time there
+# too ("MA": "skeleton"). The whole run's extra cost (B's CPU time less A's) also counts reading
+# the units and writing them grown. Then GEOS CoverageCleaner (shapely.coverage_clean, longest
 # border) on the same units, for scale.
 #
 #   scripts/bench-partition.sh              # N=1000
@@ -21,7 +23,7 @@ N=${N:-1000}
 WORK=$PWD/target/bench
 mkdir -p "$WORK"
 [ -x /usr/bin/time ] || { apt-get update -qq && apt-get install -y -qq --no-install-recommends time >/dev/null; }
-scripts/python-env.sh >/dev/null
+[ -x target/py-venv/bin/python ] || scripts/python-env.sh >/dev/null
 PY=$PWD/target/py-venv/bin/python
 DATA=$WORK/partition-$N.gpkg
 [ -f "$DATA" ] || "$PY" scripts/make_partition_bench.py "$DATA" --rivers "$N"
@@ -59,10 +61,11 @@ wall() { sed -n 's/.*Elapsed (wall clock) time (h:mm:ss or m:ss): //p' "$1" |
   awk -F: '{ s = 0; for (i = 1; i <= NF; i++) s = s * 60 + $i; printf "%.2f", s }'; }
 cpu() { awk -F': ' '/User time|System time/ { s += $2 } END { printf "%.2f", s }' "$1"; }
 rss() { sed -n 's/.*Maximum resident set size (kbytes): //p' "$1" | awk '{ printf "%.0f", $1 / 1024 }'; }
-ma_skeleton=$("$PY" -c "
+read -r ma_skeleton own <<<"$("$PY" -c "
 import json, sys, pyogrio
 r = pyogrio.read_dataframe(sys.argv[1], layer='skeletonise_runs', read_geometry=False)
-print('%.2f' % json.loads(r.stage_seconds.iloc[-1])['MA']['skeleton'])" "$WORK/partition-ma.gpkg")
+s = json.loads(r.stage_seconds.iloc[-1])
+print('%.2f %.2f' % (s['MA']['skeleton'], s['partition']))" "$WORK/partition-partition.gpkg")"
 counts=$("$PY" -c "
 import sys, pyogrio, shapely
 r = pyogrio.read_dataframe(sys.argv[1], layer='rivers')
@@ -86,5 +89,5 @@ step=$(awk -v b="$(cpu "$WORK/partition-partition.time")" -v a="$(cpu "$WORK/par
     echo "| $label | $(wall "$WORK/partition-$run.time") | $(cpu "$WORK/partition-$run.time") | $(rss "$WORK/partition-$run.time") |"
   done
   echo
-  echo "The step: $step CPU s (B − A); the MA skeleton: $ma_skeleton CPU s (A's stage_seconds); ratio $(awk -v s="$step" -v m="$ma_skeleton" 'BEGIN { printf "%.2f", s / m }')."
+  echo "The step: $own CPU s (B's stage_seconds), $(awk -v s="$own" -v m="$ma_skeleton" 'BEGIN { printf "%.2f", s / m }')× the MA skeleton's $ma_skeleton CPU s; the whole run's extra CPU time (B − A, with reading and writing the units) $step s, $(awk -v s="$step" -v m="$ma_skeleton" 'BEGIN { printf "%.2f", s / m }')×."
 } | tee "$WORK/partition.md"

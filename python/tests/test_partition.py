@@ -263,3 +263,17 @@ on_error: reject
     r = run(yaml, tmp_path / "out.gpkg", "on_error=fail", check=False)
     assert r.returncode == 65 and "overlaps the interior of unit 2" in r.stderr, r.stderr
     assert not (tmp_path / "out.gpkg").exists()
+
+
+def test_a_raster_staircase_river_is_partitioned_like_a_smooth_one(tmp_path):
+    # The Danube reach as a raster of 40 m cells makes it (staircase banks: reflex and
+    # straight-angle vertices everywhere, unit boundaries meeting the bank on a step), with a
+    # generated coverage around it.
+    import make_coverage
+    import make_partition_bench
+
+    danube = pyogrio.read_dataframe(ROOT / "tests" / "data" / "gshhg-train.gpkg", layer="river_danube")
+    stairs = make_partition_bench.staircase(danube.geometry.iloc[0], 40.0)
+    rivers, units = make_coverage.coverage(stairs, 40, 3000.0, 0.01, np.random.default_rng(7), 1)
+    m, cov, bnd, areas = partition_case(tmp_path, rivers, units)
+    assert m["nearest"] >= 0.999 and m["z_mean"] <= 0.001 and m["grown"] >= 10, m

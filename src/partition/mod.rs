@@ -223,7 +223,7 @@ pub fn partition(
         .chain(cuts.iter().cloned())
         .map(LineString)
         .collect();
-    let faces = split::faces(&owned, &vertices, &chords)?;
+    let faces = split::faces(&prepared, &owned, &vertices, &chords)?;
     let mut sides: Vec<Side> = faces
         .iter()
         .map(|f| match narrow::is_wide(&f.face.polygon, &wide_parts) {

@@ -107,6 +107,9 @@ fn insert(lines: &mut [Vec<Coord<f64>>], inserts: &Inserts) {
 /// Whether `face` lies in one of the `wide` parts: its inner point does.
 pub(super) fn is_wide(face: &Polygon<f64>, wide: &[Polygon<f64>]) -> bool {
     use geo::{Contains, InteriorPoint};
+    if wide.is_empty() {
+        return false;
+    }
     face.interior_point()
         .is_some_and(|x| wide.iter().any(|w| w.contains(&x)))
 }

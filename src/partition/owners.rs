@@ -287,6 +287,15 @@ pub(super) fn with_inserted(
     )
 }
 
+/// The rings of a unit.
+fn rings(u: &Unit) -> Vec<&LineString<f64>> {
+    u.geometry
+        .0
+        .iter()
+        .flat_map(|q| std::iter::once(q.exterior()).chain(q.interiors()))
+        .collect()
+}
+
 /// An error when a unit near `p` overlaps its interior: a vertex of one
 /// farther than `tol` inside the other, or edges that cross.
 fn overlaps(
@@ -306,28 +315,63 @@ fn overlaps(
     near.sort_unstable();
     near.dedup();
     let inside_p = |v: Coord<f64>| b.contains(v) && b.distance(v) > tol;
-    for &k in &near {
-        let unit = &cov.units[k as usize];
-        let ub = Boundary::from_rings(
-            unit.geometry
-                .0
-                .iter()
-                .flat_map(|q| std::iter::once(q.exterior()).chain(q.interiors())),
+    let bounds: Vec<Boundary> = near
+        .iter()
+        .map(|&k| Boundary::from_rings(rings(&cov.units[k as usize]).into_iter()))
+        .collect();
+    // The polygon's vertices by the units whose box holds them, so that
+    // each is tested against a few units, not all near ones.
+    let boxes: RTree<GeomWithData<rstar::primitives::Rectangle<[f64; 2]>, usize>> =
+        RTree::bulk_load(
+            near.iter()
+                .enumerate()
+                .filter_map(|(i, &k)| {
+                    let r = cov.units[k as usize].geometry.bounding_rect()?;
+                    Some(GeomWithData::new(
+                        rstar::primitives::Rectangle::from_corners(
+                            [r.min().x - tol, r.min().y - tol],
+                            [r.max().x + tol, r.max().y + tol],
+                        ),
+                        i,
+                    ))
+                })
+                .collect(),
         );
-        let inside_u = |v: Coord<f64>| ub.contains(v) && ub.distance(v) > tol;
-        let vertex_in = unit
-            .geometry
-            .0
-            .iter()
-            .flat_map(|q| std::iter::once(q.exterior()).chain(q.interiors()))
-            .flat_map(|r| r.0.iter())
-            .find(|&&v| inside_p(v))
-            .or_else(|| {
-                std::iter::once(polygon.exterior())
-                    .chain(polygon.interiors())
-                    .flat_map(|r| r.0.iter())
-                    .find(|&&v| inside_u(v))
-            });
+    // A vertex the polygon and a unit share lies on both boundaries: only
+    // the others are tested for lying inside (an overlap through shared
+    // vertices alone shows as crossing edges).
+    let p_vertices: rustc_hash::FxHashSet<(u64, u64)> = std::iter::once(polygon.exterior())
+        .chain(polygon.interiors())
+        .flat_map(|r| r.0.iter().map(|&c| key(c)))
+        .collect();
+    let unit_vertices: rustc_hash::FxHashSet<(u64, u64)> = near
+        .iter()
+        .flat_map(|&k| rings(&cov.units[k as usize]))
+        .flat_map(|r| r.0.iter().map(|&c| key(c)))
+        .collect();
+    let mut p_vertex_in: Vec<Option<Coord<f64>>> = vec![None; near.len()];
+    for &v in std::iter::once(polygon.exterior())
+        .chain(polygon.interiors())
+        .flat_map(|r| r.0.iter())
+        .filter(|&&v| !unit_vertices.contains(&key(v)))
+    {
+        for hit in boxes.locate_all_at_point(&[v.x, v.y]) {
+            let i = hit.data;
+            let ub = &bounds[i];
+            if p_vertex_in[i].is_none() && ub.contains(v) && ub.distance(v) > tol {
+                p_vertex_in[i] = Some(v);
+            }
+        }
+    }
+    for (i, &k) in near.iter().enumerate() {
+        let unit = &cov.units[k as usize];
+        let ub = &bounds[i];
+        let vertex_in = rings(unit)
+            .into_iter()
+            .flat_map(|r| r.0.iter().copied())
+            .filter(|&v| !p_vertices.contains(&key(v)))
+            .find(|&v| inside_p(v))
+            .or(p_vertex_in[i]);
         let crossing = || {
             ub.segments().iter().find_map(|s| {
                 b.segments_near(s.a, s.b)
@@ -338,7 +382,7 @@ fn overlaps(
                     .map(|t| crate::geometry::segment::crossing_point(s.a, s.b, t.a, t.b))
             })
         };
-        if let Some(at) = vertex_in.copied().or_else(crossing) {
+        if let Some(at) = vertex_in.or_else(crossing) {
             let fid = unit
                 .fid
                 .map_or_else(|| "(no fid)".into(), |f| f.to_string());

@@ -283,19 +283,19 @@ fn ray_hit(
     (t > 0.0 && (0.0..=1.0).contains(&u)).then(|| (t, a + s * u))
 }
 
-/// The polygon split along `chords` (the new boundaries, and the cuts of
-/// a partial partition), each face with its owner: the owner of the most
+/// The polygon `p` (`owned`'s, prepared) split along `chords` (the new
+/// boundaries, and the cuts of a partial partition), each face with its owner: the owner of the most
 /// of its bank by length (every bank edge of a face has the same owner
 /// unless the boundaries are broken); a face with no bank edge (a cut
 /// through the cell of a reflex vertex leaves two) takes the owner of the
 /// vertex's cell where the face lies.
 pub fn faces(
+    p: &PreparedPolygon,
     owned: &Owned,
     vertices: &Vertices,
     chords: &[LineString<f64>],
 ) -> Result<Vec<OwnedFace>, String> {
-    let p = PreparedPolygon::new(&owned.polygon).map_err(|e| e.to_string())?;
-    let faces = split_network(&p, chords).map_err(|e| {
+    let faces = split_network(p, chords).map_err(|e| {
         format!("the new boundaries do not split the polygon ({e}); please report this feature")
     })?;
     Ok(faces

@@ -369,7 +369,9 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
         progress.finish();
         // The partitioned coverage: every unit, grown by what it received.
         if let (Ok(()), Some(cov)) = (&result, &params.neighbours) {
+            let clock = crate::clock::CpuClock::start();
             let coverage = crate::partition::assemble(cov.units(), grown);
+            counts.partition_time += clock.elapsed();
             counts.units = Some(coverage.len() as u64);
             let grew: Vec<f64> = coverage
                 .iter()

@@ -27,6 +27,9 @@ pub(super) struct Counts {
     pub(super) network: Option<u64>,
     /// Units of the partitioned coverage written, when the run partitions.
     pub(super) units: Option<u64>,
+    /// The `partition` step's CPU time: the polygons, and the coverage
+    /// assembled at the end.
+    pub(super) partition_time: std::time::Duration,
 }
 
 impl Counts {
@@ -60,6 +63,7 @@ impl Counts {
         self.connections += r.rows.connections.len() as u64;
         self.lines_used
             .extend(r.rows.connections.iter().map(|c| c.line_fid));
+        self.partition_time += r.partition_time;
         for (m, t) in &r.times {
             match self.stages.iter_mut().find(|(x, _)| x == m) {
                 Some((_, total)) => *total += *t,
@@ -100,7 +104,7 @@ pub(super) fn finish_run(
         filtered: counts.filtered,
         elapsed_s,
         threads,
-        stage_seconds: stage_json(&counts.stages),
+        stage_seconds: stage_json(&counts.stages, counts.units.map(|_| counts.partition_time)),
     };
     let out = writer.finish(&record)?;
     Ok(RunSummary {
@@ -123,9 +127,10 @@ pub(super) fn finish_run(
 }
 
 /// Step times as JSON for `skeletonise_runs.stage_seconds`:
-/// `{"MA": {"skeleton": 1.2, "prune_extend": 0.3, "score": 0.4}, …}`.
-fn stage_json(stages: &[(MethodId, StageTimes)]) -> String {
-    let map: serde_json::Map<String, serde_json::Value> = stages
+/// `{"MA": {"skeleton": 1.2, "prune_extend": 0.3, "score": 0.4}, …}`, and
+/// `"partition": 0.8` when the run partitions.
+fn stage_json(stages: &[(MethodId, StageTimes)], partition: Option<std::time::Duration>) -> String {
+    let mut map: serde_json::Map<String, serde_json::Value> = stages
         .iter()
         .map(|(m, t)| {
             (
@@ -138,6 +143,9 @@ fn stage_json(stages: &[(MethodId, StageTimes)]) -> String {
             )
         })
         .collect();
+    if let Some(p) = partition {
+        map.insert("partition".into(), serde_json::json!(round_ms(p)));
+    }
     serde_json::Value::Object(map).to_string()
 }
 

@@ -22,7 +22,7 @@ pub(crate) use prepare::part_reason;
 pub use prepare::{polygon_parts, prepare, NotPrepared, PrepareParams};
 pub use rows::{feature_rows, FeatureRows, RowOptions, Skeletons, Status};
 pub use types::{
-    Candidate, CandidateSkeleton, FeatureOutcome, ProcessParams, Processed, StageTimes,
+    Candidate, CandidateSkeleton, FeatureOutcome, ProcessParams, Processed, StageTimes, StepTime,
 };
 
 /// `f` over `items`, results in the items' order: in parallel, or on the

@@ -46,6 +46,7 @@ pub fn process(geom: Option<&Geometry<f64>>, params: &ProcessParams) -> Processe
     if let (Some(pp), Some(cov), Processed::Done(o)) =
         (&params.partition, &params.neighbours, &mut processed)
     {
+        let clock = crate::clock::CpuClock::start();
         // With `width`, the medial axis's discs say what is narrow.
         let ma = o
             .candidates
@@ -62,7 +63,10 @@ pub fn process(geom: Option<&Geometry<f64>>, params: &ProcessParams) -> Processe
             })
             .collect();
         match parts {
-            Ok(parts) => o.partition = Some(parts),
+            Ok(parts) => {
+                o.partition = Some(parts);
+                o.partition_time = super::StepTime(clock.elapsed());
+            }
             Err(reason) => return Processed::Rejected(reason),
         }
     }
@@ -227,6 +231,7 @@ fn choose(candidates: Vec<Candidate>, parts: usize, params: &ProcessParams) -> P
             measures: None,
             extra: Vec::new(),
             partition: None,
+            partition_time: Default::default(),
         }),
         None => Processed::Rejected(rejection(&candidates)),
     }

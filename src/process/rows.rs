@@ -75,6 +75,8 @@ pub struct FeatureRows {
     pub status: Status,
     /// Each method's step times on this feature (all its units).
     pub times: Vec<(MethodId, StageTimes)>,
+    /// The `partition` step's CPU time on this feature.
+    pub partition_time: std::time::Duration,
 }
 
 /// The output rows of one feature (see the module documentation).
@@ -91,10 +93,12 @@ pub fn feature_rows(
             rows,
             status: Status::Rejected,
             times: Vec::new(),
+            partition_time: Default::default(),
         };
     }
     let mut methods = Vec::new();
     let mut times: Vec<(MethodId, StageTimes)> = Vec::new();
+    let mut partition_time = std::time::Duration::ZERO;
     for (part, geom) in units(f.geometry.as_ref(), opts.explode) {
         // A panic is a bug; it must cost this feature, never the run.
         let processed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| match skeletons {
@@ -123,6 +127,7 @@ pub fn feature_rows(
                         None => times.push((c.method, c.time)),
                     }
                 }
+                partition_time += o.partition_time.0;
                 methods.push(outcome_rows(f, part, &o, label, opts, &mut rows));
             }
             Processed::Filtered => {}
@@ -155,6 +160,7 @@ pub fn feature_rows(
         rows,
         status,
         times,
+        partition_time,
     }
 }
 

@@ -103,6 +103,17 @@ pub struct CandidateSkeleton {
     pub note: Option<String>,
 }
 
+/// A step's thread CPU time on one feature: a measurement, not a result
+/// (any two compare equal, as [`StageTimes`] do).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct StepTime(pub std::time::Duration);
+
+impl PartialEq for StepTime {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
 /// What the pipeline writes for one feature.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FeatureOutcome {
@@ -124,6 +135,8 @@ pub struct FeatureOutcome {
     pub extra: Vec<(&'static str, crate::layer::StepRow)>,
     /// The partition of every polygon part, when the pipeline partitions.
     pub partition: Option<Vec<crate::partition::PartPartition>>,
+    /// The `partition` step's CPU time on the feature.
+    pub partition_time: StepTime,
 }
 
 impl FeatureOutcome {

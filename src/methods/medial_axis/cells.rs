@@ -45,24 +45,31 @@ pub fn cell_edges(
     Extractor::new(&diagram, &segs, &grid, tolerance).cells()
 }
 
+/// The input vertex each grid point was rounded from (the first segment
+/// that starts there gives it).
+type Vertices = rustc_hash::FxHashMap<super::Pt, Coord<f64>>;
+
 impl Extractor<'_> {
-    /// The site in world coordinates.
-    fn world_site(&self, s: GridSite) -> CellSite {
+    /// The site in world coordinates: a vertex site the input vertex it was
+    /// rounded from.
+    fn world_site(&self, vertices: &Vertices, s: GridSite) -> CellSite {
         match s {
             GridSite::Segment(i) => CellSite::Segment(self.segs[i].wa, self.segs[i].wb),
-            GridSite::Point(p) => {
-                let w = self
-                    .segs
-                    .iter()
-                    .find(|s| s.a == p)
-                    .map_or_else(|| self.grid.world(p[0] as f64, p[1] as f64), |s| s.wa);
-                CellSite::Vertex(w)
-            }
+            GridSite::Point(p) => CellSite::Vertex(
+                vertices
+                    .get(&p)
+                    .copied()
+                    .unwrap_or_else(|| self.grid.world(p[0] as f64, p[1] as f64)),
+            ),
         }
     }
 
     /// Every inside edge with its sites (see [`cell_edges`]).
     fn cells(mut self) -> Result<Vec<CellEdge>, MethodError> {
+        let mut vertices = Vertices::default();
+        for s in self.segs {
+            vertices.entry(s.a).or_insert(s.wa);
+        }
         let kept = self.inside_edges(true)?;
         let mut rep = self.representatives(&kept);
         let mut out = Vec::with_capacity(kept.len());
@@ -76,6 +83,16 @@ impl Extractor<'_> {
             }
             let (w0, _) = self.position(r0, k.s0);
             let (w1, _) = self.position(r1, k.s0);
+            if let Some(line) = self.through_vertex(&vertices, k.s0, k.s1, r0, r1, w0, w1) {
+                out.push(CellEdge {
+                    sites: [
+                        self.world_site(&vertices, k.s0),
+                        self.world_site(&vertices, k.s1),
+                    ],
+                    line,
+                });
+                continue;
+            }
             let mut line = vec![w0];
             if k.curved {
                 let (p0, p1) = (self.vertex_at(r0), self.vertex_at(r1));
@@ -83,12 +100,56 @@ impl Extractor<'_> {
             }
             line.push(w1);
             out.push(CellEdge {
-                sites: [self.world_site(k.s0), self.world_site(k.s1)],
+                sites: [
+                    self.world_site(&vertices, k.s0),
+                    self.world_site(&vertices, k.s1),
+                ],
                 line,
             });
         }
-        out.extend(self.normals_through_vertices(&mut rep));
+        out.extend(self.normals_through_vertices(&mut rep, &vertices));
         Ok(out)
+    }
+
+    /// A secondary edge (between a segment and its own end point) that
+    /// runs through that point — the normal at a straight-angle vertex,
+    /// between Voronoi vertices on both sides of ∂P — cut there: its part
+    /// on P's side, from or to the vertex (the same direction). `None` for
+    /// any other edge.
+    #[allow(clippy::too_many_arguments)]
+    fn through_vertex(
+        &self,
+        vertices: &Vertices,
+        s0: GridSite,
+        s1: GridSite,
+        r0: usize,
+        r1: usize,
+        w0: Coord<f64>,
+        w1: Coord<f64>,
+    ) -> Option<Vec<Coord<f64>>> {
+        let (q, seg) = match (s0, s1) {
+            (GridSite::Point(q), GridSite::Segment(s))
+            | (GridSite::Segment(s), GridSite::Point(q)) => (q, s),
+            _ => return None,
+        };
+        let sg = &self.segs[seg];
+        if sg.a != q && sg.b != q {
+            return None;
+        }
+        // A secondary edge is the normal to the segment at q: it crosses ∂P
+        // (at q) when its ends lie on both sides of the segment's line.
+        let (p0, p1) = (self.vertex_at(r0), self.vertex_at(r1));
+        if super::side(sg, p0) * super::side(sg, p1) >= 0.0 {
+            return None;
+        }
+        let CellSite::Vertex(wq) = self.world_site(vertices, GridSite::Point(q)) else {
+            return None;
+        };
+        Some(if super::side(sg, p1) > 0.0 {
+            vec![wq, w1]
+        } else {
+            vec![w0, wq]
+        })
     }
 
     /// The secondary edges that pass through their vertex site (the normal
@@ -96,7 +157,7 @@ impl Extractor<'_> {
     /// the diagram holds them as rays from infinity through the vertex to a
     /// Voronoi vertex; their part in P runs from the vertex to that Voronoi
     /// vertex.
-    fn normals_through_vertices(&self, rep: &mut [usize]) -> Vec<CellEdge> {
+    fn normals_through_vertices(&self, rep: &mut [usize], vertices: &Vertices) -> Vec<CellEdge> {
         let d = self.diagram;
         let edges = d.edges();
         let mut out = Vec::new();
@@ -129,11 +190,11 @@ impl Extractor<'_> {
             }
             let r = super::find(rep, v.usize());
             let (w, _) = self.position(r, s0);
-            let CellSite::Vertex(wq) = self.world_site(GridSite::Point(q)) else {
+            let CellSite::Vertex(wq) = self.world_site(vertices, GridSite::Point(q)) else {
                 continue;
             };
             out.push(CellEdge {
-                sites: [self.world_site(s0), self.world_site(s1)],
+                sites: [self.world_site(vertices, s0), self.world_site(vertices, s1)],
                 line: vec![wq, w],
             });
         }

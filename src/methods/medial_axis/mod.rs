@@ -424,10 +424,22 @@ impl<'a> Extractor<'a> {
                 continue;
             }
             let mid = [0.5 * (p0[0] + p1[0]), 0.5 * (p0[1] + p1[1])];
-            let inside = match (s0, s1) {
-                (Site::Segment(s), _) | (_, Site::Segment(s)) => side(&self.segs[s], mid) > 0.0,
-                _ => self.point_cell_is_inside(cell0) || self.point_cell_is_inside(cell1),
-            };
+            // With `all`: the normal at a straight-angle vertex between
+            // Voronoi vertices on both sides of ∂P (the cells cut it at the
+            // vertex).
+            let straddles = all
+                && match (s0, s1) {
+                    (Site::Point(q), Site::Segment(s)) | (Site::Segment(s), Site::Point(q)) => {
+                        let sg = &self.segs[s];
+                        (sg.a == q || sg.b == q) && side(sg, p0) * side(sg, p1) < 0.0
+                    }
+                    _ => false,
+                };
+            let inside = straddles
+                || match (s0, s1) {
+                    (Site::Segment(s), _) | (_, Site::Segment(s)) => side(&self.segs[s], mid) > 0.0,
+                    _ => self.point_cell_is_inside(cell0) || self.point_cell_is_inside(cell1),
+                };
             if !inside {
                 continue;
             }
