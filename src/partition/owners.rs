@@ -317,7 +317,7 @@ fn overlaps(
     let inside_p = |v: Coord<f64>| b.contains(v) && b.distance(v) > tol;
     let bounds: Vec<Boundary> = near
         .iter()
-        .map(|&k| Boundary::from_rings(rings(&cov.units[k as usize]).into_iter()))
+        .map(|&k| Boundary::from_rings(rings(&cov.units[k as usize])))
         .collect();
     // The polygon's vertices by the units whose box holds them, so that
     // each is tested against a few units, not all near ones.
