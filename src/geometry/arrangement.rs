@@ -298,46 +298,60 @@ fn faces(g: &Graph) -> Vec<Face> {
             continue;
         }
         for part in simple_cycles(g, &cycle) {
-            let coords: Vec<Coord<f64>> = part
-                .iter()
-                .map(|&h| g.pos[g.half[h as usize].from as usize])
-                .collect();
-            let chords = part
-                .iter()
-                .filter_map(|&h| g.half[h as usize].chord)
-                .collect();
-            if signed_area(&coords) > 0.0 {
-                let edges = part
-                    .iter()
-                    .map(|&h| (g.half[h as usize].from, g.half[h as usize].to))
-                    .collect();
-                shells.push(Shell {
-                    coords,
-                    chords,
-                    edges,
-                });
-            } else {
-                // A hole of the face: a ring, or rings joined by chords. It
-                // is placed by the middle of a ring edge, which no other
-                // face has on its boundary; a hole of chords alone (a loop
-                // of boundaries around an island) by the middle of a chord,
-                // which the face inside the loop has on its boundary too.
-                let ring_edge = part
-                    .iter()
-                    .copied()
-                    .find(|&h| g.half[h as usize].chord.is_none());
-                let e = g.half[ring_edge.unwrap_or(part[0]) as usize];
-                let probe = (g.pos[e.from as usize] + g.pos[e.to as usize]) * 0.5;
-                holes.push(Hole {
-                    coords,
-                    chords,
-                    probe,
-                    on_chord: ring_edge.is_none().then_some((e.from, e.to)),
-                });
+            match ring_of(g, &part) {
+                Ring::Shell(shell) => shells.push(shell),
+                Ring::Hole(hole) => holes.push(hole),
             }
         }
     }
     assemble(shells, holes)
+}
+
+/// A simple cycle of half-edges as the shell of a face or as a hole.
+enum Ring {
+    Shell(Shell),
+    Hole(Hole),
+}
+
+/// A simple cycle of half-edges with P on its left: a shell when it turns
+/// counter-clockwise, else a hole of the face around it.
+fn ring_of(g: &Graph, part: &[u32]) -> Ring {
+    let coords: Vec<Coord<f64>> = part
+        .iter()
+        .map(|&h| g.pos[g.half[h as usize].from as usize])
+        .collect();
+    let chords = part
+        .iter()
+        .filter_map(|&h| g.half[h as usize].chord)
+        .collect();
+    if signed_area(&coords) > 0.0 {
+        let edges = part
+            .iter()
+            .map(|&h| (g.half[h as usize].from, g.half[h as usize].to))
+            .collect();
+        return Ring::Shell(Shell {
+            coords,
+            chords,
+            edges,
+        });
+    }
+    // A hole of the face: a ring, or rings joined by chords. It is placed by
+    // the middle of a ring edge, which no other face has on its boundary; a
+    // hole of chords alone (a loop of boundaries around an island) by the
+    // middle of a chord, which the face inside the loop has on its boundary
+    // too.
+    let ring_edge = part
+        .iter()
+        .copied()
+        .find(|&h| g.half[h as usize].chord.is_none());
+    let e = g.half[ring_edge.unwrap_or(part[0]) as usize];
+    let probe = (g.pos[e.from as usize] + g.pos[e.to as usize]) * 0.5;
+    Ring::Hole(Hole {
+        coords,
+        chords,
+        probe,
+        on_chord: ring_edge.is_none().then_some((e.from, e.to)),
+    })
 }
 
 /// A cycle with P on its left that turns clockwise: a hole of the face

@@ -314,29 +314,12 @@ fn overlaps(
         .collect();
     near.sort_unstable();
     near.dedup();
-    let inside_p = |v: Coord<f64>| b.contains(v) && b.distance(v) > tol;
-    let bounds: Vec<Boundary> = near
+    let units: Vec<&Unit> = near.iter().map(|&k| &cov.units[k as usize]).collect();
+    let bounds: Vec<Boundary> = units
         .iter()
-        .map(|&k| Boundary::from_rings(rings(&cov.units[k as usize])))
+        .map(|u| Boundary::from_rings(rings(u)))
         .collect();
-    // The polygon's vertices by the units whose box holds them, so that
-    // each is tested against a few units, not all near ones.
-    let boxes: RTree<GeomWithData<rstar::primitives::Rectangle<[f64; 2]>, usize>> =
-        RTree::bulk_load(
-            near.iter()
-                .enumerate()
-                .filter_map(|(i, &k)| {
-                    let r = cov.units[k as usize].geometry.bounding_rect()?;
-                    Some(GeomWithData::new(
-                        rstar::primitives::Rectangle::from_corners(
-                            [r.min().x - tol, r.min().y - tol],
-                            [r.max().x + tol, r.max().y + tol],
-                        ),
-                        i,
-                    ))
-                })
-                .collect(),
-        );
+    let inside_p = |v: Coord<f64>| b.contains(v) && b.distance(v) > tol;
     // A vertex the polygon and a unit share lies on both boundaries: only
     // the others are tested for lying inside (an overlap through shared
     // vertices alone shows as crossing edges).
@@ -344,27 +327,8 @@ fn overlaps(
         .chain(polygon.interiors())
         .flat_map(|r| r.0.iter().map(|&c| key(c)))
         .collect();
-    let unit_vertices: rustc_hash::FxHashSet<(u64, u64)> = near
-        .iter()
-        .flat_map(|&k| rings(&cov.units[k as usize]))
-        .flat_map(|r| r.0.iter().map(|&c| key(c)))
-        .collect();
-    let mut p_vertex_in: Vec<Option<Coord<f64>>> = vec![None; near.len()];
-    for &v in std::iter::once(polygon.exterior())
-        .chain(polygon.interiors())
-        .flat_map(|r| r.0.iter())
-        .filter(|&&v| !unit_vertices.contains(&key(v)))
-    {
-        for hit in boxes.locate_all_at_point(&[v.x, v.y]) {
-            let i = hit.data;
-            let ub = &bounds[i];
-            if p_vertex_in[i].is_none() && ub.contains(v) && ub.distance(v) > tol {
-                p_vertex_in[i] = Some(v);
-            }
-        }
-    }
-    for (i, &k) in near.iter().enumerate() {
-        let unit = &cov.units[k as usize];
+    let p_vertex_in = polygon_vertices_in(polygon, &units, &bounds, tol);
+    for (i, unit) in units.iter().enumerate() {
         let ub = &bounds[i];
         let vertex_in = rings(unit)
             .into_iter()
@@ -372,17 +336,7 @@ fn overlaps(
             .filter(|&v| !p_vertices.contains(&key(v)))
             .find(|&v| inside_p(v))
             .or(p_vertex_in[i]);
-        let crossing = || {
-            ub.segments().iter().find_map(|s| {
-                b.segments_near(s.a, s.b)
-                    .map(|i| &b.segments()[i])
-                    .find(|t| {
-                        properly_cross(s.a, s.b, t.a, t.b) && far_from_ends(s.a, s.b, t.a, t.b, tol)
-                    })
-                    .map(|t| crate::geometry::segment::crossing_point(s.a, s.b, t.a, t.b))
-            })
-        };
-        if let Some(at) = vertex_in.or_else(crossing) {
+        if let Some(at) = vertex_in.or_else(|| first_crossing(ub, b, tol)) {
             let fid = unit
                 .fid
                 .map_or_else(|| "(no fid)".into(), |f| f.to_string());
@@ -393,6 +347,65 @@ fn overlaps(
         }
     }
     Ok(())
+}
+
+/// For each of `units` (their boundaries `bounds`), a vertex of `polygon`
+/// farther than `tol` inside it, if any: each vertex the units do not
+/// share, tested against the units whose box holds it.
+fn polygon_vertices_in(
+    polygon: &Polygon<f64>,
+    units: &[&Unit],
+    bounds: &[Boundary],
+    tol: f64,
+) -> Vec<Option<Coord<f64>>> {
+    let boxes: RTree<GeomWithData<rstar::primitives::Rectangle<[f64; 2]>, usize>> =
+        RTree::bulk_load(
+            units
+                .iter()
+                .enumerate()
+                .filter_map(|(i, u)| {
+                    let r = u.geometry.bounding_rect()?;
+                    Some(GeomWithData::new(
+                        rstar::primitives::Rectangle::from_corners(
+                            [r.min().x - tol, r.min().y - tol],
+                            [r.max().x + tol, r.max().y + tol],
+                        ),
+                        i,
+                    ))
+                })
+                .collect(),
+        );
+    let shared: rustc_hash::FxHashSet<(u64, u64)> = units
+        .iter()
+        .flat_map(|u| rings(u))
+        .flat_map(|r| r.0.iter().map(|&c| key(c)))
+        .collect();
+    let mut inside: Vec<Option<Coord<f64>>> = vec![None; units.len()];
+    for &v in std::iter::once(polygon.exterior())
+        .chain(polygon.interiors())
+        .flat_map(|r| r.0.iter())
+        .filter(|&&v| !shared.contains(&key(v)))
+    {
+        for hit in boxes.locate_all_at_point(&[v.x, v.y]) {
+            let i = hit.data;
+            let ub = &bounds[i];
+            if inside[i].is_none() && ub.contains(v) && ub.distance(v) > tol {
+                inside[i] = Some(v);
+            }
+        }
+    }
+    inside
+}
+
+/// Where an edge of `ub` first properly crosses one of `b` (farther than
+/// `tol` from their ends).
+fn first_crossing(ub: &Boundary, b: &Boundary, tol: f64) -> Option<Coord<f64>> {
+    ub.segments().iter().find_map(|s| {
+        b.segments_near(s.a, s.b)
+            .map(|i| &b.segments()[i])
+            .find(|t| properly_cross(s.a, s.b, t.a, t.b) && far_from_ends(s.a, s.b, t.a, t.b, tol))
+            .map(|t| crate::geometry::segment::crossing_point(s.a, s.b, t.a, t.b))
+    })
 }
 
 /// Whether two crossing segments cross farther than `tol` from all four

@@ -309,13 +309,7 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
         // the thread that made them) and reports what it found first.
         let (info_tx, info_rx) = mpsc::sync_channel::<Result<SourceInfo, IoError>>(1);
         let (batch_tx, batch_rx) = mpsc::sync_channel::<Batch>(QUEUE);
-        let merge = if job.params.partition.is_some() {
-            Merge::Exactly
-        } else if job.input.merge_adjacent {
-            Merge::Dissolve
-        } else {
-            Merge::None
-        };
+        let merge = merge_of(job);
         let reader = scope
             .spawn(move || read_batches(job.input, merge, batch, make_valid, info_tx, batch_tx));
         let info = match info_rx.recv() {
@@ -324,15 +318,7 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
             Err(_) => return Err(reader_gone(reader)),
         };
         let mut params = job.params.clone();
-        if let Some(c) = &job.input.connect {
-            params.connect = Some(std::sync::Arc::new(read_network(c, &info)?));
-        }
-        let mut neighbours = None;
-        if let Some(n) = &job.input.neighbours {
-            let (coverage, source) = read_neighbours(n, &info)?;
-            params.neighbours = Some(std::sync::Arc::new(coverage));
-            neighbours = Some(source);
-        }
+        let neighbours = second_inputs(job, &info, &mut params)?;
         let params = &params;
         let writer = Writer::create(
             &job.plan,
@@ -341,16 +327,7 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
             neighbours.as_ref(),
             &job.protected(),
         )?;
-        tracing::info!(
-            pipeline = %job.name,
-            source = %info.source,
-            layer = %info.layer,
-            crs = %info.crs_name,
-            features = info.selected,
-            total_features = info.total,
-            threads,
-            "run started"
-        );
+        log_start(job, &info, threads);
         let (rows_tx, rows_rx) = mpsc::sync_channel::<Rows>(QUEUE);
         let writing = scope.spawn(move || write_batches(writer, rows_rx));
         let every = opts.progress_every.unwrap_or(PROGRESS_EVERY);
@@ -369,29 +346,8 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
         progress.finish();
         // The partitioned coverage: every unit, grown by what it received.
         if let (Ok(()), Some(cov)) = (&result, &params.neighbours) {
-            let clock = crate::clock::CpuClock::start();
-            let coverage = crate::partition::assemble(cov.units(), grown);
-            counts.partition_time += clock.elapsed();
-            counts.units = Some(coverage.len() as u64);
-            let grew: Vec<f64> = coverage
-                .iter()
-                .map(|c| c.received)
-                .filter(|&a| a > 0.0)
-                .collect();
-            tracing::info!(
-                units = coverage.len(),
-                grown = grew.len(),
-                area_given = grew.iter().sum::<f64>(),
-                "partition: {} of {} units grew by {:.6e} (CRS units²), the others are written unchanged",
-                grew.len(),
-                coverage.len(),
-                grew.iter().sum::<f64>()
-            );
             if rows_tx
-                .send(Rows {
-                    coverage,
-                    ..Rows::default()
-                })
+                .send(grown_coverage(cov, grown, &mut counts))
                 .is_err()
             {
                 result = Ok(());
@@ -407,18 +363,102 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
             })
         });
         let _ = reader.join();
-        let writer = match (result, written) {
-            (Err(e), Ok(mut w)) => {
-                w.abort();
-                return Err(e);
-            }
-            (Err(e), Err(_)) => return Err(e),
-            (Ok(()), Err(e)) => return Err(e.into()),
-            (Ok(()), Ok(w)) => w,
-        };
+        let writer = settled(result, written)?;
         counts.network = params.connect.as_ref().map(|n| n.len() as u64);
         finish_run(job, &info, counts, threads, started, clock, writer)
     })
+}
+
+/// The writer to finish the run with, when the work and the writing both
+/// succeeded; otherwise the first error (the output is then abandoned).
+fn settled(
+    result: Result<(), RunError>,
+    written: Result<Writer, IoError>,
+) -> Result<Writer, RunError> {
+    match (result, written) {
+        (Err(e), Ok(mut w)) => {
+            w.abort();
+            Err(e)
+        }
+        (Err(e), Err(_)) => Err(e),
+        (Ok(()), Err(e)) => Err(e.into()),
+        (Ok(()), Ok(w)) => Ok(w),
+    }
+}
+
+/// How the reader treats adjacent polygons: a partition merges them
+/// exactly (every vertex kept), `merge_adjacent` dissolves them.
+fn merge_of(job: &Job<'_>) -> Merge {
+    if job.params.partition.is_some() {
+        Merge::Exactly
+    } else if job.input.merge_adjacent {
+        Merge::Dissolve
+    } else {
+        Merge::None
+    }
+}
+
+/// The run's second inputs, read before any feature: the line network of
+/// `input.connect` and the coverage of `input.neighbours` (whose source,
+/// when there is one, the writer records).
+fn second_inputs(
+    job: &Job<'_>,
+    info: &SourceInfo,
+    params: &mut ProcessParams,
+) -> Result<Option<SourceInfo>, RunError> {
+    if let Some(c) = &job.input.connect {
+        params.connect = Some(std::sync::Arc::new(read_network(c, info)?));
+    }
+    let Some(n) = &job.input.neighbours else {
+        return Ok(None);
+    };
+    let (coverage, source) = read_neighbours(n, info)?;
+    params.neighbours = Some(std::sync::Arc::new(coverage));
+    Ok(Some(source))
+}
+
+fn log_start(job: &Job<'_>, info: &SourceInfo, threads: usize) {
+    tracing::info!(
+        pipeline = %job.name,
+        source = %info.source,
+        layer = %info.layer,
+        crs = %info.crs_name,
+        features = info.selected,
+        total_features = info.total,
+        threads,
+        "run started"
+    );
+}
+
+/// The partitioned coverage, once every polygon is done: every unit, grown
+/// by what it received (counted and logged).
+fn grown_coverage(
+    cov: &crate::partition::Coverage,
+    grown: Vec<(Option<u64>, geo::Polygon<f64>)>,
+    counts: &mut Counts,
+) -> Rows {
+    let clock = crate::clock::CpuClock::start();
+    let coverage = crate::partition::assemble(cov.units(), grown);
+    counts.partition_time += clock.elapsed();
+    counts.units = Some(coverage.len() as u64);
+    let grew: Vec<f64> = coverage
+        .iter()
+        .map(|c| c.received)
+        .filter(|&a| a > 0.0)
+        .collect();
+    tracing::info!(
+        units = coverage.len(),
+        grown = grew.len(),
+        area_given = grew.iter().sum::<f64>(),
+        "partition: {} of {} units grew by {:.6e} (CRS units²), the others are written unchanged",
+        grew.len(),
+        coverage.len(),
+        grew.iter().sum::<f64>()
+    );
+    Rows {
+        coverage,
+        ..Rows::default()
+    }
 }
 
 /// What the worker threads need for every batch.

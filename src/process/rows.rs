@@ -79,6 +79,30 @@ pub struct FeatureRows {
     pub partition_time: std::time::Duration,
 }
 
+/// One polygon (or polygon part) through the per-feature path, its
+/// skeletons computed or given. A panic is a bug; it must cost this
+/// feature, never the run.
+fn fenced(
+    geom: Option<&Geometry<f64>>,
+    skeletons: Skeletons<'_>,
+    params: &ProcessParams,
+) -> Processed {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| match skeletons {
+        Skeletons::Computed => process(geom, params),
+        Skeletons::Given { label, lines } => match lines {
+            Some(l) => process_given(geom, l, label, params),
+            None => Processed::Rejected(format!(
+                "{label}: no skeleton lines joined to this polygon; check the join key or the skeletons' location"
+            )),
+        },
+    }))
+    .unwrap_or_else(|_| {
+        Processed::Rejected(
+            "internal error while processing this feature; the run went on — please report it".into(),
+        )
+    })
+}
+
 /// The output rows of one feature (see the module documentation).
 pub fn feature_rows(
     f: &Feature,
@@ -100,21 +124,7 @@ pub fn feature_rows(
     let mut times: Vec<(MethodId, StageTimes)> = Vec::new();
     let mut partition_time = std::time::Duration::ZERO;
     for (part, geom) in units(f.geometry.as_ref(), opts.explode) {
-        // A panic is a bug; it must cost this feature, never the run.
-        let processed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| match skeletons {
-            Skeletons::Computed => process(geom.as_ref(), params),
-            Skeletons::Given { label, lines } => match lines {
-                Some(l) => process_given(geom.as_ref(), l, label, params),
-                None => Processed::Rejected(format!(
-                    "{label}: no skeleton lines joined to this polygon; check the join key or the skeletons' location"
-                )),
-            },
-        }))
-        .unwrap_or_else(|_| {
-            Processed::Rejected(
-                "internal error while processing this feature; the run went on — please report it".into(),
-            )
-        });
+        let processed = fenced(geom.as_ref(), skeletons, params);
         let label = match skeletons {
             Skeletons::Computed => None,
             Skeletons::Given { label, .. } => Some(label),
