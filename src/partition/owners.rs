@@ -226,11 +226,19 @@ fn with_t_junctions(p: &PreparedPolygon, cov: &Coverage, tol: f64) -> Polygon<f6
     let (lo, hi) = (b.bbox_min(), b.bbox_max());
     let mut inserts = Inserts::default();
     let mut moves: FxHashMap<(u64, u64), Coord<f64>> = FxHashMap::default();
+    // A unit vertex that is one of the polygon's is where it should be.
+    let own: rustc_hash::FxHashSet<(u64, u64)> = p
+        .rings()
+        .flat_map(|r| r.0.iter().map(|&c| key(c)))
+        .collect();
     for s in cov.near(lo, hi, tol) {
         let v = Coord {
             x: s.geom().from[0],
             y: s.geom().from[1],
         };
+        if own.contains(&key(v)) {
+            continue;
+        }
         let Some((_, i, d)) = b.nearest_within(v, tol) else {
             continue;
         };
@@ -319,7 +327,13 @@ fn overlaps(
         .iter()
         .map(|u| Boundary::from_rings(rings(u)))
         .collect();
-    let inside_p = |v: Coord<f64>| b.contains(v) && b.distance(v) > tol;
+    let inside_p = |v: Coord<f64>| {
+        let (lo, hi) = (bbox.min(), bbox.max());
+        (lo.x..=hi.x).contains(&v.x)
+            && (lo.y..=hi.y).contains(&v.y)
+            && b.contains(v)
+            && b.distance(v) > tol
+    };
     // A vertex the polygon and a unit share lies on both boundaries: only
     // the others are tested for lying inside (an overlap through shared
     // vertices alone shows as crossing edges).

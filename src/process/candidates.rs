@@ -45,7 +45,7 @@ pub(super) fn computed(
     };
     // The shared rays, split evenly between the methods.
     let rays_share = rays_time / params.skeleton.methods.len().max(1) as u32;
-    let mut candidates = super::map_in_order(&params.skeleton.methods, parallel, |k, &m| {
+    let mut candidates = map_in_order(&params.skeleton.methods, parallel, |k, &m| {
         let mut time = StageTimes::default();
         for (_, t) in per_part.iter().map(|r| &r[k]) {
             time += *t;
@@ -245,7 +245,7 @@ impl<'a> PartWork<'a> {
     /// keeps both cores busy).
     fn raw_skeletons(&self) -> Vec<Raw> {
         let methods = &self.params.skeleton.methods;
-        super::map_in_order(methods, self.parallel, |k, &m| {
+        map_in_order(methods, self.parallel, |k, &m| {
             let mut stages = Stages::new(self.parallel);
             let graph = stages.time(Stage::Skeleton, || {
                 self.params
@@ -306,7 +306,7 @@ impl<'a> PartWork<'a> {
         reference: Option<&Reference>,
     ) -> Vec<(Result<PartSkeleton, String>, StageTimes)> {
         let methods = &self.params.skeleton.methods;
-        super::map_in_order(&raws, self.parallel, |k, raw| {
+        map_in_order(&raws, self.parallel, |k, raw| {
             let mut stages = raw.stages;
             let result = stages.time(Stage::Prune, || {
                 let g = raw.graph.as_ref().map_err(Clone::clone)?;
@@ -355,7 +355,7 @@ fn bar_rays(
     if params.score.is_none() {
         return (Vec::new(), Duration::ZERO);
     }
-    let timed = super::map_in_order(prepared, parallel, |_, p| {
+    let timed = map_in_order(prepared, parallel, |_, p| {
         let clock = Stopwatch::start(parallel);
         let (rays, time) = BarRays::timed(p);
         (rays, time.unwrap_or_else(|| clock.elapsed()))
@@ -437,4 +437,21 @@ fn finish(
         note: None,
     };
     (c, cast_time + clock.elapsed().saturating_sub(in_casts))
+}
+
+/// `f` over `items`, results in the items' order: in parallel, or on the
+/// calling thread when `parallel` is false (work too small to be worth
+/// splitting, or a caller that keeps to one thread). The same results
+/// either way.
+pub fn map_in_order<T: Sync, U: Send>(
+    items: &[T],
+    parallel: bool,
+    f: impl Fn(usize, &T) -> U + Sync + Send,
+) -> Vec<U> {
+    use rayon::prelude::*;
+    if parallel {
+        items.par_iter().enumerate().map(|(i, t)| f(i, t)).collect()
+    } else {
+        items.iter().enumerate().map(|(i, t)| f(i, t)).collect()
+    }
 }

@@ -17,6 +17,7 @@ pub mod rows;
 pub mod step;
 mod types;
 
+pub use candidates::map_in_order;
 pub use outcome::{process, process_given};
 pub(crate) use prepare::part_reason;
 pub use prepare::{polygon_parts, prepare, NotPrepared, PrepareParams};
@@ -24,20 +25,3 @@ pub use rows::{feature_rows, FeatureRows, RowOptions, Skeletons, Status};
 pub use types::{
     Candidate, CandidateSkeleton, FeatureOutcome, ProcessParams, Processed, StageTimes, StepTime,
 };
-
-/// `f` over `items`, results in the items' order: in parallel, or on the
-/// calling thread when `parallel` is false (work too small to be worth
-/// splitting, or a caller that keeps to one thread). The same results
-/// either way.
-pub fn map_in_order<T: Sync, U: Send>(
-    items: &[T],
-    parallel: bool,
-    f: impl Fn(usize, &T) -> U + Sync + Send,
-) -> Vec<U> {
-    use rayon::prelude::*;
-    if parallel {
-        items.par_iter().enumerate().map(|(i, t)| f(i, t)).collect()
-    } else {
-        items.iter().enumerate().map(|(i, t)| f(i, t)).collect()
-    }
-}
