@@ -1335,11 +1335,9 @@ fn path_extent(d: &str) -> (f64, f64) {
     (hi.0 - lo.0, hi.1 - lo.1)
 }
 
-#[test]
-fn the_report_of_a_merged_feature_draws_and_scores_all_its_members() {
-    // Three reaches of a 3000 × 100 channel, merged into one feature.
-    let d = tmp();
-    let src = d.path().join("reaches.gpkg");
+/// Three reaches of a 3000 × 100 channel (layer `reaches`, EPSG:3035).
+fn three_reaches(dir: &Path) -> std::path::PathBuf {
+    let src = dir.join("reaches.gpkg");
     make_layer(
         &src,
         "reaches",
@@ -1350,6 +1348,14 @@ fn the_report_of_a_merged_feature_draws_and_scores_all_its_members() {
             Some("POLYGON((2000 0,3000 0,3000 100,2000 100,2000 0))"),
         ],
     );
+    src
+}
+
+#[test]
+fn the_report_of_a_merged_feature_draws_and_scores_all_its_members() {
+    // The three reaches, merged into one feature.
+    let d = tmp();
+    let src = three_reaches(d.path());
     let out = d.path().join("o.gpkg");
     let html = d.path().join("o.html");
     let o = skeletonise(&[
@@ -1385,17 +1391,7 @@ fn the_report_of_a_merged_feature_draws_and_scores_all_its_members() {
 #[test]
 fn null_merge_by_values_are_kept_apart() {
     let d = tmp();
-    let src = d.path().join("reaches.gpkg");
-    make_layer(
-        &src,
-        "reaches",
-        3035,
-        &[
-            Some("POLYGON((0 0,1000 0,1000 100,0 100,0 0))"),
-            Some("POLYGON((1000 0,2000 0,2000 100,1000 100,1000 0))"),
-            Some("POLYGON((2000 0,3000 0,3000 100,2000 100,2000 0))"),
-        ],
-    );
+    let src = three_reaches(d.path());
     // `river` NULL for all three: as in SQL, NULL equals nothing.
     let ds = gdal::Dataset::open_ex(
         &src,

@@ -8,7 +8,7 @@
 //! GEOS's coverage validation at hand.
 
 mod common;
-use common::{code_and_err, ints, open, pipeline, reals, skeletonise, tmp, wkts};
+use common::{code_and_err, first_text, ints, open, pipeline, reals, skeletonise, tmp, wkts};
 use gdal::vector::LayerAccess;
 
 const COVERAGE: &str = "tests/data/coverage-train.gpkg";
@@ -159,4 +159,33 @@ fn every_unit_is_written_once_in_fid_order_and_those_that_received_nothing_bit_f
     );
     // One boundaries row per pair of units, with both FIDs.
     assert!(!wkts(&ds, "boundaries").is_empty());
+    // The step's own time is in the run record.
+    let stages = first_text(&ds, "SELECT stage_seconds FROM skeletonise_runs").unwrap();
+    assert!(stages.contains("\"partition\":"), "{stages}");
+}
+
+#[test]
+fn the_neighbours_source_is_never_the_output() {
+    // As a path and through a hard link: refused before any work, the
+    // coverage left as it was.
+    let dir = tmp();
+    let units = dir.path().join("units.gpkg");
+    std::fs::copy(COVERAGE, &units).unwrap();
+    let link = dir.path().join("link.gpkg");
+    std::fs::hard_link(&units, &link).unwrap();
+    let before = std::fs::read(&units).unwrap();
+    for out in [&units, &link] {
+        let text = format!(
+            "input:\n  source: {COVERAGE}\n  layer: rivers_danube\n  neighbours: {{ source: {}, layer: units_danube }}\nsteps:\n  - skeleton: {{ methods: [MA] }}\n  - partition: {{}}\noutput: {{ path: {}, overwrite: true }}\n",
+            units.display(),
+            out.display()
+        );
+        let p = pipeline(dir.path(), "p.yaml", &text);
+        for cmd in ["validate", "run"] {
+            let (code, err) = code_and_err(&skeletonise(&[cmd, p.to_str().unwrap()]));
+            assert_eq!(code, 1, "{cmd}: {err}");
+            assert!(err.contains("neighbours source"), "{err}");
+        }
+        assert_eq!(std::fs::read(&units).unwrap(), before);
+    }
 }

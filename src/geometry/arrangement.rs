@@ -189,11 +189,8 @@ fn split_with(
     for (r, ring) in rings.iter().enumerate() {
         for (i, w) in ring.0.windows(2).enumerate() {
             let mut pts = vec![w[0]];
-            if let Some(extra) = inserts.get_mut(&(r as u32, i as u32)) {
-                let d = w[1] - w[0];
-                let t = |c: &Coord<f64>| (c.x - w[0].x) * d.x + (c.y - w[0].y) * d.y;
-                extra.sort_by(|a, b| t(a).total_cmp(&t(b)));
-                pts.extend(extra.iter().filter(|&&c| c != w[0] && c != w[1]));
+            if let Some(extra) = inserts.get(&(r as u32, i as u32)) {
+                pts.extend(super::segment::inner_points_along(w[0], w[1], extra));
             }
             pts.push(w[1]);
             pts.dedup();

@@ -208,6 +208,18 @@ pub fn crosses_rightward(s: &BoundarySegment, p: Coord<f64>) -> bool {
     (upward && o > 0.0) || (!upward && o < 0.0)
 }
 
+/// The points of `pts` (lying on segment `ab`) in order from `a` to `b`,
+/// each once, without `a` and `b` themselves: what goes between the ends
+/// when they are put into the segment.
+pub fn inner_points_along(a: Coord<f64>, b: Coord<f64>, pts: &[Coord<f64>]) -> Vec<Coord<f64>> {
+    let d = b - a;
+    let t = |c: &Coord<f64>| dot(*c - a, d);
+    let mut out: Vec<Coord<f64>> = pts.iter().copied().filter(|&c| c != a && c != b).collect();
+    out.sort_by(|p, q| t(p).total_cmp(&t(q)));
+    out.dedup();
+    out
+}
+
 /// Closest point of segment `ab` to `p` and its parameter `t` in [0, 1].
 pub fn closest_on_segment(a: Coord<f64>, b: Coord<f64>, p: Coord<f64>) -> (Coord<f64>, f64) {
     let d = b - a;

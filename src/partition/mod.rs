@@ -108,13 +108,6 @@ impl PartitionParams {
 
     /// Checks the options: `(key, message)` of the first that is wrong.
     pub fn validate(&self) -> Result<(), (String, String)> {
-        let c = CollapseParams {
-            width: self.width.unwrap_or(1.0),
-            tolerance: self.tolerance,
-            min_length: self.min_length,
-            mode: crate::collapse::CollapseMode::Partial,
-        };
-        c.validate()?;
         if self.width.is_none()
             && (self.min_length.is_some() || self.tolerance != default_tolerance())
         {
@@ -122,6 +115,9 @@ impl PartitionParams {
                 "width".into(),
                 "`tolerance` and `min_length` say which parts are narrow: give `width` too, or remove them".into(),
             ));
+        }
+        if let Some(c) = self.narrow() {
+            c.validate()?;
         }
         Ok(())
     }
@@ -302,12 +298,10 @@ impl Adjacency {
     fn of(faces: &[split::OwnedFace]) -> Self {
         let key = |c: Coord<f64>| (c.x.to_bits(), c.y.to_bits());
         let mut by_edge: FxHashMap<EdgeKey, usize> = FxHashMap::default();
-        let rings = |f: &split::OwnedFace| {
+        fn rings(f: &split::OwnedFace) -> impl Iterator<Item = &LineString<f64>> {
             let p = &f.face.polygon;
-            std::iter::once(p.exterior().clone())
-                .chain(p.interiors().iter().cloned())
-                .collect::<Vec<_>>()
-        };
+            std::iter::once(p.exterior()).chain(p.interiors())
+        }
         for (i, f) in faces.iter().enumerate() {
             for r in rings(f) {
                 for w in r.0.windows(2) {

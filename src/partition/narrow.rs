@@ -6,7 +6,9 @@
 //! put into both, with one coordinate), and the faces that lie in the
 //! parts `collapse` keeps stay polygons of their own.
 
-use crate::geometry::segment::{closest_on_segment, crossing_point, properly_cross};
+use crate::geometry::segment::{
+    closest_on_segment, crossing_point, inner_points_along, properly_cross,
+};
 use crate::geometry::vector::norm;
 use geo::{Coord, Polygon};
 use rstar::primitives::{GeomWithData, Rectangle};
@@ -91,11 +93,7 @@ fn insert(lines: &mut [Vec<Coord<f64>>], inserts: &Inserts) {
         for (j, w) in l.windows(2).enumerate() {
             out.push(w[0]);
             if let Some(extra) = inserts.get(&(i, j)) {
-                let d = w[1] - w[0];
-                let t = |c: &Coord<f64>| (c.x - w[0].x) * d.x + (c.y - w[0].y) * d.y;
-                let mut extra = extra.clone();
-                extra.sort_by(|a, b| t(a).total_cmp(&t(b)));
-                out.extend(extra.into_iter().filter(|&c| c != w[0] && c != w[1]));
+                out.extend(inner_points_along(w[0], w[1], extra));
             }
         }
         out.push(l[l.len() - 1]);

@@ -5,7 +5,7 @@
 //! and a polygon that overlaps a unit's interior refused.
 
 use crate::feature::Value;
-use crate::geometry::segment::{closest_on_segment, properly_cross};
+use crate::geometry::segment::{closest_on_segment, inner_points_along, properly_cross};
 use crate::geometry::vector::norm;
 use crate::geometry::{Boundary, PreparedPolygon};
 use geo::{BoundingRect, Coord, LineString, MultiPolygon, Polygon};
@@ -274,12 +274,7 @@ pub(super) fn with_inserted(
         for (i, w) in l.0.windows(2).enumerate() {
             out.push(moved(w[0]));
             if let Some(extra) = inserts.get(&(r as u32, i as u32)) {
-                let d = w[1] - w[0];
-                let t = |c: &Coord<f64>| (c.x - w[0].x) * d.x + (c.y - w[0].y) * d.y;
-                let mut extra = extra.clone();
-                extra.sort_by(|a, b| t(a).total_cmp(&t(b)));
-                extra.dedup();
-                out.extend(extra);
+                out.extend(inner_points_along(w[0], w[1], extra));
             }
         }
         out.push(moved(l.0[l.0.len() - 1]));
