@@ -58,7 +58,7 @@ pub enum Step {
     Prepare(PrepareParams),
     /// The skeleton methods to run.
     Skeleton(SkeletonParams),
-    /// Removal of insignificant legs: a leg goes when it protrudes less than `ratio` radii beyond the disc at its junction and is no arm (it protrudes less than `arm_ratio` times its own width at the mouth); cut ends stay; with `structure: shared` every method gets the reference method's legs.
+    /// Removal of insignificant legs: a leg goes when it protrudes less than `ratio` radii beyond the disc at its junction and is no arm (it protrudes less than `arm_ratio` times its own width at the mouth, or its mouth radius is less than `arm_width` times the junction's radius); cut ends stay; with `structure: shared` every method gets the reference method's legs.
     Prune(PruneParams),
     /// Extension of legs to the boundary: `centred` continues along the method's own removed legs, or ends between them where they fork on both sides of the line.
     Extend(ExtendParams),

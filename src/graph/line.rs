@@ -173,7 +173,9 @@ fn first_crossing(
 }
 
 /// The turn (degrees) of every line end of `g`, a skeleton of `polygon`, in
-/// node order (see the module documentation).
+/// node order (see [`crate::score::defects`]: the larger of the turn within
+/// the last local width and the last segment's turn against the stretch of
+/// half its length before it).
 pub fn end_turns(g: &SkeletonGraph, polygon: &PreparedPolygon) -> Vec<f64> {
     let adj = g.adjacency();
     let mut out = Vec::new();
@@ -201,10 +203,25 @@ pub fn end_turn(coords: &[Coord<f64>], polygon: &PreparedPolygon) -> Option<f64>
     let last = coords.iter().copied().find(|&c| c != e)?;
     let before = line.point_at(w.min(total));
     let start = line.point_at((1.5 * w).min(total));
-    if before == start {
-        return Some(0.0);
-    }
-    angle_deg(before - start, e - last)
+    let by_width = if before == start {
+        0.0
+    } else {
+        angle_deg(before - start, e - last)?
+    };
+    // The last segment against the stretch of half its length before it: a
+    // short sideways stub at the very end, which the width's stretch may
+    // pass over.
+    let l = norm(e - last);
+    let (s0, s1) = (
+        line.point_at(l.min(total)),
+        line.point_at((1.5 * l).min(total)),
+    );
+    let by_segment = if s0 == s1 {
+        0.0
+    } else {
+        angle_deg(s0 - s1, e - last).unwrap_or(0.0)
+    };
+    Some(by_width.max(by_segment))
 }
 
 #[cfg(test)]

@@ -7,7 +7,10 @@
 //!   arc length walked (one local width back,
 //!   `crate::graph::line::end_width_point`); the end's turn is the
 //!   angle between the line's course entering that stretch (from 1.5 w to
-//!   w back) and its last segment. A turn above [`HOOK_DEG`] is a hook.
+//!   w back) and its last segment, or — whichever is larger — between the
+//!   last segment (length l) and the stretch of half its length before it
+//!   (from 1.5 l to l back), which catches a short sideways stub the width's
+//!   stretch passes over. A turn above [`HOOK_DEG`] is a hook.
 //! * **Crossing**: two segments of the skeleton that cross without a node
 //!   ([`crate::graph::planar::crossings`]).
 //! * **Sharp turns**: vertices of the skeleton where the line turns by
@@ -66,6 +69,15 @@ mod tests {
         assert!(t < 1e-9, "{t}");
         // The same line turning onto the bank for its last 5 units.
         let t = end_turn(&[c(95., 0.), c(95., 5.), c(0., 5.)], &p).unwrap();
+        assert!((t - 90.0).abs() < 1e-9, "{t}");
+        // A spur into a slot 0.2 wide: the last local width lies inside the
+        // slot on a straight segment, but the segment turned 90° off the
+        // line's course where it left it.
+        let slot = PreparedPolygon::new(&polygon![(x: 0., y: 0.), (x: 100., y: 0.),
+            (x: 100., y: 20.), (x: 50.1, y: 20.), (x: 50.1, y: 45.), (x: 49.9, y: 45.),
+            (x: 49.9, y: 20.), (x: 0., y: 20.)])
+        .unwrap();
+        let t = end_turn(&[c(50., 44.95), c(50., 10.), c(0., 10.)], &slot).unwrap();
         assert!((t - 90.0).abs() < 1e-9, "{t}");
     }
 

@@ -37,10 +37,10 @@ use std::collections::BinaryHeap;
 /// two pieces joined at a former degree-2 node (a binary tree, so joining is
 /// O(1) however long the chain).
 #[derive(Debug, Clone, Copy)]
-struct Piece {
+pub(super) struct Piece {
     u: NodeId,
     v: NodeId,
-    len: f64,
+    pub(super) len: f64,
     kind: Kind,
 }
 
@@ -59,17 +59,17 @@ enum Kind {
 /// of the first `edges().len()` is edge `i`). Invariant: `adj[n]` lists the
 /// alive pieces incident to node n (a loop twice), and an alive piece's
 /// originals are kept.
-struct Work<'a> {
-    graph: &'a SkeletonGraph,
-    boundary: &'a Boundary,
-    pieces: Vec<Piece>,
-    alive: Vec<bool>,
-    adj: Vec<Vec<u32>>,
+pub(super) struct Work<'a> {
+    pub(super) graph: &'a SkeletonGraph,
+    pub(super) boundary: &'a Boundary,
+    pub(super) pieces: Vec<Piece>,
+    pub(super) alive: Vec<bool>,
+    pub(super) adj: Vec<Vec<u32>>,
     keep: Vec<bool>,
     /// How far the skeleton (with its discs) reached beyond each leaf before
     /// pruning: r_ℓ for an original leaf, the extent of the legs removed
     /// behind a junction that became a leaf.
-    reach: Vec<f64>,
+    pub(super) reach: Vec<f64>,
 }
 
 /// Heap entry; ordered by (key, leaf x, leaf y, piece id).
@@ -125,11 +125,11 @@ impl<'a> Work<'a> {
         id
     }
 
-    fn deg(&self, n: NodeId) -> usize {
+    pub(super) fn deg(&self, n: NodeId) -> usize {
         self.adj[n.index()].len()
     }
 
-    fn other(&self, p: u32, n: NodeId) -> NodeId {
+    pub(super) fn other(&self, p: u32, n: NodeId) -> NodeId {
         let pc = &self.pieces[p as usize];
         if pc.u == n {
             pc.v
@@ -152,7 +152,7 @@ impl<'a> Work<'a> {
     }
 
     /// Removes piece `p` and drops its originals from the result.
-    fn remove(&mut self, p: u32) {
+    pub(super) fn remove(&mut self, p: u32) {
         self.alive[p as usize] = false;
         let Piece { u, v, .. } = self.pieces[p as usize];
         self.adj[u.index()].retain(|&q| q != p);
@@ -199,6 +199,45 @@ impl<'a> Work<'a> {
         Some(id)
     }
 
+    /// After a removal at `j` (of branches reaching `removed_extent` from
+    /// it): when `j` is left with two branches, the sibling leg
+    /// insignificant at `j` goes too (j becomes a leaf keeping the reach of
+    /// what was cut behind it), or both are joined (when both are
+    /// insignificant legs, `j` is noted in `collapsed`). Returns the branch
+    /// to judge again.
+    pub(super) fn settle(
+        &mut self,
+        j: NodeId,
+        removed_extent: f64,
+        params: &PruneParams,
+        collapsed: &mut Vec<NodeId>,
+    ) -> Option<u32> {
+        if self.deg(j) != 2 {
+            return None;
+        }
+        let (a, b) = (self.adj[j.index()][0], self.adj[j.index()][1]);
+        let (ia, ib) = (
+            self.insignificant_at(a, j, params),
+            self.insignificant_at(b, j, params),
+        );
+        if ia != ib {
+            // The sibling leg insignificant at j goes too; j becomes a leaf
+            // of the other branch, which may now be an insignificant leg.
+            let (gone, stays) = if ia { (a, b) } else { (b, a) };
+            let gone_leaf = self.other(gone, j);
+            // j keeps the reach of what was cut behind it, so that a long
+            // arm is not eroded junction by junction.
+            self.reach[j.index()] = removed_extent.max(self.extent(gone, gone_leaf));
+            self.remove(gone);
+            Some(stays)
+        } else {
+            if ia && ib {
+                collapsed.push(j);
+            }
+            self.join(j)
+        }
+    }
+
     /// Extent of leg `p` seen from its junction: its length plus the reach
     /// of its leaf.
     fn extent(&self, p: u32, leaf: NodeId) -> f64 {
@@ -233,8 +272,25 @@ impl<'a> Work<'a> {
         leg
     }
 
+    /// The interior points of piece `p` (every original edge it joins, with
+    /// the nodes where they were joined).
+    pub(super) fn piece_coords(&self, p: u32) -> Vec<Coord<f64>> {
+        let mut out = Vec::new();
+        let mut stack = vec![p];
+        while let Some(q) = stack.pop() {
+            match self.pieces[q as usize].kind {
+                Kind::Orig(e) => out.extend(self.graph.edge(e).interior.iter().copied()),
+                Kind::Join { a, b, at } => {
+                    out.push(self.graph.node(at).pos);
+                    stack.extend([a, b]);
+                }
+            }
+        }
+        out
+    }
+
     /// The point at arc length `s` along piece `p` walked from its end `from`.
-    fn point_at(&self, p: u32, from: NodeId, s: f64) -> Coord<f64> {
+    pub(super) fn point_at(&self, p: u32, from: NodeId, s: f64) -> Coord<f64> {
         let (mut p, mut from, mut s) = (p, from, s);
         loop {
             let pc = self.pieces[p as usize];
@@ -259,7 +315,7 @@ impl<'a> Work<'a> {
         }
     }
 
-    fn radius(&self, n: NodeId) -> f64 {
+    pub(super) fn radius(&self, n: NodeId) -> f64 {
         self.graph.node(n).radius
     }
 
@@ -298,6 +354,9 @@ pub fn mask(m: &SkeletonGraph, params: &PruneParams, boundary: &Boundary) -> Vec
         }
     }
     let mut collapsed: Vec<NodeId> = Vec::new();
+    if params.mode == super::PruneMode::Significance {
+        super::sides::prune_sides(&mut w, params, &mut collapsed);
+    }
     let mut heap: BinaryHeap<Reverse<Entry>> = (0..w.pieces.len() as u32)
         .filter_map(|p| w.entry(p, params).map(Reverse))
         .collect();
@@ -312,30 +371,7 @@ pub fn mask(m: &SkeletonGraph, params: &PruneParams, boundary: &Boundary) -> Vec
         };
         let removed_extent = w.extent(e.piece, leaf);
         w.remove(e.piece);
-        if w.deg(j) != 2 {
-            continue;
-        }
-        let (a, b) = (w.adj[j.index()][0], w.adj[j.index()][1]);
-        let (ia, ib) = (
-            w.insignificant_at(a, j, params),
-            w.insignificant_at(b, j, params),
-        );
-        let next = if ia != ib {
-            // The sibling leg insignificant at j goes too; j becomes a leaf
-            // of the other branch, which may now be an insignificant leg.
-            let (gone, stays) = if ia { (a, b) } else { (b, a) };
-            let gone_leaf = w.other(gone, j);
-            // j keeps the reach of what was cut behind it, so that a long
-            // arm is not eroded junction by junction.
-            w.reach[j.index()] = removed_extent.max(w.extent(gone, gone_leaf));
-            w.remove(gone);
-            Some(stays)
-        } else {
-            if ia && ib {
-                collapsed.push(j);
-            }
-            w.join(j)
-        };
+        let next = w.settle(j, removed_extent, params, &mut collapsed);
         if let Some(entry) = next.and_then(|p| w.entry(p, params)) {
             heap.push(Reverse(entry));
         }

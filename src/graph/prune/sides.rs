@@ -1,0 +1,326 @@
+//! Insignificant sides: the leg rule applied to whole subtrees.
+//!
+//! A leg is judged at its junction j against j's disc. On a rough boundary
+//! (spiky banks, a raster's staircase, a digitised scan) the medial axis
+//! grows a thicket of small junctions in the boundary's own roughness: each
+//! small leg protrudes many radii beyond its tiny junction's disc, so the
+//! leg rule keeps it, and the thicket keeps the branch that leads out to
+//! it, although the whole thicket lies within a few metres of the bank of a
+//! disc kilometres wide. Seen from the junction J where the branch leaves
+//! the rest of the skeleton, the branch and all it carries form one *side*
+//! of J, and the rule for a leg applies to the side unchanged: its extent
+//! is the farthest reach along the skeleton from J (the length to a leaf
+//! plus that leaf's reach, the largest over the side), and it is
+//! insignificant when that protrudes less than `ratio` radii beyond J's
+//! disc and it is no arm (the mouth measured on the way to its farthest
+//! leaf). Such a side goes as a whole. A side that runs far along the
+//! skeleton but stays close to J's disc in space (a branch running along a
+//! rough rim, as the medial axis of a rough near-circular arc does) is
+//! measured in space instead: the farthest `|q − J| + r_q` over its points,
+//! bounded from above by a disc around each node that holds all it carries
+//! (built bottom-up with the peeling, so no side is walked twice). A side
+//! that ends the skeleton on a cut (a river reach's end, reach without
+//! limit) of real width against J's disc (`arm_width`) is never judged; a
+//! "cut end" a metre wide in the roughness of a rim counts with its radius.
+//! After the sides are judged, a junction left with two branches is settled
+//! as when a leg goes (its sibling leg insignificant at it goes too).
+//!
+//! A side is only judged where the rest of the skeleton seen from J is
+//! significant at J (it reaches `ratio` radii beyond J's disc): a thicket
+//! on the rim of a lake is small against the lake, but in a compact island
+//! every branch is small against every other, and which of them stays is
+//! the main-axis rule's to decide (see `legs`).
+//!
+//! Sides are found by peeling the skeleton from its leaves: a node is
+//! peeled when all but one of its branches lead to peeled nodes. What each
+//! side carries (its farthest reach, the disc that bounds it) is summed up
+//! bottom-up in peeling order and what lies beyond each node's parent
+//! top-down, so all is O(n) plus one boundary query per side that needs
+//! its mouth. Only sides that contain a junction are judged here; single
+//! legs are left to the least-significant-first pruning, which judges them
+//! by the same rule. A junction always keeps at least two branches, so a
+//! side is never cut down to a leaf here, and the cycles around holes are
+//! never peeled.
+
+use super::legs::Work;
+use super::{LegMeasure, PruneParams};
+use crate::geometry::vector::hypot;
+use crate::graph::NodeId;
+use std::collections::VecDeque;
+
+/// A peeled side of a node: the piece to the child and the child.
+type Side = (u32, NodeId);
+
+/// What peeling knows of a node and the side below it.
+#[derive(Debug, Clone, Default)]
+struct Below {
+    /// Farthest reach from the node into what it carries (its own reach
+    /// when it carries nothing), along the skeleton.
+    extent: f64,
+    /// The side through which the farthest reach runs.
+    deepest: Option<Side>,
+    /// Whether the node or anything it carries is a junction.
+    has_junction: bool,
+    /// The peeled sides it carries.
+    children: Vec<Side>,
+    /// Radius of a disc centred on the node that holds everything it
+    /// carries with its discs (the reach of a leaf; a cut end, whose reach
+    /// is unlimited, with its radius: a cut end in the roughness of a rim
+    /// is no end seen from a disc kilometres wide, and a river reach's end
+    /// is far from every disc it could be judged against).
+    bound: f64,
+    /// The largest radius of a cut end it carries (−∞ for none).
+    cut_radius: f64,
+    /// Farthest reach along the skeleton from the node through its parent
+    /// (+∞ on a cycle, −∞ at the root of a tree).
+    above: f64,
+}
+
+/// Removes every side that contains a junction and is insignificant at the
+/// node it hangs from, where the rest is significant (see the module
+/// documentation).
+pub(super) fn prune_sides(w: &mut Work, params: &PruneParams, collapsed: &mut Vec<NodeId>) {
+    let (order, mut below) = peel(w);
+    for &v in &order {
+        sum_up(w, v, &mut below);
+    }
+    for &v in order.iter().rev() {
+        hand_down(w, v, &mut below);
+    }
+    let mut touched = Vec::new();
+    for &v in &order {
+        if let Some(removed) = judge(w, params, v, &below) {
+            touched.push((v, removed));
+        }
+    }
+    // A junction left with two branches is settled as when a leg goes (its
+    // sibling leg may go too), once every side has been judged: joining
+    // pieces earlier would hide them from the sides above.
+    for (v, removed) in touched {
+        w.settle(v, removed, params, collapsed);
+    }
+}
+
+/// Peels the skeleton from its leaves: the nodes in peeling order (then the
+/// nodes on cycles, which are never peeled) and each node's peeled sides.
+fn peel(w: &Work) -> (Vec<NodeId>, Vec<Below>) {
+    let n = w.graph.nodes().len();
+    let degree: Vec<usize> = (0..n).map(|i| w.deg(NodeId::from_index(i))).collect();
+    let mut left = degree.clone();
+    let mut below: Vec<Below> = (0..n)
+        .map(|i| {
+            let (reach, radius) = (w.reach[i], w.radius(NodeId::from_index(i)));
+            Below {
+                extent: reach,
+                has_junction: degree[i] >= 3,
+                bound: if reach.is_finite() {
+                    reach.max(radius)
+                } else {
+                    radius
+                },
+                above: f64::INFINITY,
+                cut_radius: if reach.is_finite() {
+                    f64::NEG_INFINITY
+                } else {
+                    radius
+                },
+                ..Default::default()
+            }
+        })
+        .collect();
+    let mut peeled = vec![false; n];
+    let mut order = Vec::with_capacity(n);
+    let mut queue: VecDeque<NodeId> = (0..n)
+        .filter(|&i| left[i] == 1)
+        .map(NodeId::from_index)
+        .collect();
+    while let Some(v) = queue.pop_front() {
+        if peeled[v.index()] {
+            continue;
+        }
+        peeled[v.index()] = true;
+        order.push(v);
+        let up = w.adj[v.index()]
+            .iter()
+            .copied()
+            .find(|&p| !peeled[w.other(p, v).index()] && w.other(p, v) != v);
+        let Some(p) = up else {
+            below[v.index()].above = f64::NEG_INFINITY; // the root of a tree
+            continue;
+        };
+        let parent = w.other(p, v);
+        below[parent.index()].children.push((p, v));
+        left[parent.index()] -= 1;
+        if left[parent.index()] == 1 {
+            queue.push_back(parent);
+        }
+    }
+    order.extend(
+        (0..n)
+            .filter(|&i| !peeled[i] && !below[i].children.is_empty())
+            .map(NodeId::from_index),
+    );
+    (order, below)
+}
+
+/// Extent along the skeleton of the side `(p, c)` seen from its parent.
+fn side_extent(w: &Work, below: &[Below], (p, c): Side) -> f64 {
+    w.pieces[p as usize].len + below[c.index()].extent
+}
+
+/// Sums up what `v` carries from its children (all summed up before it).
+fn sum_up(w: &Work, v: NodeId, below: &mut [Below]) {
+    let vpos = w.graph.node(v).pos;
+    let b = &below[v.index()];
+    let (mut extent, mut deepest, mut has_junction, mut bound) =
+        (b.extent, None, b.has_junction, b.bound);
+    let mut cut_radius = b.cut_radius;
+    for &(p, c) in &b.children {
+        let side = side_extent(w, below, (p, c));
+        if side > extent {
+            extent = side;
+            deepest = Some((p, c));
+        }
+        let cb = &below[c.index()];
+        has_junction |= cb.has_junction;
+        cut_radius = cut_radius.max(cb.cut_radius);
+        bound = bound.max(hypot(w.graph.node(c).pos - vpos) + cb.bound);
+        for q in w.piece_coords(p) {
+            bound = bound.max(hypot(q - vpos));
+        }
+    }
+    let b = &mut below[v.index()];
+    (b.extent, b.deepest, b.has_junction, b.bound) = (extent, deepest, has_junction, bound);
+    b.cut_radius = cut_radius;
+}
+
+/// Hands down to each child of `v` how far the skeleton reaches beyond `v`
+/// seen from it: through `v`'s parent, `v`'s own reach or another side.
+fn hand_down(w: &Work, v: NodeId, below: &mut [Below]) {
+    let b = &below[v.index()];
+    let own = w.reach[v.index()].max(b.above);
+    let sides: Vec<f64> = b
+        .children
+        .iter()
+        .map(|&s| side_extent(w, below, s))
+        .collect();
+    let (mut first, mut second) = (f64::NEG_INFINITY, f64::NEG_INFINITY);
+    for &x in &sides {
+        if x > first {
+            (first, second) = (x, first);
+        } else if x > second {
+            second = x;
+        }
+    }
+    let children = b.children.clone();
+    for (&(p, c), &x) in children.iter().zip(&sides) {
+        let other = if x == first { second } else { first };
+        below[c.index()].above = w.pieces[p as usize].len + own.max(other);
+    }
+}
+
+/// Judges the peeled sides of `v` and removes the insignificant ones that
+/// contain a junction, least significant first, while `v` keeps two
+/// branches and the rest of the skeleton seen from `v` is significant.
+fn judge(w: &mut Work, params: &PruneParams, v: NodeId, below: &[Below]) -> Option<f64> {
+    if w.deg(v) < 3 {
+        return None;
+    }
+    let rv = w.radius(v);
+    let b = &below[v.index()];
+    let significant = |extent: f64| {
+        !params.is_insignificant(&LegMeasure {
+            extent,
+            r_junction: rv,
+            r_mouth: 0.0,
+        })
+    };
+    let mut candidates: Vec<(f64, (u32, NodeId, f64))> = Vec::new();
+    for &(p, c) in &b.children {
+        if !below[c.index()].has_junction {
+            continue;
+        }
+        // The rest: through the parent, or the farthest other side.
+        let rest = b
+            .children
+            .iter()
+            .filter(|s| s.0 != p)
+            .map(|&s| side_extent(w, below, s));
+        if !significant(rest.fold(b.above, f64::max)) {
+            continue;
+        }
+        // A side that ends the skeleton on a cut of real width (a river
+        // reach's end) reaches on without limit, whatever its extent in
+        // space; a cut end in the roughness of a rim counts with its radius.
+        if below[c.index()].cut_radius >= params.arm_width * rv {
+            continue;
+        }
+        // How far out of the disc the side reaches: along the skeleton, or
+        // in space when that is less (a branch running along a rough rim).
+        let path = side_extent(w, below, (p, c));
+        let space = spatial_extent(w, below, v, (p, c), (1.0 + params.ratio) * rv);
+        let mut leg = LegMeasure {
+            extent: space.map_or(path, |e| path.min(e)),
+            r_junction: rv,
+            r_mouth: f64::INFINITY,
+        };
+        if !params.is_insignificant(&leg) {
+            continue;
+        }
+        leg.r_mouth = mouth(w, below, v, (p, c), rv);
+        if params.is_insignificant(&leg) {
+            candidates.push((params.key(&leg), (p, c, path)));
+        }
+    }
+    candidates.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1 .0.cmp(&b.1 .0)));
+    let mut removed = None;
+    for (_, (p, c, extent)) in candidates {
+        if w.deg(v) <= 2 {
+            break;
+        }
+        remove_side(w, below, (p, c));
+        removed = Some(removed.map_or(extent, |r: f64| r.max(extent)));
+    }
+    removed
+}
+/// Distance to ∂P where the side `(p, c)` of `v`, followed towards its
+/// farthest reach, leaves the disc at `v` (radius `rv`); at the leaf when
+/// the path is shorter (as for a leg).
+fn mouth(w: &Work, below: &[Below], v: NodeId, (p, c): Side, rv: f64) -> f64 {
+    let (mut piece, mut from, mut to, mut s) = (p, v, c, rv);
+    loop {
+        let len = w.pieces[piece as usize].len;
+        if len >= s {
+            return w.boundary.distance(w.point_at(piece, from, s));
+        }
+        s -= len;
+        match below[to.index()].deepest {
+            Some((q, next)) => (piece, from, to) = (q, to, next),
+            None => return w.radius(to).max(w.reach[to.index()]),
+        }
+    }
+}
+
+/// How far the side `(p, c)` of `v` reaches from `v` in space, at most:
+/// the largest `|q − v|` over the piece's points and the far side of the
+/// disc that bounds what `c` carries — `None` when that reaches `limit`
+/// (the side may be significant by the radius rule, and is kept).
+fn spatial_extent(w: &Work, below: &[Below], v: NodeId, (p, c): Side, limit: f64) -> Option<f64> {
+    let centre = w.graph.node(v).pos;
+    let mut best = hypot(w.graph.node(c).pos - centre) + below[c.index()].bound;
+    for q in w.piece_coords(p) {
+        best = best.max(hypot(q - centre));
+    }
+    (best < limit).then_some(best)
+}
+
+/// Removes the piece of `side` and everything its child carries.
+fn remove_side(w: &mut Work, below: &[Below], side: Side) {
+    let mut stack = vec![side];
+    while let Some((p, c)) = stack.pop() {
+        if w.alive[p as usize] {
+            w.remove(p);
+        }
+        stack.extend(below[c.index()].children.iter().copied());
+    }
+}

@@ -1,0 +1,207 @@
+//! Rough boundaries (the constructed cases of `tests/data/rough-cases.gpkg`,
+//! made by `scripts/make_rough_cases.py`, and a generated rough polygon):
+//! a slot or a spike in a river bank gives no spur, a crescent keeps both
+//! horns, and the roughness of a rim leaves no thicket of legs.
+#![cfg(all(feature = "cli", feature = "gdal"))]
+
+mod common;
+
+use common::*;
+use geo::{Coord, LineString, MultiLineString, Polygon};
+use skeletonise::geometry::PreparedPolygon;
+use skeletonise::graph::prune::{prune, PruneParams};
+use skeletonise::graph::SkeletonGraph;
+use skeletonise::methods::{build, MethodContext, MethodId, SkeletonParams};
+use skeletonise::score::defects::{end_turns, HOOK_DEG};
+use std::path::Path;
+
+const CASES: &str = "tests/data/rough-cases.gpkg";
+
+/// Runs the default pipeline on the cases (with `--set` overrides) and
+/// returns each case's skeleton lines, in FID order.
+fn run_cases(dir: &Path, sets: &[&str]) -> Vec<MultiLineString<f64>> {
+    let out = dir.join("out.gpkg");
+    let text = format!(
+        "input: {{ source: {}, layer: cases }}\nsteps:\n  - prepare: {{}}\n  - skeleton: {{}}\n  - prune: {{}}\n  - extend: {{}}\n  - score: {{}}\n  - select: {{}}\noutput: {{ path: {}, overwrite: true }}\n",
+        root(CASES),
+        out.display()
+    );
+    let p = pipeline(dir, "p.yaml", &text);
+    let mut args = vec!["run", p.to_str().unwrap()];
+    for s in sets {
+        args.extend(["--set", s]);
+    }
+    let o = skeletonise(&args);
+    assert!(o.status.success(), "{}", code_and_err(&o).1);
+    let ds = open(&out);
+    wkts(&ds, "skeletons")
+        .into_iter()
+        .map(|w| {
+            let g: geo::Geometry<f64> =
+                wkt::TryFromWkt::try_from_wkt_str(&w.expect("a skeleton")).unwrap();
+            match g {
+                geo::Geometry::MultiLineString(m) => m,
+                geo::Geometry::LineString(l) => MultiLineString(vec![l]),
+                other => panic!("not lines: {other:?}"),
+            }
+        })
+        .collect()
+}
+
+/// The case polygons, in FID order.
+fn cases() -> Vec<PreparedPolygon> {
+    let ds = open(Path::new(&root(CASES)));
+    wkts(&ds, "cases")
+        .into_iter()
+        .map(|w| {
+            let p: Polygon<f64> = wkt::TryFromWkt::try_from_wkt_str(&w.unwrap()).unwrap();
+            PreparedPolygon::new(&p).unwrap()
+        })
+        .collect()
+}
+
+fn leaves(lines: &MultiLineString<f64>) -> Vec<Coord<f64>> {
+    let g = SkeletonGraph::from_lines(lines);
+    let deg = g.degrees();
+    (0..deg.len())
+        .filter(|&i| deg[i] == 1)
+        .map(|i| g.nodes()[i].pos)
+        .collect()
+}
+
+fn near(lines: &MultiLineString<f64>, p: Coord<f64>, d: f64) -> bool {
+    lines
+        .0
+        .iter()
+        .flat_map(|l| l.0.iter())
+        .any(|q| (q.x - p.x).hypot(q.y - p.y) < d)
+}
+
+#[test]
+fn a_slot_and_a_spike_in_a_river_bank_give_no_spur_and_no_hook() {
+    let dir = tmp();
+    let polys = cases();
+    let river = &polys[0];
+    // The slot's and the spike's far ends (see make_rough_cases.py).
+    let ring = &river.polygon().exterior().0;
+    // The far end: of the vertices at this easting, the one farthest from
+    // the river's centre line (y = 6 000 000 + 600 cos(…)).
+    let vertex_at = |x: f64| {
+        *ring
+            .iter()
+            .filter(|c| (c.x - x).abs() < 0.01)
+            .max_by(|a, b| {
+                (a.y - 6_000_000.0)
+                    .abs()
+                    .total_cmp(&(b.y - 6_000_000.0).abs())
+            })
+            .expect("the case's vertex")
+    };
+    let (slot, spike) = (vertex_at(504_001.0), vertex_at(508_002.0));
+    assert!(slot.y > spike.y + 1000.0);
+    let lines = &run_cases(dir.path(), &[])[0];
+    assert_eq!(
+        leaves(lines).len(),
+        2,
+        "one line from end to end: {lines:?}"
+    );
+    assert!(!near(lines, slot, 150.0), "a spur into the slot");
+    assert!(!near(lines, spike, 150.0), "a spur into the spike");
+    let g = SkeletonGraph::from_lines(lines);
+    let turns = end_turns(&g, river);
+    assert!(turns.iter().all(|&t| t <= HOOK_DEG), "hooks: {turns:?}");
+    // Without the width condition of an arm, both come back as spurs.
+    let old = &run_cases(dir.path(), &["steps.prune.arm_width=0"])[0];
+    assert!(near(old, slot, 150.0) && near(old, spike, 150.0));
+}
+
+#[test]
+fn a_crescent_keeps_both_horns() {
+    let dir = tmp();
+    let lines = &run_cases(dir.path(), &[])[2];
+    // The horns: where the circles of radius 3 000 (centre 0, 0) and 2 500
+    // (centre 1 400, 0) meet, moved as in make_rough_cases.py.
+    let x = (3000f64.powi(2) - 2500f64.powi(2) + 1400f64.powi(2)) / 2800.0;
+    let y = (3000f64.powi(2) - x * x).sqrt();
+    let ends = leaves(lines);
+    assert_eq!(ends.len(), 2);
+    for horn in [
+        Coord {
+            x: 520_000.0 + x,
+            y: 6_020_000.0 + y,
+        },
+        Coord {
+            x: 520_000.0 + x,
+            y: 6_020_000.0 - y,
+        },
+    ] {
+        assert!(
+            ends.iter()
+                .any(|e| (e.x - horn.x).hypot(e.y - horn.y) < 60.0),
+            "no end at the horn {horn:?}: {ends:?}"
+        );
+    }
+}
+
+/// A five-lobed polygon of radius 10 km with up to 30 m of random radial
+/// roughness at each of `n` vertices (scripts/make_rough_polygon.py's shape,
+/// with a small seeded generator of its own).
+fn rough_lobes(n: usize) -> PreparedPolygon {
+    let mut state: u64 = 20_261_205;
+    let mut uniform = || {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let ring: Vec<Coord<f64>> = (0..n)
+        .map(|i| {
+            let t = i as f64 / n as f64 * std::f64::consts::TAU;
+            let r = 10_000.0 * (1.0 + 0.3 * (5.0 * t).sin()) + 30.0 * uniform();
+            Coord {
+                x: r * t.cos(),
+                y: r * t.sin(),
+            }
+        })
+        .collect();
+    PreparedPolygon::new(&Polygon::new(LineString::new(ring), vec![])).unwrap()
+}
+
+#[test]
+fn the_roughness_of_a_rim_leaves_no_thicket_of_legs() {
+    // Vertices every 1.5 m with up to 30 m of roughness: a rim of needles.
+    // Pruned, the medial axis keeps the lobes' structure only — a handful
+    // of legs, not one per needle (thousands before sides were judged).
+    let p = rough_lobes(40_000);
+    let params = SkeletonParams {
+        methods: vec![MethodId::MA],
+        ..Default::default()
+    };
+    let ma = build(MethodId::MA, &params)
+        .skeletonise(&p, &MethodContext::default())
+        .unwrap();
+    let pruned = prune(&ma, &PruneParams::default(), p.boundary());
+    assert!(ma.leg_count() > 5_000, "{} raw legs", ma.leg_count());
+    assert!(pruned.leg_count() <= 10, "{} legs kept", pruned.leg_count());
+    // Every kept end lies on a lobe's axis (sin 5t = 1), none in the rim
+    // between the lobes.
+    let g = pruned;
+    let deg = g.degrees();
+    for (i, n) in g.nodes().iter().enumerate() {
+        if deg[i] == 1 {
+            let t = n.pos.y.atan2(n.pos.x);
+            let off = (0..5)
+                .map(|k| {
+                    let axis = std::f64::consts::PI / 10.0 + k as f64 * std::f64::consts::TAU / 5.0;
+                    let d = (t - axis).rem_euclid(std::f64::consts::TAU);
+                    d.min(std::f64::consts::TAU - d)
+                })
+                .fold(f64::INFINITY, f64::min);
+            assert!(
+                off < 0.1,
+                "an end {:.0}° off the lobes' axes",
+                off.to_degrees()
+            );
+        }
+    }
+}
