@@ -143,10 +143,10 @@ fn a_crescent_keeps_both_horns() {
     }
 }
 
-/// A five-lobed polygon of radius 10 km with up to 30 m of random radial
-/// roughness at each of `n` vertices (scripts/make_rough_polygon.py's shape,
-/// with a small seeded generator of its own).
-fn rough_lobes(n: usize) -> PreparedPolygon {
+/// A five-lobed polygon of radius `radius` with up to `rough` of random
+/// radial roughness at each of `n` vertices (scripts/make_rough_polygon.py's
+/// shape, with a small seeded generator of its own).
+fn rough_lobes(n: usize, radius: f64, rough: f64) -> PreparedPolygon {
     let mut state: u64 = 20_261_205;
     let mut uniform = || {
         state = state
@@ -157,7 +157,7 @@ fn rough_lobes(n: usize) -> PreparedPolygon {
     let ring: Vec<Coord<f64>> = (0..n)
         .map(|i| {
             let t = i as f64 / n as f64 * std::f64::consts::TAU;
-            let r = 10_000.0 * (1.0 + 0.3 * (5.0 * t).sin()) + 30.0 * uniform();
+            let r = radius * (1.0 + 0.3 * (5.0 * t).sin()) + rough * uniform();
             Coord {
                 x: r * t.cos(),
                 y: r * t.sin(),
@@ -169,10 +169,12 @@ fn rough_lobes(n: usize) -> PreparedPolygon {
 
 #[test]
 fn the_roughness_of_a_rim_leaves_no_thicket_of_legs() {
-    // Vertices every 1.5 m with up to 30 m of roughness: a rim of needles.
-    // Pruned, the medial axis keeps the lobes' structure only — a handful
-    // of legs, not one per needle (thousands before sides were judged).
-    let p = rough_lobes(40_000);
+    // Radius 10 km, vertices every 0.35 m with up to 30 m of roughness: a
+    // rim of needles (the shape of scripts/make_rough_polygon.py at 200 000
+    // vertices). Pruned, the medial axis keeps the lobes' structure only —
+    // a handful of legs, not one per needle (tens of thousands before sides
+    // were judged), and no brush of legs where a line runs into the rim.
+    let p = rough_lobes(200_000, 10_000.0, 30.0);
     let params = SkeletonParams {
         methods: vec![MethodId::MA],
         ..Default::default()
@@ -184,9 +186,19 @@ fn the_roughness_of_a_rim_leaves_no_thicket_of_legs() {
     assert!(ma.leg_count() > 5_000, "{} raw legs", ma.leg_count());
     assert!(pruned.leg_count() <= 10, "{} legs kept", pruned.leg_count());
     // Every kept end lies on a lobe's axis (sin 5t = 1), none in the rim
-    // between the lobes.
+    // between the lobes, and no two ends lie within 20 m of each other
+    // (a brush of legs where a line runs into the rim).
     let g = pruned;
     let deg = g.degrees();
+    let ends: Vec<Coord<f64>> = (0..deg.len())
+        .filter(|&i| deg[i] == 1)
+        .map(|i| g.nodes()[i].pos)
+        .collect();
+    for (i, a) in ends.iter().enumerate() {
+        for b in &ends[i + 1..] {
+            assert!((a.x - b.x).hypot(a.y - b.y) > 20.0, "a brush of ends at {a:?}");
+        }
+    }
     for (i, n) in g.nodes().iter().enumerate() {
         if deg[i] == 1 {
             let t = n.pos.y.atan2(n.pos.x);

@@ -391,8 +391,9 @@ pub fn mask(m: &SkeletonGraph, params: &PruneParams, boundary: &Boundary) -> Vec
     keep
 }
 
-/// Most leaves for which the farthest pair is searched exhaustively; a
-/// component with more falls back to its longest path.
+/// Most leaves for which the farthest pair is searched among all leaves; a
+/// component with more searches its leaves' convex hull (and falls back to
+/// its longest path when even the hull has more).
 const MAX_AXIS_LEAVES: usize = 2000;
 
 /// Keeps, in component `c` of `m`, only its main axis: the path between
@@ -406,12 +407,19 @@ fn main_axis(m: &SkeletonGraph, labels: &[usize], c: usize, keep: &mut [bool]) {
         .map(NodeId::from_index)
         .collect();
     let in_c: Vec<bool> = m.edges().iter().map(|e| labels[e.a.index()] == c).collect();
-    let pair = if leaves.len() > MAX_AXIS_LEAVES {
+    // The farthest pair lies on the leaves' convex hull: with many leaves
+    // (the thickets of a rough rim) only the hull's are paired.
+    let candidates = if leaves.len() > MAX_AXIS_LEAVES {
+        hull_leaves(m, &leaves)
+    } else {
+        leaves
+    };
+    let pair = if candidates.len() > MAX_AXIS_LEAVES {
         None
     } else {
         let mut best: Option<(f64, NodeId, NodeId)> = None;
-        for (i, &a) in leaves.iter().enumerate() {
-            for &b in &leaves[i + 1..] {
+        for (i, &a) in candidates.iter().enumerate() {
+            for &b in &candidates[i + 1..] {
                 let d = m.node(a).pos - m.node(b).pos;
                 let d2 = dot(d, d);
                 if best.is_none_or(|(bd, _, _)| d2 > bd) {
@@ -442,6 +450,28 @@ fn main_axis(m: &SkeletonGraph, labels: &[usize], c: usize, keep: &mut [bool]) {
             }
         }
     }
+}
+
+/// The leaves among `leaves` at the corners of their convex hull, in
+/// node order.
+fn hull_leaves(m: &SkeletonGraph, leaves: &[NodeId]) -> Vec<NodeId> {
+    use geo::ConvexHull;
+    let points: geo::MultiPoint<f64> = leaves.iter().map(|&n| geo::Point(m.node(n).pos)).collect();
+    let corners: std::collections::HashSet<(u64, u64)> = points
+        .convex_hull()
+        .exterior()
+        .0
+        .iter()
+        .map(|c| (c.x.to_bits(), c.y.to_bits()))
+        .collect();
+    leaves
+        .iter()
+        .copied()
+        .filter(|&n| {
+            let p = m.node(n).pos;
+            corners.contains(&(p.x.to_bits(), p.y.to_bits()))
+        })
+        .collect()
 }
 
 /// True unless the radius rule alone already keeps the leg (then its mouth

@@ -25,6 +25,12 @@
 //! After the sides are judged, a junction left with two branches is settled
 //! as when a leg goes (its sibling leg insignificant at it goes too).
 //!
+//! Where a line itself runs into a rough rim, the thicket at its end hangs
+//! from junctions as narrow as its own, so no side of it is insignificant
+//! where it hangs; it is judged against the line a little way back instead
+//! (`terminal_thicket`), and goes when it lies within that point's disc
+//! scaled by `1 + ratio` and all its discs are tiny against it.
+//!
 //! A side is only judged where the rest of the skeleton seen from J is
 //! significant at J (it reaches `ratio` radii beyond J's disc): a thicket
 //! on the rim of a lake is small against the lake, but in a compact island
@@ -71,6 +77,10 @@ struct Below {
     bound: f64,
     /// The largest radius of a cut end it carries (−∞ for none).
     cut_radius: f64,
+    /// The piece to the node's parent (None at a tree's root and on cycles).
+    up: Option<u32>,
+    /// The largest radius of the nodes it carries, itself included.
+    max_radius: f64,
     /// Farthest reach along the skeleton from the node through its parent
     /// (+∞ on a cycle, −∞ at the root of a tree).
     above: f64,
@@ -119,6 +129,7 @@ fn peel(w: &Work) -> (Vec<NodeId>, Vec<Below>) {
                     radius
                 },
                 above: f64::INFINITY,
+                max_radius: radius,
                 cut_radius: if reach.is_finite() {
                     f64::NEG_INFINITY
                 } else {
@@ -149,6 +160,7 @@ fn peel(w: &Work) -> (Vec<NodeId>, Vec<Below>) {
             continue;
         };
         let parent = w.other(p, v);
+        below[v.index()].up = Some(p);
         below[parent.index()].children.push((p, v));
         left[parent.index()] -= 1;
         if left[parent.index()] == 1 {
@@ -174,7 +186,7 @@ fn sum_up(w: &Work, v: NodeId, below: &mut [Below]) {
     let b = &below[v.index()];
     let (mut extent, mut deepest, mut has_junction, mut bound) =
         (b.extent, None, b.has_junction, b.bound);
-    let mut cut_radius = b.cut_radius;
+    let (mut cut_radius, mut max_radius) = (b.cut_radius, b.max_radius);
     for &(p, c) in &b.children {
         let side = side_extent(w, below, (p, c));
         if side > extent {
@@ -184,6 +196,7 @@ fn sum_up(w: &Work, v: NodeId, below: &mut [Below]) {
         let cb = &below[c.index()];
         has_junction |= cb.has_junction;
         cut_radius = cut_radius.max(cb.cut_radius);
+        max_radius = max_radius.max(cb.max_radius);
         bound = bound.max(hypot(w.graph.node(c).pos - vpos) + cb.bound);
         for q in w.piece_coords(p) {
             bound = bound.max(hypot(q - vpos));
@@ -191,7 +204,7 @@ fn sum_up(w: &Work, v: NodeId, below: &mut [Below]) {
     }
     let b = &mut below[v.index()];
     (b.extent, b.deepest, b.has_junction, b.bound) = (extent, deepest, has_junction, bound);
-    b.cut_radius = cut_radius;
+    (b.cut_radius, b.max_radius) = (cut_radius, max_radius);
 }
 
 /// Hands down to each child of `v` how far the skeleton reaches beyond `v`
@@ -281,7 +294,65 @@ fn judge(w: &mut Work, params: &PruneParams, v: NodeId, below: &[Below]) -> Opti
         remove_side(w, below, (p, c));
         removed = Some(removed.map_or(extent, |r: f64| r.max(extent)));
     }
+    if w.deg(v) >= 3 && terminal_thicket(w, params, v, below) {
+        for &side in &b.children {
+            remove_side(w, below, side);
+        }
+    }
     removed
+}
+
+/// Whether `v`, where a line runs into a rough rim, carries only a
+/// thicket: everything it carries (a disc of radius e around `v`) lies in
+/// the disc, scaled by `1 + ratio`, of a point q on the line back towards
+/// `v`'s parent (`(1 + ratio) r_q ≥ |q − v| + e`, q tried at e, 2e, 4e…
+/// back), the thicket holds junctions of its own, and all its discs are
+/// tiny against q's (`arm_width`). Then the line ends at `v` and the
+/// extension finishes it: seen from the line's own width a little way back
+/// the thicket is the bank's roughness. A blunt end (two legs into corners,
+/// no junction beyond) and a cut end of real width are never thickets.
+fn terminal_thicket(w: &Work, params: &PruneParams, v: NodeId, below: &[Below]) -> bool {
+    let b = &below[v.index()];
+    let Some(up) = b.up else {
+        return false;
+    };
+    let kids = |f: &dyn Fn(&Below) -> f64| {
+        b.children
+            .iter()
+            .map(|&(_, c)| f(&below[c.index()]))
+            .fold(f64::NEG_INFINITY, f64::max)
+    };
+    if !b
+        .children
+        .iter()
+        .any(|&(_, c)| below[c.index()].has_junction)
+    {
+        return false;
+    }
+    let (e, tiny) = (b.bound, kids(&|c| c.max_radius.max(c.cut_radius)));
+    if !(e.is_finite() && e > 0.0) {
+        return false;
+    }
+    // Walk back towards the root, piece by piece, trying q at e, 2e, 4e.
+    let (mut node, mut piece, mut walked, mut s) = (v, up, 0.0, e);
+    while s <= 4.0 * e {
+        let len = w.pieces[piece as usize].len;
+        if s <= walked + len {
+            let rq = w.boundary.distance(w.point_at(piece, node, s - walked));
+            if (1.0 + params.ratio) * rq >= s + e && tiny < params.arm_width * rq {
+                return true;
+            }
+            s *= 2.0;
+            continue;
+        }
+        walked += len;
+        node = w.other(piece, node);
+        match below[node.index()].up {
+            Some(next) => piece = next,
+            None => return false,
+        }
+    }
+    false
 }
 /// Distance to ∂P where the side `(p, c)` of `v`, followed towards its
 /// farthest reach, leaves the disc at `v` (radius `rv`); at the leaf when
