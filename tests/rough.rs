@@ -196,7 +196,10 @@ fn the_roughness_of_a_rim_leaves_no_thicket_of_legs() {
         .collect();
     for (i, a) in ends.iter().enumerate() {
         for b in &ends[i + 1..] {
-            assert!((a.x - b.x).hypot(a.y - b.y) > 20.0, "a brush of ends at {a:?}");
+            assert!(
+                (a.x - b.x).hypot(a.y - b.y) > 20.0,
+                "a brush of ends at {a:?}"
+            );
         }
     }
     for (i, n) in g.nodes().iter().enumerate() {
