@@ -464,6 +464,38 @@ mod tests {
     }
 
     #[test]
+    fn a_main_axis_among_thousands_of_leaves_joins_the_two_farthest() {
+        // A junction (r = 10) with 2 100 short legs to points of a spiral
+        // inside radius 14, two straight legs to (±19, 0) and two curled
+        // legs 19.4 long whose ends lie near the junction: every leg is
+        // insignificant, so the main axis is kept — between the leaves
+        // farthest apart (found on their convex hull), not along the
+        // longest path (the two curls).
+        let mut b = GraphBuilder::new();
+        for k in 1..=2100 {
+            let (r, t) = (14.0 * k as f64 / 2100.0, k as f64 * 0.37);
+            b.segment(c(0., 0.), c(r * t.cos(), r * t.sin()));
+        }
+        b.segment(c(0., 0.), c(19., 0.));
+        b.segment(c(0., 0.), c(-19., 0.));
+        b.polyline(&[c(0., 0.), c(0.3, 9.8), c(0.6, 0.2)]);
+        b.polyline(&[c(0., 0.), c(-0.3, -9.8), c(-0.6, -0.2)]);
+        let mut g = b.finish_raw();
+        for n in g.nodes_mut() {
+            if n.pos == c(0., 0.) {
+                n.radius = 10.0;
+            }
+        }
+        let p = prune(&g, &PruneParams::default(), &far());
+        assert_eq!(p.edges().len(), 1);
+        assert!(
+            (p.total_length() - 38.0).abs() < 1e-9,
+            "{}",
+            p.total_length()
+        );
+    }
+
+    #[test]
     fn trunk_is_the_tree_diameter() {
         let g = star(1.0, &[(5., 0.), (-7., 0.), (0., 6.), (0., -1.5)]);
         let t = prune(&g, &trunk_params(), &far());

@@ -81,6 +81,9 @@ struct Below {
     up: Option<u32>,
     /// The largest radius of the nodes it carries, itself included.
     max_radius: f64,
+    /// The largest distance from the parent of the points of the piece up
+    /// to it (its interior points and the joints of joined pieces).
+    piece_reach: f64,
     /// Farthest reach along the skeleton from the node through its parent
     /// (+∞ on a cycle, −∞ at the root of a tree).
     above: f64,
@@ -187,6 +190,7 @@ fn sum_up(w: &Work, v: NodeId, below: &mut [Below]) {
     let (mut extent, mut deepest, mut has_junction, mut bound) =
         (b.extent, None, b.has_junction, b.bound);
     let (mut cut_radius, mut max_radius) = (b.cut_radius, b.max_radius);
+    let mut pieces = Vec::with_capacity(b.children.len());
     for &(p, c) in &b.children {
         let side = side_extent(w, below, (p, c));
         if side > extent {
@@ -198,9 +202,11 @@ fn sum_up(w: &Work, v: NodeId, below: &mut [Below]) {
         cut_radius = cut_radius.max(cb.cut_radius);
         max_radius = max_radius.max(cb.max_radius);
         bound = bound.max(hypot(w.graph.node(c).pos - vpos) + cb.bound);
-        for q in w.piece_coords(p) {
-            bound = bound.max(hypot(q - vpos));
-        }
+        pieces.push((c, piece_reach(w, p, vpos)));
+    }
+    for &(c, r) in &pieces {
+        below[c.index()].piece_reach = r;
+        bound = bound.max(r);
     }
     let b = &mut below[v.index()];
     (b.extent, b.deepest, b.has_junction, b.bound) = (extent, deepest, has_junction, bound);
@@ -217,19 +223,26 @@ fn hand_down(w: &Work, v: NodeId, below: &mut [Below]) {
         .iter()
         .map(|&s| side_extent(w, below, s))
         .collect();
+    let (first, second) = two_largest(&sides);
+    let children = b.children.clone();
+    for (&(p, c), &x) in children.iter().zip(&sides) {
+        let other = if x == first { second } else { first };
+        below[c.index()].above = w.pieces[p as usize].len + own.max(other);
+    }
+}
+
+/// The largest and the second largest of `xs` (−∞ where there is none;
+/// equal when the largest is there twice).
+fn two_largest(xs: &[f64]) -> (f64, f64) {
     let (mut first, mut second) = (f64::NEG_INFINITY, f64::NEG_INFINITY);
-    for &x in &sides {
+    for &x in xs {
         if x > first {
             (first, second) = (x, first);
         } else if x > second {
             second = x;
         }
     }
-    let children = b.children.clone();
-    for (&(p, c), &x) in children.iter().zip(&sides) {
-        let other = if x == first { second } else { first };
-        below[c.index()].above = w.pieces[p as usize].len + own.max(other);
-    }
+    (first, second)
 }
 
 /// Judges the peeled sides of `v` and removes the insignificant ones that
@@ -248,18 +261,21 @@ fn judge(w: &mut Work, params: &PruneParams, v: NodeId, below: &[Below]) -> Opti
             r_mouth: 0.0,
         })
     };
+    // The rest seen from a side: through the parent, or the farthest other
+    // side (the two farthest sides, so each side is looked at once).
+    let sides: Vec<f64> = b
+        .children
+        .iter()
+        .map(|&s| side_extent(w, below, s))
+        .collect();
+    let (first, second) = two_largest(&sides);
     let mut candidates: Vec<(f64, (u32, NodeId, f64))> = Vec::new();
-    for &(p, c) in &b.children {
+    for (&(p, c), &path) in b.children.iter().zip(&sides) {
         if !below[c.index()].has_junction {
             continue;
         }
-        // The rest: through the parent, or the farthest other side.
-        let rest = b
-            .children
-            .iter()
-            .filter(|s| s.0 != p)
-            .map(|&s| side_extent(w, below, s));
-        if !significant(rest.fold(b.above, f64::max)) {
+        let other = if path == first { second } else { first };
+        if !significant(b.above.max(other)) {
             continue;
         }
         // A side that ends the skeleton on a cut of real width (a river
@@ -270,8 +286,7 @@ fn judge(w: &mut Work, params: &PruneParams, v: NodeId, below: &[Below]) -> Opti
         }
         // How far out of the disc the side reaches: along the skeleton, or
         // in space when that is less (a branch running along a rough rim).
-        let path = side_extent(w, below, (p, c));
-        let space = spatial_extent(w, below, v, (p, c), (1.0 + params.ratio) * rv);
+        let space = spatial_extent(w, below, v, c, (1.0 + params.ratio) * rv);
         let mut leg = LegMeasure {
             extent: space.map_or(path, |e| path.min(e)),
             r_junction: rv,
@@ -316,20 +331,15 @@ fn terminal_thicket(w: &Work, params: &PruneParams, v: NodeId, below: &[Below]) 
     let Some(up) = b.up else {
         return false;
     };
-    let kids = |f: &dyn Fn(&Below) -> f64| {
-        b.children
-            .iter()
-            .map(|&(_, c)| f(&below[c.index()]))
-            .fold(f64::NEG_INFINITY, f64::max)
-    };
-    if !b
-        .children
-        .iter()
-        .any(|&(_, c)| below[c.index()].has_junction)
-    {
+    let kids = b.children.iter().map(|&(_, c)| &below[c.index()]);
+    if !kids.clone().any(|c| c.has_junction) {
         return false;
     }
-    let (e, tiny) = (b.bound, kids(&|c| c.max_radius.max(c.cut_radius)));
+    // The widest disc of the thicket (a cut end's included).
+    let tiny = kids
+        .map(|c| c.max_radius.max(c.cut_radius))
+        .fold(f64::NEG_INFINITY, f64::max);
+    let e = b.bound;
     if !(e.is_finite() && e > 0.0) {
         return false;
     }
@@ -354,6 +364,7 @@ fn terminal_thicket(w: &Work, params: &PruneParams, v: NodeId, below: &[Below]) 
     }
     false
 }
+
 /// Distance to ∂P where the side `(p, c)` of `v`, followed towards its
 /// farthest reach, leaves the disc at `v` (radius `rv`); at the leaf when
 /// the path is shorter (as for a leg).
@@ -372,17 +383,22 @@ fn mouth(w: &Work, below: &[Below], v: NodeId, (p, c): Side, rv: f64) -> f64 {
     }
 }
 
-/// How far the side `(p, c)` of `v` reaches from `v` in space, at most:
+/// How far the side of `v` through its child `c` reaches from `v` in space, at most:
 /// the largest `|q − v|` over the piece's points and the far side of the
 /// disc that bounds what `c` carries — `None` when that reaches `limit`
 /// (the side may be significant by the radius rule, and is kept).
-fn spatial_extent(w: &Work, below: &[Below], v: NodeId, (p, c): Side, limit: f64) -> Option<f64> {
-    let centre = w.graph.node(v).pos;
-    let mut best = hypot(w.graph.node(c).pos - centre) + below[c.index()].bound;
-    for q in w.piece_coords(p) {
-        best = best.max(hypot(q - centre));
-    }
+fn spatial_extent(w: &Work, below: &[Below], v: NodeId, c: NodeId, limit: f64) -> Option<f64> {
+    let cb = &below[c.index()];
+    let best = (hypot(w.graph.node(c).pos - w.graph.node(v).pos) + cb.bound).max(cb.piece_reach);
     (best < limit).then_some(best)
+}
+
+/// The largest distance from `from` of the points of piece `p`.
+fn piece_reach(w: &Work, p: u32, from: geo::Coord<f64>) -> f64 {
+    w.piece_coords(p)
+        .into_iter()
+        .map(|q| hypot(q - from))
+        .fold(0.0, f64::max)
 }
 
 /// Removes the piece of `side` and everything its child carries.
