@@ -51,6 +51,22 @@ fn main() {
         match r {
             Ok((g, s)) => {
                 ok += 1;
+                if dt.as_secs_f64() > 1.0 {
+                    eprintln!(
+                        "feature {i}: {:.3} s, {} vertices in, {} wavefront vertices, {} pops ({} stale, {} missed splits), at most {} queued, {} edges tried (predicted {:.0}), {} candidates kept (predicted {:.0})",
+                        dt.as_secs_f64(),
+                        s.input_vertices,
+                        s.vertices,
+                        s.pops,
+                        s.stale,
+                        s.missed,
+                        s.max_queue,
+                        s.tried,
+                        s.predicted.0,
+                        s.candidates,
+                        s.predicted.1
+                    );
+                }
                 edges += g.edges().len();
                 vertices += s.input_vertices;
             }

@@ -220,3 +220,123 @@ fn the_roughness_of_a_rim_leaves_no_thicket_of_legs() {
         }
     }
 }
+
+/// Runs `cmd` with `args`, which must succeed.
+fn must(cmd: &str, args: &[&str]) {
+    let o = std::process::Command::new(cmd)
+        .args(args)
+        .output()
+        .unwrap_or_else(|e| panic!("{cmd}: {e}"));
+    assert!(
+        o.status.success(),
+        "{cmd} {args:?}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
+/// The default pipeline on every method, the candidates written: the
+/// output's path.
+fn run_all_methods(dir: &Path, name: &str, source: &str, layer: &str) -> std::path::PathBuf {
+    let out = dir.join(format!("{name}.gpkg"));
+    let text = format!(
+        "input: {{ source: {source}, layer: {layer} }}\nsteps:\n  - prepare: {{ make_valid: true }}\n  - skeleton: {{ methods: [MA, StSk, DVD, CDT, VD] }}\n  - prune: {{}}\n  - extend: {{}}\n  - score: {{}}\n  - select: {{}}\noutput: {{ path: {}, overwrite: true, candidates: true }}\n",
+        out.display()
+    );
+    let p = pipeline(dir, &format!("{name}.yaml"), &text);
+    let o = skeletonise(&["run", "-q", p.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", code_and_err(&o).1);
+    out
+}
+
+/// A river rasterised at 30 m and vectorised again with `gdal_polygonize -8`
+/// (57 000 vertices, every one a right-angled corner, half of them reflex:
+/// a satellite water mask): every method runs — the straight skeleton is
+/// neither declined nor failed (its simultaneous events and long split
+/// searches made it quadratic) — and the chosen line has the vector river's
+/// legs (± 1), is centred (Z ≤ 0.001) and has no hooked end.
+#[test]
+fn a_rasterised_river_runs_every_method_and_keeps_the_vector_rivers_legs() {
+    let dir = tmp();
+    let d = dir.path();
+    let (tif, poly, raster) = (d.join("r.tif"), d.join("poly.gpkg"), d.join("raster.gpkg"));
+    let train = root(TRAIN);
+    let layer = "river_st_lawrence";
+    must(
+        "gdal_rasterize",
+        &[
+            "-q",
+            "-burn",
+            "1",
+            "-tr",
+            "30",
+            "30",
+            "-ot",
+            "Byte",
+            "-a_nodata",
+            "0",
+            "-l",
+            layer,
+            &train,
+            tif.to_str().unwrap(),
+        ],
+    );
+    must(
+        "gdal_polygonize.py",
+        &[
+            "-q",
+            "-8",
+            tif.to_str().unwrap(),
+            "-f",
+            "GPKG",
+            poly.to_str().unwrap(),
+            "poly",
+            "v",
+        ],
+    );
+    // The largest piece: the river (the others are pixels cut off at narrows).
+    must(
+        "ogr2ogr",
+        &[
+            "-f",
+            "GPKG",
+            raster.to_str().unwrap(),
+            poly.to_str().unwrap(),
+            "-nln",
+            "raster",
+            "-sql",
+            "SELECT * FROM poly WHERE v = 1 ORDER BY ST_Area(geom) DESC LIMIT 1",
+        ],
+    );
+    let ras = run_all_methods(d, "ras", raster.to_str().unwrap(), "raster");
+    let vec = run_all_methods(d, "vec", &train, layer);
+    let ds = open(&ras);
+    let methods = strings(&ds, "candidates", "method");
+    let errors = strings(&ds, "candidates", "error");
+    assert_eq!(methods.len(), 5, "{methods:?}");
+    for (m, e) in methods.iter().zip(&errors) {
+        assert!(
+            e.as_deref().unwrap_or("").is_empty(),
+            "{m:?} did not run: {e:?}"
+        );
+    }
+    let legs = ints(&ds, "skeletons", "legs")[0].unwrap();
+    let vector_legs = ints(&open(&vec), "skeletons", "legs")[0].unwrap();
+    assert!(
+        (legs - vector_legs).abs() <= 1,
+        "raster {legs} legs, vector {vector_legs}"
+    );
+    let z = reals(&ds, "skeletons", "distortion")[0].unwrap();
+    assert!(z <= 0.001, "Z {z}");
+    let lines = &wkts(&ds, "skeletons")[0];
+    let g: geo::Geometry<f64> =
+        wkt::TryFromWkt::try_from_wkt_str(lines.as_deref().unwrap()).unwrap();
+    let g = match g {
+        geo::Geometry::MultiLineString(m) => SkeletonGraph::from_lines(&m),
+        other => panic!("not lines: {other:?}"),
+    };
+    let p: Polygon<f64> =
+        wkt::TryFromWkt::try_from_wkt_str(wkts(&open(&raster), "raster")[0].as_deref().unwrap())
+            .unwrap();
+    let turns = end_turns(&g, &PreparedPolygon::new(&p).unwrap());
+    assert!(turns.iter().all(|&t| t <= HOOK_DEG), "hooks: {turns:?}");
+}

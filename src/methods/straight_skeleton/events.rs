@@ -15,6 +15,7 @@
 
 use super::wavefront::{LineId, VertexId, Wavefront};
 use crate::geometry::vector::dot;
+use rustc_hash::{FxHashMap, FxHashSet};
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
@@ -106,6 +107,11 @@ impl EventQueue {
     pub fn peek_time(&self) -> Option<f64> {
         self.heap.peek().map(|e| e.t)
     }
+
+    /// The earliest event, without removing it.
+    pub fn peek(&self) -> Option<&Event> {
+        self.heap.peek()
+    }
 }
 
 /// Time at which the edge `x → y` collapses, if it shrinks. Clamped to be
@@ -161,4 +167,167 @@ pub fn split_candidates(
         .collect();
     out.sort_by(|a, b| a.t.total_cmp(&b.t).then(a.line.cmp(&b.line)));
     out
+}
+
+/// Events taken out of the queue because they fall within `tol` of the time
+/// of an event being handled, indexed by where they happen, so that the
+/// events at one point are found without scanning every event at that time.
+///
+/// A raster staircase makes thousands of events at one time (every pixel
+/// edge collapses at half the pixel size): scanning them all for each event
+/// of the time, and queueing the others again, was quadratic in their
+/// number. Held events keep their place in the order (their `seq`); an event
+/// is *live* until it is taken, by a group or as the next event. Each event
+/// sits in the grid cell of its point; a query looks at the 3 × 3 cells
+/// around its point, so an event's reach `r` must not exceed the cell size —
+/// a farther-reaching one (a fast vertex has a large tolerance: rare) is
+/// kept in a list scanned on every query.
+#[derive(Debug, Default)]
+pub struct Held {
+    heap: BinaryHeap<Event>,
+    live: FxHashSet<u64>,
+    cells: FxHashMap<(i64, i64), Vec<Placed>>,
+    wide: Vec<Placed>,
+    cell: f64,
+}
+
+/// A held event, its point and its reach.
+type Placed = (Event, [f64; 2], f64);
+
+impl Held {
+    /// Holds `e`, which happens within `r` of `p`; the grid's cell size is
+    /// set by the first event held (`cell`), cleared when nothing is live.
+    pub fn hold(&mut self, e: Event, p: [f64; 2], r: f64, cell: f64) {
+        if self.live.is_empty() {
+            self.heap.clear();
+            self.cells.clear();
+            self.wide.clear();
+            self.cell = cell.max(f64::MIN_POSITIVE);
+        }
+        self.live.insert(e.seq);
+        self.heap.push(e);
+        match self.key(p) {
+            Some(k) if r <= self.cell => self.cells.entry(k).or_default().push((e, p, r)),
+            _ => self.wide.push((e, p, r)),
+        }
+    }
+
+    fn key(&self, p: [f64; 2]) -> Option<(i64, i64)> {
+        let (i, j) = ((p[0] / self.cell).floor(), (p[1] / self.cell).floor());
+        // Far inside i64: the grid is in local coordinates at 1e-8 of the
+        // polygon's extent.
+        (i.abs() < 1e15 && j.abs() < 1e15).then_some((i as i64, j as i64))
+    }
+
+    /// The earliest live held event, without taking it.
+    pub fn peek(&mut self) -> Option<&Event> {
+        while let Some(e) = self.heap.peek() {
+            if self.live.contains(&e.seq) {
+                break;
+            }
+            self.heap.pop();
+        }
+        self.heap.peek()
+    }
+
+    /// Takes the earliest live held event.
+    pub fn pop(&mut self) -> Option<Event> {
+        self.peek()?;
+        let e = self.heap.pop()?;
+        self.live.remove(&e.seq);
+        Some(e)
+    }
+
+    /// Takes every live held event whose reach holds `p`, in queue order.
+    pub fn take_at(&mut self, p: [f64; 2]) -> Vec<Event> {
+        let near = |q: &[f64; 2], r: f64| (q[0] - p[0]).hypot(q[1] - p[1]) <= r;
+        let mut out: Vec<Event> = Vec::new();
+        if let Some((i, j)) = self.key(p) {
+            for k in [
+                (i - 1, j - 1),
+                (i - 1, j),
+                (i - 1, j + 1),
+                (i, j - 1),
+                (i, j),
+            ]
+            .into_iter()
+            .chain([(i, j + 1), (i + 1, j - 1), (i + 1, j), (i + 1, j + 1)])
+            {
+                if let Some(v) = self.cells.get(&k) {
+                    out.extend(
+                        v.iter()
+                            .filter(|(e, q, r)| self.live.contains(&e.seq) && near(q, *r))
+                            .map(|(e, _, _)| *e),
+                    );
+                }
+            }
+        }
+        out.extend(
+            self.wide
+                .iter()
+                .filter(|(e, q, r)| self.live.contains(&e.seq) && near(q, *r))
+                .map(|(e, _, _)| *e),
+        );
+        for e in &out {
+            self.live.remove(&e.seq);
+        }
+        // Greatest first is earliest first (the order is reversed for the heap).
+        out.sort_by(|a, b| b.cmp(a));
+        out
+    }
+
+    /// Puts back an event taken by [`Self::take_at`] and not used.
+    pub fn put_back(&mut self, e: &Event) {
+        self.live.insert(e.seq);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn edge(t: f64, seq: u64, i: usize) -> Event {
+        Event {
+            t,
+            seq,
+            kind: EventKind::Edge {
+                x: VertexId::from_index(i),
+                y: VertexId::from_index(i + 1),
+            },
+        }
+    }
+
+    #[test]
+    fn held_events_are_found_at_their_place_only_and_keep_their_order() {
+        let mut h = Held::default();
+        // A staircase's simultaneous events: 1000 places 30 apart, two
+        // events at place 500 (one reaching from a fast vertex, 0.5 away).
+        for i in 0..1000 {
+            h.hold(
+                edge(15.0, 10 + i as u64, i),
+                [30.0 * i as f64, 0.0],
+                1e-3,
+                4e-3,
+            );
+        }
+        h.hold(edge(15.0, 5, 2000), [15_000.5, 0.0], 0.6, 4e-3);
+        let here = h.take_at([15_000.0, 0.0]);
+        let seqs: Vec<u64> = here.iter().map(|e| e.seq).collect();
+        assert_eq!(seqs, vec![5, 510], "the earliest-queued first");
+        assert!(
+            h.take_at([15_000.0, 0.0]).is_empty(),
+            "taken events are gone"
+        );
+        // Put back, an event is live again, in its old place in the order.
+        h.put_back(&here[1]);
+        assert_eq!(h.pop().map(|e| e.seq), Some(10));
+        assert_eq!(h.take_at([15_000.0, 0.0]).len(), 1);
+        // Nothing between places.
+        assert!(h.take_at([15.0, 0.0]).is_empty());
+        let mut rest = 0;
+        while h.pop().is_some() {
+            rest += 1;
+        }
+        assert_eq!(rest, 998);
+    }
 }

@@ -38,8 +38,14 @@
 //!   original edges near its ray (bounded by where the ray leaves P),
 //!   sorted by time and validated against the current wavefront when
 //!   popped; events are kept in a binary heap with lazy invalidation (an
-//!   event naming an inactive vertex is dropped). The cost is about
-//!   O(n log n) on real data.
+//!   event naming an inactive vertex is dropped). A candidate whose line
+//!   has left the wavefront is skipped when queued. The events within `tol`
+//!   of the time being handled are held in a grid by place
+//!   ([`events::Held`]), so that a group is found among the events at its
+//!   point only: a raster staircase has thousands of events at one time
+//!   (every pixel edge collapses at half a pixel), and scanning them all
+//!   for each one was quadratic (31 s → 3 s on a 57 000-vertex rasterised
+//!   river). The cost is about O(n log n) on real data.
 //! * "Near its ray" is not a proven bound: a face widens without limit
 //!   next to a fast reflex vertex (nearly parallel banks), so a split can
 //!   come from an edge far from the ray. Every result is therefore
@@ -95,7 +101,7 @@ use crate::geometry::tolerance::{SAME_POINT, TRACE_CROSSING};
 use crate::geometry::vector::{cross, dot, hypot, within_hypot};
 use crate::geometry::{Boundary, PreparedPolygon};
 use crate::graph::{GraphBuilder, SkeletonGraph};
-use events::{edge_collapse_time, split_candidates, EventKind, EventQueue, SplitCandidate};
+use events::{edge_collapse_time, split_candidates, EventKind, EventQueue, Held, SplitCandidate};
 use geo::Coord;
 use std::ops::ControlFlow;
 use wavefront::{Line, LineId, VertexId, Wavefront};
@@ -113,6 +119,10 @@ pub struct Stats {
     pub vertices: usize,
     /// Events popped from the queue (stale ones included).
     pub pops: usize,
+    /// Events popped whose vertices had gone (stale).
+    pub stale: usize,
+    /// Split candidates popped that found no piece of their line there.
+    pub missed: usize,
     /// Most events queued at once (stale ones included).
     pub max_queue: usize,
     /// Edges tried as split candidates (all reflex vertices).
@@ -175,17 +185,34 @@ enum Search {
 /// [`verify`] is repeated with the next, wider one. The last is exhaustive.
 const SEARCH_PASSES: [Search; 3] = [Search::Near(2.0), Search::Near(16.0), Search::All];
 
+/// How far a reflex vertex's ray has been searched for split candidates
+/// (see [`Propagation::search_band`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+struct Band {
+    /// Distance along the ray searched so far.
+    searched: f64,
+    /// Where the search ends: the ray's exit from P, or sooner where the
+    /// vertex must have ended.
+    reach: f64,
+    /// The first band's length.
+    first: f64,
+}
+
 struct Propagation<'a> {
     /// The method's budget: its deadline is checked on the event queue.
     ctx: &'a MethodContext,
     w: Wavefront,
     q: EventQueue,
+    /// Events within `tol` of the time being handled, by place.
+    held: Held,
     /// The original edges, item `i` being `LineId(i)`.
     tree: PackedTree,
     search: Search,
     boundary: &'a Boundary,
     origin: Coord<f64>,
     candidates: Vec<Vec<SplitCandidate>>,
+    /// Per vertex, how far its ray has been searched for split candidates.
+    bands: Vec<Band>,
     arcs: Vec<Arc>,
     work: Vec<VertexId>,
     now: f64,
@@ -235,8 +262,10 @@ impl<'a> Propagation<'a> {
         Self {
             ctx,
             candidates: vec![Vec::new(); w.vertices.len()],
+            bands: vec![Band::default(); w.vertices.len()],
             w,
             q: EventQueue::default(),
+            held: Held::default(),
             tree: PackedTree::new(&entries),
             search,
             boundary: polygon.boundary(),
@@ -303,13 +332,14 @@ impl<'a> Propagation<'a> {
         }
         let id = self.w.add_vertex(p, self.now, left, right, None);
         self.candidates.push(Vec::new());
+        self.bands.push(Band::default());
         self.work.push(id);
         Ok(id)
     }
 
     fn run(mut self) -> Result<(Vec<Arc>, Stats), MethodError> {
         self.drain_work()?;
-        while let Some(ev) = self.q.pop() {
+        while let Some(ev) = self.next_event() {
             self.stats.pops += 1;
             if self.stats.pops.is_multiple_of(4096) {
                 self.ctx.check(MethodId::STSK)?;
@@ -324,18 +354,21 @@ impl<'a> Propagation<'a> {
             match ev.kind {
                 EventKind::Edge { x, y } => {
                     if !self.edge_valid(x, y) {
+                        self.stats.stale += 1;
                         continue;
                     }
                     self.now = self.now.max(ev.t);
                 }
                 EventKind::Split { v, candidate } => {
                     if !self.w.v(v).active {
+                        self.stats.stale += 1;
                         continue;
                     }
                     self.now = self.now.max(ev.t);
                     let c = self.candidates[v.index()][candidate as usize];
                     if self.find_piece(v, c.line).is_none() {
-                        self.push_candidate(v, candidate + 1);
+                        self.stats.missed += 1;
+                        self.push_candidate(v, candidate + 1)?;
                         self.drain_work()?;
                         continue;
                     }
@@ -361,6 +394,42 @@ impl<'a> Propagation<'a> {
         Ok((self.arcs, self.stats))
     }
 
+    /// The next event: the earlier of the queue's and the held events'.
+    fn next_event(&mut self) -> Option<events::Event> {
+        let queued = self.q.peek().copied();
+        match (queued, self.held.peek().copied()) {
+            (Some(a), Some(b)) if b > a => self.held.pop(),
+            (None, Some(_)) => self.held.pop(),
+            _ => self.q.pop(),
+        }
+    }
+
+    /// Where a queued event happens now and how far from there its group's
+    /// point may be (see [`Self::at`]), with room for the vertices' travel
+    /// until the event's time; `None` for a stale event.
+    fn event_place(&self, e: &events::Event) -> Option<(Coord<f64>, f64)> {
+        let v = match e.kind {
+            EventKind::Edge { x, y } => {
+                if !self.edge_valid(x, y) {
+                    return None;
+                }
+                x
+            }
+            EventKind::Split { v, .. } => {
+                if !self.w.v(v).active {
+                    return None;
+                }
+                v
+            }
+        };
+        let speed = self.w.v(v).vel.map_or(0.0, hypot);
+        let travel = speed * (e.t - self.now).max(0.0);
+        Some((
+            self.w.pos(v, self.now),
+            2.0 * self.tol * (1.0 + speed) + travel + self.tol,
+        ))
+    }
+
     fn edge_valid(&self, x: VertexId, y: VertexId) -> bool {
         self.w.v(x).active && self.w.v(y).active && self.w.v(x).next == y
     }
@@ -383,9 +452,14 @@ impl<'a> Propagation<'a> {
             EventKind::Split { v, .. } => self.w.pos(v, t0),
         };
         let mut group = vec![ev];
-        let mut elsewhere = Vec::new();
         while self.q.peek_time().is_some_and(|t| t <= t0 + self.tol) {
             let Some(e) = self.q.pop() else { break };
+            let Some((p, r)) = self.event_place(&e) else {
+                continue;
+            };
+            self.held.hold(e, [p.x, p.y], r, 16.0 * self.tol);
+        }
+        for e in self.held.take_at([p0.x, p0.y]) {
             let here = match e.kind {
                 EventKind::Edge { x, y } => {
                     if !self.edge_valid(x, y) {
@@ -403,11 +477,8 @@ impl<'a> Propagation<'a> {
             if here {
                 group.push(e);
             } else {
-                elsewhere.push(e);
+                self.held.put_back(&e);
             }
-        }
-        for e in elsewhere {
-            self.q.push(e.t, e.kind);
         }
         if group.len() > 1 && self.vertex_event(&group, p0)? {
             return Ok(());
@@ -423,10 +494,7 @@ impl<'a> Propagation<'a> {
                 let c = self.candidates[v.index()][candidate as usize];
                 match self.find_piece(v, c.line) {
                     Some(x) => self.split_event(v, x, c.line),
-                    None => {
-                        self.push_candidate(v, candidate + 1);
-                        Ok(())
-                    }
+                    None => self.push_candidate(v, candidate + 1),
                 }
             }
         }
@@ -449,13 +517,13 @@ impl<'a> Propagation<'a> {
         p0: Coord<f64>,
     ) -> Result<bool, MethodError> {
         let t0 = self.now;
-        let (inv, cuts, next_candidates) = self.involved(group, p0, t0);
+        let (inv, cuts, next_candidates) = self.involved(group, p0, t0)?;
         let chains = self.chains(&inv, &cuts);
         let Some(pairs) = self.pair_rays(&chains) else {
             return Ok(false);
         };
         for (v, i) in next_candidates {
-            self.push_candidate(v, i);
+            self.push_candidate(v, i)?;
         }
         for &u in &inv {
             self.finish(u, p0);
@@ -473,7 +541,7 @@ impl<'a> Propagation<'a> {
         group: &[events::Event],
         p0: Coord<f64>,
         t0: f64,
-    ) -> (Vec<VertexId>, Vec<(VertexId, LineId)>, Vec<(VertexId, u32)>) {
+    ) -> Result<(Vec<VertexId>, Vec<(VertexId, LineId)>, Vec<(VertexId, u32)>), MethodError> {
         let mut inv: Vec<VertexId> = Vec::new();
         let mut cuts: Vec<(VertexId, LineId)> = Vec::new();
         let mut next_candidates = Vec::new();
@@ -483,7 +551,11 @@ impl<'a> Propagation<'a> {
                 EventKind::Split { v, candidate } => {
                     let mut i = candidate as usize;
                     let mut hit = false;
-                    while let Some(&c) = self.candidates[v.index()].get(i) {
+                    loop {
+                        self.reach_candidate(v, i)?;
+                        let Some(&c) = self.candidates[v.index()].get(i) else {
+                            break;
+                        };
                         if i > candidate as usize && c.t > t0 + self.tol {
                             break;
                         }
@@ -524,7 +596,7 @@ impl<'a> Propagation<'a> {
         cuts.dedup_by_key(|c| c.0);
         let is_inv = |v: VertexId| inv.binary_search(&v).is_ok();
         cuts.retain(|c| !is_inv(c.0) && !is_inv(self.w.v(c.0).next));
-        (inv, cuts, next_candidates)
+        Ok((inv, cuts, next_candidates))
     }
 
     /// The wavefront chains meeting at the event: (arriving line, leaving
@@ -662,8 +734,14 @@ impl<'a> Propagation<'a> {
             self.q.push(te, EventKind::Edge { x: z, y: next });
         }
         if self.w.v(z).reflex {
-            self.compute_candidates(z)?;
-            self.push_candidate(z, 0);
+            if let Some((reach, first)) = self.ray_reach(z) {
+                self.bands[z.index()] = Band {
+                    searched: 0.0,
+                    reach,
+                    first,
+                };
+            }
+            self.push_candidate(z, 0)?;
         }
         Ok(())
     }
@@ -784,26 +862,40 @@ impl<'a> Propagation<'a> {
         Ok(())
     }
 
-    /// The original edges reflex vertex `z`'s split candidates are taken
-    /// from (all, or those in reach of its ray), and the latest time a
-    /// candidate may have.
-    fn candidate_lines(&self, z: VertexId) -> Option<(Vec<LineId>, f64)> {
+    /// How far reflex vertex `z`'s ray reaches inside P (the bound of its
+    /// split candidates), and the length of its first search band.
+    fn ray_reach(&self, z: VertexId) -> Option<(f64, f64)> {
+        let vx = *self.w.v(z);
+        let s = vx.vel?;
+        let speed = hypot(s);
+        let start = vx.start + self.origin;
+        let mut reach = self
+            .boundary
+            .first_hit(start, s / speed, self.tol, 4.0 * self.extent)
+            .map_or(2.0 * self.extent, |h| h.t);
+        let (l, r) = (self.w.line(vx.left), self.w.line(vx.right));
+        let step = hypot(l.b - l.a).min(hypot(r.b - r.a));
+        if let Search::Near(_) = self.search {
+            reach = self.reach_alive(vx.t0, start, s, reach, step);
+        }
+        Some((reach, (2.0 * step).clamp(reach / 4096.0, reach)))
+    }
+
+    /// The original edges reflex vertex `z`'s split candidates up to
+    /// distance `upto` along its ray are taken from (all, or those near
+    /// that part of the ray), and the latest time such a candidate may have.
+    fn candidate_lines(&self, z: VertexId, upto: f64) -> Option<(Vec<LineId>, f64)> {
         let vx = *self.w.v(z);
         let s = vx.vel?;
         let speed = hypot(s);
         let dir = s / speed;
-        let start = vx.start + self.origin;
-        let reach = self
-            .boundary
-            .first_hit(start, dir, self.tol, 4.0 * self.extent)
-            .map_or(2.0 * self.extent, |h| h.t);
-        let t_max = vx.t0 + reach / speed;
+        let t_max = vx.t0 + upto / speed;
         let lines = match self.search {
             Search::Near(factor) => {
                 // Faces of edges whose ends are reflex widen away from the
                 // edge: search a margin proportional to the reach.
-                let end = vx.start + dir * reach;
-                let m = factor * reach + self.tol;
+                let end = vx.start + dir * upto;
+                let m = factor * upto + self.tol;
                 let env = [
                     vx.start.x.min(end.x) - m,
                     vx.start.y.min(end.y) - m,
@@ -826,17 +918,93 @@ impl<'a> Propagation<'a> {
         Some((lines, t_max))
     }
 
-    /// Split candidates of reflex vertex `z` from the original edges within
-    /// reach of its ray. Fails when all the polygon's candidates together
-    /// pass the memory budget.
-    fn compute_candidates(&mut self, z: VertexId) -> Result<(), MethodError> {
-        let Some((lines, t_max)) = self.candidate_lines(z) else {
-            return Ok(());
+    /// How far along its ray a vertex that starts at `start` (absolute) at
+    /// time `t0` with velocity `s` can still be in the wavefront, at most
+    /// `reach`: a wavefront point at time `t` is at least `t` from ∂P (the
+    /// mitred offset lies within the Euclidean one), so the vertex has
+    /// ended before any time at which its position is nearer to ∂P than
+    /// that. Distances are tried doubling from `step` (the shorter of its
+    /// edges) and the first such one narrowed by bisection; the result is
+    /// an upper bound. On a rough or staircase rim a reflex vertex ends
+    /// within a few of its edges' lengths, where its ray's exit from P can
+    /// be across the polygon: the search for split candidates shrinks from
+    /// the polygon to the vertex's neighbourhood.
+    fn reach_alive(&self, t0: f64, start: Coord<f64>, s: Coord<f64>, reach: f64, step: f64) -> f64 {
+        let speed = hypot(s);
+        let margin = 16.0 * self.tol * (1.0 + speed);
+        let ended = |d: f64| {
+            let limit = t0 + d / speed - margin;
+            limit > 0.0
+                && self
+                    .boundary
+                    .nearest_within(start + s * (d / speed), limit)
+                    .is_some()
         };
+        let mut lo = 0.0;
+        let mut d = step.clamp(reach / 4096.0, reach);
+        while d < reach {
+            if ended(d) {
+                let mut hi = d;
+                for _ in 0..3 {
+                    let mid = 0.5 * (lo + hi);
+                    if ended(mid) {
+                        hi = mid;
+                    } else {
+                        lo = mid;
+                    }
+                }
+                return hi;
+            }
+            lo = d;
+            d *= 2.0;
+        }
+        reach
+    }
+
+    /// Searches the next band of reflex vertex `z`'s ray for split
+    /// candidates and appends them to its list; `false` when the ray has
+    /// been searched to its end. Bands double in length from twice the
+    /// vertex's shorter edge (the exhaustive search has one band, the whole
+    /// ray), and a band is searched only when the vertex has tried every
+    /// candidate of the bands before: most reflex vertices of a rough rim
+    /// end within their first band, so their search stays local where a
+    /// search of the whole ray (which can cross the polygon) made the
+    /// propagation quadratic. A band keeps the candidates that come after
+    /// the list's last in time order (earlier ones are past). Fails when all
+    /// the polygon's candidates together pass the memory budget.
+    fn search_band(&mut self, z: VertexId) -> Result<bool, MethodError> {
+        let band = &mut self.bands[z.index()];
+        if band.searched >= band.reach {
+            return Ok(false);
+        }
+        let upto = match (self.search, band.searched > 0.0) {
+            (Search::All, _) => band.reach,
+            (Search::Near(_), false) => band.first,
+            (Search::Near(_), true) => {
+                let next = 2.0 * band.searched;
+                if next >= 0.5 * band.reach {
+                    band.reach
+                } else {
+                    next
+                }
+            }
+        };
+        band.searched = upto;
+        let Some((lines, t_max)) = self.candidate_lines(z, upto) else {
+            return Ok(false);
+        };
+        self.ctx.check(MethodId::STSK)?;
         self.stats.tried += lines.len();
-        let c = split_candidates(&self.w, z, lines.into_iter(), t_max, self.tol);
+        let mut c = split_candidates(&self.w, z, lines.into_iter(), t_max, self.tol);
+        let list = &mut self.candidates[z.index()];
+        if let Some(&last) = list.last() {
+            let after = |x: &SplitCandidate| {
+                x.t.total_cmp(&last.t).then(x.line.cmp(&last.line)) == std::cmp::Ordering::Greater
+            };
+            c.retain(after);
+        }
         self.stats.candidates += c.len();
-        self.candidates[z.index()] = c;
+        list.extend(c);
         if self.stats.candidates > self.max_candidates {
             return Err(MethodError::OverBudget {
                 method: MethodId::STSK,
@@ -846,11 +1014,23 @@ impl<'a> Propagation<'a> {
                 ),
             });
         }
+        Ok(true)
+    }
+
+    /// Makes reflex vertex `v`'s candidate `i` known if its ray has one,
+    /// searching further bands as needed.
+    fn reach_candidate(&mut self, v: VertexId, i: usize) -> Result<(), MethodError> {
+        while i >= self.candidates[v.index()].len() && self.search_band(v)? {}
         Ok(())
     }
 
     /// The cost of the propagation, predicted from a sample of the input's
-    /// reflex vertices: (edges to try, candidates to keep) over all of them.
+    /// reflex vertices: (edges to try, candidates to keep) over all of them,
+    /// each as if it searched its whole ray. That is an upper estimate: a
+    /// vertex searches band after band only while it lives (on a rough rim
+    /// it ends early: 6× fewer tries than predicted on the rough polygon of
+    /// `scripts/make_rough_polygon.py`; about as predicted on a raster
+    /// staircase).
     /// The first eighth of the sample is spread over the whole polygon;
     /// when its estimate already makes `hopeless` true (far beyond the
     /// budget), that estimate is returned without the rest — on a huge
@@ -879,7 +1059,10 @@ impl<'a> Propagation<'a> {
         };
         let first_count = sample.len().div_ceil(8);
         for z in first.chain(rest) {
-            if let Some((lines, t_max)) = self.candidate_lines(z) {
+            let Some((upto, _)) = self.ray_reach(z) else {
+                continue;
+            };
+            if let Some((lines, t_max)) = self.candidate_lines(z, upto) {
                 tried += lines.len();
                 kept += split_candidates(&self.w, z, lines.into_iter(), t_max, self.tol).len();
             }
@@ -894,10 +1077,28 @@ impl<'a> Propagation<'a> {
         estimate(tried, kept, sampled)
     }
 
-    fn push_candidate(&mut self, v: VertexId, i: u32) {
-        if let Some(c) = self.candidates[v.index()].get(i as usize) {
-            let t = c.t.max(self.now);
-            self.q.push(t, EventKind::Split { v, candidate: i });
+    /// Queues reflex vertex `v`'s split candidate `i`, or the first after it
+    /// whose line is still in the wavefront (on a staircase most original
+    /// edges are gone before a vertex's candidate on them comes up).
+    fn push_candidate(&mut self, v: VertexId, i: u32) -> Result<(), MethodError> {
+        let mut i = i as usize;
+        loop {
+            self.reach_candidate(v, i)?;
+            let Some(c) = self.candidates[v.index()].get(i) else {
+                return Ok(());
+            };
+            if self.w.line_alive(c.line) {
+                let t = c.t.max(self.now);
+                self.q.push(
+                    t,
+                    EventKind::Split {
+                        v,
+                        candidate: i as u32,
+                    },
+                );
+                return Ok(());
+            }
+            i += 1;
         }
     }
 }
@@ -1025,7 +1226,14 @@ pub fn straight_skeleton_with_stats(
 ) -> Result<(SkeletonGraph, Stats), MethodError> {
     let mut result = Err(fail("no search pass"));
     for search in SEARCH_PASSES {
+        let t = std::time::Instant::now();
         result = propagate(polygon, search, ctx);
+        tracing::debug!(
+            ?search,
+            seconds = t.elapsed().as_secs_f64(),
+            error = ?result.as_ref().err(),
+            "straight skeleton search pass"
+        );
         if result.is_ok() {
             break;
         }
@@ -1066,8 +1274,9 @@ mod tests {
     }
 
     /// The early estimate (the first eighth of the sample, spread over the
-    /// polygon) is near the whole sample's, so declining on it at four
-    /// times the budget declines only what the whole sample would.
+    /// polygon) is below four times the whole sample's, so declining on it
+    /// at four times the budget declines only what the whole sample would;
+    /// and above a quarter of it, so that it says something.
     #[test]
     fn early_prediction_is_near_the_full_one() {
         let n = 4000;
@@ -1093,7 +1302,7 @@ mod tests {
         assert_ne!(early, full);
         for (e, f) in [(early.0, full.0), (early.1, full.1)] {
             assert!(
-                e > 0.5 * f && e < 2.0 * f,
+                e > 0.25 * f && e < 4.0 * f,
                 "early {early:?} against full {full:?}"
             );
         }

@@ -233,6 +233,16 @@ impl Wavefront {
         self.v_mut(b).prev = a;
     }
 
+    /// Whether `line` still has a piece in the wavefront (dropping the
+    /// stale entries of its list). A line without one never gets one back:
+    /// new vertices take their lines from active ones.
+    pub fn line_alive(&mut self, line: LineId) -> bool {
+        let vertices = &self.vertices;
+        let pieces = &mut self.pieces[line.index()];
+        pieces.retain(|&x| vertices[x.index()].active);
+        !pieces.is_empty()
+    }
+
     /// Deactivates a vertex.
     pub fn kill(&mut self, id: VertexId) {
         self.v_mut(id).active = false;
