@@ -115,6 +115,40 @@ fn a_slot_and_a_spike_in_a_river_bank_give_no_spur_and_no_hook() {
     assert!(near(old, slot, 150.0) && near(old, spike, 150.0));
 }
 
+/// A compact lake (a disc cut flat on its east side) with a tip to the
+/// south: its line runs into the tip, not to the middle of the broad east
+/// shore, and has no hooked end.
+#[test]
+fn a_compact_lake_reaches_its_tip_not_its_side_shore() {
+    let dir = tmp();
+    let lines = &run_cases(dir.path(), &[])[1];
+    // make_rough_cases.py: the disc's centre at (510 000, 6 020 000), the
+    // tip's end 4.3 km south, the flat shore at x = +1.6 km from y = -1.2 to
+    // +1.2 km.
+    let tip = Coord {
+        x: 510_000.0,
+        y: 6_015_700.0,
+    };
+    let side = Coord {
+        x: 511_600.0,
+        y: 6_020_000.0,
+    };
+    let ends = leaves(lines);
+    assert_eq!(ends.len(), 2, "{ends:?}");
+    let d = |a: Coord<f64>, b: Coord<f64>| (a.x - b.x).hypot(a.y - b.y);
+    assert!(
+        ends.iter().any(|&e| d(e, tip) < 60.0),
+        "no end in the tip: {ends:?}"
+    );
+    assert!(
+        ends.iter().all(|&e| d(e, side) > 800.0),
+        "an end on the middle of the east shore: {ends:?}"
+    );
+    let g = SkeletonGraph::from_lines(lines);
+    let turns = end_turns(&g, &cases()[1]);
+    assert!(turns.iter().all(|&t| t <= HOOK_DEG), "hooks: {turns:?}");
+}
+
 #[test]
 fn a_crescent_keeps_both_horns() {
     let dir = tmp();
