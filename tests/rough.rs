@@ -374,3 +374,53 @@ fn a_rasterised_river_runs_every_method_and_keeps_the_vector_rivers_legs() {
     let turns = end_turns(&g, &PreparedPolygon::new(&p).unwrap());
     assert!(turns.iter().all(|&t| t <= HOOK_DEG), "hooks: {turns:?}");
 }
+
+/// A five-lobed star, smooth and rough: its main axis runs from a lobe's
+/// tip to another's along the medial axis — never straight on from the
+/// centre into the valley between two lobes (the two lobes there forked
+/// around the line like the corners of a square end, and the line ended
+/// between them, on the shore nearest the centre).
+#[test]
+fn a_stars_line_runs_from_lobe_tip_to_lobe_tip() {
+    use skeletonise::graph::extend::{prune_and_extend, ExtendParams};
+    for (n, rough) in [(4_000, 0.0), (20_000, 30.0)] {
+        let p = rough_lobes(n, 10_000.0, rough);
+        let params = SkeletonParams {
+            methods: vec![MethodId::MA],
+            ..Default::default()
+        };
+        let ma = build(MethodId::MA, &params)
+            .skeletonise(&p, &MethodContext::default())
+            .unwrap();
+        let g = prune_and_extend(
+            &ma,
+            &p,
+            Some(&PruneParams::default()),
+            Some(&ExtendParams::default()),
+        );
+        let deg = g.degrees();
+        let ends: Vec<Coord<f64>> = (0..deg.len())
+            .filter(|&i| deg[i] == 1)
+            .map(|i| g.nodes()[i].pos)
+            .collect();
+        assert!(ends.len() >= 2, "{n} vertices: {ends:?}");
+        for e in &ends {
+            // A lobe's tip lies 13 km out on its axis (sin 5t = 1); the
+            // valleys 7 km out between them.
+            let t = e.y.atan2(e.x);
+            let off = (0..5)
+                .map(|k| {
+                    let axis = std::f64::consts::PI / 10.0 + k as f64 * std::f64::consts::TAU / 5.0;
+                    let d = (t - axis).rem_euclid(std::f64::consts::TAU);
+                    d.min(std::f64::consts::TAU - d)
+                })
+                .fold(f64::INFINITY, f64::min);
+            let r = e.x.hypot(e.y);
+            assert!(
+                off < 0.05 && r > 12_500.0,
+                "{n} vertices: an end {:.0}° off a lobe's axis, {r:.0} m from the centre",
+                off.to_degrees()
+            );
+        }
+    }
+}

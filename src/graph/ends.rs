@@ -16,7 +16,9 @@
 //!   - if the substantial child most aligned with d is within 30° of it, the
 //!     line continues along that child (a tapering tip: the medial axis runs
 //!     on into the tip vertex, and the whiskers beside it protrude little);
-//!   - else if substantial children lie on both sides of d, the removed legs
+//!   - else if substantial children lie on both sides of d and the two most
+//!     aligned do not both protrude [`HORN_PROTRUSION`] radii or more (horns:
+//!     the line follows the more aligned one, below), the removed legs
 //!     fork around the line (the corners of a rectangle's or a river reach's
 //!     cut end, at ±45° for right-angled corners): the line ends with a
 //!     straight segment from v to where v's inscribed disc touches ∂P
@@ -69,6 +71,14 @@ const FOLLOW_ANGLE_DEG: f64 = 30.0;
 /// Depth of a removed subtree is explored up to this many radii of the node
 /// it hangs from (enough to tell a whisker from a continuing leg).
 const DEPTH_CAP: f64 = 3.0;
+
+/// Legs protruding at least this many radii beyond the disc at their node
+/// on both sides of the line are horns, not the corners of an end side: the
+/// line follows the more aligned one into its tip instead of ending between
+/// them. The corner legs of a square end protrude √2 − 1 = 0.41 radii, of
+/// a 70° corner 1/sin 35° − 1 = 0.74; the two horns of a notched end or two
+/// lobes of a star more.
+const HORN_PROTRUSION: f64 = 0.75;
 
 /// Largest angle between the line's course and its last segment at a fork
 /// (beyond it the end would turn onto the bank: a hook).
@@ -450,10 +460,12 @@ impl<'a> Extender<'a> {
             return Some(Decision::Follow(best.0));
         }
         if let (Some(l), Some(r)) = (aligned(1.0), aligned(-1.0)) {
-            return Some(Decision::Fork {
-                right: r.1,
-                left: l.1,
-            });
+            if l.2.min(r.2) < HORN_PROTRUSION * rv {
+                return Some(Decision::Fork {
+                    right: r.1,
+                    left: l.1,
+                });
+            }
         }
         Some(Decision::Follow(best.0))
     }
