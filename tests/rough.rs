@@ -201,6 +201,30 @@ fn rough_lobes(n: usize, radius: f64, rough: f64) -> PreparedPolygon {
     PreparedPolygon::new(&Polygon::new(LineString::new(ring), vec![])).unwrap()
 }
 
+/// The medial axis of `p`.
+fn medial_axis(p: &PreparedPolygon) -> SkeletonGraph {
+    let params = SkeletonParams {
+        methods: vec![MethodId::MA],
+        ..Default::default()
+    };
+    build(MethodId::MA, &params)
+        .skeletonise(p, &MethodContext::default())
+        .unwrap()
+}
+
+/// The angle (radians) between the direction of `pos` from the centre of
+/// [`rough_lobes`] and the nearest lobe's axis (sin 5t = 1).
+fn off_lobe_axes(pos: Coord<f64>) -> f64 {
+    let t = pos.y.atan2(pos.x);
+    (0..5)
+        .map(|k| {
+            let axis = std::f64::consts::PI / 10.0 + k as f64 * std::f64::consts::TAU / 5.0;
+            let d = (t - axis).rem_euclid(std::f64::consts::TAU);
+            d.min(std::f64::consts::TAU - d)
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
 #[test]
 fn the_roughness_of_a_rim_leaves_no_thicket_of_legs() {
     // Radius 10 km, vertices every 0.35 m with up to 30 m of roughness: a
@@ -209,13 +233,7 @@ fn the_roughness_of_a_rim_leaves_no_thicket_of_legs() {
     // a handful of legs, not one per needle (tens of thousands before sides
     // were judged), and no brush of legs where a line runs into the rim.
     let p = rough_lobes(200_000, 10_000.0, 30.0);
-    let params = SkeletonParams {
-        methods: vec![MethodId::MA],
-        ..Default::default()
-    };
-    let ma = build(MethodId::MA, &params)
-        .skeletonise(&p, &MethodContext::default())
-        .unwrap();
+    let ma = medial_axis(&p);
     let pruned = prune(&ma, &PruneParams::default(), p.boundary());
     assert!(ma.leg_count() > 5_000, "{} raw legs", ma.leg_count());
     assert!(pruned.leg_count() <= 10, "{} legs kept", pruned.leg_count());
@@ -238,14 +256,7 @@ fn the_roughness_of_a_rim_leaves_no_thicket_of_legs() {
     }
     for (i, n) in g.nodes().iter().enumerate() {
         if deg[i] == 1 {
-            let t = n.pos.y.atan2(n.pos.x);
-            let off = (0..5)
-                .map(|k| {
-                    let axis = std::f64::consts::PI / 10.0 + k as f64 * std::f64::consts::TAU / 5.0;
-                    let d = (t - axis).rem_euclid(std::f64::consts::TAU);
-                    d.min(std::f64::consts::TAU - d)
-                })
-                .fold(f64::INFINITY, f64::min);
+            let off = off_lobe_axes(n.pos);
             assert!(
                 off < 0.1,
                 "an end {:.0}° off the lobes' axes",
@@ -385,13 +396,7 @@ fn a_stars_line_runs_from_lobe_tip_to_lobe_tip() {
     use skeletonise::graph::extend::{prune_and_extend, ExtendParams};
     for (n, rough) in [(4_000, 0.0), (20_000, 30.0)] {
         let p = rough_lobes(n, 10_000.0, rough);
-        let params = SkeletonParams {
-            methods: vec![MethodId::MA],
-            ..Default::default()
-        };
-        let ma = build(MethodId::MA, &params)
-            .skeletonise(&p, &MethodContext::default())
-            .unwrap();
+        let ma = medial_axis(&p);
         let g = prune_and_extend(
             &ma,
             &p,
@@ -407,14 +412,7 @@ fn a_stars_line_runs_from_lobe_tip_to_lobe_tip() {
         for e in &ends {
             // A lobe's tip lies 13 km out on its axis (sin 5t = 1); the
             // valleys 7 km out between them.
-            let t = e.y.atan2(e.x);
-            let off = (0..5)
-                .map(|k| {
-                    let axis = std::f64::consts::PI / 10.0 + k as f64 * std::f64::consts::TAU / 5.0;
-                    let d = (t - axis).rem_euclid(std::f64::consts::TAU);
-                    d.min(std::f64::consts::TAU - d)
-                })
-                .fold(f64::INFINITY, f64::min);
+            let off = off_lobe_axes(*e);
             let r = e.x.hypot(e.y);
             assert!(
                 off < 0.05 && r > 12_500.0,
