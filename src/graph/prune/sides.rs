@@ -218,17 +218,24 @@ fn sum_up(w: &Work, v: NodeId, below: &mut [Below]) {
 fn hand_down(w: &Work, v: NodeId, below: &mut [Below]) {
     let b = &below[v.index()];
     let own = w.reach[v.index()].max(b.above);
-    let sides: Vec<f64> = b
-        .children
-        .iter()
-        .map(|&s| side_extent(w, below, s))
-        .collect();
-    let (first, second) = two_largest(&sides);
+    let (sides, first, second) = side_extents(w, below, v);
     let children = b.children.clone();
     for (&(p, c), &x) in children.iter().zip(&sides) {
         let other = if x == first { second } else { first };
         below[c.index()].above = w.pieces[p as usize].len + own.max(other);
     }
+}
+
+/// The extent of each peeled side of `v` (in the order of its children),
+/// with the largest and the second largest of them.
+fn side_extents(w: &Work, below: &[Below], v: NodeId) -> (Vec<f64>, f64, f64) {
+    let sides: Vec<f64> = below[v.index()]
+        .children
+        .iter()
+        .map(|&s| side_extent(w, below, s))
+        .collect();
+    let (first, second) = two_largest(&sides);
+    (sides, first, second)
 }
 
 /// The largest and the second largest of `xs` (−∞ where there is none;
@@ -263,12 +270,7 @@ fn judge(w: &mut Work, params: &PruneParams, v: NodeId, below: &[Below]) -> Opti
     };
     // The rest seen from a side: through the parent, or the farthest other
     // side (the two farthest sides, so each side is looked at once).
-    let sides: Vec<f64> = b
-        .children
-        .iter()
-        .map(|&s| side_extent(w, below, s))
-        .collect();
-    let (first, second) = two_largest(&sides);
+    let (sides, first, second) = side_extents(w, below, v);
     let mut candidates: Vec<(f64, (u32, NodeId, f64))> = Vec::new();
     for (&(p, c), &path) in b.children.iter().zip(&sides) {
         if !below[c.index()].has_junction {
