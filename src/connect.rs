@@ -9,7 +9,7 @@
 
 use crate::geometry::PreparedPolygon;
 use crate::graph::{GraphBuilder, SkeletonGraph};
-use crate::layer::{col, fid, Attributes, ColumnType, GeometryKind, LayerDef, Shape, When};
+use crate::layer::{col, fid, text, Attributes, ColumnType, GeometryKind, LayerDef, Shape, When};
 use geo::{BoundingRect, Coord, Geometry, LineString, Rect};
 
 /// The lines of a geometry, appended to `out` (other kinds are skipped).
@@ -185,6 +185,40 @@ pub fn add_legs(
     (b.finish(p.boundary()), legs)
 }
 
+/// `prune: {mode: network}`: the through-lines of `raw` (a method's raw
+/// skeleton of `p`) between the connection `points` — a leg to each (see
+/// [`add_legs`]; on a raw skeleton it is short, since the skeleton reaches
+/// near every boundary vertex), then the union of the shortest paths
+/// between them along the skeleton ([`crate::graph::prune::network`]). The
+/// result's leaves are the connection points (with one point: it and the
+/// farthest tip). Nothing is extended.
+pub fn through_lines(
+    raw: &SkeletonGraph,
+    p: &PreparedPolygon,
+    points: &[Coord<f64>],
+) -> SkeletonGraph {
+    let listed: Vec<(Option<u64>, Coord<f64>)> = points.iter().map(|&c| (None, c)).collect();
+    let (with_legs, _) = add_legs(raw, p, &listed);
+    let m = with_legs.merged();
+    let tol = 1e-9 * p.extent();
+    let mut terminals: Vec<crate::graph::NodeId> = points
+        .iter()
+        .filter_map(|&c| {
+            m.nodes()
+                .iter()
+                .enumerate()
+                .map(|(i, n)| (crate::geometry::norm(n.pos - c), i))
+                .filter(|&(d, _)| d <= tol)
+                .min_by(|a, b| a.0.total_cmp(&b.0))
+                .map(|(_, i)| crate::graph::NodeId::from_index(i))
+        })
+        .collect();
+    terminals.sort();
+    terminals.dedup();
+    let keep = crate::graph::prune::network::mask(&m, &terminals);
+    m.filter_edges(|e, _| keep[e.index()]).merged()
+}
+
 /// The point of the skeleton's polylines nearest to `c` from which the
 /// straight segment to `c` stays inside P and meets ∂P within 60° of its
 /// inward normal at `c` (so that a leg never runs along the shore):
@@ -273,6 +307,178 @@ pub const CONNECTIONS: LayerDef<ConnectionRow> = LayerDef {
         col("line_fid", ColumnType::Int64, |r| fid(r.line_fid)),
     ],
 };
+
+/// What a row of the `network` layer is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NetworkKind {
+    /// A piece of a line of `input.connect`, between its connection points.
+    Line,
+    /// A piece of a polygon's skeleton (its through-lines in `network` mode).
+    Skeleton,
+    /// A leg from the skeleton to a connection point, or from a line's end
+    /// to the point on ∂P it was snapped to.
+    Connection,
+}
+
+impl NetworkKind {
+    /// The `kind` column's value.
+    pub fn name(self) -> &'static str {
+        match self {
+            NetworkKind::Line => "line",
+            NetworkKind::Skeleton => "skeleton",
+            NetworkKind::Connection => "connection",
+        }
+    }
+}
+
+/// One row of the `network` layer: the lines and the skeletons as one
+/// network, noded (every junction one shared coordinate).
+#[derive(Debug, Clone, PartialEq)]
+pub struct NetworkRow {
+    /// What the row is.
+    pub kind: NetworkKind,
+    /// Source FID of the polygon (skeletons and their legs).
+    pub src_fid: Option<u64>,
+    /// FID of the network line (lines, and the legs that serve one).
+    pub line_fid: Option<u64>,
+    /// The piece.
+    pub geometry: LineString<f64>,
+}
+
+/// The `network` layer (with `input.connect`).
+pub const NETWORK: LayerDef<NetworkRow> = LayerDef {
+    name: "network",
+    when: When::Connect,
+    geometry: GeometryKind::LineString,
+    shape: |r| Some(Shape::Line(r.geometry.clone())),
+    attributes: Attributes::None,
+    columns: &[
+        col("kind", ColumnType::Text, |r| text(r.kind.name())),
+        col("src_fid", ColumnType::Int64, |r| fid(r.src_fid)),
+        col("line_fid", ColumnType::Int64, |r| fid(r.line_fid)),
+    ],
+};
+
+/// The `network` rows of one polygon's skeleton (`g`, with the legs
+/// [`add_legs`] added): one per edge, a leg (`legs`) as `connection`.
+pub fn skeleton_rows(
+    g: &SkeletonGraph,
+    legs: &[ConnectionLeg],
+    src_fid: Option<u64>,
+) -> Vec<NetworkRow> {
+    (0..g.edges().len())
+        .map(|e| {
+            let coords = g.edge_coords(crate::graph::EdgeId::from_index(e));
+            let leg = legs.iter().find(|l| {
+                let (a, b) = (l.leg.0[0], l.leg.0[l.leg.0.len() - 1]);
+                a != b
+                    && coords.len() == 2
+                    && ((coords[0], coords[1]) == (a, b) || (coords[0], coords[1]) == (b, a))
+            });
+            NetworkRow {
+                kind: leg.map_or(NetworkKind::Skeleton, |_| NetworkKind::Connection),
+                src_fid,
+                line_fid: leg.and_then(|l| l.line_fid),
+                geometry: LineString(coords),
+            }
+        })
+        .collect()
+}
+
+impl Network {
+    /// The `network` rows of the lines: each line split at its connection
+    /// points `met` (line FID, point on ∂P, as the `connections` legs end),
+    /// the point inserted into the line where it lies on it, so that the
+    /// pieces and the skeletons share it. A point off the line (a line end
+    /// snapped to ∂P) gets a `connection` row from the nearest line end to
+    /// it instead.
+    pub fn rows(&self, met: &[(Option<u64>, Coord<f64>)]) -> Vec<NetworkRow> {
+        let mut at: std::collections::HashMap<Option<u64>, Vec<Coord<f64>>> = Default::default();
+        for &(f, c) in met {
+            at.entry(f).or_default().push(c);
+        }
+        let mut rows = Vec::new();
+        for l in &self.lines {
+            let pts = at.get(&l.fid).map_or(&[][..], Vec::as_slice);
+            let line = &l.line.0;
+            let extent = {
+                let (a, z) = (l.bbox.min(), l.bbox.max());
+                (z.x - a.x).max(z.y - a.y).max(1.0)
+            };
+            let tol = 1e-9 * extent;
+            // Cut points by (segment, parameter along it).
+            let mut cuts: Vec<(usize, f64, Coord<f64>)> = Vec::new();
+            for &c in pts {
+                let best = line
+                    .windows(2)
+                    .enumerate()
+                    .map(|(i, w)| {
+                        let (q, t) = crate::geometry::segment::closest_on_segment(w[0], w[1], c);
+                        (crate::geometry::norm(q - c), i, t)
+                    })
+                    .min_by(|a, b| a.0.total_cmp(&b.0));
+                match best {
+                    Some((d, i, t)) if d <= tol.max(1e-6 * extent) => cuts.push((i, t, c)),
+                    _ => {
+                        let (first, last) = (line[0], line[line.len() - 1]);
+                        let end = if crate::geometry::norm(first - c)
+                            <= crate::geometry::norm(last - c)
+                        {
+                            first
+                        } else {
+                            last
+                        };
+                        rows.push(NetworkRow {
+                            kind: NetworkKind::Connection,
+                            src_fid: None,
+                            line_fid: l.fid,
+                            geometry: LineString(vec![end, c]),
+                        });
+                    }
+                }
+            }
+            cuts.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+            let mut piece: Vec<Coord<f64>> = vec![line[0]];
+            let mut k = 0;
+            for i in 0..line.len() - 1 {
+                while k < cuts.len() && cuts[k].0 == i {
+                    let c = cuts[k].2;
+                    // A cut at a vertex takes the vertex's place (the
+                    // skeleton's end is the point on ∂P, bit for bit).
+                    match piece.last_mut() {
+                        Some(last) if crate::geometry::norm(*last - c) <= tol => *last = c,
+                        _ => piece.push(c),
+                    }
+                    if piece.len() > 1 {
+                        rows.push(NetworkRow {
+                            kind: NetworkKind::Line,
+                            src_fid: None,
+                            line_fid: l.fid,
+                            geometry: LineString(std::mem::take(&mut piece)),
+                        });
+                    }
+                    piece = vec![c];
+                    k += 1;
+                }
+                if piece
+                    .last()
+                    .is_none_or(|&last| crate::geometry::norm(last - line[i + 1]) > tol)
+                {
+                    piece.push(line[i + 1]);
+                }
+            }
+            if piece.len() > 1 {
+                rows.push(NetworkRow {
+                    kind: NetworkKind::Line,
+                    src_fid: None,
+                    line_fid: l.fid,
+                    geometry: LineString(piece),
+                });
+            }
+        }
+        rows
+    }
+}
 
 #[cfg(test)]
 mod tests {

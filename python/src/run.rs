@@ -225,6 +225,7 @@ fn work(
         bars: false,
         widths: false,
         measures: false,
+        network: false,
     };
     let results: Vec<FeatureRows> = map_in_order(&feats, par, |_, f| {
         feature_rows(f, Skeletons::Computed, params, row_opts)

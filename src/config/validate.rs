@@ -7,6 +7,7 @@ use crate::process::step::StepRegistry;
 pub(super) fn validate(f: &PipelineFile) -> Result<(), (String, String)> {
     validate_steps(&f.steps)?;
     partition_needs_neighbours(f)?;
+    network_needs_connect(f)?;
     f.input
         .validate()
         .map_err(|(k, m)| (format!("input.{k}"), m))?;
@@ -223,6 +224,22 @@ fn partition_needs_neighbours(f: &PipelineFile) -> Result<(), (String, String)> 
         (None, _, Some(_)) => Err((
             "input.neighbours".into(),
             "`input.neighbours` is the coverage a `partition` step gives area to: add `- partition: {}` to the steps, or remove it".into(),
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// `prune: {mode: network}` keeps the paths between the points where the
+/// lines of `input.connect` meet each polygon: without the lines it has
+/// nothing to keep.
+fn network_needs_connect(f: &PipelineFile) -> Result<(), (String, String)> {
+    let network = f.steps.iter().position(
+        |s| matches!(s, Step::Prune(p) if p.mode == crate::graph::prune::PruneMode::Network),
+    );
+    match (network, &f.input.connect) {
+        (Some(i), None) => Err((
+            format!("steps[{i}].prune.mode"),
+            "`mode: network` keeps the lines between the points where a line network meets each polygon: add `input.connect: { source: …, layer: … }`, or use another mode".into(),
         )),
         _ => Ok(()),
     }

@@ -7,7 +7,7 @@ use super::layers::{
     REJECTED, RUNS, SKELETONS, WIDTHS,
 };
 use crate::collapse::{AreaRow, AREAS};
-use crate::connect::{ConnectionRow, CONNECTIONS};
+use crate::connect::{ConnectionRow, NetworkRow, CONNECTIONS, NETWORK};
 use crate::feature::Value;
 use crate::layer::{Cell, ColumnType, GeometryKind, LayerDef, Shape, StepLayer, StepRow, When};
 use crate::partition::{BoundaryRow, CoverageRow, GivenRow, BOUNDARIES, COVERAGE, GIVEN};
@@ -39,6 +39,9 @@ pub struct Rows {
     pub areas: Vec<AreaRow>,
     /// `connections` rows.
     pub connections: Vec<ConnectionRow>,
+    /// `network` rows (the skeletons' per feature, the lines' once, after
+    /// the features).
+    pub network: Vec<NetworkRow>,
     /// `boundaries` rows (a partition's new boundaries).
     pub boundaries: Vec<BoundaryRow>,
     /// `given` rows (a partition's areas given).
@@ -65,6 +68,7 @@ impl Rows {
         self.widths.append(&mut other.widths);
         self.areas.append(&mut other.areas);
         self.connections.append(&mut other.connections);
+        self.network.append(&mut other.network);
         self.boundaries.append(&mut other.boundaries);
         self.given.append(&mut other.given);
         self.coverage.append(&mut other.coverage);
@@ -84,6 +88,7 @@ impl Rows {
             + self.widths.len()
             + self.areas.len()
             + self.connections.len()
+            + self.network.len()
             + self.boundaries.len()
             + self.given.len()
             + self.coverage.len()
@@ -248,7 +253,7 @@ pub static CANDIDATE_LAYER: Builtin<CandidateRow> = Builtin {
 
 /// Every built-in layer, in the order they are created (the run record,
 /// written once at the end of a run, last).
-pub static BUILTIN: [&dyn Layer; 11] = [
+pub static BUILTIN: [&dyn Layer; 12] = [
     &SKELETON_LAYER,
     &CANDIDATE_LAYER,
     &Builtin {
@@ -266,6 +271,10 @@ pub static BUILTIN: [&dyn Layer; 11] = [
     &Builtin {
         def: &CONNECTIONS,
         rows: |r| &r.connections,
+    },
+    &Builtin {
+        def: &NETWORK,
+        rows: |r| &r.network,
     },
     &Builtin {
         def: &COVERAGE,

@@ -340,10 +340,26 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
             pool: &pool,
             row_opts,
         };
-        let mut grown = Vec::new();
-        let mut result =
-            workers.compute(&batch_rx, &rows_tx, &mut counts, &mut progress, &mut grown);
+        let mut gathered = Gathered::default();
+        let mut result = workers.compute(
+            &batch_rx,
+            &rows_tx,
+            &mut counts,
+            &mut progress,
+            &mut gathered,
+        );
         progress.finish();
+        // The network's lines, split where they met the polygons.
+        if let (Ok(()), Some(net)) = (&result, &params.connect) {
+            let rows = Rows {
+                network: net.rows(&gathered.met),
+                ..Rows::default()
+            };
+            if rows_tx.send(rows).is_err() {
+                result = Ok(());
+            }
+        }
+        let grown = gathered.grown;
         // The partitioned coverage: every unit, grown by what it received.
         if let (Ok(()), Some(cov)) = (&result, &params.neighbours) {
             if rows_tx
@@ -461,6 +477,16 @@ fn grown_coverage(
     }
 }
 
+/// What the run gathers from every feature for the rows written once,
+/// after the features.
+#[derive(Default)]
+struct Gathered {
+    /// The pieces given to each unit of the partitioned coverage.
+    grown: Vec<(Option<u64>, geo::Polygon<f64>)>,
+    /// The connection points met by each network line (its FID).
+    met: Vec<(Option<u64>, geo::Coord<f64>)>,
+}
+
 /// What the worker threads need for every batch.
 struct Workers<'a> {
     job: &'a Job<'a>,
@@ -482,7 +508,7 @@ impl Workers<'_> {
         rows_tx: &mpsc::SyncSender<Rows>,
         counts: &mut Counts,
         progress: &mut Progress,
-        grown: &mut Vec<(Option<u64>, geo::Polygon<f64>)>,
+        gathered: &mut Gathered,
     ) -> Result<(), RunError> {
         let (job, params, row_opts) = (self.job, self.params, self.row_opts);
         let next = || batches.recv().ok().map(|b| b.map_err(RunError::from));
@@ -499,7 +525,12 @@ impl Workers<'_> {
                 counts.add(f, &r, job.on_error)?;
                 rows.append(r.rows);
             }
-            grown.append(&mut rows.grown);
+            gathered.grown.append(&mut rows.grown);
+            gathered.met.extend(
+                rows.connections
+                    .iter()
+                    .filter_map(|c| c.geometry.0.last().map(|&p| (c.line_fid, p))),
+            );
             // A closed channel: the writer stopped on an error; it says
             // which after the workers.
             let more = rows_tx.send(rows).is_ok();

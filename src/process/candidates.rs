@@ -6,6 +6,7 @@ use super::{part_reason, CandidateSkeleton, ProcessParams, StageTimes};
 use crate::clock::{CpuClock, Stage, Stages, Stopwatch};
 use crate::geometry::PreparedPolygon;
 use crate::graph::extend::prune_and_extend;
+use crate::graph::prune::PruneParams;
 use crate::graph::widths::medial_axis_transform;
 use crate::graph::SkeletonGraph;
 use crate::score::{metrics, BarRays};
@@ -161,6 +162,14 @@ pub(super) fn part_skeletons(
     parallel: bool,
 ) -> Vec<(Result<PartSkeleton, String>, StageTimes)> {
     let work = PartWork::new(p, params, parallel);
+    if let Some(why) = work.dropped() {
+        return params
+            .skeleton
+            .methods
+            .iter()
+            .map(|_| (Err(why.clone()), StageTimes::default()))
+            .collect();
+    }
     let mut raws = work.raw_skeletons();
     let reference = work.reference(&mut raws);
     work.conformed(raws, reference.as_ref())
@@ -187,16 +196,39 @@ struct PartWork<'a> {
     parallel: bool,
     order: Vec<usize>,
     trunk: bool,
+    /// The pruning this part gets: the step's, or with `mode: network` and
+    /// no connection point the fallback's (`None`: no pruning, or dropped).
+    prune: Option<PruneParams>,
+    /// With `mode: network`: the part's connection points (empty: the
+    /// fallback applies).
+    network: Option<Vec<geo::Coord<f64>>>,
 }
 
 impl<'a> PartWork<'a> {
     fn new(p: &'a PreparedPolygon, params: &'a ProcessParams, parallel: bool) -> Self {
         use crate::graph::prune::{PruneMode, Structure as Sharing};
         let methods = &params.skeleton.methods;
+        let network = params
+            .prune
+            .filter(|pr| pr.mode == PruneMode::Network)
+            .map(|_| {
+                let mut points: Vec<geo::Coord<f64>> = params
+                    .connect
+                    .as_ref()
+                    .map(|net| net.points(p).into_iter().map(|(_, c)| c).collect())
+                    .unwrap_or_default();
+                points.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+                points.dedup();
+                points
+            });
+        let connected = network.as_ref().is_some_and(|n| !n.is_empty());
+        let prune = match params.prune {
+            Some(pr) if pr.mode == PruneMode::Network && !connected => pr.without_connections(),
+            other => other,
+        };
         // One method has no other to share its structure with: it is
         // finished on its own (the same skeleton as its reference path).
-        let shared = params
-            .prune
+        let shared = prune
             .filter(|pr| pr.mode != PruneMode::None && pr.structure == Sharing::Shared)
             .filter(|_| methods.len() > 1);
         let order = shared.map_or_else(Vec::new, |_| {
@@ -212,18 +244,54 @@ impl<'a> PartWork<'a> {
             params,
             parallel,
             order,
-            trunk: params.prune.is_some_and(|pr| pr.mode == PruneMode::Trunk),
+            trunk: prune.is_some_and(|pr| pr.mode == PruneMode::Trunk),
+            prune,
+            network: network.filter(|_| connected),
         }
     }
 
-    /// A raw skeleton pruned and extended on its own.
+    /// Why this part gets no skeleton: `mode: network`, no line meets it,
+    /// and `fallback: drop`.
+    fn dropped(&self) -> Option<String> {
+        let asked = self.params.prune?;
+        (asked.mode == crate::graph::prune::PruneMode::Network
+            && self.network.is_none()
+            && self.prune.is_none())
+        .then(|| {
+            "no line of `input.connect` meets this polygon, and `prune.fallback` is `drop`; \
+             use `fallback: significance` or `trunk` to give such polygons a skeleton"
+                .to_string()
+        })
+    }
+
+    /// A raw skeleton pruned and extended on its own (with `mode: network`,
+    /// its through-lines between the connection points).
     fn finish(&self, raw: &SkeletonGraph) -> SkeletonGraph {
+        if let Some(points) = &self.network {
+            return crate::connect::through_lines(raw, self.p, points);
+        }
         prune_and_extend(
             raw,
             self.p,
-            self.params.prune.as_ref(),
+            self.prune.as_ref(),
             self.params.extend.as_ref(),
         )
+    }
+
+    /// Another method's raw skeleton conformed to the reference's structure
+    /// (with `mode: network`, then reduced to the paths between its ends, as
+    /// the reference was).
+    fn conform(
+        &self,
+        raw: &SkeletonGraph,
+        s: &crate::graph::structure::Structure,
+    ) -> SkeletonGraph {
+        let g = crate::graph::structure::conform(raw, s, self.p);
+        if self.network.is_some() {
+            crate::graph::prune::network::between_leaves(&g)
+        } else {
+            g
+        }
     }
 
     /// Method `k`'s finished skeleton as the reference, when not empty (a
@@ -313,7 +381,7 @@ impl<'a> PartWork<'a> {
                 let finished = guarded(methods[k], || {
                     Ok(match reference {
                         Some((r, _, g)) if *r == k => g.clone(),
-                        Some((_, s, _)) => crate::graph::structure::conform(g, s, self.p),
+                        Some((_, s, _)) => self.conform(g, s),
                         None => self.finish(g),
                     })
                 })?;

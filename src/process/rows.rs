@@ -39,6 +39,8 @@ pub struct RowOptions {
     pub widths: bool,
     /// M values (local width) on the skeleton layer's lines.
     pub measures: bool,
+    /// The chosen skeleton's pieces in `network` (with `input.connect`).
+    pub network: bool,
 }
 
 impl RowOptions {
@@ -51,6 +53,7 @@ impl RowOptions {
             bars: plan.holds(When::Bars),
             widths: plan.holds(When::Widths),
             measures: plan.holds(When::Measures),
+            network: plan.holds(When::Connect),
         }
     }
 }
@@ -275,6 +278,12 @@ fn outcome_rows(
             line_fid: c.line_fid,
             geometry: c.leg.clone(),
         }));
+    if opts.network {
+        for g in &chosen.graphs {
+            rows.network
+                .extend(crate::connect::skeleton_rows(g, &o.connections, f.fid));
+        }
+    }
     if opts.widths {
         rows.widths.extend(chosen.widths.iter().map(|w| WidthRow {
             src_fid: f.fid,

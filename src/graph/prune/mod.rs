@@ -48,6 +48,10 @@
 //! * `trunk`: keep only the longest leaf-to-leaf path of each component, one
 //!   centreline per part (see `trunk`).
 //! * `none`: the graph unchanged.
+//! * `network` (with `input.connect`): the union of the shortest paths
+//!   between the polygon's connection points (see `network` and
+//!   [`crate::connect::through_lines`]); `fallback` says what a polygon no
+//!   line meets gets instead.
 //!
 //! Pruning works on the *merged* raw graph (one edge per branch, see
 //! [`SkeletonGraph::merged`]) and decides per edge whether it is kept
@@ -77,6 +81,7 @@
 //! ```
 
 pub(crate) mod legs;
+pub(crate) mod network;
 mod sides;
 pub(crate) mod trunk;
 
@@ -100,6 +105,24 @@ pub enum PruneMode {
     Trunk,
     /// Keep every leg.
     None,
+    /// Keep the through-lines of a line network (`input.connect`): the
+    /// shortest paths along the skeleton between the points where the lines
+    /// meet the polygon.
+    Network,
+}
+
+/// What `network` pruning does with a polygon that no line of
+/// `input.connect` meets.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "lowercase")]
+pub enum Fallback {
+    /// Prune it as the default mode does (its significant legs, extended).
+    #[default]
+    Significance,
+    /// Keep its longest leaf-to-leaf path (one centreline).
+    Trunk,
+    /// Give it no skeleton: it is listed in `rejected` with the reason.
+    Drop,
 }
 
 /// Whether every method of a feature is pruned to one common structure.
@@ -135,6 +158,8 @@ pub struct PruneParams {
     pub min_length: f64,
     /// One common structure for all methods of a feature, or each its own.
     pub structure: Structure,
+    /// With `mode: network`, what a polygon no line meets gets instead.
+    pub fallback: Fallback,
 }
 
 impl Default for PruneParams {
@@ -146,6 +171,7 @@ impl Default for PruneParams {
             arm_width: 0.125,
             min_length: 0.0,
             structure: Structure::Shared,
+            fallback: Fallback::Significance,
         }
     }
 }
@@ -182,7 +208,7 @@ impl PruneParams {
                 !(by_radius || arm) || extent < self.min_length
             }
             PruneMode::Length => extent < self.min_length,
-            PruneMode::Trunk | PruneMode::None => false,
+            PruneMode::Trunk | PruneMode::None | PruneMode::Network => false,
         }
     }
 
@@ -220,6 +246,19 @@ impl PruneParams {
         Ok(())
     }
 
+    /// The options a polygon that no network line meets is pruned with
+    /// (`mode: network`; `None` for `fallback: drop`); the options
+    /// themselves in every other mode.
+    pub fn without_connections(&self) -> Option<PruneParams> {
+        let mode = match (self.mode, self.fallback) {
+            (PruneMode::Network, Fallback::Significance) => PruneMode::Significance,
+            (PruneMode::Network, Fallback::Trunk) => PruneMode::Trunk,
+            (PruneMode::Network, Fallback::Drop) => return None,
+            (m, _) => m,
+        };
+        Some(PruneParams { mode, ..*self })
+    }
+
     /// True for the modes that remove legs one by one.
     pub(crate) fn removes_legs(&self) -> bool {
         matches!(self.mode, PruneMode::Significance | PruneMode::Length)
@@ -247,6 +286,9 @@ pub(crate) fn prune_mask(
         PruneMode::None => vec![true; merged.edges().len()],
         PruneMode::Significance | PruneMode::Length => legs::mask(merged, params, boundary),
         PruneMode::Trunk => trunk::mask(merged),
+        // Without connection points to join (the caller's fallback decides
+        // otherwise): the graph as it is.
+        PruneMode::Network => vec![true; merged.edges().len()],
     }
 }
 

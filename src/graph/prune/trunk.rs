@@ -14,14 +14,14 @@ use std::collections::BinaryHeap;
 
 /// Shortest-path distances from one source, reusing buffers across calls so
 /// that many components cost O(total size), not O(components × size).
-struct Sweep {
-    dist: Vec<f64>,
-    pred: Vec<Option<EdgeId>>,
+pub(super) struct Sweep {
+    pub(super) dist: Vec<f64>,
+    pub(super) pred: Vec<Option<EdgeId>>,
     touched: Vec<NodeId>,
 }
 
 impl Sweep {
-    fn new(n: usize) -> Self {
+    pub(super) fn new(n: usize) -> Self {
         Self {
             dist: vec![f64::INFINITY; n],
             pred: vec![None; n],
@@ -30,7 +30,7 @@ impl Sweep {
     }
 
     /// Dijkstra from `s`; returns the farthest leaf (ties: smaller node id).
-    fn run(
+    pub(super) fn run(
         &mut self,
         g: &SkeletonGraph,
         adj: &Adjacency,
