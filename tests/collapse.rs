@@ -492,6 +492,109 @@ fn lakes_scotland_collapse_within_the_bounds() {
     assert_bounds("lakes_scotland", 1000.0);
 }
 
+/// Kept areas with a cut whose area is below `limit`: beads on a
+/// collapsed river (every kept area the step writes with a cut meets a
+/// collapsed line there).
+fn beads(out: &Path, limit: f64) -> usize {
+    use geo::Area;
+    let ds = open(out);
+    let cuts = common::ints(&ds, "areas", "cuts");
+    rows(out, "areas")
+        .iter()
+        .zip(cuts)
+        .filter(|(r, c)| c.unwrap_or(0) > 0 && r.geometry.unsigned_area() < limit)
+        .count()
+}
+
+/// The length-weighted median of the local width 2r along a layer's
+/// collapsed and kept lines (the `widths` layer of a run).
+fn median_width(out: &Path) -> f64 {
+    use geo::{Euclidean, Length};
+    let ds = open(out);
+    let (a, b) = (
+        common::reals(&ds, "widths", "width_start"),
+        common::reals(&ds, "widths", "width_end"),
+    );
+    let mut w: Vec<(f64, f64)> = rows(out, "widths")
+        .iter()
+        .zip(a.iter().zip(&b))
+        .map(|(r, (a, b))| {
+            let len: f64 = lines(&r.geometry).iter().map(|l| Euclidean.length(l)).sum();
+            ((a.unwrap() + b.unwrap()) / 2.0, len)
+        })
+        .collect();
+    w.sort_by(|x, y| x.0.total_cmp(&y.0));
+    let half = w.iter().map(|x| x.1).sum::<f64>() / 2.0;
+    let mut acc = 0.0;
+    w.into_iter()
+        .find(|x| {
+            acc += x.1;
+            acc >= half
+        })
+        .unwrap()
+        .0
+}
+
+/// `collapse.min_area` on the training rivers at their median width: the
+/// isolated kept areas below 4 width² with collapsed lines on all their cuts
+/// (there are some without it) are collapsed, and every line still ends on
+/// a cut, on ∂P or on another line.
+#[test]
+fn min_area_collapses_the_beads_on_the_training_rivers() {
+    for layer in ["river_lena", "river_st_lawrence"] {
+        let dir = tmp();
+        let probe = dir.path().join("probe.gpkg");
+        let run = |out: &Path, sets: &[String]| {
+            let mut args = vec![
+                "run".to_string(),
+                "pipelines/collapse-rivers.yaml".into(),
+                "--set".into(),
+                format!("input.layer={layer}"),
+                "-o".into(),
+                out.display().to_string(),
+                "-q".into(),
+            ];
+            for s in sets {
+                args.extend(["--set".to_string(), s.clone()]);
+            }
+            let args: Vec<&str> = args.iter().map(String::as_str).collect();
+            let o = skeletonise(&args);
+            assert!(o.status.success(), "{}", code_and_err(&o).1);
+        };
+        run(&probe, &[]);
+        let w = median_width(&probe);
+        let limit = 4.0 * w * w;
+        let (before, after) = (
+            dir.path().join("before.gpkg"),
+            dir.path().join("after.gpkg"),
+        );
+        run(&before, &[format!("steps.collapse.width={w}")]);
+        run(
+            &after,
+            &[
+                format!("steps.collapse.width={w}"),
+                format!("steps.collapse.min_area={limit}"),
+            ],
+        );
+        let n = beads(&before, limit);
+        assert!(n > 0, "{layer} at {w:.0} m has beads without min_area");
+        assert_eq!(
+            beads(&after, limit),
+            0,
+            "{layer}: no bead below {limit:.0} m² is left"
+        );
+        let m = measure(&after, &sources(TRAIN, layer), w);
+        assert_eq!(m.loose_ends, 0, "{layer}: {m:?}");
+        let kept = |p: &Path| rows(p, "areas").len();
+        assert_eq!(
+            kept(&after),
+            kept(&before) - n,
+            "{layer}: only the beads go"
+        );
+        eprintln!("{layer}: median width {w:.0} m, {n} beads below 4 w² collapsed");
+    }
+}
+
 #[test]
 fn bad_collapse_options_name_the_key_and_the_fix() {
     let dir = tmp();
@@ -504,6 +607,7 @@ fn bad_collapse_options_name_the_key_and_the_fix() {
         ),
         ("{ tolerance: 0.1 }", "collapse", "width"),
         ("{ width: 100, mode: partly }", "collapse.mode", "partial"),
+        ("{ width: 100, min_area: -1 }", "collapse.min_area", "≥ 0"),
     ] {
         let text = format!(
             "input: {{ source: {TRAIN} }}\nsteps:\n  - skeleton: {{ methods: [MA] }}\n  - collapse: {collapse}\noutput: {{ path: {}/o.gpkg }}\n",

@@ -35,7 +35,13 @@
 //!    and every piece of it is collapsed or kept as the piece of the polygon
 //!    it lies in, so no collapsed line runs through a kept area; each
 //!    collapsed line ends on a cut, on ∂P, or at another line.
-//! 5. Connection legs (`input.connect`) take the class of the skeleton where
+//! 5. With `min_area`, a kept area smaller than it whose every cut has a
+//!    collapsed face on its other side — a bead on a collapsed river, e.g.
+//!    at a confluence where the river is briefly wider — is collapsed too:
+//!    the skeleton through it joins the collapsed lines at its cuts, and its
+//!    cuts go. Smallest areas first; an area with no cut (a polygon kept
+//!    whole) is never collapsed by it.
+//! 6. Connection legs (`input.connect`) take the class of the skeleton where
 //!    they leave it: they continue the network, they are not the polygon's
 //!    shape, so a leg to a kept lake's shore is kept and cuts no notch.
 //!
@@ -82,6 +88,9 @@ pub struct CollapseParams {
     /// `partial` (default): lines where narrow, areas where wide; `whole`: a polygon part collapses entirely when more than half of its area is narrow, otherwise it is kept.
     #[serde(default)]
     pub mode: CollapseMode,
+    /// Smallest kept area (CRS units²; default 0: off): a kept area smaller than this whose every cut leads to a collapsed line (a bead on a collapsed river, at a confluence) is collapsed too; a few width² is typical.
+    #[serde(default)]
+    pub min_area: f64,
 }
 
 fn default_tolerance() -> f64 {
@@ -97,6 +106,7 @@ impl CollapseParams {
             tolerance: default_tolerance(),
             min_length: None,
             mode: CollapseMode::Partial,
+            min_area: 0.0,
         }
     }
 
@@ -117,6 +127,12 @@ impl CollapseParams {
             return Err((
                 "tolerance".into(),
                 "tolerance must be at least 0 and below 1 (a fraction of width, e.g. 0.2)".into(),
+            ));
+        }
+        if !(self.min_area.is_finite() && self.min_area >= 0.0) {
+            return Err((
+                "min_area".into(),
+                "min_area must be ≥ 0 (CRS units², e.g. 4 × width²; 0 turns it off)".into(),
             ));
         }
         if let Some(m) = self.min_length {
@@ -187,7 +203,7 @@ pub fn collapse(
         CollapseMode::Whole => s.whole(),
     }
     s.follow_legs();
-    split::split(&s, p)
+    split::split(&s, p, params.min_area)
 }
 
 /// The point at parameter `t` of segment `a`–`b`.

@@ -26,7 +26,7 @@ struct Change {
 }
 
 /// The collapse of one polygon part from its classified samples.
-pub(super) fn split(s: &Samples, p: &PreparedPolygon) -> PartCollapse {
+pub(super) fn split(s: &Samples, p: &PreparedPolygon, min_area: f64) -> PartCollapse {
     let mut changes: Vec<Change> = s.changes().map(|i| change(s, p, i)).collect();
     drop_crossing_cuts(&mut changes);
     let cuts: Vec<LineString<f64>> = changes.iter().filter_map(|c| c.cut.clone()).collect();
@@ -48,12 +48,36 @@ pub(super) fn split(s: &Samples, p: &PreparedPolygon) -> PartCollapse {
             holds_wide[k] |= !pieces.run_narrow[run];
         }
     }
-    let kept: Vec<bool> = (0..faces.len())
+    let mut kept: Vec<bool> = (0..faces.len())
         .map(|k| holds_wide[k] || !holds_any[k])
         .collect();
+    let was_kept = kept.clone();
+    if min_area > 0.0 {
+        collapse_beads(&faces, &mut kept, min_area);
+    }
     let collapsed = |run: usize| face[run].is_some_and(|k| !kept[k]);
     let (collapsed_lines, kept_lines) = pieces.lines(s, collapsed);
     let areas = areas(p, &cuts, &faces, &kept);
+    // The cuts of a collapsed bead are gone with it.
+    let gone: Vec<bool> = (0..cuts.len())
+        .map(|c| {
+            let sides = faces
+                .iter()
+                .enumerate()
+                .filter(|(_, f)| f.chords.contains(&c));
+            let (mut now, mut before) = (false, false);
+            for (k, _) in sides {
+                now |= kept[k];
+                before |= was_kept[k];
+            }
+            before && !now
+        })
+        .collect();
+    let cuts = cuts
+        .into_iter()
+        .zip(gone)
+        .filter_map(|(c, g)| (!g).then_some(c))
+        .collect();
     PartCollapse {
         collapsed: collapsed_lines,
         kept: kept_lines,
@@ -284,6 +308,71 @@ fn split_or_whole(
             Ok(faces) => return (cuts, faces),
             Err(arrangement::SplitError::Detached(k)) => {
                 cuts.remove(k);
+            }
+        }
+    }
+}
+
+/// `collapse.min_area`: kept areas (kept faces joined across the cuts
+/// between them) smaller than `min_area`, with at least one cut and a
+/// collapsed face beyond every cut, become collapsed — smallest first, each
+/// judged again after the others (collapsing one never makes another's cut
+/// lead to a kept face).
+fn collapse_beads(faces: &[Face], kept: &mut [bool], min_area: f64) {
+    use geo::Area as _;
+    let n_cuts = faces
+        .iter()
+        .flat_map(|f| f.chords.iter())
+        .max()
+        .map_or(0, |&c| c + 1);
+    let mut sides: Vec<Vec<usize>> = vec![Vec::new(); n_cuts];
+    for (k, f) in faces.iter().enumerate() {
+        for &c in &f.chords {
+            sides[c].push(k);
+        }
+    }
+    // Kept faces joined across cuts between kept faces: one area each.
+    let mut group: Vec<usize> = (0..faces.len()).collect();
+    fn root(g: &mut [usize], mut a: usize) -> usize {
+        while g[a] != a {
+            g[a] = g[g[a]];
+            a = g[a];
+        }
+        a
+    }
+    for s in &sides {
+        for w in s.windows(2) {
+            if kept[w[0]] && kept[w[1]] {
+                let (a, b) = (root(&mut group, w[0]), root(&mut group, w[1]));
+                group[a] = b;
+            }
+        }
+    }
+    let mut areas: std::collections::BTreeMap<usize, (f64, Vec<usize>)> = Default::default();
+    for k in (0..faces.len()).filter(|&k| kept[k]) {
+        let e = areas.entry(root(&mut group, k)).or_default();
+        e.0 += faces[k].polygon.unsigned_area();
+        e.1.push(k);
+    }
+    let mut small: Vec<(f64, Vec<usize>)> =
+        areas.into_values().filter(|(a, _)| *a < min_area).collect();
+    small.sort_by(|a, b| a.0.total_cmp(&b.0));
+    for (_, members) in small {
+        let mut cuts = 0;
+        let mut all_collapsed = true;
+        for &k in &members {
+            for &c in &faces[k].chords {
+                for &other in &sides[c] {
+                    if !members.contains(&other) {
+                        cuts += 1;
+                        all_collapsed &= !kept[other];
+                    }
+                }
+            }
+        }
+        if cuts > 0 && all_collapsed {
+            for &k in &members {
+                kept[k] = false;
             }
         }
     }

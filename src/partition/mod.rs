@@ -103,6 +103,7 @@ impl PartitionParams {
             tolerance: self.tolerance,
             min_length: self.min_length,
             mode: crate::collapse::CollapseMode::Partial,
+            min_area: 0.0,
         })
     }
 
