@@ -15,7 +15,9 @@ Generated from tests/data/gshhg-train.gpkg (GSHHG, Wessel & Smith, LGPL-3.0), se
   - `y_lake`: a three-armed lake with a line at each arm's end;
   - `island_river`: a river reach with an island; lines at both ends and one on each bank
     beside the island (each channel serves one);
-  - `lonely_lake`: a lake no line meets.
+  - `lonely_lake`: a lake no line meets;
+  - `spring_lake`: an elongated lake 8 km long with one line, at its west end (its line runs to
+    the far, east tip).
 
 usage: make_network.py SRC.gpkg OUT.gpkg
 needs: shapely, geopandas, pyogrio, numpy (PyPI)
@@ -147,6 +149,13 @@ def cases(out):
     lines.append({"name": "island_river_south", "geometry": LineString([(x0 + 6500, ry - 3500), (x0 + 6500, ry - 500)])})
     # A lake no line meets.
     rows.append({"name": "lonely_lake", "geometry": shapely.set_precision(disc(x0 + 20_000, y0, 1500), 0.01)})
+    # An ellipse 8 km × 1.6 km with one line at its west end.
+    t = np.linspace(0, 2 * np.pi, 128, endpoint=False)
+    sx, sy = x0 + 20_000, y0 + 15_000
+    spring = shapely.set_precision(Polygon(np.c_[sx + 4000 * np.cos(t), sy + 800 * np.sin(t)]), 0.01)
+    rows.append({"name": "spring_lake", "geometry": spring})
+    west = min(spring.exterior.coords, key=lambda c: c[0])
+    lines.append({"name": "spring_lake_out", "geometry": LineString([west, (west[0] - 3000, west[1])])})
     gpd.GeoDataFrame(rows, crs="EPSG:32633").to_file(out, layer="cases", driver="GPKG")
     gpd.GeoDataFrame(lines, crs="EPSG:32633").to_file(out, layer="cases_lines", driver="GPKG")
 

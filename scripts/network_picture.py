@@ -3,7 +3,7 @@
 networks through lakes.
 
 usage: network_picture.py OUT.png POLYS.gpkg@LAYER LINES.gpkg@LAYER SKELETONS.gpkg[,OTHER.gpkg] PANEL...
-  PANEL = FID[:xmin,ymin,xmax,ymax]  (one polygon per panel, optionally zoomed)
+  PANEL = FID[:xmin,ymin,xmax,ymax][=TITLE]  (one polygon per panel, optionally zoomed)
 needs: geopandas, pyogrio, matplotlib (PyPI)
 """
 
@@ -29,6 +29,7 @@ P, L = layer_of(polys), layer_of(lines)
 runs = [gpd.read_file(s, layer="skeletons") for s in skels.split(",")]
 fig, axes = plt.subplots(1, len(panels), figsize=(6 * len(panels), 5.5), squeeze=False)
 for ax, panel in zip(axes[0], panels):
+    panel, _, title = panel.partition("=")
     fid, _, box = panel.partition(":")
     poly = P.loc[[int(fid)]]
     poly.plot(ax=ax, facecolor="#cfe3f3", edgecolor="#4a7aa5", linewidth=0.6)
@@ -48,7 +49,6 @@ for ax, panel in zip(axes[0], panels):
     ax.set_aspect("equal")
     ax.set_xticks([])
     ax.set_yticks([])
-    name = poly.iloc[0].get("name", f"fid {fid}")
-    ax.set_title(f"{name}", fontsize=10)
+    ax.set_title(title or str(poly.iloc[0].get("name", f"fid {fid}")), fontsize=10)
 fig.tight_layout()
 fig.savefig(out, dpi=110)

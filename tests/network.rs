@@ -270,7 +270,7 @@ fn training_lakes_and_rivers_keep_exactly_their_through_lines() {
 /// The constructed cases: a lake with three bays keeps only its line from
 /// inflow to outflow; a Y keeps three arms; a river whose lines meet both
 /// channels beside an island keeps both; a lake no line meets follows
-/// `prune.fallback`.
+/// `prune.fallback`; a lake with one line runs from it to its far tip.
 #[test]
 fn constructed_cases_keep_the_channels_their_connections_need() {
     let dir = tmp();
@@ -310,6 +310,22 @@ fn constructed_cases_keep_the_channels_their_connections_need() {
     // lonely_lake: the fallback (significance) gives it a line.
     let (lonely, _) = &sk[&polys[3].0];
     assert!(!lonely.0.is_empty());
+    // spring_lake: one connection (its west end): the line runs from it to
+    // the far (east) tip.
+    let (spring, _) = &sk[&polys[4].0];
+    let got = leaves(spring);
+    let tip = Coord {
+        x: x0 + 24_000.0,
+        y: y0 + 15_000.0,
+    };
+    assert_eq!(got.len(), 2, "{got:?}");
+    assert!(got
+        .iter()
+        .any(|g| dist(*g, meeting_points(&polys[4].1, &lines)[0]) < 1e-6));
+    assert!(
+        got.iter().any(|g| dist(*g, tip) < 1.0),
+        "the far tip: {got:?}"
+    );
 
     // fallback trunk: one line; fallback drop: rejected with the reason.
     let dir2 = tmp();
