@@ -191,7 +191,8 @@ pub fn add_legs(
 /// near every boundary vertex), then the union of the shortest paths
 /// between them along the skeleton ([`crate::graph::prune::network`]). The
 /// result's leaves are the connection points (with one point: it and the
-/// farthest tip). Nothing is extended.
+/// farthest tip); a point no straight leg inside P reaches keeps the leaf
+/// nearest to it instead. Nothing is extended.
 pub fn through_lines(
     raw: &SkeletonGraph,
     p: &PreparedPolygon,
@@ -201,17 +202,24 @@ pub fn through_lines(
     let (with_legs, _) = add_legs(raw, p, &listed);
     let m = with_legs.merged();
     let tol = 1e-9 * p.extent();
+    let deg = m.degrees();
+    // The node at each point; where no straight leg inside P reached it (a
+    // conformed method's end cut short), the leaf nearest to it.
+    let nearest = |c: Coord<f64>, leaves_only: bool| {
+        m.nodes()
+            .iter()
+            .enumerate()
+            .filter(|&(i, _)| !leaves_only || deg[i] == 1)
+            .map(|(i, n)| (crate::geometry::norm(n.pos - c), i))
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+    };
     let mut terminals: Vec<crate::graph::NodeId> = points
         .iter()
-        .filter_map(|&c| {
-            m.nodes()
-                .iter()
-                .enumerate()
-                .map(|(i, n)| (crate::geometry::norm(n.pos - c), i))
-                .filter(|&(d, _)| d <= tol)
-                .min_by(|a, b| a.0.total_cmp(&b.0))
-                .map(|(_, i)| crate::graph::NodeId::from_index(i))
+        .filter_map(|&c| match nearest(c, false) {
+            Some((d, i)) if d <= tol => Some(i),
+            _ => nearest(c, true).map(|(_, i)| i),
         })
+        .map(crate::graph::NodeId::from_index)
         .collect();
     terminals.sort();
     terminals.dedup();

@@ -211,7 +211,13 @@ fn training_lakes_and_rivers_keep_exactly_their_through_lines() {
         "river_lena",
     ] {
         let lines_layer = format!("lines_{layer}");
-        let out = run(dir.path(), TRAIN, layer, &lines_layer, &[]);
+        let out = run(
+            dir.path(),
+            TRAIN,
+            layer,
+            &lines_layer,
+            &["output.candidates=true"],
+        );
         let polys = polygons(TRAIN, layer);
         let lines = network_lines(&lines_layer);
         let sk = skeletons(&out);
@@ -252,6 +258,35 @@ fn training_lakes_and_rivers_keep_exactly_their_through_lines() {
             }
             assert!(*z <= 0.0002, "{layer} {fid}: Z = {z}");
         }
+        // Every method is pruned to the same connections: MA, StSk, DVD
+        // and CDT reach each (VD, whose lines on a coarse polygon stop far
+        // from its ends, may stop short where no straight leg joins them).
+        let ds = open(&out);
+        let cands = ints(&ds, "candidates", "src_fid")
+            .into_iter()
+            .zip(strings(&ds, "candidates", "method"))
+            .zip(wkts(&ds, "candidates"));
+        let mut checked = 0;
+        for ((fid, method), w) in cands {
+            let (fid, method) = (fid.unwrap(), method.unwrap());
+            if method == "VD" {
+                continue;
+            }
+            let p = &polys.iter().find(|(f, _)| *f == fid).unwrap().1;
+            let got = leaves(&lines_of(&w.unwrap()));
+            for w in meeting_points(p, &lines) {
+                assert!(
+                    got.iter().any(|g| dist(*g, w) < 1e-6),
+                    "{layer} {fid} {method}: no leaf at {w:?}"
+                );
+            }
+            checked += 1;
+        }
+        assert_eq!(
+            checked,
+            4 * polys.len(),
+            "{layer}: four methods' candidates"
+        );
         let rows = network_rows(&out);
         let pieces: Vec<LineString<f64>> = rows.iter().map(|(_, l)| l.clone()).collect();
         assert_eq!(

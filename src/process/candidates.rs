@@ -279,18 +279,19 @@ impl<'a> PartWork<'a> {
     }
 
     /// Another method's raw skeleton conformed to the reference's structure
-    /// (with `mode: network`, then reduced to the paths between its ends, as
-    /// the reference was).
+    /// (with `mode: network`, then reduced to its through-lines as the
+    /// reference was: a conformed end that could not be joined to its
+    /// connection point gets a leg to it, and what no path between two
+    /// connection points uses goes).
     fn conform(
         &self,
         raw: &SkeletonGraph,
         s: &crate::graph::structure::Structure,
     ) -> SkeletonGraph {
         let g = crate::graph::structure::conform(raw, s, self.p);
-        if self.network.is_some() {
-            crate::graph::prune::network::between_leaves(&g)
-        } else {
-            g
+        match &self.network {
+            Some(points) => crate::connect::through_lines(&g, self.p, points),
+            None => g,
         }
     }
 

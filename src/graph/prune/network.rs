@@ -65,25 +65,6 @@ pub(crate) fn mask(m: &SkeletonGraph, terminals: &[NodeId]) -> Vec<bool> {
     keep
 }
 
-/// The kept edges of `m` (merged) joining its leaves: [`mask`] with every
-/// leaf a terminal (a skeleton already peeled to its connection points,
-/// whose cycles are kept only where a shortest path runs).
-pub(crate) fn between_leaves(g: &SkeletonGraph) -> SkeletonGraph {
-    let m = g.merged();
-    let leaves: Vec<NodeId> = m
-        .degrees()
-        .iter()
-        .enumerate()
-        .filter(|(_, &d)| d == 1)
-        .map(|(n, _)| NodeId::from_index(n))
-        .collect();
-    if leaves.len() < 2 {
-        return m;
-    }
-    let keep = mask(&m, &leaves);
-    m.filter_edges(|e, _| keep[e.index()]).merged()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
