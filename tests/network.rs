@@ -82,15 +82,6 @@ fn network_lines(layer: &str) -> Vec<LineString<f64>> {
         .collect()
 }
 
-fn leaves(lines: &MultiLineString<f64>) -> Vec<Coord<f64>> {
-    let g = SkeletonGraph::from_lines(lines);
-    let deg = g.degrees();
-    (0..deg.len())
-        .filter(|&i| deg[i] == 1)
-        .map(|i| g.nodes()[i].pos)
-        .collect()
-}
-
 fn dist(a: Coord<f64>, b: Coord<f64>) -> f64 {
     (a.x - b.x).hypot(a.y - b.y)
 }

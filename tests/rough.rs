@@ -60,15 +60,6 @@ fn cases() -> Vec<PreparedPolygon> {
         .collect()
 }
 
-fn leaves(lines: &MultiLineString<f64>) -> Vec<Coord<f64>> {
-    let g = SkeletonGraph::from_lines(lines);
-    let deg = g.degrees();
-    (0..deg.len())
-        .filter(|&i| deg[i] == 1)
-        .map(|i| g.nodes()[i].pos)
-        .collect()
-}
-
 fn near(lines: &MultiLineString<f64>, p: Coord<f64>, d: f64) -> bool {
     lines
         .0

@@ -80,3 +80,14 @@ pub fn fingerprint(text: &str) -> u64 {
         (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
     })
 }
+
+/// The leaves (degree-1 nodes) of skeleton lines, joined where their end
+/// points are equal bit for bit.
+pub fn leaves(lines: &geo::MultiLineString<f64>) -> Vec<geo::Coord<f64>> {
+    let g = skeletonise::graph::SkeletonGraph::from_lines(lines);
+    let deg = g.degrees();
+    (0..deg.len())
+        .filter(|&i| deg[i] == 1)
+        .map(|i| g.nodes()[i].pos)
+        .collect()
+}
