@@ -494,6 +494,59 @@ mod tests {
     use geo::polygon;
 
     #[test]
+    fn network_rows_split_lines_at_their_points_and_bridge_snapped_ends() {
+        let p = PreparedPolygon::new(
+            &polygon![(x: 0., y: 0.), (x: 100., y: 0.), (x: 100., y: 10.), (x: 0., y: 10.)],
+        )
+        .unwrap();
+        let net = Network::new(
+            vec![
+                // Crosses the polygon: in at x = 0, out at x = 100.
+                (
+                    Some(1),
+                    LineString::from(vec![(-10., 5.), (50., 5.), (120., 5.)]),
+                ),
+                // Ends 0.5 outside the north side.
+                (Some(2), LineString::from(vec![(50., 30.), (50., 10.5)])),
+            ],
+            1.0,
+        );
+        let pts = net.points(&p);
+        let rows = net.rows(&pts);
+        let lines: Vec<&NetworkRow> = rows
+            .iter()
+            .filter(|r| r.kind == NetworkKind::Line)
+            .collect();
+        let pieces: Vec<Vec<(f64, f64)>> = lines
+            .iter()
+            .filter(|r| r.line_fid == Some(1))
+            .map(|r| r.geometry.0.iter().map(|c| (c.x, c.y)).collect())
+            .collect();
+        assert_eq!(
+            pieces,
+            vec![
+                vec![(-10., 5.), (0., 5.)],
+                vec![(0., 5.), (50., 5.), (100., 5.)],
+                vec![(100., 5.), (120., 5.)]
+            ],
+            "split at both crossings, the points shared"
+        );
+        // The snapped end: the line unchanged, a connection from its end to
+        // the point on the boundary.
+        assert_eq!(lines.iter().filter(|r| r.line_fid == Some(2)).count(), 1);
+        let bridge: Vec<&NetworkRow> = rows
+            .iter()
+            .filter(|r| r.kind == NetworkKind::Connection)
+            .collect();
+        assert_eq!(bridge.len(), 1);
+        assert_eq!(
+            bridge[0].geometry,
+            LineString::from(vec![(50., 10.5), (50., 10.)])
+        );
+        assert_eq!(bridge[0].line_fid, Some(2));
+    }
+
+    #[test]
     fn a_line_crossing_and_one_ending_near_the_boundary_connect_once_each() {
         let p = PreparedPolygon::new(
             &polygon![(x: 0., y: 0.), (x: 100., y: 0.), (x: 100., y: 10.), (x: 0., y: 10.)],
