@@ -328,8 +328,10 @@ fn default_output_on_every_training_layer_has_no_hooks_or_crossings() {
     for layer in LAYERS {
         let (hooks, n_ends, crossing, _, _) = layer_defects(layer, &defaults());
         println!("{layer}: {hooks} hooks of {n_ends} ends, {crossing} crossing skeletons");
+        // Below half a percent of the ends on every layer (the issue on
+        // rough boundaries; 11 of 2 392 on the islands, none elsewhere).
         assert!(
-            (hooks as f64) < 0.02 * n_ends as f64,
+            (hooks as f64) < 0.005 * n_ends as f64,
             "{layer}: {hooks} of {n_ends} ends hook"
         );
         assert_eq!(crossing, 0, "{layer}: skeletons cross themselves");

@@ -452,7 +452,7 @@ fn finish(
     let mut all_bars = Vec::new();
     let mut widths = Vec::new();
     let mut graphs = Vec::new();
-    let (mut components, mut legs_raw, mut legs) = (0, 0, 0);
+    let (mut components, mut legs_raw, mut legs, mut hooks) = (0, 0, 0, 0);
     let mut branch_offset = 0;
     for (k, (p, part)) in prepared.iter().zip(parts).enumerate() {
         let g: &SkeletonGraph = &part.graph;
@@ -477,6 +477,10 @@ fn finish(
             }
             branch_offset += parts;
             all_bars.extend(b);
+            hooks += crate::score::defects::end_turns(g, p)
+                .iter()
+                .filter(|&&t| t > crate::score::defects::HOOK_DEG)
+                .count();
         }
         if params.keep_widths {
             widths.extend(medial_axis_transform(g, Some(p.boundary())));
@@ -500,6 +504,7 @@ fn finish(
         components,
         legs_raw,
         legs,
+        hooks,
         bars: all_bars,
         widths,
         graphs,

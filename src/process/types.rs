@@ -90,6 +90,9 @@ pub struct CandidateSkeleton {
     pub legs_raw: usize,
     /// Legs after pruning and extension.
     pub legs: usize,
+    /// Line ends that are hooks ([`crate::score::defects`]), when the
+    /// pipeline scores.
+    pub hooks: usize,
     /// Bars, when requested (`part` indices are unique across polygon parts).
     pub bars: Vec<Bar>,
     /// The skeleton's segments with the disc radius at both ends (the medial
