@@ -407,84 +407,93 @@ impl Network {
         }
         let mut rows = Vec::new();
         for l in &self.lines {
-            let pts = at.get(&l.fid).map_or(&[][..], Vec::as_slice);
-            let line = &l.line.0;
-            let extent = {
-                let (a, z) = (l.bbox.min(), l.bbox.max());
-                (z.x - a.x).max(z.y - a.y).max(1.0)
+            let row = |kind, geometry| NetworkRow {
+                kind,
+                src_fid: None,
+                line_fid: l.fid,
+                geometry,
             };
-            let tol = 1e-9 * extent;
-            // Cut points by (segment, parameter along it).
-            let mut cuts: Vec<(usize, f64, Coord<f64>)> = Vec::new();
-            for &c in pts {
-                let best = line
-                    .windows(2)
-                    .enumerate()
-                    .map(|(i, w)| {
-                        let (q, t) = crate::geometry::segment::closest_on_segment(w[0], w[1], c);
-                        (crate::geometry::norm(q - c), i, t)
-                    })
-                    .min_by(|a, b| a.0.total_cmp(&b.0));
-                match best {
-                    Some((d, i, t)) if d <= tol.max(1e-6 * extent) => cuts.push((i, t, c)),
-                    _ => {
-                        let (first, last) = (line[0], line[line.len() - 1]);
-                        let end = if crate::geometry::norm(first - c)
-                            <= crate::geometry::norm(last - c)
-                        {
-                            first
-                        } else {
-                            last
-                        };
-                        rows.push(NetworkRow {
-                            kind: NetworkKind::Connection,
-                            src_fid: None,
-                            line_fid: l.fid,
-                            geometry: LineString(vec![end, c]),
-                        });
-                    }
-                }
-            }
-            cuts.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
-            let mut piece: Vec<Coord<f64>> = vec![line[0]];
-            let mut k = 0;
-            for i in 0..line.len() - 1 {
-                while k < cuts.len() && cuts[k].0 == i {
-                    let c = cuts[k].2;
-                    // A cut at a vertex takes the vertex's place (the
-                    // skeleton's end is the point on ∂P, bit for bit).
-                    match piece.last_mut() {
-                        Some(last) if crate::geometry::norm(*last - c) <= tol => *last = c,
-                        _ => piece.push(c),
-                    }
-                    if piece.len() > 1 {
-                        rows.push(NetworkRow {
-                            kind: NetworkKind::Line,
-                            src_fid: None,
-                            line_fid: l.fid,
-                            geometry: LineString(std::mem::take(&mut piece)),
-                        });
-                    }
-                    piece = vec![c];
-                    k += 1;
-                }
-                if piece
-                    .last()
-                    .is_none_or(|&last| crate::geometry::norm(last - line[i + 1]) > tol)
-                {
-                    piece.push(line[i + 1]);
-                }
-            }
-            if piece.len() > 1 {
-                rows.push(NetworkRow {
-                    kind: NetworkKind::Line,
-                    src_fid: None,
-                    line_fid: l.fid,
-                    geometry: LineString(piece),
-                });
-            }
+            let (cuts, snapped) = l.cuts(at.get(&l.fid).map_or(&[][..], Vec::as_slice));
+            rows.extend(snapped.into_iter().map(|s| row(NetworkKind::Connection, s)));
+            rows.extend(
+                l.pieces(&cuts)
+                    .into_iter()
+                    .map(|p| row(NetworkKind::Line, p)),
+            );
         }
         rows
+    }
+}
+
+/// Where a point cuts a line: the segment, the parameter along it, the point.
+type Cut = (usize, f64, Coord<f64>);
+
+impl NetworkLine {
+    /// A point counts as on the line within this distance.
+    fn tolerance(&self) -> f64 {
+        let (a, z) = (self.bbox.min(), self.bbox.max());
+        1e-6 * (z.x - a.x).max(z.y - a.y).max(1.0)
+    }
+
+    /// Where `points` cut the line, as (segment, parameter along it, point),
+    /// in order along it; and for each point off the line, the segment from
+    /// the nearer line end to it.
+    fn cuts(&self, points: &[Coord<f64>]) -> (Vec<Cut>, Vec<LineString<f64>>) {
+        let line = &self.line.0;
+        let (mut cuts, mut snapped) = (Vec::new(), Vec::new());
+        for &c in points {
+            let nearest = line
+                .windows(2)
+                .enumerate()
+                .map(|(i, w)| {
+                    let (q, t) = crate::geometry::segment::closest_on_segment(w[0], w[1], c);
+                    (crate::geometry::norm(q - c), i, t)
+                })
+                .min_by(|a, b| a.0.total_cmp(&b.0));
+            match nearest {
+                Some((d, i, t)) if d <= self.tolerance() => cuts.push((i, t, c)),
+                _ => {
+                    let (first, last) = (line[0], line[line.len() - 1]);
+                    let far = crate::geometry::norm(first - c) > crate::geometry::norm(last - c);
+                    snapped.push(LineString(vec![if far { last } else { first }, c]));
+                }
+            }
+        }
+        cuts.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+        (cuts, snapped)
+    }
+
+    /// The line's pieces between `cuts` (see [`NetworkLine::cuts`]); a cut at
+    /// a vertex takes the vertex's place (the skeleton's end is the point on
+    /// ∂P, bit for bit).
+    fn pieces(&self, cuts: &[Cut]) -> Vec<LineString<f64>> {
+        let line = &self.line.0;
+        let tol = 1e-3 * self.tolerance();
+        let near = |a: Coord<f64>, b: Coord<f64>| crate::geometry::norm(a - b) <= tol;
+        let mut out = Vec::new();
+        let mut piece: Vec<Coord<f64>> = vec![line[0]];
+        let mut k = 0;
+        for i in 0..line.len() - 1 {
+            while k < cuts.len() && cuts[k].0 == i {
+                let c = cuts[k].2;
+                match piece.last_mut() {
+                    Some(last) if near(*last, c) => *last = c,
+                    _ => piece.push(c),
+                }
+                if piece.len() > 1 {
+                    out.push(LineString(std::mem::take(&mut piece)));
+                }
+                piece = vec![c];
+                k += 1;
+            }
+            if piece.last().is_none_or(|&last| !near(last, line[i + 1])) {
+                piece.push(line[i + 1]);
+            }
+        }
+        if piece.len() > 1 {
+            out.push(LineString(piece));
+        }
+        out
     }
 }
 

@@ -52,26 +52,17 @@ pub(super) fn split(s: &Samples, p: &PreparedPolygon, min_area: f64) -> PartColl
         .map(|k| holds_wide[k] || !holds_any[k])
         .collect();
     let was_kept = kept.clone();
+    let sides = cut_sides(&faces, cuts.len());
     if min_area > 0.0 {
-        collapse_beads(&faces, &mut kept, min_area);
+        collapse_beads(&faces, &sides, &mut kept, min_area);
     }
     let collapsed = |run: usize| face[run].is_some_and(|k| !kept[k]);
     let (collapsed_lines, kept_lines) = pieces.lines(s, collapsed);
-    let areas = areas(p, &cuts, &faces, &kept);
+    let areas = areas(p, &cuts, &faces, &sides, &kept);
     // The cuts of a collapsed bead are gone with it.
-    let gone: Vec<bool> = (0..cuts.len())
-        .map(|c| {
-            let sides = faces
-                .iter()
-                .enumerate()
-                .filter(|(_, f)| f.chords.contains(&c));
-            let (mut now, mut before) = (false, false);
-            for (k, _) in sides {
-                now |= kept[k];
-                before |= was_kept[k];
-            }
-            before && !now
-        })
+    let gone: Vec<bool> = sides
+        .iter()
+        .map(|s| s.iter().any(|&k| was_kept[k]) && !s.iter().any(|&k| kept[k]))
         .collect();
     let cuts = cuts
         .into_iter()
@@ -313,25 +304,24 @@ fn split_or_whole(
     }
 }
 
-/// `collapse.min_area`: kept areas (kept faces joined across the cuts
-/// between them) smaller than `min_area`, with at least one cut and a
-/// collapsed face beyond every cut, become collapsed — smallest first, each
-/// judged again after the others (collapsing one never makes another's cut
-/// lead to a kept face).
-fn collapse_beads(faces: &[Face], kept: &mut [bool], min_area: f64) {
-    use geo::Area as _;
-    let n_cuts = faces
-        .iter()
-        .flat_map(|f| f.chords.iter())
-        .max()
-        .map_or(0, |&c| c + 1);
+/// The faces on either side of every cut (indices into `faces`).
+fn cut_sides(faces: &[Face], n_cuts: usize) -> Vec<Vec<usize>> {
     let mut sides: Vec<Vec<usize>> = vec![Vec::new(); n_cuts];
     for (k, f) in faces.iter().enumerate() {
         for &c in &f.chords {
             sides[c].push(k);
         }
     }
-    // Kept faces joined across cuts between kept faces: one area each.
+    sides
+}
+
+/// `collapse.min_area`: kept areas (kept faces joined across the cuts
+/// between them) smaller than `min_area` and bounded by at least one cut
+/// become collapsed. Beyond each of an area's cuts lies a collapsed face (a
+/// kept one would belong to the area), so every such area is a bead with
+/// collapsed lines on all its cuts.
+fn collapse_beads(faces: &[Face], sides: &[Vec<usize>], kept: &mut [bool], min_area: f64) {
+    use geo::Area as _;
     let mut group: Vec<usize> = (0..faces.len()).collect();
     fn root(g: &mut [usize], mut a: usize) -> usize {
         while g[a] != a {
@@ -340,7 +330,7 @@ fn collapse_beads(faces: &[Face], kept: &mut [bool], min_area: f64) {
         }
         a
     }
-    for s in &sides {
+    for s in sides {
         for w in s.windows(2) {
             if kept[w[0]] && kept[w[1]] {
                 let (a, b) = (root(&mut group, w[0]), root(&mut group, w[1]));
@@ -348,30 +338,21 @@ fn collapse_beads(faces: &[Face], kept: &mut [bool], min_area: f64) {
             }
         }
     }
-    let mut areas: std::collections::BTreeMap<usize, (f64, Vec<usize>)> = Default::default();
+    let mut areas: std::collections::BTreeMap<usize, (f64, bool, Vec<usize>)> = Default::default();
     for k in (0..faces.len()).filter(|&k| kept[k]) {
-        let e = areas.entry(root(&mut group, k)).or_default();
+        let g = root(&mut group, k);
+        let cut = faces[k]
+            .chords
+            .iter()
+            .any(|&c| sides[c].iter().any(|&o| !kept[o]));
+        let e = areas.entry(g).or_default();
         e.0 += faces[k].polygon.unsigned_area();
-        e.1.push(k);
+        e.1 |= cut;
+        e.2.push(k);
     }
-    let mut small: Vec<(f64, Vec<usize>)> =
-        areas.into_values().filter(|(a, _)| *a < min_area).collect();
-    small.sort_by(|a, b| a.0.total_cmp(&b.0));
-    for (_, members) in small {
-        let mut cuts = 0;
-        let mut all_collapsed = true;
-        for &k in &members {
-            for &c in &faces[k].chords {
-                for &other in &sides[c] {
-                    if !members.contains(&other) {
-                        cuts += 1;
-                        all_collapsed &= !kept[other];
-                    }
-                }
-            }
-        }
-        if cuts > 0 && all_collapsed {
-            for &k in &members {
+    for (area, cut, members) in areas.into_values() {
+        if cut && area < min_area {
+            for k in members {
                 kept[k] = false;
             }
         }
@@ -385,18 +366,13 @@ fn areas(
     p: &PreparedPolygon,
     cuts: &[LineString<f64>],
     faces: &[Face],
+    sides: &[Vec<usize>],
     kept: &[bool],
 ) -> Vec<Area> {
-    let mut sides: Vec<Vec<bool>> = vec![Vec::new(); cuts.len()];
-    for (f, &k) in faces.iter().zip(kept) {
-        for &c in &f.chords {
-            sides[c].push(k);
-        }
-    }
     let between: Vec<LineString<f64>> = cuts
         .iter()
-        .zip(&sides)
-        .filter(|(_, s)| s.iter().any(|&k| k) && s.iter().any(|&k| !k))
+        .zip(sides)
+        .filter(|(_, s)| s.iter().any(|&k| kept[k]) && s.iter().any(|&k| !kept[k]))
         .map(|(c, _)| c.clone())
         .collect();
     let (_, merged) = split_or_whole(p, &between);
