@@ -15,6 +15,7 @@ use std::process::ExitCode;
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 const EXIT_RUNTIME: u8 = 1;
+const EXIT_USAGE: u8 = 2;
 const EXIT_REJECTED: u8 = 65;
 const EXIT_CONFIG: u8 = 78;
 
@@ -44,40 +45,71 @@ enum LogFormat {
     Json,
 }
 
-/// A pipeline file and what the command line overrides in it.
+/// A pipeline file (or none: every step with its defaults) and what the
+/// command line overrides in it.
 #[derive(clap::Args)]
 struct PipelineArgs {
-    /// The pipeline file (YAML).
-    pipeline: PathBuf,
+    /// The pipeline file (YAML). Without it, `-i` and `-o` are required and
+    /// every step runs with its defaults (`pipelines/default.yaml`).
+    pipeline: Option<PathBuf>,
     /// Override a key, e.g. `--set steps.prune.ratio=2` (repeatable).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     set: Vec<String>,
-    /// Override `input.source`.
+    /// Override `input.source` (any OGR source: file, folder, `PG:…`, `/vsizip/…`).
     #[arg(short = 'i', long = "input", value_name = "SOURCE")]
     input: Option<String>,
+    /// Override `input.layer` (a layer name); with `-i` and no `-l` the
+    /// pipeline's layer is kept when the new source has it, otherwise the
+    /// error lists the layers there are.
+    #[arg(short = 'l', long = "layer", value_name = "LAYER")]
+    layer: Option<String>,
     /// Override `output.path`.
     #[arg(short = 'o', long = "output", value_name = "OUT.gpkg")]
     output: Option<PathBuf>,
+    /// Replace an existing output (`output.overwrite: true`).
+    #[arg(long)]
+    overwrite: bool,
+}
+
+/// The pipeline of a run without a pipeline file.
+const DEFAULT_PIPELINE: &str = include_str!("../pipelines/default.yaml");
+
+/// JSON-quoted, so that any path or name survives YAML parsing as a string.
+fn quoted(s: &str) -> String {
+    serde_json::to_string(s).unwrap_or_default()
 }
 
 impl PipelineArgs {
-    /// Loads the file with the overrides; an invalid file logs and exits 78.
+    /// Loads the file (or the built-in defaults) with the overrides; an
+    /// invalid file logs and exits 78, a missing `-i`/`-o` without a file
+    /// exits 2.
     fn load(&self) -> Result<config::Pipeline, ExitCode> {
         let mut ov = self.set.clone();
-        // Quoted so that any path survives YAML parsing as a string.
         if let Some(i) = &self.input {
-            ov.push(format!(
-                "input.source={}",
-                serde_json::to_string(i).unwrap_or_default()
-            ));
+            ov.push(format!("input.source={}", quoted(i)));
+        }
+        if let Some(l) = &self.layer {
+            ov.push(format!("input.layer={}", quoted(l)));
         }
         if let Some(o) = &self.output {
-            ov.push(format!(
-                "output.path={}",
-                serde_json::to_string(&o.display().to_string()).unwrap_or_default()
-            ));
+            ov.push(format!("output.path={}", quoted(&o.display().to_string())));
         }
-        config::load(&self.pipeline, &ov).map_err(|e| {
+        if self.overwrite {
+            ov.push("output.overwrite=true".into());
+        }
+        let loaded = match &self.pipeline {
+            Some(path) => config::load(path, &ov),
+            None => {
+                if self.input.is_none() || self.output.is_none() {
+                    tracing::error!(
+                        "give a pipeline file, or run every step with its defaults with `-i SOURCE -o OUT.gpkg` (and `-l LAYER` for another layer than the first)"
+                    );
+                    return Err(ExitCode::from(EXIT_USAGE));
+                }
+                config::load_str(DEFAULT_PIPELINE, "pipelines/default.yaml (built in)", &ov)
+            }
+        };
+        loaded.map_err(|e| {
             tracing::error!("{e}");
             ExitCode::from(EXIT_CONFIG)
         })
@@ -86,7 +118,7 @@ impl PipelineArgs {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Run a pipeline file.
+    /// Run a pipeline file, or every step with its defaults: `run -i SOURCE [-l LAYER] -o OUT.gpkg`.
     Run {
         #[command(flatten)]
         file: PipelineArgs,
@@ -491,7 +523,7 @@ fn cmd_report(args: &ReportArgs) -> ExitCode {
         Ok(j) => j,
         Err(e) => {
             tracing::error!("{e}");
-            return ExitCode::from(2);
+            return ExitCode::from(EXIT_USAGE);
         }
     };
     match skeletonise::reporting::write_report(&job) {

@@ -718,3 +718,154 @@ fn a_where_filter_the_source_rejects_stops_the_run_with_the_reason() {
     );
     assert!(!out.exists());
 }
+
+/// The rows a user compares: source fid, method, scores and geometry.
+fn rows(out: &std::path::Path) -> Vec<String> {
+    let ds = open(out);
+    let fids = ints(&ds, "skeletons", "src_fid");
+    let methods = strings(&ds, "skeletons", "method");
+    let z = reals(&ds, "skeletons", "distortion");
+    let w = wkts(&ds, "skeletons");
+    (0..fids.len())
+        .map(|i| format!("{:?} {:?} {:?} {:?}", fids[i], methods[i], z[i], w[i]))
+        .collect()
+}
+
+#[test]
+fn runs_without_a_pipeline_file_like_the_default_pipeline() {
+    let d = tmp();
+    let a = d.path().join("a.gpkg");
+    let b = d.path().join("b.gpkg");
+    let o = skeletonise(&[
+        "run",
+        "-i",
+        TRAIN,
+        "-l",
+        "lakes_scotland",
+        "-o",
+        a.to_str().unwrap(),
+    ]);
+    let (code, err) = code_and_err(&o);
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("18 read, 18 written"), "{err}");
+    let o = skeletonise(&[
+        "run",
+        "pipelines/default.yaml",
+        "-i",
+        TRAIN,
+        "--layer",
+        "lakes_scotland",
+        "-o",
+        b.to_str().unwrap(),
+    ]);
+    assert_eq!(code_and_err(&o).0, 0);
+    let (ra, rb) = (rows(&a), rows(&b));
+    assert_eq!(ra.len(), 18);
+    assert_eq!(ra, rb);
+    // The built-in pipeline is recorded as the run's provenance.
+    assert!(strings(&open(&a), "skeletonise_runs", "pipeline")[0]
+        .as_deref()
+        .unwrap()
+        .contains("name: default"));
+    // `--set` works there too.
+    let c = d.path().join("c.gpkg");
+    let o = skeletonise(&[
+        "run",
+        "-i",
+        TRAIN,
+        "-l",
+        "lakes_scotland",
+        "-o",
+        c.to_str().unwrap(),
+        "--set",
+        "steps.skeleton.methods=[CDT]",
+    ]);
+    assert_eq!(code_and_err(&o).0, 0);
+    assert!(strings(&open(&c), "skeletons", "method")
+        .iter()
+        .all(|m| m.as_deref() == Some("CDT")));
+    // Without `-l`, the first layer (GDAL's order) is read.
+    let f = d.path().join("f.gpkg");
+    let o = skeletonise(&["run", "-i", TRAIN, "-o", f.to_str().unwrap()]);
+    let (code, err) = code_and_err(&o);
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("layer=islands_hebrides"), "{err}");
+    // No pipeline file and no output: a usage error that says what to give.
+    let o = skeletonise(&["run", "-i", TRAIN]);
+    let (code, err) = code_and_err(&o);
+    assert_eq!(code, 2);
+    assert!(err.contains("-i SOURCE -o OUT.gpkg"), "{err}");
+}
+
+#[test]
+fn a_pipelines_layer_missing_from_another_source_points_to_dash_l() {
+    let d = tmp();
+    let out = d.path().join("o.gpkg");
+    let o = skeletonise(&[
+        "run",
+        "pipelines/demo.yaml",
+        "-i",
+        TRAIN,
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let (code, err) = code_and_err(&o);
+    assert_eq!(code, 1);
+    assert!(
+        err.contains("layer `demo` not found")
+            && err.contains("lakes_scotland")
+            && err.contains("-l LAYER"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    let o = skeletonise(&[
+        "run",
+        "pipelines/demo.yaml",
+        "-i",
+        TRAIN,
+        "-l",
+        "river_danube",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code_and_err(&o).0, 0);
+    assert_eq!(
+        count(&open(&out), "skeletons"),
+        count(&open(std::path::Path::new(TRAIN)), "river_danube")
+    );
+}
+
+#[test]
+fn overwrite_flag_replaces_an_output_but_never_the_input() {
+    let d = tmp();
+    let out = d.path().join("o.gpkg");
+    std::fs::write(&out, b"precious").unwrap();
+    let args = |extra: &[&str]| {
+        let mut a = vec!["run", "-i", DEMO, "-o", out.to_str().unwrap()];
+        a.extend_from_slice(extra);
+        skeletonise(&a.iter().map(|s| &**s).collect::<Vec<_>>())
+    };
+    let (code, err) = code_and_err(&args(&[]));
+    assert_eq!(code, 1);
+    assert!(err.contains("--overwrite"), "{err}");
+    assert_eq!(std::fs::read(&out).unwrap(), b"precious");
+    let (code, err) = code_and_err(&args(&["--overwrite"]));
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(count(&open(&out), "skeletons"), 17);
+    // `--overwrite` never makes the input a target.
+    let input = d.path().join("in.gpkg");
+    std::fs::copy(DEMO, &input).unwrap();
+    let before = std::fs::read(&input).unwrap();
+    let o = skeletonise(&[
+        "run",
+        "-i",
+        input.to_str().unwrap(),
+        "-o",
+        input.to_str().unwrap(),
+        "--overwrite",
+    ]);
+    let (code, err) = code_and_err(&o);
+    assert_ne!(code, 0);
+    assert!(err.contains("input"), "{err}");
+    assert_eq!(std::fs::read(&input).unwrap(), before);
+}

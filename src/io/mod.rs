@@ -35,7 +35,7 @@ pub enum IoError {
         reason: String,
     },
     /// The requested layer does not exist.
-    #[error("layer {layer} not found in `{source_name}`; available layers: {available}")]
+    #[error("layer {layer} not found in `{source_name}`; available layers: {available}; choose one with `-l LAYER` (`input.layer`)")]
     NoLayer {
         /// The data source string.
         source_name: String,
@@ -99,7 +99,7 @@ pub enum IoError {
         reason: String,
     },
     /// The output exists and `overwrite` is off.
-    #[error("output `{path}` already exists; set `output.overwrite: true` or choose another path with `-o`")]
+    #[error("output `{path}` already exists; set `output.overwrite: true` (or `--overwrite`) or choose another path with `-o`")]
     OutputExists {
         /// The output path.
         path: String,
