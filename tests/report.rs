@@ -232,6 +232,31 @@ fn features_are_chosen_by_fid_or_by_where_and_a_bad_filter_names_itself() {
 }
 
 #[test]
+fn a_candidate_without_lines_is_drawn_as_none_not_a_failed_report() {
+    // A method can end with no lines on a polygon (on a very rough rim,
+    // StSk conformed to the medial axis' structure kept nothing): the run
+    // writes its candidate row with a NULL geometry. The report shows the
+    // feature with the other methods' lines instead of failing.
+    let d = tmp();
+    let (gpkg, _) = demo_run(d.path(), &[]);
+    let g = gpkg.to_str().unwrap();
+    let o = std::process::Command::new("ogrinfo")
+        .args([
+            g,
+            "-sql",
+            "UPDATE candidates SET geom = NULL WHERE method = 'VD' AND src_fid = 1",
+        ])
+        .output()
+        .expect("ogrinfo (GDAL) runs");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let html = d.path().join("one.html");
+    let o = skeletonise(&["report", g, "--fid", "1", "-o", html.to_str().unwrap()]);
+    let (code, err) = code_and_err(&o);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(attr_values(&read(&html), "section", "data-fid"), ["1"]);
+}
+
+#[test]
 fn polygons_that_cannot_be_reopened_name_the_fix_and_can_be_given() {
     let d = tmp();
     let src = d.path().join("moved.gpkg");

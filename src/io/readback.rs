@@ -85,7 +85,13 @@ impl Fields {
 }
 
 fn lines(f: &Feature<'_>) -> Option<geo::MultiLineString<f64>> {
-    let g = f.geometry()?.clone();
+    // A NULL geometry (a candidate with no lines) reads as a geometry
+    // without a handle: no lines, not a clone of nothing.
+    // SAFETY: the handle is only compared with null, not dereferenced.
+    let g = f
+        .geometry()
+        .filter(|g| !unsafe { g.c_geometry() }.is_null())?
+        .clone();
     // M values (`output.measures`) are not part of the lines read back.
     // SAFETY: the handle is the clone's own, valid while `g` lives.
     unsafe { gdal_sys::OGR_G_SetMeasured(g.c_geometry(), 0) };
