@@ -305,3 +305,48 @@ fn every_training_layer_and_method_ends_clean() {
     }
     assert!(any, "no method succeeded on the training data");
 }
+
+#[test]
+fn a_lone_method_gets_the_legs_it_has_among_all_five() {
+    // The reference (MA) sets the legs even when it is not among the
+    // methods: CDT or StSk alone draw exactly the lines they have as
+    // candidates of the five-method comparison (pruned on its own, a lone
+    // method on a rough rim kept thousands of legs).
+    let d = common::tmp();
+    let all = d.path().join("all.gpkg");
+    let run = |out: &std::path::Path, methods: &str| {
+        let o = common::skeletonise(&[
+            "run",
+            "pipelines/compare-methods.yaml",
+            "--set",
+            "input.layer=lakes_scotland",
+            "--set",
+            &format!("steps.skeleton.methods={methods}"),
+            "-o",
+            out.to_str().unwrap(),
+            "-q",
+        ]);
+        let (code, err) = common::code_and_err(&o);
+        assert_eq!(code, 0, "{err}");
+    };
+    run(&all, "[MA, StSk, DVD, CDT, VD]");
+    let ds = common::open(&all);
+    let methods = common::strings(&ds, "candidates", "method");
+    let fids = common::ints(&ds, "candidates", "src_fid");
+    let lines = common::wkts(&ds, "candidates");
+    for m in ["CDT", "StSk"] {
+        let alone = d.path().join(format!("{m}.gpkg"));
+        run(&alone, &format!("[{m}]"));
+        let a = common::open(&alone);
+        let want: Vec<(Option<i64>, Option<String>)> = (0..methods.len())
+            .filter(|&i| methods[i].as_deref() == Some(m))
+            .map(|i| (fids[i], lines[i].clone()))
+            .collect();
+        let got: Vec<(Option<i64>, Option<String>)> = common::ints(&a, "skeletons", "src_fid")
+            .into_iter()
+            .zip(common::wkts(&a, "skeletons"))
+            .collect();
+        assert_eq!(got.len(), 18);
+        assert_eq!(got, want, "{m} alone");
+    }
+}

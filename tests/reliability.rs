@@ -438,6 +438,55 @@ fn budgets_reject_a_feature_or_stop_a_method_with_the_reason() {
 }
 
 #[test]
+fn the_memory_budget_covers_pruning_and_scoring_too() {
+    // MA's raw skeleton of a 12 000-vertex reach is made (the method does
+    // not predict its memory), but its pruning would need more than a
+    // megabyte: the method fails for the feature with the stage and the
+    // option in the reason, and the feature is listed, never dropped.
+    let d = tmp();
+    let out = d.path().join("o.gpkg");
+    let o = skeletonise(&[
+        "run",
+        "pipelines/compare-methods.yaml",
+        "--set",
+        "input.layer=river_lena",
+        "--set",
+        "input.where=fid = 2",
+        "--set",
+        "steps.skeleton.max_memory_mb=1",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", out_err(&o));
+    let ds = open(&out);
+    let reasons = strings(&ds, "rejected", "reason");
+    assert_eq!(reasons.len(), 1, "{reasons:?}");
+    let r = reasons[0].clone().unwrap_or_default();
+    assert!(
+        r.contains("MA skipped: it would need about")
+            && r.contains("for pruning and extending this polygon")
+            && r.contains("`skeleton.max_memory_mb` = 1"),
+        "{r}"
+    );
+    // With a budget that holds, the same reach goes through.
+    let o = skeletonise(&[
+        "run",
+        "pipelines/compare-methods.yaml",
+        "--set",
+        "input.layer=river_lena",
+        "--set",
+        "input.where=fid = 2",
+        "--set",
+        "steps.skeleton.max_memory_mb=64",
+        "-o",
+        out.to_str().unwrap(),
+        "--overwrite",
+    ]);
+    assert!(o.status.success(), "{}", out_err(&o));
+    assert_eq!(count(&open(&out), "skeletons"), 1);
+}
+
+#[test]
 fn a_memory_budget_out_of_range_is_a_clear_error() {
     let o = skeletonise(&[
         "validate",

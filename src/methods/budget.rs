@@ -112,12 +112,62 @@ pub fn with_budget<T>(
     budget: Budget,
     f: impl FnOnce(&MethodContext) -> Result<T, MethodError>,
 ) -> Result<T, MethodError> {
-    let ctx = MethodContext::start(budget);
-    match f(&ctx) {
+    within(id, &MethodContext::start(budget), f)
+}
+
+/// Runs `f` (method `id`) in `ctx`, whose clock may have started before (a
+/// method's budget covers its pruning, extension and scores too); a result
+/// that came after the deadline becomes [`MethodError::TimedOut`].
+pub fn within<T>(
+    id: MethodId,
+    ctx: &MethodContext,
+    f: impl FnOnce(&MethodContext) -> Result<T, MethodError>,
+) -> Result<T, MethodError> {
+    match f(ctx) {
         Ok(_) if ctx.deadline.is_some_and(|d| Instant::now() > d) => {
-            Err(timed_out(id, budget.time.unwrap_or_default()))
+            Err(timed_out(id, ctx.budget.time.unwrap_or_default()))
         }
         other => other,
+    }
+}
+
+impl MethodContext {
+    /// After (or before) a later stage of the method's work on the polygon
+    /// — `stage` says which, e.g. "pruning and extending" — fails with
+    /// [`MethodError::StageTimedOut`] once the deadline has passed: the
+    /// budget is the method's whole work on the polygon, not its raw
+    /// skeleton alone.
+    pub fn check_stage(&self, method: MethodId, stage: &'static str) -> Result<(), MethodError> {
+        match self.deadline {
+            Some(d) if Instant::now() > d => Err(MethodError::StageTimedOut {
+                method,
+                seconds: self.budget.time.unwrap_or_default().as_secs_f64(),
+                stage,
+            }),
+            _ => Ok(()),
+        }
+    }
+
+    /// Declines a later stage (`stage`, e.g. "scoring") of the method's work
+    /// that would need about `bytes` of working memory, more than
+    /// `skeleton.max_memory_mb` ([`MethodError::OverBudget`]).
+    pub fn afford_stage(
+        &self,
+        method: MethodId,
+        stage: &'static str,
+        bytes: f64,
+    ) -> Result<(), MethodError> {
+        match self.memory_limit() {
+            Some(max) if bytes > max as f64 => Err(MethodError::OverBudget {
+                method,
+                reason: format!(
+                    "would need about {:.0} MB for {stage} this polygon, more than `skeleton.max_memory_mb` = {:.0}",
+                    bytes / 1e6,
+                    max as f64 / 1e6
+                ),
+            }),
+            _ => Ok(()),
+        }
     }
 }
 
@@ -205,5 +255,36 @@ mod tests {
             .afford(MethodId::STSK, 1e9, 1e18)
             .is_ok());
         assert_eq!(MethodContext::start(mem).memory_limit(), Some(1_000_000));
+    }
+
+    #[test]
+    fn later_stages_are_judged_against_the_same_deadline() {
+        let ctx = MethodContext::start(Budget {
+            time: Some(Duration::from_millis(5)),
+            memory: Some(1_000_000),
+        });
+        assert!(ctx.check_stage(MethodId::MA, "scoring").is_ok());
+        let e = ctx
+            .afford_stage(MethodId::MA, "scoring", 3e6)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("about 3 MB for scoring this polygon") && e.contains("max_memory_mb"),
+            "{e}"
+        );
+        assert!(ctx.afford_stage(MethodId::MA, "scoring", 5e5).is_ok());
+        std::thread::sleep(Duration::from_millis(10));
+        let e = ctx
+            .check_stage(MethodId::MA, "pruning and extending")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("while pruning and extending") && e.contains("skeleton.timeout_s"),
+            "{e}"
+        );
+        // No limits: every stage passes.
+        let free = MethodContext::default();
+        assert!(free.check_stage(MethodId::MA, "scoring").is_ok());
+        assert!(free.afford_stage(MethodId::MA, "scoring", 1e15).is_ok());
     }
 }

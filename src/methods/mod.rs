@@ -135,6 +135,17 @@ pub enum MethodError {
         /// The budget, in seconds.
         seconds: f64,
     },
+    /// The method's pruning, extension or scores ran past its time budget
+    /// on this polygon (the budget covers every stage of its work).
+    #[error("{method} ran past `skeleton.timeout_s` ({seconds} s) on this polygon while {stage}; raise the budget, or leave {method} out for such polygons")]
+    StageTimedOut {
+        /// The method.
+        method: MethodId,
+        /// The budget, in seconds.
+        seconds: f64,
+        /// The stage, e.g. "pruning and extending".
+        stage: &'static str,
+    },
     /// The method predicted that this polygon would cost more than its
     /// budget and did not start.
     #[error(

@@ -9,6 +9,7 @@ use crate::graph::extend::prune_and_extend;
 use crate::graph::prune::PruneParams;
 use crate::graph::widths::medial_axis_transform;
 use crate::graph::SkeletonGraph;
+use crate::methods::budget::{self, MethodContext};
 use crate::score::{metrics, BarRays};
 use geo::{LineString, MultiLineString};
 use std::time::Duration;
@@ -56,10 +57,12 @@ pub(super) fn computed(
             .map(|r| r[k].0.clone())
             .collect::<Result<_, _>>()
             .and_then(|parts| every_part_has_a_skeleton(parts, m));
-        let result = parts.map(|parts| finish(prepared, &rays, &parts, params, parallel));
-        let result = result.map(|(c, t)| {
+        let result = parts.and_then(|parts| {
+            scoring_budget(m, &parts, &rays, params)?;
+            let (c, t) = finish(prepared, &rays, &parts, params, parallel);
             time.score += t + rays_share;
-            c
+            scoring_budget(m, &parts, &[], params)?;
+            Ok(c)
         });
         super::Candidate {
             method: m,
@@ -131,6 +134,7 @@ pub(super) fn given(
         .map(|_| PartSkeleton {
             graph: graph.clone(),
             legs_raw: legs,
+            ctx: MethodContext::default(),
         })
         .collect();
     let parallel = worth_splitting(prepared);
@@ -149,6 +153,9 @@ pub(super) fn given(
 pub(super) struct PartSkeleton {
     graph: crate::graph::SkeletonGraph,
     legs_raw: usize,
+    /// The method's budget on this part (its clock started with the raw
+    /// skeleton); scoring is under it too.
+    ctx: MethodContext,
 }
 
 /// Every method's finished skeleton of one polygon part, in `methods`
@@ -170,14 +177,33 @@ pub(super) fn part_skeletons(
             .map(|_| (Err(why.clone()), StageTimes::default()))
             .collect();
     }
-    let mut raws = work.raw_skeletons();
-    let reference = work.reference(&mut raws);
+    // A reference that is no candidate (`skeleton.reference` not among
+    // `methods`) is made beside the candidates' raw skeletons.
+    let (mut raws, hidden) = if parallel && work.hidden.is_some() {
+        rayon::join(|| work.raw_skeletons(), || work.hidden_reference())
+    } else {
+        (work.raw_skeletons(), work.hidden_reference())
+    };
+    let reference = match hidden {
+        Some((r, time)) => {
+            // Its time is the candidates' pruning, shared evenly.
+            let share = time / raws.len().max(1) as u32;
+            for raw in &mut raws {
+                raw.stages.add(Stage::Prune, share);
+            }
+            r.or_else(|| work.reference(&mut raws))
+        }
+        None => work.reference(&mut raws),
+    };
     work.conformed(raws, reference.as_ref())
 }
 
-/// The reference's index among the methods, its structure and its finished
-/// skeleton.
+/// The reference's index among the methods ([`HIDDEN`] for a reference
+/// that is no candidate), its structure and its finished skeleton.
 type Reference = (usize, crate::graph::structure::Structure, SkeletonGraph);
+
+/// The index of a reference that is not among the methods.
+const HIDDEN: usize = usize::MAX;
 
 /// One method's raw skeleton of a polygon part, the time taken so far, and
 /// (for the first method of the reference order) its finished skeleton.
@@ -185,6 +211,11 @@ struct Raw {
     graph: Result<SkeletonGraph, String>,
     stages: Stages,
     reference: Option<Reference>,
+    /// Whether its finished skeleton was tried as the reference.
+    tried: bool,
+    /// The method's budget on this part, its clock started with the raw
+    /// skeleton: pruning, extension and scores are under it too.
+    ctx: MethodContext,
 }
 
 /// The work on one polygon part: the polygon, the steps, whether its work
@@ -195,6 +226,11 @@ struct PartWork<'a> {
     params: &'a ProcessParams,
     parallel: bool,
     order: Vec<usize>,
+    /// The reference method when it is not among the methods: its
+    /// structure is made for the others all the same (on a rough boundary
+    /// a lone CDT, VD, DVD or StSk pruned on its own keeps thousands of
+    /// legs; against the medial axis' structure it keeps the few it has).
+    hidden: Option<crate::methods::MethodId>,
     trunk: bool,
     /// The pruning this part gets: the step's, or with `mode: network` and
     /// no connection point the fallback's (`None`: no pruning, or dropped).
@@ -226,11 +262,15 @@ impl<'a> PartWork<'a> {
             Some(pr) if pr.mode == PruneMode::Network && !connected => pr.without_connections(),
             other => other,
         };
-        // One method has no other to share its structure with: it is
-        // finished on its own (the same skeleton as its reference path).
+        // The reference alone has no other to share its structure with: it
+        // is finished on its own (the same skeleton as its reference path).
+        let reference = params.skeleton.reference;
         let shared = prune
             .filter(|pr| pr.mode != PruneMode::None && pr.structure == Sharing::Shared)
-            .filter(|_| methods.len() > 1);
+            .filter(|_| methods.len() > 1 || methods.first() != Some(&reference));
+        let hidden = shared
+            .filter(|_| !methods.contains(&reference))
+            .map(|_| reference);
         let order = shared.map_or_else(Vec::new, |_| {
             params
                 .skeleton
@@ -244,6 +284,7 @@ impl<'a> PartWork<'a> {
             params,
             parallel,
             order,
+            hidden,
             trunk: prune.is_some_and(|pr| pr.mode == PruneMode::Trunk),
             prune,
             network: network.filter(|_| connected),
@@ -297,15 +338,45 @@ impl<'a> PartWork<'a> {
 
     /// Method `k`'s finished skeleton as the reference, when not empty (a
     /// polygon thinner than MA's grid has no medial axis).
-    fn reference_of(&self, k: usize, raw: &SkeletonGraph) -> Option<Reference> {
-        let g = self.finish(raw);
-        (!g.is_empty()).then(|| {
+    /// Fails (method `k`'s error on this part) when its pruning and
+    /// extension would need more memory than the budget allows, or ran past
+    /// its deadline.
+    fn reference_of(
+        &self,
+        k: usize,
+        raw: &SkeletonGraph,
+        ctx: &MethodContext,
+    ) -> Result<Option<Reference>, String> {
+        let m = self.params.skeleton.methods[k];
+        let g = self.staged(m, ctx, || self.finish(raw))?;
+        Ok((!g.is_empty()).then(|| {
             (
                 k,
                 crate::graph::structure::Structure::of(&g, self.p, self.trunk),
                 g,
             )
-        })
+        }))
+    }
+
+    /// `finish` (pruning and extending, method `m`) under the method's
+    /// budget: declined when its working memory would pass
+    /// `skeleton.max_memory_mb`, dropped when it ended past the deadline
+    /// (it is judged when it returns, as a method that cannot be
+    /// interrupted is).
+    fn staged(
+        &self,
+        m: crate::methods::MethodId,
+        ctx: &MethodContext,
+        finish: impl FnOnce() -> SkeletonGraph,
+    ) -> Result<SkeletonGraph, String> {
+        const STAGE: &str = "pruning and extending";
+        let bytes = PRUNE_BYTES_PER_VERTEX * self.p.vertex_count() as f64;
+        ctx.check_stage(m, STAGE)
+            .and_then(|()| ctx.afford_stage(m, STAGE, bytes))
+            .map_err(|e| e.to_string())?;
+        let g = finish();
+        ctx.check_stage(m, STAGE).map_err(|e| e.to_string())?;
+        Ok(g)
     }
 
     /// Every method's raw skeleton. The first of the reference order is
@@ -315,34 +386,64 @@ impl<'a> PartWork<'a> {
     fn raw_skeletons(&self) -> Vec<Raw> {
         let methods = &self.params.skeleton.methods;
         map_in_order(methods, self.parallel, |k, &m| {
+            let ctx = MethodContext::start(self.params.skeleton.budget());
             let mut stages = Stages::new(self.parallel);
-            let graph = stages.time(Stage::Skeleton, || {
+            let mut graph = stages.time(Stage::Skeleton, || {
                 self.params
                     .registry
                     .build(m, &self.params.skeleton)
                     .and_then(|method| {
                         guarded(m, || {
-                            crate::methods::budget::with_budget(
-                                m,
-                                self.params.skeleton.budget(),
-                                |ctx| method.skeletonise(self.p, ctx),
-                            )
-                            .map_err(|e| e.to_string())
+                            budget::within(m, &ctx, |ctx| method.skeletonise(self.p, ctx))
+                                .map_err(|e| e.to_string())
                         })
                     })
             });
-            let reference = match &graph {
-                Ok(g) if self.order.first() == Some(&k) => {
-                    stages.time(Stage::Prune, || self.reference_of(k, g))
+            let mut reference = None;
+            let tried = self.hidden.is_none() && self.order.first() == Some(&k);
+            if tried {
+                if let Ok(g) = &graph {
+                    match stages.time(Stage::Prune, || self.reference_of(k, g, &ctx)) {
+                        Ok(r) => reference = r,
+                        Err(e) => graph = Err(e),
+                    }
                 }
-                _ => None,
-            };
+            }
             Raw {
                 graph,
                 stages,
                 reference,
+                tried,
+                ctx,
             }
         })
+    }
+
+    /// The reference's finished skeleton when it is no candidate (`None`
+    /// inside when it has none: a polygon thinner than its grid, or over
+    /// its budget; the candidates are then tried in the reference order),
+    /// and the time it took.
+    fn hidden_reference(&self) -> Option<(Option<Reference>, std::time::Duration)> {
+        let m = self.hidden?;
+        let mut stages = Stages::new(self.parallel);
+        let r = stages.time(Stage::Prune, || {
+            let ctx = MethodContext::start(self.params.skeleton.budget());
+            let method = self.params.registry.build(m, &self.params.skeleton).ok()?;
+            let raw = guarded(m, || {
+                budget::within(m, &ctx, |ctx| method.skeletonise(self.p, ctx))
+                    .map_err(|e| e.to_string())
+            })
+            .ok()?;
+            let g = self.staged(m, &ctx, || self.finish(&raw)).ok()?;
+            (!g.is_empty()).then(|| {
+                (
+                    HIDDEN,
+                    crate::graph::structure::Structure::of(&g, self.p, self.trunk),
+                    g,
+                )
+            })
+        });
+        Some((r, stages.times().prune_extend))
     }
 
     /// The reference: the first method in the reference order whose
@@ -352,15 +453,20 @@ impl<'a> PartWork<'a> {
         if let Some(r) = raws.iter_mut().find_map(|r| r.reference.take()) {
             return Some(r);
         }
-        for &k in self.order.iter().skip(1) {
+        for &k in &self.order {
+            if raws[k].tried {
+                continue;
+            }
             let Ok(raw) = &raws[k].graph else { continue };
             let mut stages = Stages::new(self.parallel);
-            let r = stages.time(Stage::Prune, || self.reference_of(k, raw));
+            let r = stages.time(Stage::Prune, || self.reference_of(k, raw, &raws[k].ctx));
             raws[k]
                 .stages
                 .add(Stage::Prune, stages.times().prune_extend);
-            if r.is_some() {
-                return r;
+            match r {
+                Ok(Some(r)) => return Some(r),
+                Ok(None) => {}
+                Err(e) => raws[k].graph = Err(e),
             }
         }
         None
@@ -379,16 +485,15 @@ impl<'a> PartWork<'a> {
             let mut stages = raw.stages;
             let result = stages.time(Stage::Prune, || {
                 let g = raw.graph.as_ref().map_err(Clone::clone)?;
-                let finished = guarded(methods[k], || {
-                    Ok(match reference {
-                        Some((r, _, g)) if *r == k => g.clone(),
-                        Some((_, s, _)) => self.conform(g, s),
-                        None => self.finish(g),
-                    })
+                let finished = guarded(methods[k], || match reference {
+                    Some((r, _, g)) if *r == k => Ok(g.clone()),
+                    Some((_, s, _)) => self.staged(methods[k], &raw.ctx, || self.conform(g, s)),
+                    None => self.staged(methods[k], &raw.ctx, || self.finish(g)),
                 })?;
                 Ok(PartSkeleton {
                     graph: finished,
                     legs_raw: g.leg_count(),
+                    ctx: raw.ctx,
                 })
             });
             (result, stages.times())
@@ -511,6 +616,39 @@ fn finish(
         note: None,
     };
     (c, cast_time + clock.elapsed().saturating_sub(in_casts))
+}
+
+/// A method's working memory in pruning and extension per boundary vertex
+/// of the polygon: the peak measured with `examples/stage_memory.rs` is
+/// 450–590 bytes for MA (Lena reaches, the rough 200 000-vertex polygon)
+/// and 280 for CDT; with room for the allocator. (Per raw-skeleton node it
+/// varies fourfold between MA's grid and the others.)
+const PRUNE_BYTES_PER_VERTEX: f64 = 1000.0;
+
+/// Scoring `parts` (method `m`) under its budget: declined when the bars
+/// it casts (`rays`, one bar each, when the run scores) would pass
+/// `skeleton.max_memory_mb`, failed when a part's deadline has passed
+/// (checked before scoring and after it, with no rays).
+fn scoring_budget(
+    m: crate::methods::MethodId,
+    parts: &[PartSkeleton],
+    rays: &[BarRays],
+    params: &ProcessParams,
+) -> Result<(), String> {
+    const STAGE: &str = "scoring";
+    if params.score.is_none() {
+        return Ok(());
+    }
+    let bars: usize = rays.iter().map(BarRays::len).sum();
+    let bytes = (bars * std::mem::size_of::<crate::score::Bar>()) as f64;
+    parts
+        .iter()
+        .try_for_each(|p| {
+            p.ctx
+                .check_stage(m, STAGE)
+                .and_then(|()| p.ctx.afford_stage(m, STAGE, bytes))
+        })
+        .map_err(|e| e.to_string())
 }
 
 /// `f` over `items`, results in the items' order: in parallel, or on the
