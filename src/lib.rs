@@ -55,6 +55,7 @@ pub mod geometry;
 pub mod graph;
 #[cfg(feature = "gdal")]
 pub mod io;
+pub mod label;
 pub mod layer;
 pub mod methods;
 pub mod output;

@@ -202,8 +202,10 @@ impl Writer {
             path,
             spec: spec.clone(),
             plan: plan.clone(),
-            source_fields: source_fields(source),
-            neighbour_fields: neighbours.map(source_fields).unwrap_or_default(),
+            source_fields: source_fields(source, plan),
+            neighbour_fields: neighbours
+                .map(|n| source_fields(n, plan))
+                .unwrap_or_default(),
             in_transaction: None,
         };
         let r = plan
@@ -403,14 +405,23 @@ impl Writer {
 }
 
 /// The source's fields as the output names them: those whose names clash
-/// with a column of the skeleton layer get a `src_` prefix.
-fn source_fields(source: &SourceInfo) -> Vec<(String, FieldInfo)> {
+/// with a column of the skeleton layer, or of another layer of the plan that
+/// carries the source's fields (a registered step's, e.g. `labels`), get a
+/// `src_` prefix — in every layer alike.
+fn source_fields(source: &SourceInfo, plan: &Plan) -> Vec<(String, FieldInfo)> {
+    let steps: Vec<&'static str> = plan
+        .layers()
+        .into_iter()
+        .filter(|l| l.fields() == Some(crate::layer::Fields::Input))
+        .flat_map(|l| l.columns().into_iter().map(|c| c.name))
+        .collect();
     source
         .fields
         .iter()
         .map(|f| {
             let clash = SKELETONS
                 .column_names()
+                .chain(steps.iter().copied())
                 .any(|n| n.eq_ignore_ascii_case(&f.name));
             (
                 if clash {

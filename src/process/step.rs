@@ -83,8 +83,8 @@ pub struct StepEntry {
     pub build: fn(&serde_json::Value) -> Result<Arc<dyn FeatureStep>, OptionError>,
 }
 
-/// The registered steps (none are built in yet: the built-in steps are the
-/// variants of `config::Step`).
+/// The registered steps: the `label` step, and what a caller adds (the
+/// other built-in steps are the variants of `config::Step`).
 #[derive(Debug, Clone, Default)]
 pub struct StepRegistry {
     entries: Vec<StepEntry>,
@@ -93,7 +93,7 @@ pub struct StepRegistry {
 impl StepRegistry {
     /// The steps every pipeline file may use.
     pub fn builtin() -> Self {
-        Self::default()
+        Self::default().with(crate::label::ENTRY)
     }
 
     /// This registry and `entry`.

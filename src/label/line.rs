@@ -1,0 +1,381 @@
+//! A polygon part's label line: the medial-axis path a curved label follows,
+//! smoothed, kept off the shore and trimmed at narrow tips, or the centre of
+//! its largest inscribed disc where the part is not elongated enough.
+//!
+//! 1. **Path.** The medial axis, pruned and extended as the default pipeline
+//!    does (its legs reach the tips), gives the candidate paths: every
+//!    shortest path between two of its leaves. Each is scored by its length
+//!    over its curvature, `L / (1 + T / π)`, T its total turning measured
+//!    on the path resampled one local width apart (so that a wiggle smaller
+//!    than the lake does not count): the longest path that does not wind.
+//! 2. **Trim.** A label's letters need room: from each end the path is cut
+//!    back while the local radius is below half the path's median radius
+//!    (a narrow tip or outflow the text would stick out of).
+//! 3. **Smooth.** The path is resampled at a quarter of the local radius
+//!    and averaged over a window one local width long, repeatedly, until no
+//!    stretch one local width long turns by more than `smooth` degrees (at
+//!    most 200 rounds).
+//! 4. **Margin.** A smoothed point closer to ∂P than `margin` × the local
+//!    radius is moved back towards its medial-axis point until it is not
+//!    (the medial-axis point itself is one local radius away).
+//! 5. **Line or point.** With length / max width ≥ `min_elongation` the
+//!    line is written; otherwise (a round lake) the centre of the largest
+//!    inscribed disc, which lies on the medial axis: the pole of
+//!    inaccessibility.
+
+use crate::geometry::vector::hypot;
+use crate::geometry::{Boundary, PreparedPolygon};
+use crate::graph::{EdgeId, NodeId, SkeletonGraph};
+use geo::{Coord, LineString};
+
+/// What a polygon part is labelled with.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Label {
+    /// A curved label along this line.
+    Line(LineString<f64>),
+    /// A label at this point (the largest disc's centre).
+    Point(Coord<f64>),
+}
+
+/// A label and its measures.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Labelled {
+    /// The geometry.
+    pub label: Label,
+    /// Length of the line (0 for a point).
+    pub length: f64,
+    /// Diameter of the largest inscribed disc (2r).
+    pub max_width: f64,
+    /// Length of the chosen medial-axis path over `max_width`.
+    pub elongation: f64,
+}
+
+/// The options the algorithm needs (see [`super::LabelParams`]).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Shape {
+    pub smooth_deg: f64,
+    pub margin: f64,
+    pub min_elongation: f64,
+}
+
+/// The label of polygon part `p` from its finished medial axis `g`
+/// (`None` when the axis is empty).
+pub(super) fn label(p: &PreparedPolygon, g: &SkeletonGraph, o: Shape) -> Option<Labelled> {
+    let b = p.boundary();
+    let radius = |c: Coord<f64>| b.nearest(c).map_or(0.0, |(_, _, d)| d);
+    // The largest disc: over every vertex of the axis.
+    let (centre, r_max) = (0..g.edges().len())
+        .flat_map(|e| g.edge_coords(EdgeId::from_index(e)))
+        .map(|c| (c, radius(c)))
+        .max_by(|a, b| a.1.total_cmp(&b.1))?;
+    let max_width = 2.0 * r_max;
+    let point = |elongation: f64| Labelled {
+        label: Label::Point(centre),
+        length: 0.0,
+        max_width,
+        elongation,
+    };
+    let Some(path) = best_path(g, b) else {
+        return Some(point(0.0));
+    };
+    let axis_length = length(&path);
+    let elongation = axis_length / max_width;
+    if elongation < o.min_elongation {
+        return Some(point(elongation));
+    }
+    let radii: Vec<f64> = path.iter().map(|&c| radius(c)).collect();
+    let (path, radii) = trim(&path, &radii);
+    if path.len() < 2 {
+        return Some(point(elongation));
+    }
+    let line = smooth_inside(&path, &radii, b, o);
+    let line = LineString(dedup(line));
+    if line.0.len() < 2 {
+        return Some(point(elongation));
+    }
+    Some(Labelled {
+        length: length(&line.0),
+        label: Label::Line(line),
+        max_width,
+        elongation,
+    })
+}
+
+fn length(c: &[Coord<f64>]) -> f64 {
+    c.windows(2).map(|w| hypot(w[1] - w[0])).sum()
+}
+
+fn dedup(mut c: Vec<Coord<f64>>) -> Vec<Coord<f64>> {
+    c.dedup();
+    c
+}
+
+/// The leaf-to-leaf shortest path with the best `L / (1 + T / π)`.
+fn best_path(g: &SkeletonGraph, b: &Boundary) -> Option<Vec<Coord<f64>>> {
+    let m = g.merged();
+    let deg = m.degrees();
+    let leaves: Vec<NodeId> = (0..deg.len())
+        .filter(|&i| deg[i] == 1)
+        .map(NodeId::from_index)
+        .collect();
+    if leaves.len() < 2 {
+        return None;
+    }
+    // Many leaves (a ragged shape): the pairs among the farthest apart.
+    let leaves = if leaves.len() > MAX_LEAVES {
+        let mut far: Vec<(f64, NodeId)> = leaves
+            .iter()
+            .map(|&l| {
+                let p = m.node(l).pos;
+                let d = leaves
+                    .iter()
+                    .map(|&k| hypot(m.node(k).pos - p))
+                    .fold(0.0, f64::max);
+                (d, l)
+            })
+            .collect();
+        far.sort_by(|a, b| b.0.total_cmp(&a.0));
+        far.into_iter().take(MAX_LEAVES).map(|x| x.1).collect()
+    } else {
+        leaves
+    };
+    let usable = vec![true; m.edges().len()];
+    let mut best: Option<(f64, Vec<Coord<f64>>)> = None;
+    for (i, &a) in leaves.iter().enumerate() {
+        for &z in &leaves[i + 1..] {
+            let Some(edges) = crate::graph::prune::trunk::shortest_path(&m, &usable, a, z) else {
+                continue;
+            };
+            let path = coords_of(&m, &edges, z);
+            let score = straightness_score(&path, b);
+            if best.as_ref().is_none_or(|(s, _)| score > *s) {
+                best = Some((score, path));
+            }
+        }
+    }
+    best.map(|(_, p)| p)
+}
+
+/// Leaves whose pairs are tried at most (the farthest apart).
+const MAX_LEAVES: usize = 12;
+
+/// The coordinates of a path given as edges walked back from `to`.
+fn coords_of(m: &SkeletonGraph, edges: &[EdgeId], to: NodeId) -> Vec<Coord<f64>> {
+    let mut out: Vec<Coord<f64>> = vec![m.node(to).pos];
+    let mut at = to;
+    for &e in edges {
+        let mut c = m.edge_coords(e);
+        if c.first().copied() != Some(m.node(at).pos) {
+            c.reverse();
+        }
+        out.extend_from_slice(&c[1..]);
+        at = m.opposite(e, at);
+    }
+    out
+}
+
+/// `L / (1 + T / π)`: T the total turning of the path resampled one local
+/// width apart.
+fn straightness_score(path: &[Coord<f64>], b: &Boundary) -> f64 {
+    let l = length(path);
+    let mut coarse: Vec<Coord<f64>> = vec![path[0]];
+    let mut since = 0.0;
+    for w in path.windows(2) {
+        since += hypot(w[1] - w[0]);
+        let r = b.nearest(w[1]).map_or(0.0, |(_, _, d)| d);
+        if since >= (2.0 * r).max(l / 200.0) {
+            coarse.push(w[1]);
+            since = 0.0;
+        }
+    }
+    if coarse.last() != path.last() {
+        coarse.push(path[path.len() - 1]);
+    }
+    let turning: f64 = coarse
+        .windows(3)
+        .map(|w| turn(w[1] - w[0], w[2] - w[1]).abs())
+        .sum();
+    l / (1.0 + turning / std::f64::consts::PI)
+}
+
+/// The signed angle from `u` to `v` (radians).
+fn turn(u: Coord<f64>, v: Coord<f64>) -> f64 {
+    (u.x * v.y - u.y * v.x).atan2(u.x * v.x + u.y * v.y)
+}
+
+/// The path cut back at both ends while the local radius is below half
+/// the path's median radius.
+fn trim(path: &[Coord<f64>], radii: &[f64]) -> (Vec<Coord<f64>>, Vec<f64>) {
+    let mut sorted = radii.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    let floor = 0.5 * sorted[sorted.len() / 2];
+    let first = radii.iter().position(|&r| r >= floor).unwrap_or(0);
+    let last = radii.iter().rposition(|&r| r >= floor).unwrap_or(radii.len() - 1);
+    if first >= last {
+        return (Vec::new(), Vec::new());
+    }
+    (path[first..=last].to_vec(), radii[first..=last].to_vec())
+}
+
+/// Smoothing and keeping off the shore, alternately (a point moved back
+/// towards the axis may make a kink again), at most [`MAX_PASSES`] times.
+/// The turn is judged over a stretch `2 d` long at each point, d its
+/// distance to ∂P: the local width 2r where the line is on the axis.
+fn smooth_inside(path: &[Coord<f64>], radii: &[f64], b: &Boundary, o: Shape) -> Vec<Coord<f64>> {
+    let at = resample(path, radii);
+    let cur: Vec<Coord<f64>> = at.iter().map(|p| p.0).collect();
+    let cur = smooth(cur, &at, b, o);
+    keep_off_shore(&cur, &at, b, o.margin)
+}
+
+/// Smoothing and pulling back, alternately, at most.
+const MAX_PASSES: usize = 4;
+
+/// The stretch over which the turn is judged at each point: `2 d`, d its
+/// distance to ∂P (the local width 2r where the line is on the axis).
+fn windows(line: &[Coord<f64>], b: &Boundary) -> Vec<f64> {
+    line.iter()
+        .map(|&c| 2.0 * b.nearest(c).map_or(0.0, |(_, _, d)| d))
+        .collect()
+}
+
+/// The path resampled at a quarter of the local radius: each point with the
+/// medial-axis point it is and that point's radius.
+fn resample(path: &[Coord<f64>], radii: &[f64]) -> Vec<(Coord<f64>, f64)> {
+    // Resample: points at most r/4 apart (r interpolated).
+    let mut pts: Vec<(Coord<f64>, f64)> = vec![(path[0], radii[0])];
+    for i in 0..path.len() - 1 {
+        let (a, z) = (path[i], path[i + 1]);
+        let step = (0.25 * radii[i].min(radii[i + 1])).max(1e-9);
+        let n = (hypot(z - a) / step).ceil().clamp(1.0, 10_000.0) as usize;
+        for k in 1..=n {
+            let t = k as f64 / n as f64;
+            pts.push((a + (z - a) * t, radii[i] + (radii[i + 1] - radii[i]) * t));
+        }
+    }
+    pts
+}
+
+/// `line` averaged over a window of nine points (one local width: points a
+/// quarter radius apart) where it turns too much — only the points of the
+/// stretches that turn by more than `max_deg` (and their windows), so that
+/// the rest stays on the medial axis — until none does.
+fn smooth(mut cur: Vec<Coord<f64>>, at: &[(Coord<f64>, f64)], b: &Boundary, o: Shape) -> Vec<Coord<f64>> {
+    let half = 4usize;
+    let max_turn = o.smooth_deg.to_radians();
+    for _ in 0..MAX_ROUNDS {
+        let bad = too_curved(&cur, &windows(&cur, b), max_turn);
+        if !bad.iter().any(|&x| x) {
+            break;
+        }
+        let n = cur.len();
+        // Each bad point's window is smoothed too.
+        let mut touch = vec![false; n];
+        for (i, _) in bad.iter().enumerate().filter(|(_, &x)| x) {
+            for t in &mut touch[i.saturating_sub(half)..(i + half + 1).min(n)] {
+                *t = true;
+            }
+        }
+        let prev = cur.clone();
+        for i in (1..n - 1).filter(|&i| touch[i]) {
+            let k = half.min(i).min(n - 1 - i);
+            let mut s = Coord { x: 0.0, y: 0.0 };
+            for q in &prev[i - k..=i + k] {
+                s = s + *q;
+            }
+            // Within the corridor: at most (1 − margin) r from the axis.
+            let (axis, r) = at[i];
+            let c = s / (2 * k + 1) as f64;
+            let off = c - axis;
+            let reach = (1.0 - o.margin) * r;
+            let d = hypot(off);
+            cur[i] = if d > reach && d > 0.0 { axis + off * (reach / d) } else { c };
+        }
+    }
+    cur
+}
+
+/// Smoothing rounds at most.
+const MAX_ROUNDS: usize = 400;
+
+/// The points of every stretch (starting at a point, `window[i]` long) that
+/// turns by more than `max_turn` (radians) somewhere along it.
+fn too_curved(line: &[Coord<f64>], window: &[f64], max_turn: f64) -> Vec<bool> {
+    let mut bad = vec![false; line.len()];
+    for i in 0..line.len().saturating_sub(2) {
+        if let Some(end) = turn_exceeded(line, i, window[i], max_turn) {
+            for b in &mut bad[i..=end] {
+                *b = true;
+            }
+        }
+    }
+    bad
+}
+
+/// Where the stretch from point `i`, `width` long, first turns by more than
+/// `max_turn` in all (the point it happens at), if it does.
+fn turn_exceeded(line: &[Coord<f64>], i: usize, width: f64, max_turn: f64) -> Option<usize> {
+    let mut prev = line[i + 1] - line[i];
+    let (mut along, mut total) = (0.0, 0.0);
+    let mut j = i + 1;
+    while j + 1 < line.len() && along < width {
+        let d = line[j + 1] - line[j];
+        if hypot(d) > 0.0 && hypot(prev) > 0.0 {
+            total += turn(prev, d);
+            if total.abs() > max_turn {
+                return Some(j);
+            }
+            prev = d;
+        }
+        along += hypot(d);
+        j += 1;
+    }
+    None
+}
+
+/// The largest turn of `line` over the stretch starting at each point and
+/// `window[i]` long.
+fn max_turn_over_width(line: &[Coord<f64>], window: &[f64]) -> f64 {
+    let mut worst: f64 = 0.0;
+    for i in 0..line.len().saturating_sub(2) {
+        let mut prev = line[i + 1] - line[i];
+        let (mut along, mut total) = (0.0, 0.0);
+        let mut j = i + 1;
+        while j + 1 < line.len() && along < window[i] {
+            let d = line[j + 1] - line[j];
+            if hypot(d) > 0.0 && hypot(prev) > 0.0 {
+                total += turn(prev, d);
+                worst = worst.max(total.abs());
+                prev = d;
+            }
+            along += hypot(d);
+            j += 1;
+        }
+    }
+    worst
+}
+
+/// Each point moved back towards its medial-axis point until it is at least
+/// `margin` × that point's radius from ∂P (bisection, 20 steps).
+fn keep_off_shore(line: &[Coord<f64>], at: &[(Coord<f64>, f64)], b: &Boundary, margin: f64) -> Vec<Coord<f64>> {
+    line.iter()
+        .zip(at)
+        .map(|(&p, &(axis, r))| {
+            let need = margin * r;
+            let ok = |c: Coord<f64>| b.contains(c) && b.nearest(c).is_some_and(|(_, _, d)| d >= need);
+            if ok(p) {
+                return p;
+            }
+            let (mut lo, mut hi) = (0.0, 1.0); // 0: the axis point, 1: p
+            for _ in 0..20 {
+                let mid = 0.5 * (lo + hi);
+                if ok(axis + (p - axis) * mid) {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            axis + (p - axis) * lo
+        })
+        .collect()
+}

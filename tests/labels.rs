@@ -1,0 +1,205 @@
+//! Label lines: the `label` step of `pipelines/lake-labels.yaml` on the
+//! training lakes and islands gives every polygon part exactly one label —
+//! a simple line inside its polygon, off the shore, turning gently and
+//! centred (scored with `skeletonise score`), or a point at the centre of
+//! the largest inscribed disc.
+#![cfg(all(feature = "cli", feature = "gdal"))]
+
+mod common;
+
+use common::*;
+use gdal::vector::LayerAccess;
+use geo::{Contains, Coord, Geometry, LineString, Polygon};
+use skeletonise::geometry::PreparedPolygon;
+use std::collections::HashMap;
+use std::path::Path;
+
+const TRAIN: &str = "tests/data/gshhg-train.gpkg";
+
+fn geometry(w: &str) -> Geometry<f64> {
+    wkt::TryFromWkt::try_from_wkt_str(w).unwrap()
+}
+
+/// The layer's polygons by FID (every part of a multipolygon).
+fn polygons(layer: &str) -> HashMap<i64, Vec<Polygon<f64>>> {
+    let ds = open(Path::new(&root(TRAIN)));
+    let mut l = ds.layer_by_name(layer).unwrap();
+    l.features()
+        .map(|f| {
+            let parts = match geometry(&f.geometry().unwrap().wkt().unwrap()) {
+                Geometry::Polygon(p) => vec![p],
+                Geometry::MultiPolygon(m) => m.0,
+                other => panic!("not a polygon: {other:?}"),
+            };
+            (f.fid().unwrap() as i64, parts)
+        })
+        .collect()
+}
+
+fn run(dir: &Path, layer: &str) -> std::path::PathBuf {
+    let out = dir.join(format!("{layer}.gpkg"));
+    let o = skeletonise(&[
+        "run",
+        &root("pipelines/lake-labels.yaml"),
+        "--set",
+        &format!("input.layer={layer}"),
+        "-o",
+        out.to_str().unwrap(),
+        "-q",
+    ]);
+    assert!(o.status.success(), "{}", code_and_err(&o).1);
+    out
+}
+
+fn dist(a: Coord<f64>, b: Coord<f64>) -> f64 {
+    (a.x - b.x).hypot(a.y - b.y)
+}
+
+/// The signed angle from `u` to `v` (radians).
+fn turn(u: Coord<f64>, v: Coord<f64>) -> f64 {
+    (u.x * v.y - u.y * v.x).atan2(u.x * v.x + u.y * v.y)
+}
+
+/// True when no two non-adjacent segments of `l` meet.
+fn simple(l: &LineString<f64>) -> bool {
+    use geo::Intersects;
+    let segs: Vec<geo::Line<f64>> = l.lines().collect();
+    for i in 0..segs.len() {
+        for j in i + 2..segs.len() {
+            if segs[i].intersects(&segs[j]) {
+                return false;
+            }
+        }
+    }
+    true
+}
+
+/// The largest turn of `l` over a stretch starting at each vertex and
+/// `2 d` long, d the vertex's distance to ∂P: the local width 2r where the
+/// line is on the medial axis.
+fn worst_turn(l: &LineString<f64>, p: &PreparedPolygon) -> f64 {
+    let c = &l.0;
+    let mut worst: f64 = 0.0;
+    for i in 0..c.len().saturating_sub(2) {
+        let d = p.boundary().nearest(c[i]).unwrap().2;
+        let (mut along, mut total) = (0.0, 0.0);
+        let mut j = i + 1;
+        while j + 1 < c.len() && along < 2.0 * d {
+            total += turn(c[j] - c[j - 1], c[j + 1] - c[j]);
+            worst = worst.max(total.abs());
+            along += dist(c[j], c[j + 1]);
+            j += 1;
+        }
+    }
+    worst.to_degrees()
+}
+
+/// The largest distance to ∂P over a grid of points inside `p` (a check of
+/// the largest inscribed disc, independent of the medial axis).
+fn grid_max_radius(poly: &Polygon<f64>, p: &PreparedPolygon) -> f64 {
+    use geo::BoundingRect;
+    let r = poly.bounding_rect().unwrap();
+    let n = 120;
+    let mut best: f64 = 0.0;
+    for i in 0..=n {
+        for j in 0..=n {
+            let c = Coord {
+                x: r.min().x + r.width() * i as f64 / n as f64,
+                y: r.min().y + r.height() * j as f64 / n as f64,
+            };
+            if poly.contains(&geo::Point(c)) {
+                best = best.max(p.boundary().nearest(c).unwrap().2);
+            }
+        }
+    }
+    best
+}
+
+fn check_layer(layer: &str) -> (usize, usize) {
+    let dir = tmp();
+    let out = run(dir.path(), layer);
+    let polys = polygons(layer);
+    let ds = open(&out);
+    let fids = ints(&ds, "labels", "src_fid");
+    let parts = ints(&ds, "labels", "polygon_part");
+    let kinds = strings(&ds, "labels", "kind");
+    let widths = reals(&ds, "labels", "max_width");
+    let geoms = wkts(&ds, "labels");
+    let expected: usize = polys.values().map(Vec::len).sum();
+    assert_eq!(fids.len(), expected, "{layer}: one label per polygon part");
+    let mut seen = std::collections::HashSet::new();
+    let (mut lines, mut points) = (0, 0);
+    for k in 0..fids.len() {
+        let (fid, part) = (fids[k].unwrap(), parts[k].unwrap() as usize);
+        assert!(seen.insert((fid, part)), "{layer} {fid}/{part}: one row");
+        let poly = &polys[&fid][part];
+        let p = PreparedPolygon::new(poly).unwrap();
+        match (kinds[k].as_deref(), geometry(geoms[k].as_deref().unwrap())) {
+            (Some("line"), Geometry::LineString(l)) => {
+                lines += 1;
+                assert!(simple(&l), "{layer} {fid}: the line is simple");
+                assert!(poly.contains(&l), "{layer} {fid}: the line lies inside its polygon");
+                let near = l.0.iter().map(|&c| p.boundary().nearest(c).unwrap().2).fold(f64::INFINITY, f64::min);
+                assert!(near > 0.0, "{layer} {fid}: off the shore");
+                let t = worst_turn(&l, &p);
+                assert!(t <= 60.0, "{layer} {fid}: turns {t:.1}° over one local width");
+            }
+            (Some("point"), Geometry::Point(c)) => {
+                points += 1;
+                let r = p.boundary().nearest(c.0).unwrap().2;
+                let w = widths[k].unwrap();
+                assert!((2.0 * r - w).abs() <= 1e-6 * w.max(1.0), "{layer} {fid}: max_width is the point's disc");
+                let grid = grid_max_radius(poly, &p);
+                assert!(r >= 0.99 * grid, "{layer} {fid}: the largest disc ({r} against {grid} on a grid)");
+            }
+            other => panic!("{layer} {fid}: {other:?}"),
+        }
+    }
+    // Centred: the lines scored against their polygons.
+    let lines_only = dir.path().join("lines.gpkg");
+    let ok = std::process::Command::new("ogr2ogr")
+        .args(["-f", "GPKG", lines_only.to_str().unwrap(), out.to_str().unwrap(), "labels", "-where", "kind = 'line'", "-nln", "lines"])
+        .status()
+        .unwrap();
+    assert!(ok.success());
+    let scored = dir.path().join("scored.gpkg");
+    let o = skeletonise(&[
+        "score",
+        "--polygons",
+        &root(TRAIN),
+        "--polygons-layer",
+        layer,
+        "--skeletons",
+        lines_only.to_str().unwrap(),
+        "--skeletons-layer",
+        "lines",
+        "--skeleton-key",
+        "src_fid",
+        "--label",
+        "label",
+        "-o",
+        scored.to_str().unwrap(),
+        "-q",
+    ]);
+    assert!(o.status.success(), "{}", code_and_err(&o).1);
+    let sds = open(&scored);
+    let z: Vec<f64> = reals(&sds, "skeletons", "distortion").into_iter().flatten().collect();
+    assert_eq!(z.len(), lines, "{layer}: every line scored");
+    let worst = z.iter().cloned().fold(0.0, f64::max);
+    let mean = z.iter().sum::<f64>() / z.len().max(1) as f64;
+    eprintln!("{layer}: {lines} lines, {points} points; Z mean {mean:.6}, worst {worst:.6}");
+    assert!(worst <= 0.01, "{layer}: Z ≤ 0.01 on every line (worst {worst})");
+    (lines, points)
+}
+
+#[test]
+fn training_lakes_get_one_smooth_centred_label_each() {
+    let (lines, _) = check_layer("lakes_scotland");
+    assert!(lines >= 15, "the lochs are long and narrow: lines");
+}
+
+#[test]
+fn training_islands_get_one_label_each_lines_or_points() {
+    let (lines, points) = check_layer("islands_hebrides");
+    assert!(lines > 0 && points > 0, "elongated islands get lines, round ones points");
+}
