@@ -138,19 +138,34 @@ fn check_layer(layer: &str) -> (usize, usize) {
             (Some("line"), Geometry::LineString(l)) => {
                 lines += 1;
                 assert!(simple(&l), "{layer} {fid}: the line is simple");
-                assert!(poly.contains(&l), "{layer} {fid}: the line lies inside its polygon");
-                let near = l.0.iter().map(|&c| p.boundary().nearest(c).unwrap().2).fold(f64::INFINITY, f64::min);
+                assert!(
+                    poly.contains(&l),
+                    "{layer} {fid}: the line lies inside its polygon"
+                );
+                let near =
+                    l.0.iter()
+                        .map(|&c| p.boundary().nearest(c).unwrap().2)
+                        .fold(f64::INFINITY, f64::min);
                 assert!(near > 0.0, "{layer} {fid}: off the shore");
                 let t = worst_turn(&l, &p);
-                assert!(t <= 60.0, "{layer} {fid}: turns {t:.1}° over one local width");
+                assert!(
+                    t <= 60.0,
+                    "{layer} {fid}: turns {t:.1}° over one local width"
+                );
             }
             (Some("point"), Geometry::Point(c)) => {
                 points += 1;
                 let r = p.boundary().nearest(c.0).unwrap().2;
                 let w = widths[k].unwrap();
-                assert!((2.0 * r - w).abs() <= 1e-6 * w.max(1.0), "{layer} {fid}: max_width is the point's disc");
+                assert!(
+                    (2.0 * r - w).abs() <= 1e-6 * w.max(1.0),
+                    "{layer} {fid}: max_width is the point's disc"
+                );
                 let grid = grid_max_radius(poly, &p);
-                assert!(r >= 0.99 * grid, "{layer} {fid}: the largest disc ({r} against {grid} on a grid)");
+                assert!(
+                    r >= 0.99 * grid,
+                    "{layer} {fid}: the largest disc ({r} against {grid} on a grid)"
+                );
             }
             other => panic!("{layer} {fid}: {other:?}"),
         }
@@ -158,7 +173,17 @@ fn check_layer(layer: &str) -> (usize, usize) {
     // Centred: the lines scored against their polygons.
     let lines_only = dir.path().join("lines.gpkg");
     let ok = std::process::Command::new("ogr2ogr")
-        .args(["-f", "GPKG", lines_only.to_str().unwrap(), out.to_str().unwrap(), "labels", "-where", "kind = 'line'", "-nln", "lines"])
+        .args([
+            "-f",
+            "GPKG",
+            lines_only.to_str().unwrap(),
+            out.to_str().unwrap(),
+            "labels",
+            "-where",
+            "kind = 'line'",
+            "-nln",
+            "lines",
+        ])
         .status()
         .unwrap();
     assert!(ok.success());
@@ -183,12 +208,18 @@ fn check_layer(layer: &str) -> (usize, usize) {
     ]);
     assert!(o.status.success(), "{}", code_and_err(&o).1);
     let sds = open(&scored);
-    let z: Vec<f64> = reals(&sds, "skeletons", "distortion").into_iter().flatten().collect();
+    let z: Vec<f64> = reals(&sds, "skeletons", "distortion")
+        .into_iter()
+        .flatten()
+        .collect();
     assert_eq!(z.len(), lines, "{layer}: every line scored");
     let worst = z.iter().cloned().fold(0.0, f64::max);
     let mean = z.iter().sum::<f64>() / z.len().max(1) as f64;
     eprintln!("{layer}: {lines} lines, {points} points; Z mean {mean:.6}, worst {worst:.6}");
-    assert!(worst <= 0.01, "{layer}: Z ≤ 0.01 on every line (worst {worst})");
+    assert!(
+        worst <= 0.01,
+        "{layer}: Z ≤ 0.01 on every line (worst {worst})"
+    );
     (lines, points)
 }
 
@@ -201,5 +232,8 @@ fn training_lakes_get_one_smooth_centred_label_each() {
 #[test]
 fn training_islands_get_one_label_each_lines_or_points() {
     let (lines, points) = check_layer("islands_hebrides");
-    assert!(lines > 0 && points > 0, "elongated islands get lines, round ones points");
+    assert!(
+        lines > 0 && points > 0,
+        "elongated islands get lines, round ones points"
+    );
 }

@@ -210,7 +210,10 @@ fn trim(path: &[Coord<f64>], radii: &[f64]) -> (Vec<Coord<f64>>, Vec<f64>) {
     sorted.sort_by(f64::total_cmp);
     let floor = 0.5 * sorted[sorted.len() / 2];
     let first = radii.iter().position(|&r| r >= floor).unwrap_or(0);
-    let last = radii.iter().rposition(|&r| r >= floor).unwrap_or(radii.len() - 1);
+    let last = radii
+        .iter()
+        .rposition(|&r| r >= floor)
+        .unwrap_or(radii.len() - 1);
     if first >= last {
         return (Vec::new(), Vec::new());
     }
@@ -260,7 +263,12 @@ fn resample(path: &[Coord<f64>], radii: &[f64]) -> Vec<(Coord<f64>, f64)> {
 /// quarter radius apart) where it turns too much — only the points of the
 /// stretches that turn by more than `max_deg` (and their windows), so that
 /// the rest stays on the medial axis — until none does.
-fn smooth(mut cur: Vec<Coord<f64>>, at: &[(Coord<f64>, f64)], b: &Boundary, o: Shape) -> Vec<Coord<f64>> {
+fn smooth(
+    mut cur: Vec<Coord<f64>>,
+    at: &[(Coord<f64>, f64)],
+    b: &Boundary,
+    o: Shape,
+) -> Vec<Coord<f64>> {
     let half = 4usize;
     let max_turn = o.smooth_deg.to_radians();
     for _ in 0..MAX_ROUNDS {
@@ -289,7 +297,11 @@ fn smooth(mut cur: Vec<Coord<f64>>, at: &[(Coord<f64>, f64)], b: &Boundary, o: S
             let off = c - axis;
             let reach = (1.0 - o.margin) * r;
             let d = hypot(off);
-            cur[i] = if d > reach && d > 0.0 { axis + off * (reach / d) } else { c };
+            cur[i] = if d > reach && d > 0.0 {
+                axis + off * (reach / d)
+            } else {
+                c
+            };
         }
     }
     cur
@@ -357,12 +369,18 @@ fn max_turn_over_width(line: &[Coord<f64>], window: &[f64]) -> f64 {
 
 /// Each point moved back towards its medial-axis point until it is at least
 /// `margin` × that point's radius from ∂P (bisection, 20 steps).
-fn keep_off_shore(line: &[Coord<f64>], at: &[(Coord<f64>, f64)], b: &Boundary, margin: f64) -> Vec<Coord<f64>> {
+fn keep_off_shore(
+    line: &[Coord<f64>],
+    at: &[(Coord<f64>, f64)],
+    b: &Boundary,
+    margin: f64,
+) -> Vec<Coord<f64>> {
     line.iter()
         .zip(at)
         .map(|(&p, &(axis, r))| {
             let need = margin * r;
-            let ok = |c: Coord<f64>| b.contains(c) && b.nearest(c).is_some_and(|(_, _, d)| d >= need);
+            let ok =
+                |c: Coord<f64>| b.contains(c) && b.nearest(c).is_some_and(|(_, _, d)| d >= need);
             if ok(p) {
                 return p;
             }

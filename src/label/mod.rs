@@ -64,9 +64,9 @@ pub struct LabelParams {
 impl Default for LabelParams {
     fn default() -> Self {
         Self {
-            smooth: 45.0,
-            margin: 0.5,
-            min_elongation: 2.0,
+            smooth: 60.0,
+            margin: 0.9,
+            min_elongation: 3.0,
             parts: Parts::Each,
         }
     }
@@ -143,7 +143,11 @@ impl FeatureStep for LabelParams {
         use geo::Area;
         let mut parts: Vec<(usize, &PreparedPolygon)> = input.parts.iter().enumerate().collect();
         if self.parts == Parts::Largest {
-            parts.sort_by(|a, b| b.1.polygon().unsigned_area().total_cmp(&a.1.polygon().unsigned_area()));
+            parts.sort_by(|a, b| {
+                b.1.polygon()
+                    .unsigned_area()
+                    .total_cmp(&a.1.polygon().unsigned_area())
+            });
             parts.truncate(1);
         }
         parts
@@ -151,11 +155,14 @@ impl FeatureStep for LabelParams {
             .map(|(i, p)| {
                 let l = self.label(p);
                 let (geometry, kind) = match l.as_ref().map(|l| &l.label) {
-                    Some(Label::Line(line)) => (Some(geo::Geometry::LineString(line.clone())), "line"),
+                    Some(Label::Line(line)) => {
+                        (Some(geo::Geometry::LineString(line.clone())), "line")
+                    }
                     Some(Label::Point(c)) => (Some(geo::Geometry::Point((*c).into())), "point"),
                     None => (None, "none"),
                 };
-                let real = |f: fn(&Labelled) -> f64| l.as_ref().map_or(Cell::Null, |l| Cell::Real(f(l)));
+                let real =
+                    |f: fn(&Labelled) -> f64| l.as_ref().map_or(Cell::Null, |l| Cell::Real(f(l)));
                 let cells = vec![
                     Cell::Int(i as i64),
                     Cell::Text(kind.into()),
