@@ -60,13 +60,21 @@ pub(super) struct Shape {
 
 /// The label of polygon part `p` from its finished medial axis `g`
 /// (`None` when the axis is empty).
-pub(super) fn label(p: &PreparedPolygon, g: &SkeletonGraph, o: Shape) -> Option<Labelled> {
+/// The largest inscribed disc is the raw axis' node of largest radius (its
+/// nodes carry their disc radius; pruning may drop the node of a wide,
+/// short basin).
+pub(super) fn label(
+    p: &PreparedPolygon,
+    raw: &SkeletonGraph,
+    g: &SkeletonGraph,
+    o: Shape,
+) -> Option<Labelled> {
     let b = p.boundary();
     let radius = |c: Coord<f64>| b.nearest(c).map_or(0.0, |(_, _, d)| d);
-    // The largest disc: over every vertex of the axis.
-    let (centre, r_max) = (0..g.edges().len())
-        .flat_map(|e| g.edge_coords(EdgeId::from_index(e)))
-        .map(|c| (c, radius(c)))
+    let (centre, r_max) = raw
+        .nodes()
+        .iter()
+        .map(|n| (n.pos, n.radius))
         .max_by(|a, b| a.1.total_cmp(&b.1))?;
     let max_width = 2.0 * r_max;
     let point = |elongation: f64| Labelled {

@@ -114,6 +114,7 @@ impl LabelParams {
         );
         line::label(
             p,
+            &raw,
             &g,
             line::Shape {
                 smooth_deg: self.smooth,
