@@ -18,10 +18,14 @@
 //! 4. **Margin.** A smoothed point closer to ∂P than `margin` × the local
 //!    radius is moved back towards its medial-axis point until it is not
 //!    (the medial-axis point itself is one local radius away).
-//! 5. **Line or point.** With length / max width ≥ `min_elongation` the
-//!    line is written; otherwise (a round lake) the centre of the largest
-//!    inscribed disc, which lies on the medial axis: the pole of
-//!    inaccessibility.
+//! 5. **Gentle enough.** Where the smoothed line still turns by more than
+//!    `smooth` over a stretch one local width long (a bend sharper than the
+//!    corridor lets the smoothing round off), only the longest run without
+//!    such a stretch is kept.
+//! 6. **Line or point.** With length / max width ≥ `min_elongation` (of
+//!    the axis path, and of the kept run) the line is written; otherwise (a
+//!    round lake) the centre of the largest inscribed disc — the raw medial
+//!    axis' node of largest radius, the pole of inaccessibility.
 
 use crate::geometry::vector::hypot;
 use crate::geometry::{Boundary, PreparedPolygon};
@@ -96,9 +100,12 @@ pub(super) fn label(
     if path.len() < 2 {
         return Some(point(elongation));
     }
-    let line = smooth_inside(&path, &radii, b, o);
-    let line = LineString(dedup(line));
-    if line.0.len() < 2 {
+    let line = dedup(smooth_inside(&path, &radii, b, o));
+    // Where the corridor kept a bend too sharp for the letters, the label
+    // runs along the longest stretch that is gentle enough, if that is
+    // still long enough for a line.
+    let line = LineString(gentlest_run(line, b, o.smooth_deg.to_radians()));
+    if line.0.len() < 2 || length(&line.0) / max_width < o.min_elongation {
         return Some(point(elongation));
     }
     Some(Labelled {
@@ -229,7 +236,7 @@ fn trim(path: &[Coord<f64>], radii: &[f64]) -> (Vec<Coord<f64>>, Vec<f64>) {
 }
 
 /// Smoothing and keeping off the shore, alternately (a point moved back
-/// towards the axis may make a kink again), at most [`MAX_PASSES`] times.
+/// towards the axis may make a kink again).
 /// The turn is judged over a stretch `2 d` long at each point, d its
 /// distance to ∂P: the local width 2r where the line is on the axis.
 fn smooth_inside(path: &[Coord<f64>], radii: &[f64], b: &Boundary, o: Shape) -> Vec<Coord<f64>> {
@@ -238,9 +245,6 @@ fn smooth_inside(path: &[Coord<f64>], radii: &[f64], b: &Boundary, o: Shape) -> 
     let cur = smooth(cur, &at, b, o);
     keep_off_shore(&cur, &at, b, o.margin)
 }
-
-/// Smoothing and pulling back, alternately, at most.
-const MAX_PASSES: usize = 4;
 
 /// The stretch over which the turn is judged at each point: `2 d`, d its
 /// distance to ∂P (the local width 2r where the line is on the axis).
@@ -353,26 +357,32 @@ fn turn_exceeded(line: &[Coord<f64>], i: usize, width: f64, max_turn: f64) -> Op
     None
 }
 
-/// The largest turn of `line` over the stretch starting at each point and
-/// `window[i]` long.
-fn max_turn_over_width(line: &[Coord<f64>], window: &[f64]) -> f64 {
-    let mut worst: f64 = 0.0;
-    for i in 0..line.len().saturating_sub(2) {
-        let mut prev = line[i + 1] - line[i];
-        let (mut along, mut total) = (0.0, 0.0);
-        let mut j = i + 1;
-        while j + 1 < line.len() && along < window[i] {
-            let d = line[j + 1] - line[j];
-            if hypot(d) > 0.0 && hypot(prev) > 0.0 {
-                total += turn(prev, d);
-                worst = worst.max(total.abs());
-                prev = d;
+/// The longest run of `line` in which no stretch one local width long
+/// turns by more than `max_turn` (the whole line when none does).
+fn gentlest_run(line: Vec<Coord<f64>>, b: &Boundary, max_turn: f64) -> Vec<Coord<f64>> {
+    let bad = too_curved(&line, &windows(&line, b), max_turn);
+    if !bad.iter().any(|&x| x) {
+        return line;
+    }
+    // Runs of good points: no stretch starting in one turns too much
+    // within it.
+    let mut best = (0usize, 0usize, 0.0f64);
+    let mut start = None;
+    for i in 0..=line.len() {
+        let good = i < line.len() && !bad[i];
+        match (good, start) {
+            (true, None) => start = Some(i),
+            (false, Some(s0)) => {
+                let l = length(&line[s0..i]);
+                if l > best.2 {
+                    best = (s0, i - 1, l);
+                }
+                start = None;
             }
-            along += hypot(d);
-            j += 1;
+            _ => {}
         }
     }
-    worst
+    line[best.0..=best.1].to_vec()
 }
 
 /// Each point moved back towards its medial-axis point until it is at least
