@@ -664,3 +664,83 @@ def apply(
 
 
 __all__.append("load_pipeline")
+
+
+_LABEL_COLUMNS = ("polygon_part", "kind", "length", "max_width", "elongation", "rejected")
+
+
+def labels(
+    geometries: Any,
+    *,
+    smooth: float = 60.0,
+    margin: float = 0.9,
+    min_elongation: float = 3.0,
+    parts: str = "each",
+    make_valid: bool = True,
+    threads: int | None = None,
+):
+    """One label per polygon part: the ``label`` step of the command line.
+
+    A smooth line along the medial axis where the part is elongated enough to
+    carry a curved name (its axis path at least ``min_elongation`` times its
+    largest width), turning by at most ``smooth`` degrees over any stretch one
+    local width long and staying within ``1 - margin`` local radii of the
+    axis; otherwise the centre of the part's largest inscribed disc (the pole
+    of inaccessibility). Holes (islands) are respected.
+
+    Parameters
+    ----------
+    geometries
+        A GeoDataFrame, a GeoSeries, a shapely array or a list of polygons,
+        in a projected CRS.
+    smooth, margin, min_elongation, parts
+        The ``label`` step's options, as in the pipeline file: ``parts`` is
+        ``"each"`` (every polygon part its label) or ``"largest"``.
+    make_valid
+        Repair invalid polygons with GEOS MakeValid first (as the command
+        line's ``prepare`` step does by default).
+    threads
+        Worker threads (``None``: one per core).
+
+    Returns a GeoDataFrame with one row per labelled part: the input's index
+    (repeated for the parts of a multipolygon), a GeoDataFrame's own columns,
+    ``polygon_part``, ``kind`` (``line``, ``point``, or ``none`` for a part
+    thinner than the axis's grid), ``length``, ``max_width`` (2r),
+    ``elongation`` and ``rejected`` (why a feature has no label: NULL, not a
+    polygon, invalid), and the label as geometry (same CRS). Every input row
+    gives at least one output row.
+    """
+    import geopandas as gpd
+
+    attributes = None
+    if isinstance(geometries, gpd.GeoDataFrame):
+        attributes = geometries.drop(columns=[geometries.geometry.name])
+    arr, index, crs = _geometry_array(geometries)
+    _check_call(crs, threads)
+    arr, _, _ = _prepare(arr, make_valid)
+    options = {"smooth": smooth, "margin": margin, "min_elongation": min_elongation, "parts": parts}
+    row, part, kind, length, width, elong, wkb, rejected = _core.labels(
+        _encode(arr, "wkb"), json.dumps(options, default=_json_default), threads
+    )
+    row = np.asarray(row, dtype=np.int64)
+    idx = (index if index is not None else pd.RangeIndex(len(arr)))[row]
+    frame = pd.DataFrame(
+        {
+            "polygon_part": pd.array(part, dtype="Int32"),
+            "kind": pd.array(kind, dtype="string"),
+            "length": pd.array(length, dtype="Float64"),
+            "max_width": pd.array(width, dtype="Float64"),
+            "elongation": pd.array(elong, dtype="Float64"),
+            "rejected": pd.array(rejected, dtype="string"),
+        },
+        index=idx,
+    )
+    if attributes is not None and len(attributes.columns):
+        own = attributes.iloc[row].set_axis(idx)
+        own = own.rename(columns={c: f"src_{c}" for c in own.columns if c in _LABEL_COLUMNS})
+        frame = pd.concat([own, frame], axis=1)
+    geometry = shapely.from_wkb(np.asarray(wkb, dtype=object))
+    return gpd.GeoDataFrame(frame, geometry=geometry, crs=crs)
+
+
+__all__.append("labels")

@@ -72,3 +72,20 @@ def describe() -> str:
 
 def schema() -> str:
     """The JSON Schema of the pipeline file, as JSON text."""
+
+def labels(
+    wkbs: list[bytes | None], options: str, threads: int | None = None
+) -> tuple[
+    list[int],
+    list[int | None],
+    list[str | None],
+    list[float | None],
+    list[float | None],
+    list[float | None],
+    list[bytes | None],
+    list[str | None],
+]:
+    """The ``label`` step on every feature (WKB in, ``options`` the step's keys as JSON):
+    the columns ``(row, polygon_part, kind, length, max_width, elongation, wkb, rejected)``,
+    one row per labelled part, one row with the reason for a feature that cannot be
+    prepared. Raises PipelineError for a wrong option."""

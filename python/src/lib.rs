@@ -9,6 +9,7 @@
 //! back the columns of the `skeletons` (or `candidates`) layer as the
 //! declarative tables of `skeletonise::output` describe them.
 
+mod labels;
 mod run;
 mod wkb;
 
@@ -239,6 +240,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(columns, m)?)?;
     m.add_function(wrap_pyfunction!(describe, m)?)?;
     m.add_function(wrap_pyfunction!(schema, m)?)?;
+    m.add_function(wrap_pyfunction!(labels::labels, m)?)?;
     Ok(())
 }
 

@@ -318,7 +318,7 @@ thread_local! {
 }
 
 /// This thread's pool of `n` worker threads.
-fn pool_of(n: usize) -> PyResult<std::sync::Arc<rayon::ThreadPool>> {
+pub(crate) fn pool_of(n: usize) -> PyResult<std::sync::Arc<rayon::ThreadPool>> {
     POOLS.with(|pools| {
         if let Some((_, p)) = pools.borrow().iter().find(|(k, _)| *k == n) {
             return Ok(p.clone());

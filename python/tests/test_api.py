@@ -324,3 +324,51 @@ def test_a_geographic_crs_and_threads_out_of_range_are_refused_as_on_the_command
         with pytest.raises(ValueError, match="give between 1 and 256 worker threads"):
             skeletonise.skeletonise([RIVER], threads=bad)
     assert skeletonise.skeletonise([RIVER], threads=1)["method"][0] == "MA"
+
+
+def test_labels_give_every_lake_part_a_line_or_its_largest_disc():
+    """``skeletonise.labels`` is the ``label`` step of the command line: the same rows
+    as ``skeletonise run pipelines/lake-labels.yaml`` on the training lochs."""
+    import subprocess
+    import tempfile
+    from pathlib import Path
+
+    from conftest import cli_binary
+
+    src = ROOT / "tests" / "data" / "gshhg-train.gpkg"
+    lakes = gpd.read_file(src, layer="lakes_scotland", fid_as_index=True)
+    got = skeletonise.labels(lakes)
+    assert got.crs == lakes.crs
+    assert (got.index.value_counts().sort_index() == 1).all()
+    assert set(got.index) == set(lakes.index)
+    assert "kind" in lakes.columns and "src_kind" in got.columns
+    assert (got.kind == "line").sum() >= 15
+    # Lines lie inside their lake; a point is the centre of the largest disc.
+    for fid, row in got.iterrows():
+        poly = lakes.geometry[fid]
+        assert poly.contains(row.geometry)
+        if row.kind == "point":
+            r = poly.exterior.distance(row.geometry)
+            assert abs(2 * r - row.max_width) <= 1e-6 * row.max_width
+    # The same rows as the command line's `labels` layer.
+    with tempfile.TemporaryDirectory() as d:
+        out = Path(d) / "l.gpkg"
+        subprocess.run(
+            [str(cli_binary()), "run", str(ROOT / "pipelines" / "lake-labels.yaml"), "-o", str(out), "-q"],
+            cwd=ROOT, check=True,
+        )
+        cli = gpd.read_file(out, layer="labels").set_index("src_fid")
+    assert list(cli.kind) == list(got.kind)
+    assert shapely.equals_exact(np.asarray(cli.geometry.values), np.asarray(got.geometry.values), 1e-9).all()
+    # Options: `parts`, and a wrong option is the command line's message.
+    islands = gpd.read_file(src, layer="islands_hebrides", fid_as_index=True).head(50)
+    parts = shapely.get_parts(np.asarray(islands.geometry.values))[:3]
+    multi = gpd.GeoDataFrame(geometry=[shapely.MultiPolygon(list(parts))], crs=lakes.crs)
+    assert len(skeletonise.labels(multi)) == 3
+    assert len(skeletonise.labels(multi, parts="largest")) == 1
+    with pytest.raises(skeletonise.PipelineError, match="smooth"):
+        skeletonise.labels(lakes, smooth=0)
+    # Nothing is dropped: a NULL and a line get a row with the reason.
+    odd = gpd.GeoSeries([None, shapely.LineString([(0, 0), (1, 1)])], crs=lakes.crs)
+    rows = skeletonise.labels(odd)
+    assert len(rows) == 2 and rows.rejected.notna().all()

@@ -242,7 +242,7 @@ fn trim(path: &[Coord<f64>], radii: &[f64]) -> (Vec<Coord<f64>>, Vec<f64>) {
 fn smooth_inside(path: &[Coord<f64>], radii: &[f64], b: &Boundary, o: Shape) -> Vec<Coord<f64>> {
     let at = resample(path, radii);
     let cur: Vec<Coord<f64>> = at.iter().map(|p| p.0).collect();
-    let cur = smooth(cur, &at, b, o);
+    let cur = smooth(cur, &at, o);
     keep_off_shore(&cur, &at, b, o.margin)
 }
 
@@ -275,18 +275,32 @@ fn resample(path: &[Coord<f64>], radii: &[f64]) -> Vec<(Coord<f64>, f64)> {
 /// quarter radius apart) where it turns too much — only the points of the
 /// stretches that turn by more than `max_deg` (and their windows), so that
 /// the rest stays on the medial axis — until none does.
-fn smooth(
-    mut cur: Vec<Coord<f64>>,
-    at: &[(Coord<f64>, f64)],
-    b: &Boundary,
-    o: Shape,
-) -> Vec<Coord<f64>> {
+fn smooth(mut cur: Vec<Coord<f64>>, at: &[(Coord<f64>, f64)], o: Shape) -> Vec<Coord<f64>> {
     let half = 4usize;
     let max_turn = o.smooth_deg.to_radians();
+    // A point within the corridor is at most (2 − margin) r from ∂P: its
+    // stretch is judged over that much while smoothing (no boundary query
+    // per point and round); the exact check follows (`gentlest_run`).
+    let window: Vec<f64> = at
+        .iter()
+        .map(|&(_, r)| 2.0 * (2.0 - o.margin) * r)
+        .collect();
+    let (mut fewest, mut since) = (usize::MAX, 0);
     for _ in 0..MAX_ROUNDS {
-        let bad = too_curved(&cur, &windows(&cur, b), max_turn);
-        if !bad.iter().any(|&x| x) {
+        let bad = too_curved(&cur, &window, max_turn);
+        let count = bad.iter().filter(|&&x| x).count();
+        if count == 0 {
             break;
+        }
+        // Where the corridor holds a bend, averaging cannot round it off:
+        // stop once the bad points have not become fewer for a while.
+        if count < fewest {
+            (fewest, since) = (count, 0);
+        } else {
+            since += 1;
+            if since >= STALLED_ROUNDS {
+                break;
+            }
         }
         let n = cur.len();
         // Each bad point's window is smoothed too.
@@ -322,39 +336,52 @@ fn smooth(
 /// Smoothing rounds at most.
 const MAX_ROUNDS: usize = 400;
 
+/// Rounds without fewer bad points after which smoothing stops.
+const STALLED_ROUNDS: usize = 20;
+
 /// The points of every stretch (starting at a point, `window[i]` long) that
-/// turns by more than `max_turn` (radians) somewhere along it.
+/// turns by more than `max_turn` (radians) somewhere along it. The
+/// segments' lengths and turns are found once (a trigonometric call per
+/// point, not per point and stretch).
 fn too_curved(line: &[Coord<f64>], window: &[f64], max_turn: f64) -> Vec<bool> {
-    let mut bad = vec![false; line.len()];
-    for i in 0..line.len().saturating_sub(2) {
-        if let Some(end) = turn_exceeded(line, i, window[i], max_turn) {
-            for b in &mut bad[i..=end] {
-                *b = true;
+    let n = line.len();
+    let mut bad = vec![false; n];
+    if n < 3 {
+        return bad;
+    }
+    let seg: Vec<Coord<f64>> = line.windows(2).map(|w| w[1] - w[0]).collect();
+    let len: Vec<f64> = seg.iter().map(|&d| hypot(d)).collect();
+    // The turn into segment j from the last segment of non-zero length
+    // before it (0 for a segment of zero length).
+    let mut into = vec![0.0; seg.len()];
+    let mut last = (len[0] > 0.0).then_some(0);
+    for j in 1..seg.len() {
+        if len[j] > 0.0 {
+            if let Some(k) = last {
+                into[j] = turn(seg[k], seg[j]);
             }
+            last = Some(j);
+        }
+    }
+    for i in 0..n - 2 {
+        if len[i] == 0.0 {
+            continue;
+        }
+        let (mut along, mut total) = (0.0, 0.0);
+        let mut j = i + 1;
+        while j + 1 < n && along < window[i] {
+            total += into[j];
+            if total.abs() > max_turn {
+                for b in &mut bad[i..=j] {
+                    *b = true;
+                }
+                break;
+            }
+            along += len[j];
+            j += 1;
         }
     }
     bad
-}
-
-/// Where the stretch from point `i`, `width` long, first turns by more than
-/// `max_turn` in all (the point it happens at), if it does.
-fn turn_exceeded(line: &[Coord<f64>], i: usize, width: f64, max_turn: f64) -> Option<usize> {
-    let mut prev = line[i + 1] - line[i];
-    let (mut along, mut total) = (0.0, 0.0);
-    let mut j = i + 1;
-    while j + 1 < line.len() && along < width {
-        let d = line[j + 1] - line[j];
-        if hypot(d) > 0.0 && hypot(prev) > 0.0 {
-            total += turn(prev, d);
-            if total.abs() > max_turn {
-                return Some(j);
-            }
-            prev = d;
-        }
-        along += hypot(d);
-        j += 1;
-    }
-    None
 }
 
 /// The longest run of `line` in which no stretch one local width long

@@ -17,7 +17,7 @@
 //! ```yaml
 //! steps:
 //!   - skeleton: { methods: [MA] }
-//!   - label: { smooth: 45, margin: 0.5, min_elongation: 2 }
+//!   - label: { smooth: 60, margin: 0.9, min_elongation: 3 }
 //! ```
 
 pub mod line;
@@ -139,10 +139,13 @@ pub const LABELS: &[StepLayer] = &[StepLayer {
     ],
 }];
 
-impl FeatureStep for LabelParams {
-    fn rows(&self, input: &StepInput<'_>) -> Vec<(&'static str, StepRow)> {
+impl LabelParams {
+    /// The labels of one feature's polygon parts (every part, or only the
+    /// largest by area), each with the part's index: `None` for a part with
+    /// no medial axis (thinner than the axis's grid).
+    pub fn labels(&self, parts: &[PreparedPolygon]) -> Vec<(usize, Option<Labelled>)> {
         use geo::Area;
-        let mut parts: Vec<(usize, &PreparedPolygon)> = input.parts.iter().enumerate().collect();
+        let mut parts: Vec<(usize, &PreparedPolygon)> = parts.iter().enumerate().collect();
         if self.parts == Parts::Largest {
             parts.sort_by(|a, b| {
                 b.1.polygon()
@@ -151,10 +154,15 @@ impl FeatureStep for LabelParams {
             });
             parts.truncate(1);
         }
-        parts
+        parts.into_iter().map(|(i, p)| (i, self.label(p))).collect()
+    }
+}
+
+impl FeatureStep for LabelParams {
+    fn rows(&self, input: &StepInput<'_>) -> Vec<(&'static str, StepRow)> {
+        self.labels(input.parts)
             .into_iter()
-            .map(|(i, p)| {
-                let l = self.label(p);
+            .map(|(i, l)| {
                 let (geometry, kind) = match l.as_ref().map(|l| &l.label) {
                     Some(Label::Line(line)) => {
                         (Some(geo::Geometry::LineString(line.clone())), "line")
@@ -183,9 +191,9 @@ pub const ENTRY: StepEntry = StepEntry {
     after: "skeleton",
     description: "one label per polygon part: a smooth line along the medial axis where the part is elongated, else the centre of its largest inscribed disc (layer `labels`)",
     options: &[
-        ("smooth", "most the line turns over one local width, degrees (45)"),
-        ("margin", "fraction of the local radius kept from the shore (0.5)"),
-        ("min_elongation", "length / largest width below which a part gets a point (2)"),
+        ("smooth", "most the line turns over one local width, degrees (60)"),
+        ("margin", "fraction of the local radius kept from the shore (0.9: the line stays within 0.1 r of the medial axis)"),
+        ("min_elongation", "length / largest width below which a part gets a point (3)"),
         ("parts", "`each` (default) or `largest`: which parts of a feature get a label"),
     ],
     layers: LABELS,

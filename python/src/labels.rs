@@ -1,0 +1,156 @@
+//! `_core.labels`: the `label` step's labels of every feature — a line
+//! where a polygon part is elongated enough for a curved name, else the
+//! centre of its largest inscribed disc — WKB in, one row per labelled part
+//! out, on rayon's threads with the GIL released.
+
+use crate::wkb;
+use geo::{Coord, Geometry};
+use pyo3::prelude::*;
+use pyo3::types::PyBytes;
+use rayon::prelude::*;
+use skeletonise::label::{Label, LabelParams, Labelled};
+use skeletonise::process::{prepare, NotPrepared, PrepareParams};
+
+/// One output row: the input row, the part, the label (or why the feature
+/// has none).
+type Row = (usize, Option<usize>, Result<Option<Labelled>, String>);
+
+/// The labels of the features `wkbs` (`None`: NULL) with the `label`
+/// step's options (`options`: JSON with its keys); `threads` worker
+/// threads (`None`: rayon's global pool). Returns the columns
+/// `(row, polygon_part, kind, length, max_width, elongation, wkb,
+/// rejected)`: one row per labelled part; a feature that cannot be
+/// prepared (NULL, not a polygon, invalid) one row with its reason in
+/// `rejected`.
+#[pyfunction]
+#[pyo3(signature = (wkbs, options, threads = None))]
+#[allow(clippy::type_complexity)]
+pub fn labels<'py>(
+    py: Python<'py>,
+    wkbs: Vec<Option<Vec<u8>>>,
+    options: &str,
+    threads: Option<usize>,
+) -> PyResult<(
+    Vec<usize>,
+    Vec<Option<usize>>,
+    Vec<Option<&'static str>>,
+    Vec<Option<f64>>,
+    Vec<Option<f64>>,
+    Vec<Option<f64>>,
+    Vec<Option<Bound<'py, PyBytes>>>,
+    Vec<Option<String>>,
+)> {
+    let params: LabelParams = serde_json::from_str(options)
+        .map_err(|e| crate::PipelineError::new_err(format!("label options: {e}")))?;
+    params
+        .validate()
+        .map_err(|(k, m)| crate::PipelineError::new_err(format!("`{k}`: {m}")))?;
+    let prep = PrepareParams {
+        make_valid: false,
+        min_area: 0.0,
+        max_vertices: 0,
+    };
+    let one = |i: usize, w: &Option<Vec<u8>>| -> Vec<Row> {
+        let geom = match w.as_deref().map(wkb::read).transpose() {
+            Ok(g) => g,
+            Err(e) => return vec![(i, None, Err(e))],
+        };
+        match prepare(geom.as_ref(), &prep) {
+            Ok(parts) => params
+                .labels(&parts)
+                .into_iter()
+                .map(|(k, l)| (i, Some(k), Ok(l)))
+                .collect(),
+            Err(NotPrepared::Rejected(r)) => vec![(i, None, Err(r))],
+            Err(NotPrepared::Filtered) => vec![(i, None, Err("no polygon part".into()))],
+        }
+    };
+    let work = || -> Vec<Row> {
+        wkbs.par_iter()
+            .enumerate()
+            .flat_map_iter(|(i, w)| one(i, w))
+            .collect()
+    };
+    let rows: Vec<Row> = match threads {
+        Some(n) => {
+            let pool = crate::run::pool_of(n)?;
+            py.detach(|| pool.install(work))
+        }
+        None => py.detach(work),
+    };
+    let n = rows.len();
+    let (mut row, mut part, mut kind) = (
+        Vec::with_capacity(n),
+        Vec::with_capacity(n),
+        Vec::with_capacity(n),
+    );
+    let (mut length, mut width, mut elongation) = (
+        Vec::with_capacity(n),
+        Vec::with_capacity(n),
+        Vec::with_capacity(n),
+    );
+    let (mut geometry, mut rejected) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    for (i, k, l) in rows {
+        row.push(i);
+        part.push(k);
+        let (g, reason) = match l {
+            Ok(Some(l)) => {
+                kind.push(Some(match l.label {
+                    Label::Line(_) => "line",
+                    Label::Point(_) => "point",
+                }));
+                length.push(Some(l.length));
+                width.push(Some(l.max_width));
+                elongation.push(Some(l.elongation));
+                let mut out = Vec::new();
+                match &l.label {
+                    Label::Line(line) => write(&Geometry::LineString(line.clone()), &mut out),
+                    Label::Point(c) => write(&Geometry::Point(c.to_owned().into()), &mut out),
+                }
+                (Some(PyBytes::new(py, &out)), None)
+            }
+            Ok(None) => {
+                kind.push(Some("none"));
+                length.push(None);
+                width.push(None);
+                elongation.push(None);
+                (None, None)
+            }
+            Err(r) => {
+                kind.push(None);
+                length.push(None);
+                width.push(None);
+                elongation.push(None);
+                (None, Some(r))
+            }
+        };
+        geometry.push(g);
+        rejected.push(reason);
+    }
+    Ok((
+        row, part, kind, length, width, elongation, geometry, rejected,
+    ))
+}
+
+/// A point or a line as little-endian ISO WKB.
+fn write(g: &Geometry<f64>, out: &mut Vec<u8>) {
+    let xy = |c: &Coord<f64>, out: &mut Vec<u8>| {
+        out.extend_from_slice(&c.x.to_le_bytes());
+        out.extend_from_slice(&c.y.to_le_bytes());
+    };
+    out.push(1);
+    match g {
+        Geometry::Point(p) => {
+            out.extend_from_slice(&1u32.to_le_bytes());
+            xy(&p.0, out);
+        }
+        Geometry::LineString(l) => {
+            out.extend_from_slice(&2u32.to_le_bytes());
+            out.extend_from_slice(&(l.0.len() as u32).to_le_bytes());
+            for c in &l.0 {
+                xy(c, out);
+            }
+        }
+        _ => unreachable!("labels are points and lines"),
+    }
+}
