@@ -200,7 +200,7 @@ fn score_note(s: &crate::score::Scores) -> Option<String> {
     match (s.bars, s.hits) {
         (0, _) => Some("the polygon has no bars to score its skeleton with; the scores are NULL".into()),
         (n, 0) => Some(format!(
-            "none of the {n} bars hits the skeleton: the polygon is too thin to score at its scale (bars shorter than a millionth of its extent); the scores are NULL"
+            "none of the {n} bars hits the skeleton: the lines are too short or too far off the polygon's middle for a bar to reach them, or the polygon is too thin to score at its scale (bars shorter than a millionth of its extent); the scores are NULL"
         )),
         _ => None,
     }
