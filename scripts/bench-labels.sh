@@ -110,6 +110,34 @@ for name, t, per in tools:
 print("\nlabel_centerlines s per lake: median of its get_centerline calls; skeletonise: wall / lakes.")
 PY
 
+# Per lake, library call against library call: skeletonise.labels on one lake at a time, one thread
+# (best of 5 per lake; the Python package as scripts/test-python.sh builds it into target/py-venv),
+# against the median of label_centerlines' get_centerline calls above. Skipped without the package.
+if [ -x target/py-venv/bin/python ] && target/py-venv/bin/python -c "import skeletonise" 2>/dev/null; then
+  target/py-venv/bin/python - "$DATA" "$LAYER" "$OUT/lc-lakes.gpkg" <<'PY' | tee -a "$OUT/labels.md"
+import statistics, sys, time
+import geopandas as gpd
+import skeletonise
+data, layer, lc = sys.argv[1:4]
+lakes = gpd.read_file(data, layer=layer, fid_as_index=True)
+per = []
+for i in range(len(lakes)):
+    one = lakes.iloc[i:i + 1]
+    best = float("inf")
+    for _ in range(5):
+        t = time.perf_counter()
+        skeletonise.labels(one, threads=1)
+        best = min(best, time.perf_counter() - t)
+    per.append(best)
+peer = statistics.median(gpd.read_file(lc, layer="lines")["seconds"])
+mine = statistics.median(per)
+print(f"per lake (library calls): skeletonise.labels median {mine:.4f} s (max {max(per):.4f}), "
+      f"label_centerlines median {peer:.3f} s: {peer / mine:.0f}x")
+PY
+else
+  echo "(no skeletonise package in target/py-venv: scripts/test-python.sh builds it; per-lake calls skipped)"
+fi
+
 # The world's lakes (GSHHG level 2, full resolution, 6 660 polygons, 842 159 vertices): made by
 # scripts/make-gshhg-lakes.sh (Debian gmt + gmt-gshhg-full), skipped when absent. The label step
 # alone (skeleton MA, label, prune trunk: no scores) and the whole lake-labels pipeline.
