@@ -125,6 +125,26 @@ fn check_layer(layer: &str, max_z: f64) -> (usize, usize) {
     let kinds = strings(&ds, "labels", "kind");
     let widths = reals(&ds, "labels", "max_width");
     let geoms = wkts(&ds, "labels");
+    let zooms = ints(&ds, "labels", "minzoom");
+    let lengths = reals(&ds, "labels", "length");
+    // Longitude and latitude of the layer's coordinates, by GDAL.
+    let to_lonlat = {
+        use gdal::spatial_ref::{AxisMappingStrategy, CoordTransform, SpatialRef};
+        let mut from = ds.layer_by_name("labels").unwrap().spatial_ref().unwrap();
+        from.set_axis_mapping_strategy(AxisMappingStrategy::TraditionalGisOrder);
+        let mut to = SpatialRef::from_epsg(4326).unwrap();
+        to.set_axis_mapping_strategy(AxisMappingStrategy::TraditionalGisOrder);
+        CoordTransform::new(&from, &to).unwrap()
+    };
+    // The zoom from which a label is 64 pixels long (a point's disc wide)
+    // on 256-pixel web-map tiles at its own latitude.
+    let zoom_ok = |metres: f64, at: Coord<f64>, z: i64| {
+        let (mut x, mut y, mut zz) = ([at.x], [at.y], [0.0]);
+        to_lonlat.transform_coords(&mut x, &mut y, &mut zz).unwrap();
+        let per_pixel = 156_543.033_928_041 * y[0].to_radians().cos();
+        let px = |z: i64| metres / (per_pixel / 2f64.powi(z as i32));
+        px(z) >= 64.0 && (z == 0 || px(z - 1) < 64.0)
+    };
     let expected: usize = polys.values().map(Vec::len).sum();
     assert_eq!(fids.len(), expected, "{layer}: one label per polygon part");
     let mut seen = std::collections::HashSet::new();
@@ -147,6 +167,13 @@ fn check_layer(layer: &str, max_z: f64) -> (usize, usize) {
                         .map(|&c| p.boundary().nearest(c).unwrap().2)
                         .fold(f64::INFINITY, f64::min);
                 assert!(near > 0.0, "{layer} {fid}: off the shore");
+                use geo::{Euclidean, InterpolateLine};
+                let mid = Euclidean.point_at_ratio_from_start(&l, 0.5).unwrap().0;
+                let z = zooms[k].expect("a line has a minzoom");
+                assert!(
+                    zoom_ok(lengths[k].unwrap(), mid, z),
+                    "{layer} {fid}: minzoom {z}"
+                );
                 let t = worst_turn(&l, &p);
                 assert!(
                     t <= 60.0,
@@ -161,6 +188,8 @@ fn check_layer(layer: &str, max_z: f64) -> (usize, usize) {
                     (2.0 * r - w).abs() <= 1e-6 * w.max(1.0),
                     "{layer} {fid}: max_width is the point's disc"
                 );
+                let z = zooms[k].expect("a point has a minzoom");
+                assert!(zoom_ok(w, c.0, z), "{layer} {fid}: minzoom {z}");
                 let grid = grid_max_radius(poly, &p);
                 assert!(
                     r >= 0.99 * grid,

@@ -307,6 +307,7 @@ fn every_training_layer_and_method_ends_clean() {
 }
 
 #[test]
+#[cfg(all(feature = "cli", feature = "gdal"))]
 fn a_lone_method_gets_the_legs_it_has_among_all_five() {
     // The reference (MA) sets the legs even when it is not among the
     // methods: CDT or StSk alone draw exactly the lines they have as

@@ -666,7 +666,7 @@ def apply(
 __all__.append("load_pipeline")
 
 
-_LABEL_COLUMNS = ("polygon_part", "kind", "length", "max_width", "elongation", "rejected")
+_LABEL_COLUMNS = ("polygon_part", "kind", "length", "max_width", "elongation", "minzoom", "rejected")
 
 
 def labels(
@@ -676,6 +676,7 @@ def labels(
     margin: float = 0.9,
     min_elongation: float = 3.0,
     parts: str = "each",
+    min_pixels: float = 64.0,
     make_valid: bool = True,
     threads: int | None = None,
 ):
@@ -693,9 +694,10 @@ def labels(
     geometries
         A GeoDataFrame, a GeoSeries, a shapely array or a list of polygons,
         in a projected CRS.
-    smooth, margin, min_elongation, parts
+    smooth, margin, min_elongation, parts, min_pixels
         The ``label`` step's options, as in the pipeline file: ``parts`` is
-        ``"each"`` (every polygon part its label) or ``"largest"``.
+        ``"each"`` (every polygon part its label) or ``"largest"``;
+        ``min_pixels`` sets ``minzoom``.
     make_valid
         Repair invalid polygons with GEOS MakeValid first (as the command
         line's ``prepare`` step does by default).
@@ -706,9 +708,11 @@ def labels(
     (repeated for the parts of a multipolygon), a GeoDataFrame's own columns,
     ``polygon_part``, ``kind`` (``line``, ``point``, or ``none`` for a part
     thinner than the axis's grid), ``length``, ``max_width`` (2r),
-    ``elongation`` and ``rejected`` (why a feature has no label: NULL, not a
-    polygon, invalid), and the label as geometry (same CRS). Every input row
-    gives at least one output row.
+    ``elongation``, ``minzoom`` (the smallest web-map zoom at which the line
+    is ``min_pixels`` long, or a point's disc that wide, at the label's
+    latitude; NA without a CRS) and ``rejected`` (why a feature has no label:
+    NULL, not a polygon, invalid), and the label as geometry (same CRS).
+    Every input row gives at least one output row.
     """
     import geopandas as gpd
 
@@ -718,7 +722,13 @@ def labels(
     arr, index, crs = _geometry_array(geometries)
     _check_call(crs, threads)
     arr, _, _ = _prepare(arr, make_valid)
-    options = {"smooth": smooth, "margin": margin, "min_elongation": min_elongation, "parts": parts}
+    options = {
+        "smooth": smooth,
+        "margin": margin,
+        "min_elongation": min_elongation,
+        "parts": parts,
+        "min_pixels": min_pixels,
+    }
     row, part, kind, length, width, elong, wkb, rejected = _core.labels(
         _encode(arr, "wkb"), json.dumps(options, default=_json_default), threads
     )
@@ -740,7 +750,35 @@ def labels(
         own = own.rename(columns={c: f"src_{c}" for c in own.columns if c in _LABEL_COLUMNS})
         frame = pd.concat([own, frame], axis=1)
     geometry = shapely.from_wkb(np.asarray(wkb, dtype=object))
+    frame.insert(frame.columns.get_loc("rejected"), "minzoom", _minzoom(geometry, np.asarray(length, dtype=float),
+                 np.asarray(width, dtype=float), crs, min_pixels))
     return gpd.GeoDataFrame(frame, geometry=geometry, crs=crs)
+
+
+# Metres per pixel at zoom 0 on the equator (256-pixel tiles, 2π · 6 378 137 m / 256), as the
+# command line's `label` step.
+_EQUATOR_M_PER_PIXEL = 156_543.033928041
+
+
+def _minzoom(geometry: np.ndarray, length: np.ndarray, width: np.ndarray, crs: Any, pixels: float) -> Any:
+    """The ``minzoom`` of each label: the smallest web-map zoom (0–24) at which a line is
+    ``pixels`` long (a point's disc that wide) at the latitude of the line's middle (the point)."""
+    import geopandas as gpd
+
+    out = pd.array([None] * len(geometry), dtype="Int32")
+    present = ~shapely.is_missing(geometry)
+    if crs is None or not present.any():
+        return out
+    lines = present & (shapely.get_type_id(geometry) == int(shapely.GeometryType.LINESTRING))
+    anchors = geometry.copy()
+    anchors[lines] = shapely.line_interpolate_point(geometry[lines], 0.5, normalized=True)
+    lat = np.full(len(geometry), np.nan)
+    lat[present] = gpd.GeoSeries(anchors[present], crs=crs).to_crs(4326).y.to_numpy()
+    metres = np.where(lines, length, width)
+    ok = present & np.isfinite(lat) & (metres > 0)
+    z = np.ceil(np.log2(pixels * _EQUATOR_M_PER_PIXEL * np.cos(np.radians(lat[ok])) / metres[ok]))
+    out[ok] = np.clip(z, 0, 24).astype(np.int64)
+    return out
 
 
 __all__.append("labels")

@@ -359,6 +359,8 @@ def test_labels_give_every_lake_part_a_line_or_its_largest_disc():
         )
         cli = gpd.read_file(out, layer="labels").set_index("src_fid")
     assert list(cli.kind) == list(got.kind)
+    assert list(cli.minzoom) == [int(z) for z in got.minzoom]
+    assert got.minzoom.notna().all() and got.minzoom.between(0, 24).all()
     assert shapely.equals_exact(np.asarray(cli.geometry.values), np.asarray(got.geometry.values), 1e-9).all()
     # Options: `parts`, and a wrong option is the command line's message.
     islands = gpd.read_file(src, layer="islands_hebrides", fid_as_index=True).head(50)

@@ -5,6 +5,7 @@
 
 pub mod gdal_errors;
 pub mod guard;
+pub mod lonlat;
 pub mod readback;
 pub mod reader;
 pub(crate) mod signals;

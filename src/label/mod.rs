@@ -13,6 +13,7 @@
 //! | `length` | the line's length (0 for a point) |
 //! | `max_width` | the largest inscribed disc's diameter 2r |
 //! | `elongation` | the medial-axis path's length over `max_width` |
+//! | `minzoom` | the smallest web-map zoom at which the line is `min_pixels` long (a point's disc that wide) at its latitude; NULL when the run's CRS is unknown |
 //!
 //! ```yaml
 //! steps:
@@ -27,7 +28,7 @@ use crate::graph::extend::{prune_and_extend, ExtendParams};
 use crate::graph::prune::PruneParams;
 use crate::layer::{Cell, ColumnType, GeometryKind, StepLayer, StepRow};
 use crate::methods::{MethodContext, MethodId, SkeletonParams};
-use crate::process::step::{FeatureStep, OptionError, StepEntry, StepInput};
+use crate::process::step::{FeatureStep, LonLat, OptionError, StepEntry, StepInput};
 use serde::Deserialize;
 use std::sync::Arc;
 
@@ -59,6 +60,40 @@ pub struct LabelParams {
     pub min_elongation: f64,
     /// Every part, or only the largest part of a feature.
     pub parts: Parts,
+    /// A line is shown from the web-map zoom at which it is at least this
+    /// many pixels long (256-pixel tiles, at the feature's latitude); a
+    /// point from the zoom at which its largest disc is this many pixels
+    /// wide (column `minzoom`).
+    pub min_pixels: f64,
+}
+
+/// Metres per pixel at zoom 0 on the equator: the web map's 256-pixel
+/// tile over the WGS 84 equator (2π · 6 378 137 m / 256).
+const EQUATOR_M_PER_PIXEL: f64 = 156_543.033_928_041;
+
+/// The smallest web-map zoom (0–24) at which `metres` span at least
+/// `pixels` at latitude `lat` (degrees); `None` for no length.
+pub fn minzoom(metres: f64, lat: f64, pixels: f64) -> Option<i64> {
+    if !(metres > 0.0 && metres.is_finite() && lat.is_finite()) {
+        return None;
+    }
+    let per_pixel_z0 = EQUATOR_M_PER_PIXEL * lat.to_radians().cos();
+    let z = (pixels * per_pixel_z0 / metres).log2().ceil();
+    Some(z.clamp(0.0, 24.0) as i64)
+}
+
+/// Where a label's zoom is judged: the middle of its line (half its
+/// length along it) or its point.
+fn anchor(l: &Labelled) -> geo::Coord<f64> {
+    match &l.label {
+        Label::Point(c) => *c,
+        Label::Line(line) => {
+            use geo::{Euclidean, InterpolateLine};
+            Euclidean
+                .point_at_ratio_from_start(line, 0.5)
+                .map_or(line.0[0], |p| p.0)
+        }
+    }
 }
 
 impl Default for LabelParams {
@@ -68,6 +103,7 @@ impl Default for LabelParams {
             margin: 0.9,
             min_elongation: 3.0,
             parts: Parts::Each,
+            min_pixels: 64.0,
         }
     }
 }
@@ -85,6 +121,12 @@ impl LabelParams {
             return Err((
                 "margin".into(),
                 "margin is a fraction of the local radius kept from the shore: at least 0 and below 1 (e.g. 0.5)".into(),
+            ));
+        }
+        if !(self.min_pixels > 0.0 && self.min_pixels.is_finite()) {
+            return Err((
+                "min_pixels".into(),
+                "min_pixels is how many pixels long a line (or wide a point's disc) must be on the web map to be shown: above 0 (e.g. 64)".into(),
             ));
         }
         if !(self.min_elongation >= 0.0 && self.min_elongation.is_finite()) {
@@ -136,6 +178,7 @@ pub const LABELS: &[StepLayer] = &[StepLayer {
         ("length", ColumnType::Real),
         ("max_width", ColumnType::Real),
         ("elongation", ColumnType::Real),
+        ("minzoom", ColumnType::Int32),
     ],
 }];
 
@@ -155,6 +198,18 @@ impl LabelParams {
             parts.truncate(1);
         }
         parts.into_iter().map(|(i, p)| (i, self.label(p))).collect()
+    }
+
+    /// A label's `minzoom` at its own latitude (`None`: no label, or no
+    /// longitude and latitude for the run's coordinates).
+    pub fn zoom_of(&self, l: Option<&Labelled>, lonlat: Option<&LonLat>) -> Option<i64> {
+        let l = l?;
+        let lat = lonlat?.of(anchor(l))?.y;
+        let metres = match l.label {
+            Label::Line(_) => l.length,
+            Label::Point(_) => l.max_width,
+        };
+        minzoom(metres, lat, self.min_pixels)
     }
 }
 
@@ -178,6 +233,8 @@ impl FeatureStep for LabelParams {
                     real(|l| l.length),
                     real(|l| l.max_width),
                     real(|l| l.elongation),
+                    self.zoom_of(l.as_ref(), input.lonlat)
+                        .map_or(Cell::Null, Cell::Int),
                 ];
                 ("labels", StepRow { geometry, cells })
             })
@@ -195,6 +252,7 @@ pub const ENTRY: StepEntry = StepEntry {
         ("margin", "fraction of the local radius kept from the shore (0.9: the line stays within 0.1 r of the medial axis)"),
         ("min_elongation", "length / largest width below which a part gets a point (3)"),
         ("parts", "`each` (default) or `largest`: which parts of a feature get a label"),
+        ("min_pixels", "pixels a line must be long (a point's disc wide) on the web map from `minzoom` on (64)"),
     ],
     layers: LABELS,
     build: |v| {
@@ -207,3 +265,22 @@ pub const ENTRY: StepEntry = StepEntry {
         Ok(Arc::new(p))
     },
 };
+
+#[cfg(test)]
+mod tests {
+    use super::minzoom;
+
+    #[test]
+    fn minzoom_is_the_first_zoom_at_which_the_label_is_long_enough() {
+        // On the equator a pixel is 156 543 m at zoom 0, 611.5 m at zoom 8:
+        // a 64-pixel label needs 39 136 m there, so 40 km shows from 8, 39 km from 9.
+        assert_eq!(minzoom(40_000.0, 0.0, 64.0), Some(8));
+        assert_eq!(minzoom(39_000.0, 0.0, 64.0), Some(9));
+        // At 60° a pixel covers half as much ground: one zoom level earlier.
+        assert_eq!(minzoom(20_000.0, 60.0, 64.0), Some(8));
+        // Clamped to the web map's zooms; no length, no zoom.
+        assert_eq!(minzoom(1e9, 0.0, 64.0), Some(0));
+        assert_eq!(minzoom(0.001, 0.0, 64.0), Some(24));
+        assert_eq!(minzoom(0.0, 0.0, 64.0), None);
+    }
+}

@@ -318,6 +318,12 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
             Err(_) => return Err(reader_gone(reader)),
         };
         let mut params = job.params.clone();
+        if !params.extra.is_empty() {
+            params.lonlat = info
+                .srs_wkt
+                .as_deref()
+                .and_then(crate::io::lonlat::lonlat_of);
+        }
         let neighbours = second_inputs(job, &info, &mut params)?;
         let params = &params;
         let writer = Writer::create(

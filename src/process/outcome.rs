@@ -75,6 +75,7 @@ pub fn process(geom: Option<&Geometry<f64>>, params: &ProcessParams) -> Processe
             let rows = e.step.rows(&step::StepInput {
                 parts: &prepared,
                 outcome: o,
+                lonlat: params.lonlat.as_ref(),
             });
             o.extra.extend(rows);
         }

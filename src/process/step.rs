@@ -54,6 +54,52 @@ pub struct StepInput<'a> {
     pub parts: &'a [PreparedPolygon],
     /// The outcome so far.
     pub outcome: &'a FeatureOutcome,
+    /// The run's coordinates as longitude and latitude (degrees), when the
+    /// run knows its CRS (a GDAL source does; a library caller may not).
+    pub lonlat: Option<&'a LonLat>,
+}
+
+/// A map from the run's coordinates to longitude and latitude in degrees
+/// (`None` where it cannot be done): what a step needs that depends on
+/// where on Earth a feature lies (a label's minimum web-map zoom).
+#[derive(Clone)]
+pub struct LonLat(
+    Arc<
+        dyn Fn(geo::Coord<f64>) -> Option<geo::Coord<f64>>
+            + Send
+            + Sync
+            + std::panic::RefUnwindSafe,
+    >,
+);
+
+impl LonLat {
+    /// The map `f`.
+    pub fn new(
+        f: impl Fn(geo::Coord<f64>) -> Option<geo::Coord<f64>>
+            + Send
+            + Sync
+            + std::panic::RefUnwindSafe
+            + 'static,
+    ) -> Self {
+        Self(Arc::new(f))
+    }
+
+    /// Longitude and latitude of `c`.
+    pub fn of(&self, c: geo::Coord<f64>) -> Option<geo::Coord<f64>> {
+        (self.0)(c)
+    }
+}
+
+impl std::fmt::Debug for LonLat {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("LonLat")
+    }
+}
+
+impl PartialEq for LonLat {
+    fn eq(&self, other: &Self) -> bool {
+        Arc::ptr_eq(&self.0, &other.0)
+    }
 }
 
 /// A registered step's work on one feature: rows of its own layers, each

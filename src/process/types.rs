@@ -49,6 +49,9 @@ pub struct ProcessParams {
     pub registry: Registry,
     /// Registered steps, in the pipeline's order.
     pub extra: Vec<super::step::Extra>,
+    /// The run's coordinates as longitude and latitude, when its CRS is
+    /// known (for registered steps, see [`super::step::StepInput::lonlat`]).
+    pub lonlat: Option<super::step::LonLat>,
 }
 
 impl ProcessParams {
