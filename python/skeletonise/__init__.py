@@ -27,8 +27,18 @@ import time
 from typing import Any, Mapping, Sequence, Union
 
 import numpy as np
-import pandas as pd
-import shapely
+
+try:
+    import pandas as pd
+    import shapely
+except ImportError as _missing:  # pragma: no cover - QGIS's Python, which the plugin drives through _core
+    pd = shapely = None  # type: ignore[assignment]
+    _GEO_MISSING: str | None = (
+        f"{_missing.name} is not installed: skeletonise(), apply() and labels() need numpy, "
+        "shapely and geopandas (pip install skeletonise installs them)"
+    )
+else:
+    _GEO_MISSING = None
 
 from . import _core
 from ._core import PipelineError, RejectedError
@@ -127,7 +137,15 @@ def _options_pipeline(
 _OPTIONS: dict[str, "_core.Pipeline"] = {}
 
 
+def _need_geo() -> None:
+    """The GeoPandas functions need pandas and shapely; ``_core`` (which the
+    QGIS plugin drives) needs only numpy."""
+    if _GEO_MISSING is not None:
+        raise ImportError(_GEO_MISSING)
+
+
 def _geometry_array(geometries: Any) -> tuple[np.ndarray, pd.Index | None, Any]:
+    _need_geo()
     """The geometries as a shapely array, with the index and CRS when they have them."""
     import geopandas as gpd
 
@@ -164,7 +182,8 @@ def _prepare(arr: np.ndarray, make_valid: bool) -> tuple[np.ndarray, np.ndarray,
     return arr, repaired, time.perf_counter() - t0
 
 
-_POLYGONAL = (int(shapely.GeometryType.POLYGON), int(shapely.GeometryType.MULTIPOLYGON))
+# shapely's type ids of Polygon and MultiPolygon (shapely.GeometryType).
+_POLYGONAL = (3, 6)
 
 
 def _encode(arr: np.ndarray, exchange: str) -> Any:
@@ -644,6 +663,7 @@ def apply(
     For Dask-GeoPandas, ``ddf.map_partitions(skeletonise.apply, "file.yaml",
     threads=1, meta=...)``: see ``examples/dask_islands.py``.
     """
+    _need_geo()
     p = _load(pipeline, overrides)
     geometry_name = gdf.geometry.name
     arr = np.asarray(gdf.geometry.values, dtype=object)

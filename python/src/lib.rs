@@ -37,6 +37,39 @@ pyo3::create_exception!(
     "A feature was rejected under `on_error: fail`; the text is the command line's (exit status 65 there)."
 );
 
+pyo3::create_exception!(
+    _core,
+    Cancelled,
+    PyRuntimeError,
+    "The call was cancelled through its `Cancel` flag before every feature was done; nothing of it is returned."
+);
+
+/// A cancel flag for `Pipeline.run`: another Python thread sets it (a QGIS
+/// task's cancel) and the call stops before the next feature, raising
+/// `Cancelled`. The flag is read without the GIL.
+#[pyclass(frozen, module = "skeletonise._core")]
+#[derive(Default)]
+pub struct Cancel(std::sync::Arc<std::sync::atomic::AtomicBool>);
+
+#[pymethods]
+impl Cancel {
+    /// A flag not set.
+    #[new]
+    fn new() -> Self {
+        Self::default()
+    }
+
+    /// Sets the flag: the calls given it stop before their next feature.
+    fn set(&self) {
+        self.0.store(true, std::sync::atomic::Ordering::Relaxed);
+    }
+
+    /// Whether the flag is set.
+    fn is_set(&self) -> bool {
+        self.0.load(std::sync::atomic::Ordering::Relaxed)
+    }
+}
+
 /// The validated steps of a pipeline, from a file or from keyword options.
 #[pyclass(frozen, module = "skeletonise._core")]
 pub struct Pipeline {
@@ -151,7 +184,7 @@ impl Pipeline {
     /// Runs the steps on geometries given as WKB (`geometry` a list of bytes
     /// or None) or as ragged arrays (`geometry` a tuple `(type_id, coords,
     /// offsets, null)`, the layout of `shapely.to_ragged_array`).
-    #[pyo3(signature = (geometry, *, fids = None, repaired = None, candidates = false, explode = None, threads = None, output = "geoarrow"))]
+    #[pyo3(signature = (geometry, *, fids = None, repaired = None, candidates = false, explode = None, threads = None, output = "geoarrow", cancel = None))]
     #[allow(clippy::too_many_arguments)]
     fn run<'py>(
         &self,
@@ -163,6 +196,7 @@ impl Pipeline {
         explode: Option<bool>,
         threads: Option<usize>,
         output: &str,
+        cancel: Option<PyRef<'py, Cancel>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let params = self.steps.process_params();
         let opts = run::Options {
@@ -179,6 +213,7 @@ impl Pipeline {
                     )))
                 }
             },
+            cancel: cancel.map(|c| c.0.clone()),
         };
         run::run(py, geometry, fids, repaired, &params, &opts)
     }
@@ -236,7 +271,9 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("PipelineError", m.py().get_type::<PipelineError>())?;
     m.add("RejectedError", m.py().get_type::<RejectedError>())?;
+    m.add("Cancelled", m.py().get_type::<Cancelled>())?;
     m.add_class::<Pipeline>()?;
+    m.add_class::<Cancel>()?;
     m.add_function(wrap_pyfunction!(columns, m)?)?;
     m.add_function(wrap_pyfunction!(describe, m)?)?;
     m.add_function(wrap_pyfunction!(schema, m)?)?;

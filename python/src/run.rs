@@ -1,7 +1,7 @@
 //! One call of `Pipeline.run`: geometries in, the layer's columns out, all
 //! the work done with the GIL released.
 
-use crate::{type_name, wkb, RejectedError};
+use crate::{type_name, wkb, Cancelled, RejectedError};
 use geo::{Coord, Geometry, LineString, MultiPolygon, Polygon};
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
@@ -27,6 +27,16 @@ pub struct Options {
     pub fail: bool,
     /// Return geometries as GeoArrow buffers (else WKB).
     pub geoarrow_out: bool,
+    /// Stop before the next feature once set (`Cancel`).
+    pub cancel: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+}
+
+/// Why a call returns no rows.
+enum Stop {
+    /// A rejected feature under `on_error: fail`: the command line's text.
+    Rejected(String),
+    /// The cancel flag was set.
+    Cancelled,
 }
 
 /// The geometries as handed over.
@@ -212,7 +222,7 @@ fn work(
     repaired: Option<&[bool]>,
     params: &ProcessParams,
     opts: &Options,
-) -> Result<Done, String> {
+) -> Result<Done, Stop> {
     // One feature: no hop to a worker thread (waking one costs more than
     // a small polygon's work); a large one still splits its own work.
     let par = opts.threads != Some(1) && input.len() > 1;
@@ -227,9 +237,17 @@ fn work(
         measures: false,
         network: false,
     };
-    let results: Vec<FeatureRows> = map_in_order(&feats, par, |_, f| {
-        feature_rows(f, Skeletons::Computed, params, row_opts)
+    let cancelled = || {
+        opts.cancel
+            .as_ref()
+            .is_some_and(|c| c.load(std::sync::atomic::Ordering::Relaxed))
+    };
+    let results: Vec<Option<FeatureRows>> = map_in_order(&feats, par, |_, f| {
+        (!cancelled()).then(|| feature_rows(f, Skeletons::Computed, params, row_opts))
     });
+    let Some(results) = results.into_iter().collect::<Option<Vec<FeatureRows>>>() else {
+        return Err(Stop::Cancelled);
+    };
     let t2 = Instant::now();
     if opts.fail {
         if let Some((f, rej)) = feats
@@ -238,7 +256,10 @@ fn work(
             .find_map(|(f, r)| r.rows.rejected.first().map(|j| (f, j)))
         {
             let fid = f.fid.map_or_else(|| "(no fid)".into(), |x| x.to_string());
-            return Err(skeletonise::config::rejected_under_fail(&fid, &rej.reason));
+            return Err(Stop::Rejected(skeletonise::config::rejected_under_fail(
+                &fid,
+                &rej.reason,
+            )));
         }
     }
     let mut counts = [feats.len() as u64, 0, 0, 0];
@@ -295,7 +316,7 @@ fn detached(
     repaired: Option<&[bool]>,
     params: &ProcessParams,
     opts: &Options,
-) -> PyResult<Result<Done, String>> {
+) -> PyResult<Result<Done, Stop>> {
     match opts.threads {
         Some(0) => Err(PyValueError::new_err(
             "threads must be ≥ 1 (or None for one per core)",
@@ -440,8 +461,10 @@ pub fn run<'py>(
             )));
         }
     }
-    let done =
-        detached(py, &input, fids, repaired, params, opts)?.map_err(RejectedError::new_err)?;
+    let done = detached(py, &input, fids, repaired, params, opts)?.map_err(|e| match e {
+        Stop::Rejected(text) => RejectedError::new_err(text),
+        Stop::Cancelled => Cancelled::new_err("cancelled"),
+    })?;
     to_python(py, done)
 }
 

@@ -1,0 +1,286 @@
+"""Between QGIS features and the skeletonise wheel (``skeletonise._core``).
+
+Geometries cross as WKB (``QgsGeometry.asWkb``); the work runs in Rust with
+the GIL released, in batches of about ``BATCH_VERTICES`` vertices so that
+progress moves and a cancel is seen between batches, and within one (a cancel
+flag the Rust loop checks, where the wheel has it). Results come back as WKB
+and column buffers and become the sink's features here. No GDAL and no
+pandas: QGIS's own numpy is all the wheel needs.
+"""
+
+import json
+import math
+import threading
+
+import numpy as np
+from qgis.core import (
+    QgsCoordinateReferenceSystem,
+    QgsCoordinateTransform,
+    QgsFeature,
+    QgsFeatureSink,
+    QgsField,
+    QgsFields,
+    QgsGeometry,
+    QgsProcessingException,
+    QgsProject,
+    QgsWkbTypes,
+)
+from qgis.PyQt.QtCore import QVariant
+
+INSTALL_HINT = (
+    "install the skeletonise wheel into QGIS's Python, e.g. `python3 -m pip install --no-deps "
+    "skeletonise` (OSGeo4W shell on Windows), or run QGIS through scripts/qgis-process.sh of a "
+    "skeletonise checkout"
+)
+
+# The work of one call into Rust: enough for the threads to share (a batch of
+# small lakes), small enough that progress moves and a cancel between batches
+# is seen in well under a second on a laptop.
+BATCH_VERTICES = 100_000
+BATCH_FEATURES = 2_000
+
+_TYPES = {"int32": QVariant.Int, "int64": QVariant.LongLong, "real": QVariant.Double, "text": QVariant.String}
+
+
+def core():
+    """The wheel's Rust module, or a Processing error saying how to install it."""
+    try:
+        from skeletonise import _core
+    except ImportError as e:
+        raise QgsProcessingException(
+            f"the skeletonise Python package is not installed in QGIS's Python ({e}): {INSTALL_HINT}"
+        ) from None
+    return _core
+
+
+def version():
+    """The wheel's version, or None when it is not installed."""
+    try:
+        return core().__version__
+    except QgsProcessingException:
+        return None
+
+
+def check_crs(crs, name):
+    """What the command line refuses before any work: a geographic CRS (radii and scores would be in degrees)."""
+    if crs.isValid() and crs.isGeographic():
+        raise QgsProcessingException(
+            f"layer `{name}` has the geographic CRS {crs.authid() or crs.description()}; skeleton radii and "
+            "scores need a projected CRS: reproject it first (Processing ▸ Vector general ▸ Reproject layer, "
+            "native:reprojectlayer), e.g. to the UTM zone or an equal-area CRS of the region"
+        )
+
+
+class Features:
+    """The features of a source as the wheel takes them: FIDs, attributes, WKB."""
+
+    def __init__(self):
+        self.fids = []
+        self.attributes = []
+        self.wkbs = []
+        self.repaired = []
+        self.vertices = []
+
+    def __len__(self):
+        return len(self.fids)
+
+
+def read(source, make_valid, feedback, share=10.0):
+    """Every feature of ``source`` (a QgsProcessingFeatureSource): invalid
+    polygons repaired (GEOS MakeValid, as the command line's reader) when the
+    pipeline's ``prepare.make_valid`` is on; curves segmentised; Z and M
+    dropped by the reader in Rust. Progress runs to ``share`` percent."""
+    out = Features()
+    total = source.featureCount() or 1
+    for i, f in enumerate(source.getFeatures()):
+        if feedback.isCanceled():
+            break
+        out.fids.append(int(f.id()))
+        out.attributes.append(f.attributes())
+        wkb, repaired, n = None, False, 0
+        if f.hasGeometry():
+            g = f.geometry()
+            if QgsWkbTypes.isCurvedType(g.wkbType()):
+                g = QgsGeometry(g.constGet().segmentize())
+            if make_valid and not g.isGeosValid():
+                fixed = g.makeValid()
+                if not fixed.isNull():
+                    g, repaired = fixed, True
+            n = g.constGet().nCoordinates()
+            wkb = bytes(g.asWkb())
+        out.wkbs.append(wkb)
+        out.repaired.append(repaired)
+        out.vertices.append(n)
+        if i % 1000 == 0:
+            feedback.setProgress(share * i / total)
+    return out
+
+
+def batches(features):
+    """Ranges of features for one call each: about BATCH_VERTICES vertices or BATCH_FEATURES features."""
+    start, vertices = 0, 0
+    for i, n in enumerate(features.vertices):
+        if i > start and (vertices + n > BATCH_VERTICES or i - start >= BATCH_FEATURES):
+            yield start, i
+            start, vertices = i, 0
+        vertices += n
+    if start < len(features):
+        yield start, len(features)
+
+
+def source_fields(fields, skip):
+    """The source's fields to carry (not those in ``skip``, the GeoPackage's FID column)."""
+    return [i for i in range(fields.count()) if fields.at(i).name() not in skip]
+
+
+def output_fields(fields, carried, tool_columns, rejected=True):
+    """The sink's fields: the carried source fields (``src_<name>`` where a
+    name is one of the tool's, as the command line's writer renames them),
+    the tool's columns, then ``rejected``."""
+    out = QgsFields()
+    clash = {name.lower() for name, _ in tool_columns} | {"rejected"}
+    for i in carried:
+        f = QgsField(fields.at(i))
+        if f.name().lower() in clash:
+            f.setName(f"src_{f.name()}")
+        out.append(f)
+    for name, kind in tool_columns:
+        out.append(QgsField(name, _TYPES[kind]))
+    if rejected:
+        out.append(QgsField("rejected", QVariant.String))
+    return out
+
+
+def _texts(offsets, data, null):
+    n = len(offsets) - 1
+    if null is True:
+        return [None] * n
+    return [
+        None if null is not None and null[i] else data[offsets[i] : offsets[i + 1]].decode() for i in range(n)
+    ]
+
+
+def columns(done):
+    """The columns of a ``Pipeline.run`` result as Python lists (NULL as None)."""
+    reals = done["reals"]
+    out = []
+    for _name, kind, values in done["columns"]:
+        if kind in ("int32", "int64"):
+            v, null = values
+            out.append([None if m else int(x) for x, m in zip(v.tolist(), null.tolist())])
+        elif kind == "real":
+            out.append([None if math.isnan(x) else x for x in reals[values].tolist()])
+        else:
+            out.append(_texts(*values))
+    out.append(_texts(*done["rejected"]))
+    return out
+
+
+def geometry(wkb):
+    """A QgsGeometry from WKB (an empty one for NULL)."""
+    g = QgsGeometry()
+    if wkb is not None:
+        g.fromWkb(wkb)
+    return g
+
+
+class Cancelled(Exception):
+    """The user cancelled: the batch in progress stopped before its next feature."""
+
+
+def cancellable(feedback, call, *args, **kwargs):
+    """``call(*args, cancel=flag, **kwargs)`` in a thread of its own (Rust
+    releases the GIL), while this one watches ``feedback`` every 20 ms and sets
+    the wheel's cancel flag once the user cancels: the call then stops before
+    its next feature and :class:`Cancelled` is raised here."""
+    core_ = core()
+    flag = core_.Cancel()
+    out = {}
+
+    def work():
+        try:
+            out["done"] = call(*args, cancel=flag, **kwargs)
+        except BaseException as e:  # noqa: BLE001 - handed to the caller's thread
+            out["error"] = e
+
+    t = threading.Thread(target=work, name="skeletonise", daemon=True)
+    t.start()
+    while t.is_alive():
+        t.join(0.02)
+        if feedback.isCanceled() and not flag.is_set():
+            flag.set()
+    if isinstance(out.get("error"), core_.Cancelled):
+        raise Cancelled()
+    if "error" in out:
+        raise out["error"]
+    return out["done"]
+
+
+def run_pipeline(pipeline, features, batch, feedback, *, candidates, explode=None):
+    """One batch through ``Pipeline.run``, cancellable: the result's rows
+    (input positions within the batch), columns and WKB geometries."""
+    start, end = batch
+    return cancellable(
+        feedback,
+        pipeline.run,
+        features.wkbs[start:end],
+        fids=np.asarray(features.fids[start:end], dtype=np.int64),
+        repaired=np.asarray(features.repaired[start:end], dtype=bool),
+        candidates=candidates,
+        explode=explode,
+        output="wkb",
+    )
+
+
+def write(sink, done, features, start, carried, feedback, fid_of=None):
+    """The rows of ``done`` as features of ``sink``; a rejected feature is
+    reported through ``feedback.reportError`` (its row is kept: NULL
+    geometry, the reason in ``rejected``). Returns the number rejected."""
+    cols = columns(done)
+    rows = done["row"].tolist()
+    wkbs = done["geometry"][1]
+    reasons = cols[-1]
+    rejected = 0
+    for k, r in enumerate(rows):
+        i = start + r
+        attrs = [features.attributes[i][j] for j in carried]
+        attrs.extend(c[k] for c in cols)
+        f = QgsFeature()
+        f.setAttributes(attrs)
+        if wkbs[k] is not None:
+            f.setGeometry(geometry(wkbs[k]))
+        if not sink.addFeature(f, QgsFeatureSink.FastInsert):
+            raise QgsProcessingException(f"could not write a feature of FID {features.fids[i]} to the output")
+        if reasons[k] is not None:
+            rejected += 1
+            feedback.reportError(f"feature {features.fids[i]} rejected: {reasons[k]}")
+    return rejected
+
+
+def options_pipeline(doc, origin):
+    """A pipeline from a steps document (the pipeline file's keys)."""
+    try:
+        return core().Pipeline.from_options(json.dumps(doc), origin)
+    except core().PipelineError as e:
+        raise QgsProcessingException(str(e)) from None
+
+
+EQUATOR_M_PER_PIXEL = 156_543.033928041
+
+
+def minzoom(geom, kind, length, width, crs, pixels):
+    """The smallest web-map zoom (0–24) at which a line is ``pixels`` long (a
+    point's disc that wide) at the latitude of the line's middle (the point),
+    as the command line's ``label`` step computes it."""
+    if geom is None or geom.isNull() or not crs.isValid():
+        return None
+    metres = length if kind == "line" else width
+    if metres is None or not metres > 0:
+        return None
+    anchor = geom.interpolate(geom.length() / 2) if kind == "line" else geom
+    to_lonlat = QgsCoordinateTransform(crs, QgsCoordinateReferenceSystem("EPSG:4326"), QgsProject.instance())
+    lat = to_lonlat.transform(anchor.asPoint()).y()
+    if not math.isfinite(lat):
+        return None
+    z = math.ceil(math.log2(pixels * EQUATOR_M_PER_PIXEL * math.cos(math.radians(lat)) / metres))
+    return int(min(max(z, 0), 24))

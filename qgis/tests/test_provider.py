@@ -1,0 +1,313 @@
+"""The QGIS plugin in a real, headless QGIS: every algorithm of the `skeletonise`
+provider through `processing.run` (PyQGIS) and through `qgis_process`, compared
+row for row with the command line's output on the training layers.
+
+Run by scripts/test-qgis.sh (QGIS's own Python, the wheel and the plugin on its
+paths, a throw-away profile); the command line binary is $SKELETONISE_BIN, else
+target/release/skeletonise, else target/debug/skeletonise.
+"""
+
+import json
+import math
+import os
+import random
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+import unittest
+
+from qgis.core import (
+    QgsApplication,
+    QgsFeature,
+    QgsGeometry,
+    QgsPointXY,
+    QgsProcessingException,
+    QgsProcessingFeedback,
+    QgsVectorLayer,
+)
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+TRAIN = os.path.join(ROOT, "tests", "data", "gshhg-train.gpkg")
+
+APP = QgsApplication([], False)
+APP.initQgis()
+sys.path.append("/usr/share/qgis/python/plugins")
+import processing  # noqa: E402
+from processing.core.Processing import Processing  # noqa: E402
+
+Processing.initialize()
+sys.path.insert(0, os.path.join(ROOT, "qgis"))
+from skeletonise_qgis.provider import SkeletoniseProvider  # noqa: E402
+
+PROVIDER = SkeletoniseProvider()
+QgsApplication.processingRegistry().addProvider(PROVIDER)
+
+
+def binary():
+    for b in (os.environ.get("SKELETONISE_BIN"), "target/release/skeletonise", "target/debug/skeletonise"):
+        if b and os.path.exists(os.path.join(ROOT, b) if not os.path.isabs(b) else b):
+            return os.path.join(ROOT, b) if not os.path.isabs(b) else b
+    raise RuntimeError("no skeletonise binary: cargo build --release")
+
+
+def cli(*args, check=True):
+    p = subprocess.run([binary(), *args], cwd=ROOT, capture_output=True, text=True)
+    if check and p.returncode != 0:
+        raise AssertionError(f"skeletonise {' '.join(args)} failed ({p.returncode}): {p.stderr}")
+    return p
+
+
+def rows(path, layer=None):
+    """The features of a GeoPackage layer as {field: value} with the geometry's WKB, in FID order."""
+    uri = f"{path}|layername={layer}" if layer else path
+    vl = QgsVectorLayer(uri, "t", "ogr")
+    assert vl.isValid(), uri
+    out = []
+    for f in vl.getFeatures():
+        r = {name: f[name] for name in vl.fields().names() if name != "fid"}
+        r = {k: (None if v is not None and hasattr(v, "isNull") and v.isNull() else v) for k, v in r.items()}
+        r["_geom"] = f.geometry() if f.hasGeometry() else None
+        out.append(r)
+    return out
+
+
+def vertices(g):
+    return [(p.x(), p.y()) for p in g.vertices()]
+
+
+class Case(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory()
+        self.dir = self.tmp.name
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def out(self, name):
+        return os.path.join(self.dir, name)
+
+    def assertSameRows(self, got, want, key=("src_fid",), columns=None):  # noqa: N802
+        """Row for row: the same keys, and every column of ``want`` equal (reals within 1e-9), geometries equal."""
+        self.assertEqual(len(got), len(want))
+        self.assertGreater(len(want), 0)
+        by = {tuple(r[k] for k in key): r for r in got}
+        self.assertEqual(len(by), len(got), "keys repeat")
+        for w in want:
+            g = by[tuple(w[k] for k in key)]
+            for c in columns or [c for c in w if c != "_geom"]:
+                a, b = g[c], w[c]
+                if isinstance(b, float) and a is not None:
+                    self.assertTrue(math.isclose(a, b, rel_tol=1e-9, abs_tol=1e-9), f"{c}: {a} != {b} ({w[key[0]]})")
+                else:
+                    self.assertEqual(a, b, f"{c} of {tuple(w[k] for k in key)}")
+            if w["_geom"] is None:
+                self.assertIsNone(g["_geom"])
+            else:
+                va, vb = vertices(g["_geom"]), vertices(w["_geom"])
+                self.assertEqual(len(va), len(vb))
+                self.assertTrue(all(math.dist(p, q) <= 1e-6 for p, q in zip(va, vb)))
+
+
+class Feedback(QgsProcessingFeedback):
+    """Collects the errors reported."""
+
+    def __init__(self):
+        super().__init__()
+        self.errors = []
+
+    def reportError(self, error, fatalError=False):  # noqa: N802
+        self.errors.append(error)
+
+
+class Skeletonise(Case):
+    def test_defaults_give_the_command_lines_rows_on_lakes_and_islands(self):
+        for layer in ("lakes_scotland", "river_lena"):
+            with self.subTest(layer=layer):
+                cli("run", "-i", TRAIN, "-l", layer, "-o", self.out(f"{layer}-cli.gpkg"))
+                res = processing.run(
+                    "skeletonise:skeletonise",
+                    {"INPUT": f"{TRAIN}|layername={layer}", "OUTPUT": self.out(f"{layer}-qgis.gpkg")},
+                )
+                self.assertEqual(res["FEATURES_REJECTED"], 0)
+                want = rows(self.out(f"{layer}-cli.gpkg"), "skeletons")
+                got = rows(res["OUTPUT"])
+                self.assertTrue(all(r["rejected"] is None for r in got))
+                for r in got:
+                    del r["rejected"]
+                self.assertSameRows(got, want)
+                self.assertIn("method", want[0])
+
+    def test_options_and_candidates_give_the_command_lines_rows(self):
+        cli(
+            "run", "-i", TRAIN, "-l", "lakes_scotland", "-o", self.out("cli.gpkg"),
+            "--set", "steps.skeleton.methods=[MA, CDT]", "--set", "steps.prune.mode=trunk",
+            "--set", "steps.extend.mode=ray", "--set", "steps.select.by=deviation",
+            "--set", "output.candidates=true",
+        )
+        res = processing.run(
+            "skeletonise:skeletonise",
+            {
+                "INPUT": f"{TRAIN}|layername=lakes_scotland",
+                "METHODS": [0, 3],
+                "PRUNE": 2,
+                "EXTEND": 1,
+                "SELECT": 1,
+                "OUTPUT": self.out("q.gpkg"),
+                "CANDIDATES": self.out("qc.gpkg"),
+            },
+        )
+        got = rows(res["OUTPUT"])
+        for r in got:
+            del r["rejected"]
+        self.assertSameRows(got, rows(self.out("cli.gpkg"), "skeletons"))
+        cand = rows(res["CANDIDATES"])
+        for r in cand:
+            del r["rejected"]
+        self.assertSameRows(cand, rows(self.out("cli.gpkg"), "candidates"), key=("src_fid", "method"))
+        self.assertEqual({r["method"] for r in cand}, {"MA", "CDT"})
+
+    def test_qgis_process_gives_the_command_lines_rows(self):
+        cli("run", "-i", TRAIN, "-l", "islands_hebrides", "-o", self.out("cli.gpkg"))
+        p = subprocess.run(
+            [
+                os.path.join(ROOT, "scripts", "qgis-process.sh"), "--json", "run", "skeletonise:skeletonise", "--",
+                f"INPUT={TRAIN}|layername=islands_hebrides", f"OUTPUT={self.out('qp.gpkg')}",
+            ],
+            capture_output=True, text=True, cwd=ROOT,
+        )
+        self.assertEqual(p.returncode, 0, p.stderr)
+        result = json.loads(p.stdout[p.stdout.index("{"):])
+        self.assertEqual(result["results"]["FEATURES_READ"], 1192)
+        got = rows(self.out("qp.gpkg"))
+        for r in got:
+            del r["rejected"]
+        self.assertSameRows(got, rows(self.out("cli.gpkg"), "skeletons"))
+
+    def test_a_geographic_layer_is_refused_with_the_reprojection_hint(self):
+        lonlat = processing.run(
+            "native:reprojectlayer",
+            {"INPUT": f"{TRAIN}|layername=lakes_scotland", "TARGET_CRS": "EPSG:4326", "OUTPUT": "memory:"},
+        )["OUTPUT"]
+        with self.assertRaises(QgsProcessingException) as e:
+            processing.run("skeletonise:skeletonise", {"INPUT": lonlat, "OUTPUT": self.out("x.gpkg")})
+        self.assertIn("geographic CRS EPSG:4326", str(e.exception))
+        self.assertIn("native:reprojectlayer", str(e.exception))
+        self.assertFalse(os.path.exists(self.out("x.gpkg")))
+
+    def test_a_feature_without_polygon_is_reported_and_kept(self):
+        layer = QgsVectorLayer("Polygon?crs=EPSG:32630&field=name:string", "bad", "memory")
+        good = QgsFeature(layer.fields())
+        good.setAttributes(["square"])
+        good.setGeometry(QgsGeometry.fromPolygonXY([[QgsPointXY(0, 0), QgsPointXY(1000, 0), QgsPointXY(1000, 200), QgsPointXY(0, 200)]]))
+        empty = QgsFeature(layer.fields())
+        empty.setAttributes(["nothing"])
+        layer.dataProvider().addFeatures([good, empty])
+        feedback = Feedback()
+        res = processing.run(
+            "skeletonise:skeletonise", {"INPUT": layer, "OUTPUT": self.out("r.gpkg")}, feedback=feedback
+        )
+        got = rows(res["OUTPUT"])
+        self.assertEqual(len(got), 2)
+        self.assertEqual(res["FEATURES_REJECTED"], 1)
+        bad = [r for r in got if r["name"] == "nothing"][0]
+        # No line (QGIS's GeoPackage writer stores a missing geometry as an empty one).
+        self.assertTrue(bad["_geom"] is None or bad["_geom"].isEmpty())
+        self.assertTrue(bad["rejected"])
+        self.assertEqual(len(feedback.errors), 1)
+        self.assertIn(bad["rejected"], feedback.errors[0])
+        ok = [r for r in got if r["name"] == "square"][0]
+        self.assertIsNotNone(ok["_geom"])
+
+    def test_cancel_stops_within_a_second(self):
+        # 60 rough lobed polygons of 12 000 vertices (the roughness of scripts/make_rough_polygon.py).
+        layer = QgsVectorLayer("Polygon?crs=EPSG:3857", "rough", "memory")
+        rnd = random.Random(7)
+        feats = []
+        for k in range(60):
+            ring = []
+            n = 12_000
+            for i in range(n):
+                t = 2 * math.pi * i / n
+                r = 10_000 * (1 + 0.3 * math.sin(5 * t)) + rnd.uniform(0, 30)
+                ring.append(QgsPointXY(k * 40_000 + r * math.cos(t), r * math.sin(t)))
+            f = QgsFeature()
+            f.setGeometry(QgsGeometry.fromPolygonXY([ring]))
+            feats.append(f)
+        layer.dataProvider().addFeatures(feats)
+        feedback = Feedback()
+        cancelled = []
+
+        def cancel():
+            cancelled.append(time.monotonic())
+            feedback.cancel()
+
+        timer = threading.Timer(1.5, cancel)
+        timer.start()
+        t0 = time.monotonic()
+        res = processing.run(
+            "skeletonise:skeletonise", {"INPUT": layer, "OUTPUT": self.out("c.gpkg")}, feedback=feedback
+        )
+        end = time.monotonic()
+        timer.cancel()
+        self.assertTrue(cancelled, "the run ended before the cancel: make the layer larger")
+        self.assertLess(end - cancelled[0], 1.0, f"stopped {end - cancelled[0]:.2f} s after the cancel")
+        written = len(rows(res["OUTPUT"]))
+        self.assertLess(written, 60)
+        self.assertGreater(end - t0, 1.5)
+
+
+class Pipeline(Case):
+    def test_a_pipeline_file_with_overrides_gives_the_command_lines_rows(self):
+        pipeline = os.path.join(ROOT, "pipelines", "islands.yaml")
+        cli("run", pipeline, "-i", TRAIN, "-l", "lakes_scotland", "-o", self.out("cli.gpkg"),
+            "--set", "steps.skeleton.methods=[MA, StSk]")
+        res = processing.run(
+            "skeletonise:pipeline",
+            {
+                "INPUT": f"{TRAIN}|layername=lakes_scotland",
+                "PIPELINE": pipeline,
+                "OVERRIDES": "steps.skeleton.methods=[MA, StSk]",
+                "OUTPUT": self.out("q.gpkg"),
+            },
+        )
+        got = rows(res["OUTPUT"])
+        for r in got:
+            del r["rejected"]
+        self.assertSameRows(got, rows(self.out("cli.gpkg"), "skeletons"))
+
+    def test_a_bad_pipeline_file_gives_the_command_lines_message(self):
+        bad = self.out("bad.yaml")
+        with open(bad, "w") as f:
+            f.write("steps:\n  - skeleton: { methods: [MA, Nope] }\n")
+        p = cli("validate", bad, check=False)
+        self.assertNotEqual(p.returncode, 0)
+        with self.assertRaises(QgsProcessingException) as e:
+            processing.run(
+                "skeletonise:pipeline",
+                {"INPUT": f"{TRAIN}|layername=lakes_scotland", "PIPELINE": bad, "OUTPUT": self.out("q.gpkg")},
+            )
+        message = str(e.exception)
+        self.assertIn("Nope", message)
+        self.assertIn(message.splitlines()[0].split(": ", 1)[-1][:40], p.stderr)
+
+
+class Labels(Case):
+    def test_labels_give_the_command_lines_rows_with_minzoom(self):
+        cli("run", os.path.join(ROOT, "pipelines", "lake-labels.yaml"), "-o", self.out("cli.gpkg"))
+        res = processing.run(
+            "skeletonise:label", {"INPUT": f"{TRAIN}|layername=lakes_scotland", "OUTPUT": self.out("q.gpkg")}
+        )
+        got = rows(res["OUTPUT"])
+        want = rows(self.out("cli.gpkg"), "labels")
+        for r in got:
+            del r["rejected"]
+        self.assertIn("src_kind", want[0])
+        self.assertSameRows(got, want, key=("src_fid", "polygon_part"))
+        self.assertEqual({r["kind"] for r in got}, {"line", "point"})
+        self.assertTrue(all(r["minzoom"] is not None for r in got))
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)
