@@ -12,14 +12,12 @@
 
 use crate::config::{InputSpec, OnError, OutputSpec};
 use crate::feature::Feature;
-use crate::geometry::PreparedPolygon;
 use crate::io::guard::Protected;
 use crate::io::reader::Reader;
 use crate::pipeline::{run_job, Given, Job, RunError, RunOptions, RunSummary};
-use crate::process::{polygon_parts, PrepareParams, ProcessParams};
-use crate::score::ScoreParams;
-use geo::{BoundingRect, LineString, MultiLineString};
-use rstar::{primitives::GeomWithData, primitives::Rectangle, RTree, AABB};
+use crate::process::{PrepareParams, ProcessParams};
+use crate::score::{join, ScoreParams};
+use geo::{LineString, MultiLineString};
 use std::collections::HashMap;
 
 /// How skeleton features find their polygon.
@@ -51,8 +49,6 @@ pub struct ScoreJob {
     /// The output.
     pub output: OutputSpec,
 }
-
-use crate::connect::lines_of;
 
 fn key_text(f: &Feature, field: Option<usize>) -> Option<String> {
     match field {
@@ -105,7 +101,8 @@ pub fn score_external(job: &ScoreJob, keep_bars: bool) -> Result<RunSummary, Run
         ],
     )?;
     let (lines, unjoined) = join(job)?;
-    unjoined.report(
+    report(
+        &unjoined,
         &job.skeletons.source,
         lines.values().any(|l| !l.0.is_empty()),
     )?;
@@ -143,61 +140,29 @@ pub fn score_external(job: &ScoreJob, keep_bars: bool) -> Result<RunSummary, Run
     run_job(&run, &RunOptions::default())
 }
 
-/// Skeleton rows that were joined to no polygon, by why.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct Unjoined {
-    /// Rows whose key is NULL.
-    pub null_key: usize,
-    /// Rows whose key no polygon has, with the first such key.
-    pub unknown_key: (usize, Option<String>),
-    /// Rows without a geometry, or whose geometry has no line (points,
-    /// polygons).
-    pub not_lines: usize,
-    /// Lines (joined by location) that lie in no polygon.
-    pub outside: usize,
-}
+pub use crate::score::join::Unjoined;
 
-impl Unjoined {
-    /// Logs what was left out; with nothing joined at all, the error
-    /// saying why.
-    fn report(&self, source: &str, any_joined: bool) -> Result<(), RunError> {
-        let mut why = Vec::new();
-        if self.null_key > 0 {
-            why.push(format!("{} with a NULL key", self.null_key));
-        }
-        if let (n, Some(k)) = &self.unknown_key {
-            why.push(format!("{n} with a key no polygon has (e.g. `{k}`)"));
-        }
-        if self.not_lines > 0 {
-            why.push(format!(
-                "{} without a line geometry (points, polygons or NULL)",
-                self.not_lines
-            ));
-        }
-        if self.outside > 0 {
-            why.push(format!("{} lines inside no polygon", self.outside));
-        }
-        if !any_joined {
-            return Err(RunError::Io(crate::io::IoError::Read {
-                source_name: source.to_string(),
-                reason: format!(
-                    "no skeleton line could be joined to a polygon ({}); check `--skeleton-key`/`--polygon-key` (or, joining by location, that the lines lie in the polygons) and that both layers are the ones meant",
-                    if why.is_empty() { "the layer has no rows".to_string() } else { why.join(", ") }
-                ),
-            }));
-        }
-        if !why.is_empty() {
-            tracing::warn!(
-                null_key = self.null_key,
-                unknown_key = self.unknown_key.0,
-                not_lines = self.not_lines,
-                outside = self.outside,
-                "skeleton rows joined to no polygon and left out: {}",
-                why.join(", ")
-            );
-        }
-        Ok(())
+/// Logs what was left out of the join; with nothing joined at all, the
+/// error saying why.
+fn report(unjoined: &Unjoined, source: &str, any_joined: bool) -> Result<(), RunError> {
+    if !any_joined {
+        return Err(RunError::Io(crate::io::IoError::Read {
+            source_name: source.to_string(),
+            reason: unjoined.nothing_joined("`--skeleton-key`/`--polygon-key`"),
+        }));
     }
+    let why = unjoined.reasons();
+    if !why.is_empty() {
+        tracing::warn!(
+            null_key = unjoined.null_key,
+            unknown_key = unjoined.unknown_key.0,
+            not_lines = unjoined.not_lines,
+            outside = unjoined.outside,
+            "skeleton rows joined to no polygon and left out: {}",
+            why.join(", ")
+        );
+    }
+    Ok(())
 }
 
 /// The skeleton lines of `job`, by the FID of the polygon they are joined
@@ -263,45 +228,19 @@ fn join_by_key(
     skeleton_field: &str,
     unjoined: &mut Unjoined,
 ) -> Result<Vec<Vec<LineString<f64>>>, RunError> {
-    let mut assigned = vec![Vec::new(); polygons.len()];
     let pf = polygon_field
         .as_deref()
         .map(|n| field_index(pr, n, "polygon"))
         .transpose()?;
     let sf = field_index(sr, skeleton_field, "skeleton")?;
-    let by_key: HashMap<String, usize> = polygons
-        .iter()
-        .enumerate()
-        .filter_map(|(i, f)| key_text(f, pf).map(|k| (k, i)))
-        .collect();
-    for s in skeletons {
-        let ls = feature_lines(s);
-        if ls.is_empty() {
-            unjoined.not_lines += 1;
-            continue;
-        }
-        let Some(k) = key_text(s, Some(sf)) else {
-            unjoined.null_key += 1;
-            continue;
-        };
-        match by_key.get(&k) {
-            Some(&i) => assigned[i].extend(ls),
-            None => {
-                unjoined.unknown_key.0 += 1;
-                unjoined.unknown_key.1.get_or_insert(k);
-            }
-        }
-    }
-    Ok(assigned)
-}
-
-/// The lines of a skeleton feature (none when it has no line geometry).
-fn feature_lines(s: &Feature) -> Vec<LineString<f64>> {
-    let mut ls = Vec::new();
-    if let Some(g) = &s.geometry {
-        lines_of(g, &mut ls);
-    }
-    ls
+    let keys: Vec<Option<String>> = polygons.iter().map(|f| key_text(f, pf)).collect();
+    Ok(join::by_key(
+        &keys,
+        skeletons
+            .iter()
+            .map(|s| (key_text(s, Some(sf)), join::lines_of(s.geometry.as_ref()))),
+        unjoined,
+    ))
 }
 
 fn join_by_location(
@@ -309,55 +248,12 @@ fn join_by_location(
     skeletons: &[Feature],
     unjoined: &mut Unjoined,
 ) -> Vec<Vec<LineString<f64>>> {
-    let mut assigned = vec![Vec::new(); polygons.len()];
-    let prepared: Vec<Vec<PreparedPolygon>> = polygons
-        .iter()
-        .map(|f| {
-            polygon_parts(f.geometry.as_ref())
-                .map(|ps| {
-                    ps.iter()
-                        .filter_map(|p| PreparedPolygon::new(p).ok())
-                        .collect()
-                })
-                .unwrap_or_default()
-        })
-        .collect();
-    let boxes: Vec<GeomWithData<Rectangle<[f64; 2]>, usize>> = polygons
-        .iter()
-        .enumerate()
-        .filter_map(|(i, f)| {
-            let r = f.geometry.as_ref()?.bounding_rect()?;
-            Some(GeomWithData::new(
-                Rectangle::from_corners([r.min().x, r.min().y], [r.max().x, r.max().y]),
-                i,
-            ))
-        })
-        .collect();
-    let tree = RTree::bulk_load(boxes);
-    for s in skeletons {
-        let ls = feature_lines(s);
-        if ls.is_empty() {
-            unjoined.not_lines += 1;
-        }
-        for l in ls {
-            let Some(w) = l.0.windows(2).find(|w| w[0] != w[1]) else {
-                continue;
-            };
-            let m = (w[0] + w[1]) * 0.5;
-            let hit = tree
-                .locate_in_envelope_intersecting(&AABB::from_point([m.x, m.y]))
-                .map(|c| c.data)
-                .filter(|&i| {
-                    prepared[i]
-                        .iter()
-                        .any(|p| p.boundary().contains_with_tolerance(m, 1e-9 * p.extent()))
-                })
-                .min();
-            match hit {
-                Some(i) => assigned[i].push(l),
-                None => unjoined.outside += 1,
-            }
-        }
-    }
-    assigned
+    let geoms: Vec<_> = polygons.iter().map(|f| f.geometry.as_ref()).collect();
+    join::by_location(
+        &geoms,
+        skeletons
+            .iter()
+            .map(|s| join::lines_of(s.geometry.as_ref())),
+        unjoined,
+    )
 }

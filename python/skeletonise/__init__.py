@@ -665,6 +665,12 @@ def apply(
     """
     _need_geo()
     p = _load(pipeline, overrides)
+    if p.collapse:
+        raise PipelineError(
+            "the `collapse` step writes kept areas beside the lines, which a GeoDataFrame cannot hold: it runs "
+            "from the command line (`skeletonise run`) and in QGIS (skeletonise:collapse); leave it out of the "
+            "pipeline given to Python"
+        )
     geometry_name = gdf.geometry.name
     arr = np.asarray(gdf.geometry.values, dtype=object)
     attributes = gdf.drop(columns=[geometry_name])

@@ -17,6 +17,18 @@ class RejectedError(RuntimeError):
 # (type id 3 polygon / 6 multipolygon, coords (n, 2) float64, offsets int64 per level, null mask or None)
 Ragged = tuple[int, npt.NDArray[np.float64], list[npt.NDArray[np.int64]], Optional[npt.NDArray[np.bool_]]]
 
+class Cancelled(RuntimeError):
+    """A call stopped because its :class:`Cancel` flag was set; nothing of it is returned."""
+
+class Cancel:
+    """A cancel flag for :meth:`Pipeline.run`: set from another thread, the call stops before its next feature."""
+
+    def __init__(self) -> None: ...
+    def set(self) -> None:
+        """Sets the flag."""
+    def is_set(self) -> bool:
+        """Whether the flag is set."""
+
 class Pipeline:
     """The validated steps of a pipeline, from a file or from keyword options."""
 
@@ -29,6 +41,9 @@ class Pipeline:
     @property
     def make_valid(self) -> bool:
         """Whether the ``prepare`` step repairs invalid polygons."""
+    @property
+    def collapse(self) -> bool:
+        """Whether the pipeline has a ``collapse`` step (``run`` then also returns ``areas``)."""
     @property
     def explode(self) -> bool:
         """One row per polygon part (``output.explode``)."""
@@ -51,6 +66,10 @@ class Pipeline:
         explode: Optional[bool] = None,
         threads: Optional[int] = None,
         output: Literal["geoarrow", "wkb"] = "geoarrow",
+        cancel: Optional[Cancel] = None,
+        connect: Optional[list[Optional[bytes]]] = None,
+        connect_fids: Optional[Sequence[int]] = None,
+        snap: float = 0.0,
     ) -> dict[str, Any]:
         """Runs the steps with the GIL released.
 
@@ -60,12 +79,36 @@ class Pipeline:
         as Arrow large-string buffers ``(offsets, data, null mask or None)``),
         ``rejected`` (reasons, texts as the columns'), ``geometry``
         (``("geoarrow", coords, line_offsets, geom_offsets, null)`` or
-        ``("wkb", list)``), ``counts`` and ``timings``.
-        Raises RejectedError under ``on_error: fail``.
+        ``("wkb", list)``), ``counts`` and ``timings``; with a ``collapse``
+        step also ``areas`` (``row``, ``columns``, ``reals``, ``geometry`` as
+        WKB polygons). ``connect`` (WKB lines, FIDs in ``connect_fids``) is
+        the line network of ``input.connect``, ``snap`` its snap distance.
+        Raises RejectedError under ``on_error: fail``, Cancelled once
+        ``cancel`` is set.
         """
 
-def columns(layer: str, explode: bool = False) -> tuple[list[tuple[str, str]], bool]:
-    """The columns of ``skeletons`` or ``candidates`` as ``(name, type)``, and whether the layer carries the source's attributes."""
+def columns(layer: str, explode: bool = False, collapse: bool = False) -> tuple[list[tuple[str, str]], bool]:
+    """The columns of ``skeletons``, ``candidates`` or ``areas`` as ``(name, type)`` (``collapse``: with a
+    collapse step), and whether the layer carries the source's attributes."""
+
+def score(
+    polygons: list[Optional[bytes]],
+    lines: list[Optional[bytes]],
+    *,
+    fids: Optional[npt.NDArray[np.int64]] = None,
+    polygon_keys: Optional[list[Optional[str]]] = None,
+    line_keys: Optional[list[Optional[str]]] = None,
+    label: str = "external",
+    threads: Optional[int] = None,
+    output: Literal["geoarrow", "wkb"] = "wkb",
+    cancel: Optional[Cancel] = None,
+) -> dict[str, Any]:
+    """Scores another tool's lines against their polygons (``skeletonise score``): joined by key
+    (both key lists) or by location; what ``Pipeline.run`` returns, and ``unjoined`` (why some
+    line rows joined no polygon). Raises ValueError when no line joins any polygon."""
+
+def reserved(collapse: bool = False) -> list[str]:
+    """The names for which a source field is written as ``src_<name>`` (in every layer alike), with or without a collapse step."""
 
 def describe() -> str:
     """The methods and every step's options with their defaults."""

@@ -99,9 +99,8 @@ fn pipeline_error(e: ConfigError) -> PyErr {
 }
 
 impl Pipeline {
-    /// The steps, unless they need what only the command line writes: the
-    /// `collapse` step's kept areas are a second layer beside the lines, and
-    /// the `partition` step reads a second source (`input.neighbours`) and
+    /// The steps, unless they need what only the command line does: the
+    /// `partition` step reads a second source (`input.neighbours`) and
     /// writes the grown coverage once every polygon is done.
     fn supported(steps: config::Steps) -> PyResult<Self> {
         if steps.process_params().partition.is_some() {
@@ -109,12 +108,6 @@ impl Pipeline {
                 "the `partition` step reads the coverage of `input.neighbours` and writes it grown once every \
                  polygon is done, so it runs from the command line only (`skeletonise run`); leave it out \
                  of the pipeline given to Python",
-            ));
-        }
-        if steps.process_params().collapse.is_some() {
-            return Err(PipelineError::new_err(
-                "the `collapse` step writes kept areas beside the lines and runs from the command line only \
-                 (`skeletonise run`); leave it out of the pipeline given to Python",
             ));
         }
         Ok(Self { steps })
@@ -146,6 +139,13 @@ impl Pipeline {
                 })
             })
             .and_then(Self::supported)
+    }
+
+    /// Whether the pipeline has a `collapse` step (its kept areas come back
+    /// as `areas` from `run`).
+    #[getter]
+    fn collapse(&self) -> bool {
+        self.steps.process_params().collapse.is_some()
     }
 
     /// Whether the `prepare` step repairs invalid polygons.
@@ -184,7 +184,12 @@ impl Pipeline {
     /// Runs the steps on geometries given as WKB (`geometry` a list of bytes
     /// or None) or as ragged arrays (`geometry` a tuple `(type_id, coords,
     /// offsets, null)`, the layout of `shapely.to_ragged_array`).
-    #[pyo3(signature = (geometry, *, fids = None, repaired = None, candidates = false, explode = None, threads = None, output = "geoarrow", cancel = None))]
+    ///
+    /// With a `collapse` step the result also holds `areas`: the kept areas
+    /// (`row`, `columns`, `reals`, `geometry` as WKB polygons). `connect`
+    /// (WKB lines, with `connect_fids`) is the line network of
+    /// `input.connect`, `snap` its snap distance.
+    #[pyo3(signature = (geometry, *, fids = None, repaired = None, candidates = false, explode = None, threads = None, output = "geoarrow", cancel = None, connect = None, connect_fids = None, snap = 0.0))]
     #[allow(clippy::too_many_arguments)]
     fn run<'py>(
         &self,
@@ -197,8 +202,18 @@ impl Pipeline {
         threads: Option<usize>,
         output: &str,
         cancel: Option<PyRef<'py, Cancel>>,
+        connect: Option<Vec<Option<Vec<u8>>>>,
+        connect_fids: Option<Vec<i64>>,
+        snap: f64,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let params = self.steps.process_params();
+        let mut params = self.steps.process_params();
+        if let Some(lines) = connect {
+            params.connect = Some(std::sync::Arc::new(network(
+                &lines,
+                connect_fids.as_deref(),
+                snap,
+            )?));
+        }
         let opts = run::Options {
             explode: explode.unwrap_or_else(|| self.explode()),
             candidates,
@@ -213,28 +228,163 @@ impl Pipeline {
                     )))
                 }
             },
+            collapse: params.collapse.is_some(),
             cancel: cancel.map(|c| c.0.clone()),
+            given: None,
         };
         run::run(py, geometry, fids, repaired, &params, &opts)
     }
 }
 
-/// The columns of a layer (`skeletons` or `candidates`) as `(name, type)`
-/// pairs, type one of `int32`, `int64`, `real`, `text`, and whether the
-/// layer carries the source's attributes.
+/// Scores another tool's skeleton lines against their polygons with the
+/// paper's metrics, as `skeletonise score` does: the lines (WKB) are joined
+/// to the polygons (WKB) by key (`polygon_keys` and `line_keys`, texts) or,
+/// without keys, by location (the polygon holding the midpoint of a line's
+/// first segment); every polygon gets a row (`method` = `label`), one
+/// without lines a NULL one with the reason in `rejected`. Returns what
+/// `Pipeline.run` returns, and `unjoined`: why some line rows joined no
+/// polygon. Raises ValueError when no line joins any polygon.
 #[pyfunction]
-#[pyo3(signature = (layer, explode = false))]
-fn columns(layer: &str, explode: bool) -> PyResult<(Vec<(&'static str, &'static str)>, bool)> {
+#[pyo3(signature = (polygons, lines, *, fids = None, polygon_keys = None, line_keys = None, label = "external".to_string(), threads = None, output = "wkb", cancel = None))]
+#[allow(clippy::too_many_arguments)]
+fn score<'py>(
+    py: Python<'py>,
+    polygons: &Bound<'py, PyAny>,
+    lines: Vec<Option<Vec<u8>>>,
+    fids: Option<numpy::PyReadonlyArray1<'py, i64>>,
+    polygon_keys: Option<Vec<Option<String>>>,
+    line_keys: Option<Vec<Option<String>>>,
+    label: String,
+    threads: Option<usize>,
+    output: &str,
+    cancel: Option<PyRef<'py, Cancel>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    use skeletonise::score::join;
+    let wkbs: Vec<Option<Vec<u8>>> = polygons.extract()?;
+    let geoms: Vec<Option<geo::Geometry<f64>>> = wkbs
+        .iter()
+        .map(|w| w.as_deref().and_then(|w| wkb::read(w).ok()))
+        .collect();
+    let line_geoms: Vec<Vec<geo::LineString<f64>>> = lines
+        .iter()
+        .map(|w| join::lines_of(w.as_deref().and_then(|w| wkb::read(w).ok()).as_ref()))
+        .collect();
+    let mut unjoined = join::Unjoined::default();
+    let assigned =
+        match (polygon_keys, line_keys) {
+            (Some(pk), Some(lk)) => {
+                if pk.len() != geoms.len() || lk.len() != line_geoms.len() {
+                    return Err(PyValueError::new_err(
+                        "polygon_keys and line_keys must have one key per polygon and per line row",
+                    ));
+                }
+                join::by_key(&pk, lk.into_iter().zip(line_geoms), &mut unjoined)
+            }
+            (None, None) => {
+                let g: Vec<_> = geoms.iter().map(Option::as_ref).collect();
+                join::by_location(&g, line_geoms, &mut unjoined)
+            }
+            _ => return Err(PyValueError::new_err(
+                "give both polygon_keys and line_keys (join by key), or neither (join by location)",
+            )),
+        };
+    if assigned.iter().all(Vec::is_empty) {
+        return Err(PyValueError::new_err(
+            unjoined.nothing_joined("the join keys"),
+        ));
+    }
+    let params = skeletonise::process::ProcessParams {
+        prepare: skeletonise::process::PrepareParams {
+            make_valid: false,
+            ..Default::default()
+        },
+        score: Some(skeletonise::score::ScoreParams::default()),
+        ..Default::default()
+    };
+    let opts = run::Options {
+        explode: false,
+        candidates: false,
+        threads,
+        fail: false,
+        geoarrow_out: output == "geoarrow",
+        collapse: false,
+        cancel: cancel.map(|c| c.0.clone()),
+        given: Some(run::Given {
+            label,
+            lines: assigned.into_iter().map(geo::MultiLineString).collect(),
+        }),
+    };
+    let out = run::run(py, polygons, fids, None, &params, &opts)?;
+    out.cast::<pyo3::types::PyDict>()?
+        .set_item("unjoined", unjoined.reasons())?;
+    Ok(out)
+}
+
+/// The line network of `input.connect` from WKB lines (any line or
+/// polygon geometry: its lines), each with its source FID.
+fn network(
+    lines: &[Option<Vec<u8>>],
+    fids: Option<&[i64]>,
+    snap: f64,
+) -> PyResult<skeletonise::connect::Network> {
+    if fids.is_some_and(|f| f.len() != lines.len()) {
+        return Err(PyValueError::new_err(
+            "connect_fids must have one FID per line of connect",
+        ));
+    }
+    if !(snap.is_finite() && snap >= 0.0) {
+        return Err(PipelineError::new_err(format!(
+            "`snap`: {snap} is not a distance ≥ 0"
+        )));
+    }
+    let mut out = Vec::new();
+    for (i, w) in lines.iter().enumerate() {
+        let Some(w) = w else { continue };
+        let g = wkb::read(w).map_err(|e| {
+            PyValueError::new_err(format!("connecting line {i}: unsupported geometry: {e}"))
+        })?;
+        let mut ls = Vec::new();
+        skeletonise::connect::lines_of(&g, &mut ls);
+        let fid = fids.and_then(|f| u64::try_from(f[i]).ok());
+        out.extend(ls.into_iter().map(|l| (fid, l)));
+    }
+    if out.is_empty() {
+        return Err(PipelineError::new_err(
+            "the connecting layer has no lines: give a line layer (rivers, roads) that meets the polygons",
+        ));
+    }
+    Ok(skeletonise::connect::Network::new(out, snap))
+}
+
+/// The columns of a layer (`skeletons`, `candidates`, or `areas`, the
+/// `collapse` step's kept areas) as `(name, type)` pairs, type one of
+/// `int32`, `int64`, `real`, `text`, and whether the layer carries the
+/// source's attributes; `collapse`: the pipeline has a `collapse` step.
+#[pyfunction]
+#[pyo3(signature = (layer, explode = false, collapse = false))]
+fn columns(
+    layer: &str,
+    explode: bool,
+    collapse: bool,
+) -> PyResult<(Vec<(&'static str, &'static str)>, bool)> {
     let layer: &dyn Layer = match layer {
         "skeletons" => &SKELETON_LAYER,
         "candidates" => &CANDIDATE_LAYER,
+        "areas" => skeletonise::output::BUILTIN
+            .iter()
+            .copied()
+            .find(|l| l.name() == skeletonise::collapse::AREAS.name)
+            .expect("the areas layer is built in"),
         other => {
             return Err(PyValueError::new_err(format!(
-                "no layer `{other}`; the layers are `skeletons` and `candidates`"
+                "no layer `{other}`; the layers are `skeletons`, `candidates` and `areas`"
             )))
         }
     };
-    let holds = if explode { vec![When::Explode] } else { vec![] };
+    let mut holds = if explode { vec![When::Explode] } else { vec![] };
+    if collapse {
+        holds.extend([When::Collapse, When::Areas]);
+    }
     let plan = Plan::new(skeletonise::output::SKELETONS.name, holds, &[]);
     let cols = plan
         .columns(layer)
@@ -242,6 +392,20 @@ fn columns(layer: &str, explode: bool) -> PyResult<(Vec<(&'static str, &'static 
         .map(|(_, name, ty)| (name, type_name(ty)))
         .collect();
     Ok((cols, layer.fields().is_some()))
+}
+
+/// The names for which a source field is written as `src_<name>` (in every
+/// layer alike, as the command line's writer renames them), with or without
+/// a `collapse` step.
+#[pyfunction]
+#[pyo3(signature = (collapse = false))]
+fn reserved(collapse: bool) -> Vec<&'static str> {
+    let holds = if collapse {
+        vec![When::Collapse, When::Areas]
+    } else {
+        vec![]
+    };
+    Plan::new(skeletonise::output::SKELETONS.name, holds, &[]).reserved_names()
 }
 
 pub(crate) fn type_name(t: ColumnType) -> &'static str {
@@ -275,6 +439,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Pipeline>()?;
     m.add_class::<Cancel>()?;
     m.add_function(wrap_pyfunction!(columns, m)?)?;
+    m.add_function(wrap_pyfunction!(score, m)?)?;
+    m.add_function(wrap_pyfunction!(reserved, m)?)?;
     m.add_function(wrap_pyfunction!(describe, m)?)?;
     m.add_function(wrap_pyfunction!(schema, m)?)?;
     m.add_function(wrap_pyfunction!(labels::labels, m)?)?;

@@ -27,8 +27,22 @@ pub struct Options {
     pub fail: bool,
     /// Return geometries as GeoArrow buffers (else WKB).
     pub geoarrow_out: bool,
+    /// The pipeline has a `collapse` step: the skeletons have `collapsed`,
+    /// and the kept areas come back too (`areas`).
+    pub collapse: bool,
     /// Stop before the next feature once set (`Cancel`).
     pub cancel: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+    /// Another tool's skeletons to score, in place of the methods'.
+    pub given: Option<Given>,
+}
+
+/// Skeletons made by another tool (`score`): its name and the lines joined
+/// to each input polygon.
+pub struct Given {
+    /// The tool's name (the `method` column).
+    pub label: String,
+    /// The lines of each polygon, in input order.
+    pub lines: Vec<geo::MultiLineString<f64>>,
 }
 
 /// Why a call returns no rows.
@@ -129,6 +143,16 @@ struct Done {
     geometry: Encoded,
     counts: [u64; 4],
     timings: [f64; 3],
+    /// The `areas` layer (with a `collapse` step).
+    areas: Option<Areas>,
+}
+
+/// The rows of the `areas` layer: the input row of each, its columns and
+/// its polygon as WKB.
+struct Areas {
+    rows: Vec<i64>,
+    columns: Vec<ColumnData>,
+    geometry: Vec<Vec<u8>>,
 }
 
 enum Encoded {
@@ -213,6 +237,9 @@ pub fn plan_of(opts: &Options) -> Plan {
     if opts.explode {
         holds.push(When::Explode);
     }
+    if opts.collapse {
+        holds.extend([When::Collapse, When::Areas]);
+    }
     Plan::new(skeletonise::output::SKELETONS.name, holds, &[])
 }
 
@@ -242,8 +269,17 @@ fn work(
             .as_ref()
             .is_some_and(|c| c.load(std::sync::atomic::Ordering::Relaxed))
     };
-    let results: Vec<Option<FeatureRows>> = map_in_order(&feats, par, |_, f| {
-        (!cancelled()).then(|| feature_rows(f, Skeletons::Computed, params, row_opts))
+    let results: Vec<Option<FeatureRows>> = map_in_order(&feats, par, |i, f| {
+        (!cancelled()).then(|| {
+            let skeletons = match &opts.given {
+                None => Skeletons::Computed,
+                Some(g) => Skeletons::Given {
+                    label: &g.label,
+                    lines: g.lines.get(i),
+                },
+            };
+            feature_rows(f, skeletons, params, row_opts)
+        })
     });
     let Some(results) = results.into_iter().collect::<Option<Vec<FeatureRows>>>() else {
         return Err(Stop::Cancelled);
@@ -271,6 +307,12 @@ fn work(
         }
     }
     let plan = plan_of(opts);
+    // The input row of every kept area, before the rows are merged.
+    let area_rows: Vec<i64> = results
+        .iter()
+        .enumerate()
+        .flat_map(|(i, r)| std::iter::repeat_n(i as i64, r.rows.areas.len()))
+        .collect();
     let layer: &dyn Layer = if opts.candidates {
         &CANDIDATE_LAYER
     } else {
@@ -290,12 +332,14 @@ fn work(
             })
         }))
     };
+    let areas = (opts.collapse && !opts.candidates).then(|| areas_of(&plan, &all, area_rows));
     let t3 = Instant::now();
     Ok(Done {
         rows,
         columns,
         rejected,
         geometry,
+        areas,
         counts,
         timings: [
             (t1 - t0).as_secs_f64(),
@@ -303,6 +347,30 @@ fn work(
             (t3 - t2).as_secs_f64(),
         ],
     })
+}
+
+/// The `areas` layer of a call's rows (`rows`: the input row of each area).
+fn areas_of(plan: &Plan, all: &Rows, rows: Vec<i64>) -> Areas {
+    let layer = skeletonise::output::BUILTIN
+        .iter()
+        .copied()
+        .find(|l| l.name() == skeletonise::collapse::AREAS.name)
+        .expect("the areas layer is built in");
+    let items: Vec<Item> = (0..layer.count(all)).map(Item::Row).collect();
+    let geometry = (0..items.len())
+        .map(|i| {
+            let mut out = Vec::new();
+            if let Some(skeletonise::output::Shape::Polygon(p)) = layer.shape(all, i) {
+                wkb::write_polygon(p, &mut out);
+            }
+            out
+        })
+        .collect();
+    Areas {
+        rows,
+        columns: table::columns(layer, plan, all, &items),
+        geometry,
+    }
 }
 
 /// Runs with the GIL released, in a pool of `threads` when given: also for
@@ -501,20 +569,18 @@ fn text_buffers<'py>(py: Python<'py>, v: &[Option<String>]) -> PyResult<Bound<'p
         .into_any())
 }
 
-fn to_python(py: Python<'_>, d: Done) -> PyResult<Bound<'_, PyAny>> {
-    let out = PyDict::new(py);
-    // One row per input row, in order (no candidates, no parts, no rows
-    // added): the input's index is the output's as it is.
-    let in_order = d.rows.len() as u64 == d.counts[0]
-        && d.rows.iter().enumerate().all(|(i, &r)| r == i as i64);
-    out.set_item("in_order", in_order)?;
-    let n = d.rows.len();
-    out.set_item("row", PyArray1::from_vec(py, d.rows))?;
-    // The real columns as one block (a row each, as pandas keeps them);
-    // a real column's values are its row number in it.
+/// Columns for Python: `(name, type, values)` each (integers as `(values,
+/// null mask)`, texts as Arrow buffers, reals as their row in the block),
+/// and the real columns as one `(k, n)` block (a row each, as pandas keeps
+/// them).
+fn columns_to_python(
+    py: Python<'_>,
+    columns: Vec<ColumnData>,
+    n: usize,
+) -> PyResult<(Bound<'_, PyList>, Bound<'_, PyAny>)> {
     let (mut reals, mut real_rows): (Vec<f64>, usize) = (Vec::new(), 0);
     let cols = PyList::empty(py);
-    for c in d.columns {
+    for c in columns {
         let values = match c.values {
             Values::Int(v, null) if c.ty == ColumnType::Int32 => (
                 // In the column's width (the values came from 32-bit cells).
@@ -535,11 +601,38 @@ fn to_python(py: Python<'_>, d: Done) -> PyResult<Bound<'_, PyAny>> {
         };
         cols.append((c.name, type_name(c.ty), values))?;
     }
+    let reals = PyArray1::from_vec(py, reals)
+        .reshape([real_rows, n])?
+        .into_any();
+    Ok((cols, reals))
+}
+
+fn to_python(py: Python<'_>, d: Done) -> PyResult<Bound<'_, PyAny>> {
+    let out = PyDict::new(py);
+    // One row per input row, in order (no candidates, no parts, no rows
+    // added): the input's index is the output's as it is.
+    let in_order = d.rows.len() as u64 == d.counts[0]
+        && d.rows.iter().enumerate().all(|(i, &r)| r == i as i64);
+    out.set_item("in_order", in_order)?;
+    let n = d.rows.len();
+    out.set_item("row", PyArray1::from_vec(py, d.rows))?;
+    let (cols, reals) = columns_to_python(py, d.columns, n)?;
     out.set_item("columns", cols)?;
-    out.set_item(
-        "reals",
-        PyArray1::from_vec(py, reals).reshape([real_rows, n])?,
-    )?;
+    out.set_item("reals", reals)?;
+    if let Some(a) = d.areas {
+        let areas = PyDict::new(py);
+        let n = a.rows.len();
+        areas.set_item("row", PyArray1::from_vec(py, a.rows))?;
+        let (cols, reals) = columns_to_python(py, a.columns, n)?;
+        areas.set_item("columns", cols)?;
+        areas.set_item("reals", reals)?;
+        let list = PyList::empty(py);
+        for g in a.geometry {
+            list.append(PyBytes::new(py, &g))?;
+        }
+        areas.set_item("geometry", ("wkb", list))?;
+        out.set_item("areas", areas)?;
+    }
     out.set_item("rejected", text_buffers(py, &d.rejected)?)?;
     match d.geometry {
         Encoded::Ragged(r) => out.set_item(

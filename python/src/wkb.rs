@@ -189,6 +189,23 @@ pub fn write_lines(m: &MultiLineString<f64>, out: &mut Vec<u8>) {
     }
 }
 
+/// Writes a POLYGON as little-endian ISO WKB, appending to `out`.
+pub fn write_polygon(p: &Polygon<f64>, out: &mut Vec<u8>) {
+    let rings: Vec<&geo::LineString<f64>> =
+        std::iter::once(p.exterior()).chain(p.interiors()).collect();
+    out.reserve(9 + rings.iter().map(|r| 4 + 16 * r.0.len()).sum::<usize>());
+    out.push(1);
+    out.extend_from_slice(&3u32.to_le_bytes());
+    out.extend_from_slice(&(rings.len() as u32).to_le_bytes());
+    for r in rings {
+        out.extend_from_slice(&(r.0.len() as u32).to_le_bytes());
+        for c in &r.0 {
+            out.extend_from_slice(&c.x.to_le_bytes());
+            out.extend_from_slice(&c.y.to_le_bytes());
+        }
+    }
+}
+
 /// The areal parts of a repaired geometry, as the command line's reader
 /// keeps them after MakeValid: a polygon or multipolygon as it is, the
 /// polygons of a collection as a multipolygon, or the reason there are none.
@@ -254,6 +271,22 @@ mod tests {
         assert_eq!(read(&wkb_polygon(true, 1003, 3)).unwrap(), want);
         assert_eq!(read(&wkb_polygon(true, 3003, 4)).unwrap(), want);
         assert_eq!(read(&wkb_polygon(true, 0x8000_0003, 3)).unwrap(), want);
+    }
+
+    #[test]
+    fn polygons_round_trip() {
+        let p = Polygon::new(
+            LineString::from(vec![(0.0, 0.0), (4.0, 0.0), (4.0, 3.0), (0.0, 0.0)]),
+            vec![LineString::from(vec![
+                (1.0, 0.5),
+                (2.0, 0.5),
+                (2.0, 1.0),
+                (1.0, 0.5),
+            ])],
+        );
+        let mut out = Vec::new();
+        write_polygon(&p, &mut out);
+        assert_eq!(read(&out).unwrap(), Geometry::Polygon(p));
     }
 
     #[test]

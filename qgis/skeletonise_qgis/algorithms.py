@@ -10,8 +10,11 @@ the feedback.
 import json
 import os
 
+import numpy as np
+
 from qgis.core import (
     QgsFeature,
+    QgsFeatureRequest,
     QgsFeatureSink,
     QgsProcessing,
     QgsProcessingAlgorithm,
@@ -20,6 +23,7 @@ from qgis.core import (
     QgsProcessingParameterEnum,
     QgsProcessingParameterFeatureSink,
     QgsProcessingParameterFeatureSource,
+    QgsProcessingParameterField,
     QgsProcessingParameterFile,
     QgsProcessingParameterNumber,
     QgsProcessingParameterString,
@@ -35,6 +39,7 @@ PRUNE = ["significance", "length", "trunk", "none"]
 EXTEND = ["centred", "ray", "nearest", "none"]
 SELECT = ["distortion", "deviation", "deviation_parts", "distortion_sum"]
 PARTS = ["each", "largest"]
+COLLAPSE_MODES = ["partial", "whole"]
 
 HELP_URL = "https://github.com/skeletonise/skeletonise#in-qgis"
 
@@ -97,48 +102,80 @@ class _Algorithm(QgsProcessingAlgorithm):
             skip = {fields.at(i).name() for i in layer.dataProvider().pkAttributeIndexes()}
         return source, skip
 
-    def _pipeline_rows(self, pipeline, parameters, context, feedback, explode):
-        """Runs ``pipeline`` on INPUT, writing OUTPUT (and CANDIDATES when given)."""
+    def _connect(self, parameters, context, crs):
+        """The optional CONNECT line layer, in the polygons' CRS: (WKB lines, FIDs) or None."""
+        if parameters.get("CONNECT") is None:
+            return None
+        lines = self.parameterAsSource(parameters, "CONNECT", context)
+        if lines is None:
+            return None
+        request = QgsFeatureRequest().setDestinationCrs(crs, context.transformContext())
+        wkbs, fids = [], []
+        for f in lines.getFeatures(request):
+            fids.append(int(f.id()))
+            wkbs.append(bytes(f.geometry().asWkb()) if f.hasGeometry() else None)
+        return wkbs, fids
+
+    def _pipeline_rows(self, pipeline, parameters, context, feedback, explode, snap=0.0):
+        """Runs ``pipeline`` on INPUT, writing OUTPUT, CANDIDATES when given and,
+        with a collapse step, AREAS (the kept areas)."""
         source, skip = self._input(parameters, context)
+        crs = source.sourceCrs()
+        connect = self._connect(parameters, context, crs)
         features = bridge.read(source, pipeline.make_valid, feedback)
-        carried = bridge.source_fields(source.fields(), skip) if core_columns("skeletons", explode)[1] else []
-        results = {}
-        sinks = [("OUTPUT", False)]
-        if parameters.get("CANDIDATES") is not None and "CANDIDATES" in [p.name() for p in self.parameterDefinitions()]:
-            sinks.append(("CANDIDATES", True))
-        outputs = {}
-        for key, candidates in sinks:
-            tool, carries = core_columns("candidates" if candidates else "skeletons", explode)
-            fields = bridge.output_fields(source.fields(), carried if carries else [], tool)
-            sink, dest = self.parameterAsSink(
-                parameters, key, context, fields, QgsWkbTypes.MultiLineString, source.sourceCrs()
+        collapse = pipeline.collapse
+        carried = bridge.source_fields(source.fields(), skip)
+        names = [p.name() for p in self.parameterDefinitions()]
+        sinks = [("OUTPUT", "skeletons", QgsWkbTypes.MultiLineString)]
+        if "CANDIDATES" in names and parameters.get("CANDIDATES") is not None:
+            sinks.append(("CANDIDATES", "candidates", QgsWkbTypes.MultiLineString))
+        if collapse and "AREAS" in names:
+            sinks.append(("AREAS", "areas", QgsWkbTypes.Polygon))
+        results, outputs = {}, {}
+        for key, layer, kind in sinks:
+            tool, carries = core_columns(layer, explode, collapse)
+            fields = bridge.output_fields(
+                source.fields(),
+                carried if carries else [],
+                tool,
+                rejected=layer != "areas",
+                reserved=bridge.core().reserved(collapse),
             )
+            sink, dest = self.parameterAsSink(parameters, key, context, fields, kind, crs)
             if sink is None and key == "OUTPUT":
                 raise QgsProcessingException(self.invalidSinkError(parameters, key))
             if sink is not None:
-                outputs[key] = (sink, candidates, carried if carries else [])
+                outputs[key] = (sink, layer, carried if carries else [])
                 results[key] = dest
+        extra = {}
+        if connect is not None:
+            extra = {"connect": connect[0], "connect_fids": connect[1], "snap": snap}
         counts = {"read": len(features), "written": 0, "rejected": 0}
         parts = list(bridge.batches(features))
         for k, (start, end) in enumerate(parts):
-            done_all = {}
+            done = {}
             try:
-                for key, (_sink, candidates, _carried) in outputs.items():
-                    done_all[key] = bridge.run_pipeline(
-                        pipeline, features, (start, end), feedback, candidates=candidates, explode=explode
+                done["skeletons"] = bridge.run_pipeline(
+                    pipeline, features, (start, end), feedback, candidates=False, explode=explode, **extra
+                )
+                if "CANDIDATES" in outputs:
+                    done["candidates"] = bridge.run_pipeline(
+                        pipeline, features, (start, end), feedback, candidates=True, explode=explode, **extra
                     )
             except bridge.Cancelled:
                 feedback.pushInfo(f"cancelled: the first {start} of {len(features)} features are written")
                 break
             except bridge.core().RejectedError as e:
                 raise QgsProcessingException(str(e)) from None
-            for key, (sink, candidates, carried_here) in outputs.items():
-                done = done_all[key]
+            for _key, (sink, layer, carried_here) in outputs.items():
+                if layer == "areas":
+                    bridge.write(sink, done["skeletons"]["areas"], features, start, carried_here, _Quiet())
+                    continue
                 rejected = bridge.write(
-                    sink, done, features, start, carried_here, feedback if not candidates else _Quiet()
+                    sink, done[layer], features, start, carried_here, feedback if layer == "skeletons" else _Quiet()
                 )
-                if not candidates:
-                    counts["written"] += done["counts"]["written"]
+                if layer == "skeletons":
+                    counts["written"] += done[layer]["counts"]["written"]
                     counts["rejected"] += rejected
             feedback.setProgress(10 + 90 * (k + 1) / len(parts))
         feedback.pushInfo(
@@ -156,9 +193,9 @@ class _Quiet:
         pass
 
 
-def core_columns(layer, explode):
+def core_columns(layer, explode, collapse=False):
     """The tool's columns of ``layer`` and whether it carries the source's fields."""
-    return bridge.core().columns(layer, explode)
+    return bridge.core().columns(layer, explode, collapse)
 
 
 def _sinks(alg, candidates=True):
@@ -220,47 +257,145 @@ class SkeletoniseAlgorithm(_Algorithm):
 
     def initAlgorithm(self, config=None):  # noqa: N802
         _polygons(self)
-        self.addParameter(
-            QgsProcessingParameterEnum(
-                "METHODS", _tr("Methods"), options=METHODS, allowMultiple=True, defaultValue=list(range(len(METHODS)))
-            )
-        )
-        self.addParameter(QgsProcessingParameterEnum("PRUNE", _tr("Prune"), options=PRUNE, defaultValue=0))
-        self.addParameter(
-            QgsProcessingParameterNumber(
-                "MIN_LENGTH",
-                _tr("Minimum leg length (layer units; 0: none)"),
-                QgsProcessingParameterNumber.Double,
-                defaultValue=0.0,
-                minValue=0.0,
-            )
-        )
-        self.addParameter(QgsProcessingParameterEnum("EXTEND", _tr("Extend"), options=EXTEND, defaultValue=0))
-        self.addParameter(QgsProcessingParameterEnum("SELECT", _tr("Select by"), options=SELECT, defaultValue=0))
+        _method_parameters(self)
         self.addParameter(QgsProcessingParameterBoolean("EXPLODE", _tr("One row per polygon part"), defaultValue=False))
         _sinks(self)
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802
-        methods = [METHODS[i] for i in self.parameterAsEnums(parameters, "METHODS", context)]
-        if not methods:
-            raise QgsProcessingException("`methods`: choose at least one method")
-        prune = {"mode": PRUNE[self.parameterAsEnum(parameters, "PRUNE", context)]}
-        min_length = self.parameterAsDouble(parameters, "MIN_LENGTH", context)
-        if min_length > 0:
-            prune["min_length"] = min_length
-        doc = {
-            "steps": [
-                {"prepare": {}},
-                {"skeleton": {"methods": methods}},
-                {"prune": prune},
-                {"extend": {"mode": EXTEND[self.parameterAsEnum(parameters, "EXTEND", context)]}},
-                {"score": {}},
-                {"select": {"by": SELECT[self.parameterAsEnum(parameters, "SELECT", context)]}},
-            ]
-        }
+        doc = {"steps": _method_steps(self, parameters, context)}
         pipeline = bridge.options_pipeline(doc, "skeletonise:skeletonise")
         explode = self.parameterAsBoolean(parameters, "EXPLODE", context)
         return self._pipeline_rows(pipeline, parameters, context, feedback, explode)
+
+
+def _method_parameters(alg):
+    """METHODS, PRUNE, MIN_LENGTH, EXTEND and SELECT: the skeleton, prune, extend and select steps."""
+    alg.addParameter(
+        QgsProcessingParameterEnum(
+            "METHODS", _tr("Methods"), options=METHODS, allowMultiple=True, defaultValue=list(range(len(METHODS)))
+        )
+    )
+    alg.addParameter(QgsProcessingParameterEnum("PRUNE", _tr("Prune"), options=PRUNE, defaultValue=0))
+    alg.addParameter(
+        QgsProcessingParameterNumber(
+            "MIN_LENGTH",
+            _tr("Minimum leg length (layer units; 0: none)"),
+            QgsProcessingParameterNumber.Double,
+            defaultValue=0.0,
+            minValue=0.0,
+        )
+    )
+    alg.addParameter(QgsProcessingParameterEnum("EXTEND", _tr("Extend"), options=EXTEND, defaultValue=0))
+    alg.addParameter(QgsProcessingParameterEnum("SELECT", _tr("Select by"), options=SELECT, defaultValue=0))
+
+
+def _method_steps(alg, parameters, context, collapse=None):
+    """The steps of the method parameters (a collapse step after extend when given), as the pipeline file's."""
+    methods = [METHODS[i] for i in alg.parameterAsEnums(parameters, "METHODS", context)]
+    if not methods:
+        raise QgsProcessingException("`methods`: choose at least one method")
+    prune = {"mode": PRUNE[alg.parameterAsEnum(parameters, "PRUNE", context)]}
+    min_length = alg.parameterAsDouble(parameters, "MIN_LENGTH", context)
+    if min_length > 0:
+        prune["min_length"] = min_length
+    steps = [
+        {"prepare": {}},
+        {"skeleton": {"methods": methods}},
+        {"prune": prune},
+        {"extend": {"mode": EXTEND[alg.parameterAsEnum(parameters, "EXTEND", context)]}},
+    ]
+    if collapse is not None:
+        steps.append({"collapse": collapse})
+    steps += [{"score": {}}, {"select": {"by": SELECT[alg.parameterAsEnum(parameters, "SELECT", context)]}}]
+    return steps
+
+
+def _connect_parameters(alg):
+    alg.addParameter(
+        QgsProcessingParameterFeatureSource(
+            "CONNECT",
+            _tr("Connecting lines (rivers, roads: the skeleton gets a leg to where they meet the polygon)"),
+            [QgsProcessing.TypeVectorLine],
+            optional=True,
+        )
+    )
+    alg.addParameter(
+        QgsProcessingParameterNumber(
+            "SNAP",
+            _tr("Snap distance of the connecting lines (layer units)"),
+            QgsProcessingParameterNumber.Double,
+            defaultValue=0.0,
+            minValue=0.0,
+        )
+    )
+
+
+def _areas_sink(alg):
+    alg.addParameter(
+        QgsProcessingParameterFeatureSink(
+            "AREAS", _tr("Kept areas"), QgsProcessing.TypeVectorPolygon, optional=True
+        )
+    )
+
+
+class CollapseAlgorithm(_Algorithm):
+    """Narrow polygons to lines, wide parts kept as areas (the collapse step)."""
+
+    NAME = "collapse"
+    DISPLAY = "Collapse narrow polygons"
+    HELP = (
+        "Collapses polygons to lines where they are narrower than a width and keeps them as areas where "
+        "they are wider, cut across the polygon between, as the command line's collapse step: rivers "
+        "that become lines where narrow and stay areas where wide, lakes on a river network.\n\n"
+        "<b>Polygons</b>: a polygon layer in a projected CRS.\n"
+        "<b>Collapse width</b>: the polygon becomes a line where its local width is below this (layer "
+        "units).\n"
+        "<b>Tolerance</b>: a band around the width, as a fraction of it (0.2): a point within "
+        "width·(1 ± tolerance) takes the class of the nearer point outside the band, so that a river "
+        "oscillating around the width is not chopped into pieces.\n"
+        "<b>Minimum length</b>: the shortest collapsed or kept stretch (0: the width); a shorter one "
+        "takes its neighbours' class.\n"
+        "<b>Mode</b>: partial (lines where narrow, areas where wide) or whole (a polygon part collapses "
+        "entirely when more than half of its area is narrow, otherwise it is kept).\n"
+        "<b>Smallest kept area</b>: a kept area smaller than this whose every cut leads to a collapsed "
+        "line is collapsed too (0: off; a few width² is typical).\n"
+        "<b>Connecting lines</b>: optional line layer (rivers into a lake, roads): the skeleton gets a leg "
+        "to every point where a line meets the polygon (within the snap distance).\n"
+        "<b>Methods</b>, <b>Prune</b>, <b>Extend</b>, <b>Select by</b>: as in Skeletonise polygons.\n"
+        "<b>Skeletons</b>: the lines, with collapsed = 1 where the polygon collapsed.\n"
+        "<b>Kept areas</b>: the pieces kept as areas, with cuts (where collapsed lines meet them)."
+    )
+
+    def initAlgorithm(self, config=None):  # noqa: N802
+        _polygons(self)
+        number = QgsProcessingParameterNumber.Double
+        self.addParameter(QgsProcessingParameterNumber("WIDTH", _tr("Collapse width (layer units)"), number, minValue=0.0))
+        self.addParameter(QgsProcessingParameterNumber("TOLERANCE", _tr("Tolerance (fraction of the width)"), number, 0.2, minValue=0.0, maxValue=0.99))
+        self.addParameter(QgsProcessingParameterNumber("COLLAPSE_MIN_LENGTH", _tr("Minimum length (layer units; 0: the width)"), number, 0.0, minValue=0.0))
+        self.addParameter(QgsProcessingParameterEnum("MODE", _tr("Mode"), options=COLLAPSE_MODES, defaultValue=0))
+        self.addParameter(QgsProcessingParameterNumber("MIN_AREA", _tr("Smallest kept area (layer units²; 0: off)"), number, 0.0, minValue=0.0))
+        _connect_parameters(self)
+        _method_parameters(self)
+        _sinks(self, candidates=False)
+        _areas_sink(self)
+
+    def processAlgorithm(self, parameters, context, feedback):  # noqa: N802
+        width = self.parameterAsDouble(parameters, "WIDTH", context)
+        if not width > 0:
+            raise QgsProcessingException("`width`: give the collapse width, a distance > 0 in the layer's units")
+        collapse = {
+            "width": width,
+            "tolerance": self.parameterAsDouble(parameters, "TOLERANCE", context),
+            "mode": COLLAPSE_MODES[self.parameterAsEnum(parameters, "MODE", context)],
+            "min_area": self.parameterAsDouble(parameters, "MIN_AREA", context),
+        }
+        min_length = self.parameterAsDouble(parameters, "COLLAPSE_MIN_LENGTH", context)
+        if min_length > 0:
+            collapse["min_length"] = min_length
+        doc = {"steps": _method_steps(self, parameters, context, collapse)}
+        pipeline = bridge.options_pipeline(doc, "skeletonise:collapse")
+        snap = self.parameterAsDouble(parameters, "SNAP", context)
+        return self._pipeline_rows(pipeline, parameters, context, feedback, False, snap)
 
 
 class PipelineAlgorithm(_Algorithm):
@@ -271,13 +406,16 @@ class PipelineAlgorithm(_Algorithm):
     HELP = (
         "Runs the steps of a skeletonise pipeline file (YAML) on a polygon layer: the same file as "
         "`skeletonise run FILE.yaml` takes; its input and output sections are not used (the layers of "
-        "this dialog are), except output.explode and on_error. The collapse and partition steps, which "
-        "write layers of their own, run from the command line only.\n\n"
+        "this dialog are), except output.explode and on_error. The partition step, which reads a "
+        "second coverage, runs from the command line only.\n\n"
         "<b>Pipeline file</b>: the YAML file; it is validated as `skeletonise validate` does, with the "
         "same messages.\n"
+        "<b>Connecting lines</b>, <b>Snap distance</b>: the line network of input.connect (for prune "
+        "mode network, or legs to where the lines meet the polygons).\n"
         "<b>Overrides</b>: optional KEY=VALUE settings, as the command line's --set, separated by "
         "semicolons or new lines, e.g. steps.skeleton.methods=[MA]; steps.prune.mode=trunk.\n"
-        "<b>Skeletons</b>, <b>Candidates</b>: as in Skeletonise polygons."
+        "<b>Skeletons</b>, <b>Candidates</b>: as in Skeletonise polygons; <b>Kept areas</b>: with a "
+        "collapse step, as in Collapse narrow polygons."
     )
 
     def initAlgorithm(self, config=None):  # noqa: N802
@@ -290,7 +428,9 @@ class PipelineAlgorithm(_Algorithm):
         self.addParameter(
             QgsProcessingParameterString("OVERRIDES", _tr("Overrides (KEY=VALUE; …)"), optional=True, multiLine=True)
         )
+        _connect_parameters(self)
         _sinks(self)
+        _areas_sink(self)
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802
         path = self.parameterAsFile(parameters, "PIPELINE", context)
@@ -301,7 +441,8 @@ class PipelineAlgorithm(_Algorithm):
             pipeline = core.Pipeline.load(path, overrides)
         except (core.PipelineError, OSError) as e:
             raise QgsProcessingException(str(e)) from None
-        return self._pipeline_rows(pipeline, parameters, context, feedback, pipeline.explode)
+        snap = self.parameterAsDouble(parameters, "SNAP", context)
+        return self._pipeline_rows(pipeline, parameters, context, feedback, pipeline.explode, snap)
 
 
 class LabelAlgorithm(_Algorithm):
@@ -390,4 +531,104 @@ class LabelAlgorithm(_Algorithm):
         return {"OUTPUT": dest, "FEATURES_READ": len(features), "FEATURES_REJECTED": rejected_count}
 
 
-ALGORITHMS = [SkeletoniseAlgorithm, PipelineAlgorithm, LabelAlgorithm]
+def _key_text(value):
+    """A join key as the command line reads it: integers without a decimal point, NULL as None."""
+    if value is None or (hasattr(value, "isNull") and value.isNull()):
+        return None
+    if isinstance(value, float):
+        return str(int(value)) if value.is_integer() else repr(value)
+    return str(value)
+
+
+class ScoreAlgorithm(_Algorithm):
+    """Any line layer scored against a polygon layer (the `score` command)."""
+
+    NAME = "score"
+    DISPLAY = "Score skeletons"
+    HELP = (
+        "Scores skeleton lines made by any tool (GRASS v.voronoi -s, PostGIS ST_ApproximateMedialAxis, "
+        "a hand-drawn centreline, …) against their polygons with the deviation and distortion metrics of "
+        "Szombara's comparison of skeletonisation methods, as `skeletonise score` does: every polygon "
+        "gets one row with its lines merged and their scores.\n\n"
+        "<b>Polygons</b>: a polygon layer in a projected CRS.\n"
+        "<b>Skeletons</b>: the line layer to score (reprojected to the polygons' CRS when it differs).\n"
+        "<b>Skeleton key</b>: the skeleton field holding its polygon's key (the polygon's FID, or the "
+        "Polygon key field); without it, each line goes to the polygon holding the midpoint of its first "
+        "segment.\n"
+        "<b>Polygon key</b>: the polygon field the skeleton key matches (default: the FID).\n"
+        "<b>Label</b>: the method column's value (the other tool's name).\n"
+        "<b>Scores</b>: the polygon's fields, src_fid, method, the scores and counts, and rejected (why a "
+        "polygon has no score: no line joined, or most of its line outside it)."
+    )
+
+    def initAlgorithm(self, config=None):  # noqa: N802
+        _polygons(self)
+        self.addParameter(
+            QgsProcessingParameterFeatureSource("SKELETONS", _tr("Skeletons (lines)"), [QgsProcessing.TypeVectorLine])
+        )
+        self.addParameter(
+            QgsProcessingParameterField("SKELETON_KEY", _tr("Skeleton key field"), parentLayerParameterName="SKELETONS", optional=True)
+        )
+        self.addParameter(
+            QgsProcessingParameterField("POLYGON_KEY", _tr("Polygon key field (default: the FID)"), parentLayerParameterName="INPUT", optional=True)
+        )
+        self.addParameter(QgsProcessingParameterString("LABEL", _tr("Label (the method column)"), defaultValue="external"))
+        self.addParameter(QgsProcessingParameterFeatureSink("OUTPUT", _tr("Scores"), QgsProcessing.TypeVectorLine))
+
+    def processAlgorithm(self, parameters, context, feedback):  # noqa: N802
+        source, skip = self._input(parameters, context)
+        crs = source.sourceCrs()
+        lines = self.parameterAsSource(parameters, "SKELETONS", context)
+        if lines is None:
+            raise QgsProcessingException(self.invalidSourceError(parameters, "SKELETONS"))
+        skeleton_key = self.parameterAsString(parameters, "SKELETON_KEY", context) or None
+        polygon_key = self.parameterAsString(parameters, "POLYGON_KEY", context) or None
+        if polygon_key and not skeleton_key:
+            raise QgsProcessingException(
+                "a polygon key field needs a skeleton key field (the skeleton field that holds it); "
+                "leave both empty to join by location"
+            )
+        features = bridge.read(source, False, feedback)
+        request = QgsFeatureRequest().setDestinationCrs(crs, context.transformContext())
+        line_wkbs, line_keys = [], []
+        for f in lines.getFeatures(request):
+            line_wkbs.append(bytes(f.geometry().asWkb()) if f.hasGeometry() else None)
+            if skeleton_key:
+                line_keys.append(_key_text(f[skeleton_key]))
+        keys = {}
+        if skeleton_key:
+            if polygon_key:
+                index = source.fields().lookupField(polygon_key)
+                polygon_keys = [_key_text(a[index]) for a in features.attributes]
+            else:
+                polygon_keys = [str(fid) for fid in features.fids]
+            keys = {"polygon_keys": polygon_keys, "line_keys": line_keys}
+        core = bridge.core()
+        try:
+            done = bridge.cancellable(
+                feedback,
+                core.score,
+                features.wkbs,
+                line_wkbs,
+                fids=np.asarray(features.fids, dtype=np.int64),
+                label=self.parameterAsString(parameters, "LABEL", context) or "external",
+                output="wkb",
+                **keys,
+            )
+        except bridge.Cancelled:
+            return {}
+        except ValueError as e:
+            raise QgsProcessingException(str(e)) from None
+        for why in done["unjoined"]:
+            feedback.pushInfo(f"skeleton rows joined to no polygon and left out: {why}")
+        carried = bridge.source_fields(source.fields(), skip)
+        tool, carries = core_columns("skeletons", False)
+        fields = bridge.output_fields(source.fields(), carried if carries else [], tool, reserved=core.reserved())
+        sink, dest = self.parameterAsSink(parameters, "OUTPUT", context, fields, QgsWkbTypes.MultiLineString, crs)
+        if sink is None:
+            raise QgsProcessingException(self.invalidSinkError(parameters, "OUTPUT"))
+        rejected = bridge.write(sink, done, features, 0, carried if carries else [], feedback)
+        return {"OUTPUT": dest, "FEATURES_READ": len(features), "FEATURES_REJECTED": rejected}
+
+
+ALGORITHMS = [SkeletoniseAlgorithm, CollapseAlgorithm, ScoreAlgorithm, PipelineAlgorithm, LabelAlgorithm]

@@ -133,12 +133,12 @@ def source_fields(fields, skip):
     return [i for i in range(fields.count()) if fields.at(i).name() not in skip]
 
 
-def output_fields(fields, carried, tool_columns, rejected=True):
+def output_fields(fields, carried, tool_columns, rejected=True, reserved=()):
     """The sink's fields: the carried source fields (``src_<name>`` where a
-    name is one of the tool's, as the command line's writer renames them),
-    the tool's columns, then ``rejected``."""
+    name is one of the tool's or of ``reserved``, as the command line's
+    writer renames them), the tool's columns, then ``rejected``."""
     out = QgsFields()
-    clash = {name.lower() for name, _ in tool_columns} | {"rejected"}
+    clash = {name.lower() for name, _ in tool_columns} | {n.lower() for n in reserved} | {"rejected"}
     for i in carried:
         f = QgsField(fields.at(i))
         if f.name().lower() in clash:
@@ -172,7 +172,8 @@ def columns(done):
             out.append([None if math.isnan(x) else x for x in reals[values].tolist()])
         else:
             out.append(_texts(*values))
-    out.append(_texts(*done["rejected"]))
+    if "rejected" in done:
+        out.append(_texts(*done["rejected"]))
     return out
 
 
@@ -216,7 +217,7 @@ def cancellable(feedback, call, *args, **kwargs):
     return out["done"]
 
 
-def run_pipeline(pipeline, features, batch, feedback, *, candidates, explode=None):
+def run_pipeline(pipeline, features, batch, feedback, *, candidates, explode=None, **extra):
     """One batch through ``Pipeline.run``, cancellable: the result's rows
     (input positions within the batch), columns and WKB geometries."""
     start, end = batch
@@ -229,17 +230,18 @@ def run_pipeline(pipeline, features, batch, feedback, *, candidates, explode=Non
         candidates=candidates,
         explode=explode,
         output="wkb",
+        **extra,
     )
 
 
-def write(sink, done, features, start, carried, feedback, fid_of=None):
+def write(sink, done, features, start, carried, feedback):
     """The rows of ``done`` as features of ``sink``; a rejected feature is
     reported through ``feedback.reportError`` (its row is kept: NULL
     geometry, the reason in ``rejected``). Returns the number rejected."""
     cols = columns(done)
     rows = done["row"].tolist()
     wkbs = done["geometry"][1]
-    reasons = cols[-1]
+    reasons = cols[-1] if "rejected" in done else [None] * len(rows)
     rejected = 0
     for k, r in enumerate(rows):
         i = start + r

@@ -15,9 +15,7 @@ use super::reader::{FieldInfo, SourceInfo};
 use super::{signals, IoError};
 use crate::feature::Value;
 use crate::layer::Fields;
-use crate::output::{
-    Cell, ColumnType, GeometryKind, Layer, Plan, Rows, RunRecord, Shape, SKELETONS,
-};
+use crate::output::{Cell, ColumnType, GeometryKind, Layer, Plan, Rows, RunRecord, Shape};
 use gdal::spatial_ref::SpatialRef;
 use gdal::vector::{
     Feature, FieldDefn, FieldValue, Geometry, LayerAccess, LayerOptions, OGRFieldType,
@@ -405,24 +403,14 @@ impl Writer {
 }
 
 /// The source's fields as the output names them: those whose names clash
-/// with a column of the skeleton layer, or of another layer of the plan that
-/// carries the source's fields (a registered step's, e.g. `labels`), get a
-/// `src_` prefix — in every layer alike.
+/// with [`Plan::reserved_names`] get a `src_` prefix — in every layer alike.
 fn source_fields(source: &SourceInfo, plan: &Plan) -> Vec<(String, FieldInfo)> {
-    let steps: Vec<&'static str> = plan
-        .layers()
-        .into_iter()
-        .filter(|l| l.fields() == Some(crate::layer::Fields::Input))
-        .flat_map(|l| l.columns().into_iter().map(|c| c.name))
-        .collect();
+    let reserved = plan.reserved_names();
     source
         .fields
         .iter()
         .map(|f| {
-            let clash = SKELETONS
-                .column_names()
-                .chain(steps.iter().copied())
-                .any(|n| n.eq_ignore_ascii_case(&f.name));
+            let clash = reserved.iter().any(|n| n.eq_ignore_ascii_case(&f.name));
             (
                 if clash {
                     format!("src_{}", f.name)

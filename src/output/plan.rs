@@ -54,6 +54,23 @@ impl Plan {
             .collect()
     }
 
+    /// The names for which a source field is written as `src_<name>`: the
+    /// columns of the skeleton layer (every one, whether written or not)
+    /// and of every other layer of the plan that carries the source's
+    /// fields (the kept `areas`, a registered step's, e.g. `labels`) — in
+    /// every layer alike, so that a field keeps one name in the output.
+    pub fn reserved_names(&self) -> Vec<&'static str> {
+        super::SKELETONS
+            .column_names()
+            .chain(
+                self.layers()
+                    .into_iter()
+                    .filter(|l| l.fields() == Some(crate::layer::Fields::Input))
+                    .flat_map(|l| l.columns().into_iter().map(|c| c.name)),
+            )
+            .collect()
+    }
+
     /// The name `layer` is written under (the skeleton layer's is
     /// configurable).
     pub fn name_of<'a>(&'a self, layer: &dyn Layer) -> &'a str {

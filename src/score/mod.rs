@@ -63,6 +63,7 @@
 
 mod bars;
 pub mod defects;
+pub mod join;
 mod metrics;
 pub mod select;
 
