@@ -433,5 +433,28 @@ class Labels(Case):
         self.assertTrue(all(r["minzoom"] is not None for r in got))
 
 
+class Screenshots(Case):
+    def test_the_dialog_and_a_result_are_drawn(self):
+        p = subprocess.run(
+            [sys.executable, os.path.join(ROOT, "qgis", "tests", "screenshots.py"), self.dir],
+            capture_output=True, text=True, cwd=ROOT,
+        )
+        self.assertEqual(p.returncode, 0, p.stderr)
+        from qgis.PyQt.QtGui import QImage
+
+        def colours(name):
+            img = QImage(self.out(name))
+            self.assertFalse(img.isNull(), name)
+            return img, {img.pixel(x, y) & 0xFFFFFF for x in range(0, img.width(), 3) for y in range(0, img.height(), 3)}
+
+        dialog, seen = colours("qgis-dialog.png")
+        self.assertGreaterEqual(dialog.width(), 900)
+        self.assertGreater(len(seen), 20, "the dialog is blank")
+        _, seen = colours("qgis-canvas.png")
+        # The lochs' fill, the skeletons' red and the label lines' green are all drawn.
+        for rgb in (0xA6CEE3, 0xE31A1C, 0x33A02C):
+            self.assertIn(rgb, seen, f"colour {rgb:06x} not drawn")
+
+
 if __name__ == "__main__":
     unittest.main(verbosity=2)
