@@ -197,6 +197,23 @@ class Skeletonise(Case):
             del r["rejected"]
         self.assertSameRows(got, rows(self.out("cli.gpkg"), "skeletons"))
 
+    def test_without_the_wheel_the_provider_loads_and_says_what_to_install(self):
+        env = dict(os.environ, SKELETONISE_QGIS_NO_WHEEL="1")
+        env.pop("PYTHONPATH", None)
+        script = os.path.join(ROOT, "scripts", "qgis-process.sh")
+        listed = subprocess.run([script, "list"], capture_output=True, text=True, cwd=ROOT, env=env)
+        self.assertEqual(listed.returncode, 0, listed.stderr)
+        self.assertIn("skeletonise:skeletonise", listed.stdout)
+        run = subprocess.run(
+            [script, "run", "skeletonise:skeletonise", "--", f"INPUT={TRAIN}|layername=lakes_scotland",
+             f"OUTPUT={self.out('x.gpkg')}"],
+            capture_output=True, text=True, cwd=ROOT, env=env,
+        )
+        self.assertNotEqual(run.returncode, 0)
+        self.assertIn("skeletonise Python package", run.stdout + run.stderr)
+        self.assertIn("pip install --no-deps", run.stdout + run.stderr)
+        self.assertFalse(os.path.exists(self.out("x.gpkg")))
+
     def test_a_geographic_layer_is_refused_with_the_reprojection_hint(self):
         lonlat = processing.run(
             "native:reprojectlayer",
