@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
 # Makes the Python environment under target/py-venv (nothing is installed system-wide):
-# maturin, pytest, GeoPandas, Dask from PyPI, then builds the package's abi3 wheel into
-# target/wheels and installs it there. The wheel is built with the cargo profile
-# $SKELETONISE_WHEEL_PROFILE (default release; CI uses `dev`, whose dependencies
-# scripts/test.sh has compiled). On a fresh Debian/Ubuntu machine it
-# first installs Python's venv module and headers (the binding's unit tests link to
-# libpython) when they are missing.
+# maturin, pytest, GeoPandas, Dask from PyPI, then builds the package's wheel into
+# target/wheels with scripts/build-wheel.sh (abi3, manylinux_2_28: the wheel that installs
+# on any Linux, checked by auditwheel) and installs it there. The wheel is built with the
+# cargo profile $SKELETONISE_WHEEL_PROFILE (default release, as CI).
+#   scripts/python-env.sh             # the environment and the wheel
+#   scripts/python-env.sh --no-wheel  # the environment only (scripts/build-wheel.sh uses it)
+# On a fresh Debian/Ubuntu machine it first installs Python's venv module and headers (the
+# binding's unit tests link to libpython) when they are missing.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 venv=target/py-venv
@@ -22,7 +24,9 @@ fi
 [ -x "$venv/bin/python" ] || "$py" -m venv "$venv"
 "$venv/bin/python" -m pip install -q --upgrade pip
 "$venv/bin/python" -m pip install -q maturin pytest geopandas dask distributed dask-geopandas pyarrow "shapely>=2.2" pyogrio
-rm -rf target/wheels
-"$venv/bin/maturin" build --profile "${SKELETONISE_WHEEL_PROFILE:-release}" --quiet -m python/Cargo.toml \
-  -i "$venv/bin/python" -o target/wheels
+if [ "${1:-}" = --no-wheel ]; then
+  exit 0
+fi
+# It leaves one wheel in target/wheels, or fails.
+scripts/build-wheel.sh
 "$venv/bin/python" -m pip install -q --force-reinstall --no-deps target/wheels/skeletonise-*.whl
