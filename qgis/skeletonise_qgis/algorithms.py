@@ -268,13 +268,15 @@ class SkeletoniseAlgorithm(_Algorithm):
         return self._pipeline_rows(pipeline, parameters, context, feedback, explode)
 
 
-def _method_parameters(alg):
-    """METHODS, PRUNE, MIN_LENGTH, EXTEND and SELECT: the skeleton, prune, extend and select steps."""
-    alg.addParameter(
-        QgsProcessingParameterEnum(
-            "METHODS", _tr("Methods"), options=METHODS, allowMultiple=True, defaultValue=list(range(len(METHODS)))
+def _method_parameters(alg, choose=True):
+    """METHODS, PRUNE, MIN_LENGTH, EXTEND and SELECT: the skeleton, prune, extend and select steps
+    (without METHODS and SELECT when the method is not a choice: collapse draws the medial axis)."""
+    if choose:
+        alg.addParameter(
+            QgsProcessingParameterEnum(
+                "METHODS", _tr("Methods"), options=METHODS, allowMultiple=True, defaultValue=list(range(len(METHODS)))
+            )
         )
-    )
     alg.addParameter(QgsProcessingParameterEnum("PRUNE", _tr("Prune"), options=PRUNE, defaultValue=0))
     alg.addParameter(
         QgsProcessingParameterNumber(
@@ -286,12 +288,17 @@ def _method_parameters(alg):
         )
     )
     alg.addParameter(QgsProcessingParameterEnum("EXTEND", _tr("Extend"), options=EXTEND, defaultValue=0))
-    alg.addParameter(QgsProcessingParameterEnum("SELECT", _tr("Select by"), options=SELECT, defaultValue=0))
+    if choose:
+        alg.addParameter(QgsProcessingParameterEnum("SELECT", _tr("Select by"), options=SELECT, defaultValue=0))
 
 
 def _method_steps(alg, parameters, context, collapse=None):
-    """The steps of the method parameters (a collapse step after extend when given), as the pipeline file's."""
-    methods = [METHODS[i] for i in alg.parameterAsEnums(parameters, "METHODS", context)]
+    """The steps of the method parameters (a collapse step after extend when given, with the
+    medial axis alone, as the collapse step needs), as the pipeline file's."""
+    if collapse is not None:
+        methods = ["MA"]
+    else:
+        methods = [METHODS[i] for i in alg.parameterAsEnums(parameters, "METHODS", context)]
     if not methods:
         raise QgsProcessingException("`methods`: choose at least one method")
     prune = {"mode": PRUNE[alg.parameterAsEnum(parameters, "PRUNE", context)]}
@@ -305,8 +312,9 @@ def _method_steps(alg, parameters, context, collapse=None):
         {"extend": {"mode": EXTEND[alg.parameterAsEnum(parameters, "EXTEND", context)]}},
     ]
     if collapse is not None:
-        steps.append({"collapse": collapse})
-    steps += [{"score": {}}, {"select": {"by": SELECT[alg.parameterAsEnum(parameters, "SELECT", context)]}}]
+        steps += [{"collapse": collapse}, {"score": {}}, {"select": {}}]
+    else:
+        steps += [{"score": {}}, {"select": {"by": SELECT[alg.parameterAsEnum(parameters, "SELECT", context)]}}]
     return steps
 
 
@@ -322,7 +330,7 @@ def _connect_parameters(alg):
     alg.addParameter(
         QgsProcessingParameterNumber(
             "SNAP",
-            _tr("Snap distance of the connecting lines (layer units)"),
+            _tr("Snap distance (layer units)"),
             QgsProcessingParameterNumber.Double,
             defaultValue=0.0,
             minValue=0.0,
@@ -360,8 +368,11 @@ class CollapseAlgorithm(_Algorithm):
         "<b>Smallest kept area</b>: a kept area smaller than this whose every cut leads to a collapsed "
         "line is collapsed too (0: off; a few width² is typical).\n"
         "<b>Connecting lines</b>: optional line layer (rivers into a lake, roads): the skeleton gets a leg "
-        "to every point where a line meets the polygon (within the snap distance).\n"
-        "<b>Methods</b>, <b>Prune</b>, <b>Extend</b>, <b>Select by</b>: as in Skeletonise polygons.\n"
+        "to every point where a line meets the polygon.\n"
+        "<b>Snap distance</b>: a connecting line's end this close to the polygon's boundary meets it too "
+        "(layer units; 0: only lines that touch or cross it).\n"
+        "<b>Prune</b>, <b>Minimum leg length</b>, <b>Extend</b>: as in Skeletonise polygons; the lines are "
+        "the medial axis's (MA), on whose inscribed discs the polygon is cut.\n"
         "<b>Skeletons</b>: the lines, with collapsed = 1 where the polygon collapsed.\n"
         "<b>Kept areas</b>: the pieces kept as areas, with cuts (where collapsed lines meet them)."
     )
@@ -375,7 +386,7 @@ class CollapseAlgorithm(_Algorithm):
         self.addParameter(QgsProcessingParameterEnum("MODE", _tr("Mode"), options=COLLAPSE_MODES, defaultValue=0))
         self.addParameter(QgsProcessingParameterNumber("MIN_AREA", _tr("Smallest kept area (layer units²; 0: off)"), number, 0.0, minValue=0.0))
         _connect_parameters(self)
-        _method_parameters(self)
+        _method_parameters(self, choose=False)
         _sinks(self, candidates=False)
         _areas_sink(self)
 
@@ -408,6 +419,7 @@ class PipelineAlgorithm(_Algorithm):
         "`skeletonise run FILE.yaml` takes; its input and output sections are not used (the layers of "
         "this dialog are), except output.explode and on_error. The partition step, which reads a "
         "second coverage, runs from the command line only.\n\n"
+        "<b>Polygons</b>: a polygon layer in a projected CRS.\n"
         "<b>Pipeline file</b>: the YAML file; it is validated as `skeletonise validate` does, with the "
         "same messages.\n"
         "<b>Connecting lines</b>, <b>Snap distance</b>: the line network of input.connect (for prune "
@@ -567,10 +579,10 @@ class ScoreAlgorithm(_Algorithm):
             QgsProcessingParameterFeatureSource("SKELETONS", _tr("Skeletons (lines)"), [QgsProcessing.TypeVectorLine])
         )
         self.addParameter(
-            QgsProcessingParameterField("SKELETON_KEY", _tr("Skeleton key field"), parentLayerParameterName="SKELETONS", optional=True)
+            QgsProcessingParameterField("SKELETON_KEY", _tr("Skeleton key"), parentLayerParameterName="SKELETONS", optional=True)
         )
         self.addParameter(
-            QgsProcessingParameterField("POLYGON_KEY", _tr("Polygon key field (default: the FID)"), parentLayerParameterName="INPUT", optional=True)
+            QgsProcessingParameterField("POLYGON_KEY", _tr("Polygon key (default: the FID)"), parentLayerParameterName="INPUT", optional=True)
         )
         self.addParameter(QgsProcessingParameterString("LABEL", _tr("Label (the method column)"), defaultValue="external"))
         self.addParameter(QgsProcessingParameterFeatureSink("OUTPUT", _tr("Scores"), QgsProcessing.TypeVectorLine))

@@ -297,7 +297,6 @@ class Collapse(Case):
             {
                 "INPUT": f"{TRAIN}|layername=river_lena",
                 "WIDTH": 1500,
-                "METHODS": [0],
                 "OUTPUT": self.out("q.gpkg"),
                 "AREAS": self.out("qa.gpkg"),
             },
@@ -338,7 +337,6 @@ class Collapse(Case):
             {
                 "INPUT": f"{TRAIN}|layername=lakes_scotland",
                 "WIDTH": 400,
-                "METHODS": [0],
                 "CONNECT": f"{network}|layername=lines_lakes_scotland",
                 "SNAP": 1,
                 "OUTPUT": self.out("q.gpkg"),
@@ -352,7 +350,7 @@ class Collapse(Case):
         # The lines reach the connecting lines: without them the skeletons differ.
         res = processing.run(
             "skeletonise:collapse",
-            {"INPUT": f"{TRAIN}|layername=lakes_scotland", "WIDTH": 400, "METHODS": [0], "OUTPUT": self.out("n.gpkg")},
+            {"INPUT": f"{TRAIN}|layername=lakes_scotland", "WIDTH": 400, "OUTPUT": self.out("n.gpkg")},
         )
         plain = {r["src_fid"]: r["_geom"].length() for r in rows(res["OUTPUT"])}
         self.assertTrue(any(r["_geom"].length() > plain[r["src_fid"]] + 1 for r in got))
@@ -397,6 +395,21 @@ class Score(Case):
                 {"INPUT": f"{TRAIN}|layername=lakes_scotland", "SKELETONS": far, "OUTPUT": self.out("s.gpkg")},
             )
         self.assertIn("no skeleton line could be joined to a polygon (1 lines inside no polygon)", str(e.exception))
+
+
+class Help(unittest.TestCase):
+    def test_every_algorithm_explains_every_parameter(self):
+        for alg in PROVIDER.algorithms():
+            text = alg.shortHelpString()
+            self.assertGreater(len(text), 200, alg.id())
+            for p in alg.parameterDefinitions():
+                name = p.description().split(" (")[0]
+                with self.subTest(algorithm=alg.id(), parameter=p.name()):
+                    self.assertIn(f"<b>{name}</b>", text)
+        self.assertEqual(
+            {a.id() for a in PROVIDER.algorithms()},
+            {f"skeletonise:{n}" for n in ("skeletonise", "collapse", "score", "pipeline", "label")},
+        )
 
 
 class Pipeline(Case):
@@ -448,6 +461,41 @@ class Labels(Case):
         self.assertSameRows(got, want, key=("src_fid", "polygon_part"))
         self.assertEqual({r["kind"] for r in got}, {"line", "point"})
         self.assertTrue(all(r["minzoom"] is not None for r in got))
+
+
+class QgisProcess(Case):
+    """Every algorithm through `qgis_process` gives what it gives through processing.run
+    (which the tests above compare with the command line)."""
+
+    def qgis_process(self, algorithm, params):
+        args = [os.path.join(ROOT, "scripts", "qgis-process.sh"), "--json", "run", algorithm]
+        for k, v in params.items():
+            # qgis_process 3.22 takes several values of an enum as one comma-separated value.
+            args.append(f"--{k}={','.join(map(str, v)) if isinstance(v, list) else v}")
+        p = subprocess.run(args, capture_output=True, text=True, cwd=ROOT)
+        self.assertEqual(p.returncode, 0, p.stdout + p.stderr)
+        return json.loads(p.stdout[p.stdout.index("{"):])["results"]
+
+    def same(self, algorithm, params, sinks):
+        a = dict(params, **{k: self.out(f"qp-{k}.gpkg") for k in sinks})
+        b = dict(params, **{k: self.out(f"pr-{k}.gpkg") for k in sinks})
+        got = self.qgis_process(algorithm, a)
+        want = processing.run(algorithm, b)
+        for k in sinks:
+            with self.subTest(algorithm=algorithm, sink=k):
+                self.assertSameRows(rows(got[k]), rows(want[k]))
+
+    def test_every_algorithm_through_qgis_process(self):
+        lakes = f"{TRAIN}|layername=lakes_scotland"
+        self.same("skeletonise:collapse", {"INPUT": f"{TRAIN}|layername=river_lena", "WIDTH": 1500, "PRUNE": 0},
+                  ["OUTPUT", "AREAS"])
+        cli("run", "-i", TRAIN, "-l", "lakes_scotland", "-o", self.out("run.gpkg"), "--set", "steps.skeleton.methods=[VD]")
+        self.same("skeletonise:score", {"INPUT": lakes, "SKELETONS": f"{self.out('run.gpkg')}|layername=skeletons",
+                                        "SKELETON_KEY": "src_fid", "LABEL": "vd"}, ["OUTPUT"])
+        self.same("skeletonise:pipeline", {"INPUT": lakes, "PIPELINE": os.path.join(ROOT, "pipelines", "collapse-rivers.yaml"),
+                                           "OVERRIDES": "steps.collapse.width=300"}, ["OUTPUT", "AREAS"])
+        self.same("skeletonise:label", {"INPUT": lakes, "PARTS": 1, "MIN_PIXELS": 32}, ["OUTPUT"])
+        self.same("skeletonise:skeletonise", {"INPUT": lakes, "METHODS": [0, 3], "PRUNE": 2}, ["OUTPUT", "CANDIDATES"])
 
 
 class Screenshots(Case):
