@@ -665,6 +665,12 @@ def apply(
     """
     _need_geo()
     p = _load(pipeline, overrides)
+    if p.partition:
+        raise PipelineError(
+            "the `partition` step reads the coverage of `input.neighbours` and writes it grown once every "
+            "polygon is done, so it runs from the command line (`skeletonise run`) and in QGIS "
+            "(skeletonise:partition); leave it out of the pipeline given to Python"
+        )
     if p.collapse:
         raise PipelineError(
             "the `collapse` step writes kept areas beside the lines, which a GeoDataFrame cannot hold: it runs "

@@ -45,6 +45,9 @@ class Pipeline:
     def collapse(self) -> bool:
         """Whether the pipeline has a ``collapse`` step (``run`` then also returns ``areas``)."""
     @property
+    def partition(self) -> bool:
+        """Whether the pipeline has a ``partition`` step (``run`` then needs ``neighbours``)."""
+    @property
     def explode(self) -> bool:
         """One row per polygon part (``output.explode``)."""
     @property
@@ -70,6 +73,8 @@ class Pipeline:
         connect: Optional[list[Optional[bytes]]] = None,
         connect_fids: Optional[Sequence[int]] = None,
         snap: float = 0.0,
+        neighbours: Optional[list[Optional[bytes]]] = None,
+        neighbour_fids: Optional[Sequence[int]] = None,
     ) -> dict[str, Any]:
         """Runs the steps with the GIL released.
 
@@ -79,17 +84,25 @@ class Pipeline:
         as Arrow large-string buffers ``(offsets, data, null mask or None)``),
         ``rejected`` (reasons, texts as the columns'), ``geometry``
         (``("geoarrow", coords, line_offsets, geom_offsets, null)`` or
-        ``("wkb", list)``), ``counts`` and ``timings``; with a ``collapse``
-        step also ``areas`` (``row``, ``columns``, ``reals``, ``geometry`` as
-        WKB polygons). ``connect`` (WKB lines, FIDs in ``connect_fids``) is
-        the line network of ``input.connect``, ``snap`` its snap distance.
+        ``("wkb", list)``), ``counts``, ``timings`` and ``layers``: the
+        other layers of the steps by name (``areas`` with ``collapse``;
+        ``coverage``, ``boundaries``, ``given`` and ``areas`` with
+        ``partition``), each ``fields`` (``input``, ``neighbours`` or None:
+        whose fields it carries, by ``src_fid``), ``columns``, ``reals`` and
+        ``geometry`` as WKB. ``connect`` (WKB lines, FIDs in
+        ``connect_fids``) is the line network of ``input.connect``, ``snap``
+        its snap distance; ``neighbours`` (WKB polygons, FIDs in
+        ``neighbour_fids``) the coverage of ``input.neighbours``.
         Raises RejectedError under ``on_error: fail``, Cancelled once
         ``cancel`` is set.
         """
 
-def columns(layer: str, explode: bool = False, collapse: bool = False) -> tuple[list[tuple[str, str]], bool]:
-    """The columns of ``skeletons``, ``candidates`` or ``areas`` as ``(name, type)`` (``collapse``: with a
-    collapse step), and whether the layer carries the source's attributes."""
+def columns(
+    layer: str, explode: bool = False, collapse: bool = False, partition: bool = False
+) -> tuple[list[tuple[str, str]], bool]:
+    """The columns of ``skeletons``, ``candidates``, ``areas``, ``coverage``, ``boundaries`` or ``given``
+    as ``(name, type)`` (with a collapse or partition step as given), and whether the layer carries
+    the input's attributes."""
 
 def score(
     polygons: list[Optional[bytes]],
@@ -107,7 +120,7 @@ def score(
     (both key lists) or by location; what ``Pipeline.run`` returns, and ``unjoined`` (why some
     line rows joined no polygon). Raises ValueError when no line joins any polygon."""
 
-def reserved(collapse: bool = False) -> list[str]:
+def reserved(collapse: bool = False, partition: bool = False) -> list[str]:
     """The names for which a source field is written as ``src_<name>`` (in every layer alike), with or without a collapse step."""
 
 def describe() -> str:

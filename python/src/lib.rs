@@ -22,7 +22,7 @@ static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use skeletonise::config::{self, ConfigError, OnError, Steps};
-use skeletonise::output::{ColumnType, Layer, Plan, When, CANDIDATE_LAYER, SKELETON_LAYER};
+use skeletonise::output::{ColumnType, Plan, When};
 
 pyo3::create_exception!(
     _core,
@@ -99,17 +99,9 @@ fn pipeline_error(e: ConfigError) -> PyErr {
 }
 
 impl Pipeline {
-    /// The steps, unless they need what only the command line does: the
-    /// `partition` step reads a second source (`input.neighbours`) and
-    /// writes the grown coverage once every polygon is done.
+    /// The steps (every step runs here; what a GeoDataFrame cannot hold
+    /// is refused by the Python functions).
     fn supported(steps: config::Steps) -> PyResult<Self> {
-        if steps.process_params().partition.is_some() {
-            return Err(PipelineError::new_err(
-                "the `partition` step reads the coverage of `input.neighbours` and writes it grown once every \
-                 polygon is done, so it runs from the command line only (`skeletonise run`); leave it out \
-                 of the pipeline given to Python",
-            ));
-        }
         Ok(Self { steps })
     }
 }
@@ -146,6 +138,13 @@ impl Pipeline {
     #[getter]
     fn collapse(&self) -> bool {
         self.steps.process_params().collapse.is_some()
+    }
+
+    /// Whether the pipeline has a `partition` step (`run` then needs
+    /// `neighbours` and also returns the partitioned coverage).
+    #[getter]
+    fn partition(&self) -> bool {
+        self.steps.process_params().partition.is_some()
     }
 
     /// Whether the `prepare` step repairs invalid polygons.
@@ -188,8 +187,11 @@ impl Pipeline {
     /// With a `collapse` step the result also holds `areas`: the kept areas
     /// (`row`, `columns`, `reals`, `geometry` as WKB polygons). `connect`
     /// (WKB lines, with `connect_fids`) is the line network of
-    /// `input.connect`, `snap` its snap distance.
-    #[pyo3(signature = (geometry, *, fids = None, repaired = None, candidates = false, explode = None, threads = None, output = "geoarrow", cancel = None, connect = None, connect_fids = None, snap = 0.0))]
+    /// `input.connect`, `snap` its snap distance. With a `partition` step,
+    /// `neighbours` (WKB polygons, with `neighbour_fids`) is the coverage of
+    /// `input.neighbours`, and the result's `layers` hold `coverage`,
+    /// `boundaries`, `given` and `areas`.
+    #[pyo3(signature = (geometry, *, fids = None, repaired = None, candidates = false, explode = None, threads = None, output = "geoarrow", cancel = None, connect = None, connect_fids = None, snap = 0.0, neighbours = None, neighbour_fids = None))]
     #[allow(clippy::too_many_arguments)]
     fn run<'py>(
         &self,
@@ -205,8 +207,42 @@ impl Pipeline {
         connect: Option<Vec<Option<Vec<u8>>>>,
         connect_fids: Option<Vec<i64>>,
         snap: f64,
+        neighbours: Option<Vec<Option<Vec<u8>>>>,
+        neighbour_fids: Option<Vec<i64>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let mut params = self.steps.process_params();
+        let partition = params.partition.is_some();
+        match (partition, neighbours) {
+            (true, Some(units)) => {
+                params.neighbours = Some(std::sync::Arc::new(coverage(
+                    &units,
+                    neighbour_fids.as_deref(),
+                )?));
+            }
+            (true, None) => {
+                return Err(PipelineError::new_err(
+                    "the `partition` step gives the polygons' area to the units of a coverage: give it as `neighbours` (the polygons of `input.neighbours`)",
+                ))
+            }
+            (false, Some(_)) => {
+                return Err(PipelineError::new_err(
+                    "`neighbours` is the coverage of a `partition` step, and the pipeline has none",
+                ))
+            }
+            (false, None) => {}
+        }
+        // A partition merges adjacent polygons by FID: positions stand in for missing FIDs.
+        let positions: Option<numpy::PyReadonlyArray1<'py, i64>> = match (&fids, partition) {
+            (None, true) => {
+                let n = geometry.len()? as i64;
+                Some(numpy::PyArrayMethods::readonly(&numpy::PyArray1::from_vec(
+                    py,
+                    (0..n).collect(),
+                )))
+            }
+            _ => None,
+        };
+        let fids = fids.or(positions);
         if let Some(lines) = connect {
             params.connect = Some(std::sync::Arc::new(network(
                 &lines,
@@ -229,6 +265,7 @@ impl Pipeline {
                 }
             },
             collapse: params.collapse.is_some(),
+            partition,
             cancel: cancel.map(|c| c.0.clone()),
             given: None,
         };
@@ -308,6 +345,7 @@ fn score<'py>(
         fail: false,
         geoarrow_out: output == "geoarrow",
         collapse: false,
+        partition: false,
         cancel: cancel.map(|c| c.0.clone()),
         given: Some(run::Given {
             label,
@@ -318,6 +356,39 @@ fn score<'py>(
     out.cast::<pyo3::types::PyDict>()?
         .set_item("unjoined", unjoined.reasons())?;
     Ok(out)
+}
+
+/// The coverage of `input.neighbours` from WKB polygons, each with its
+/// source FID (a NULL geometry is a unit without area; anything but
+/// polygons is refused, as the command line refuses it).
+fn coverage(
+    units: &[Option<Vec<u8>>],
+    fids: Option<&[i64]>,
+) -> PyResult<skeletonise::partition::Coverage> {
+    if fids.is_some_and(|f| f.len() != units.len()) {
+        return Err(PyValueError::new_err(
+            "neighbour_fids must have one FID per polygon of neighbours",
+        ));
+    }
+    let mut out = Vec::with_capacity(units.len());
+    for (i, w) in units.iter().enumerate() {
+        let fid = fids.map_or(Some(i as u64), |f| u64::try_from(f[i]).ok());
+        let geometry = match w.as_deref().map(wkb::read).transpose() {
+            Ok(None) => geo::MultiPolygon(Vec::new()),
+            Ok(Some(geo::Geometry::Polygon(p))) => geo::MultiPolygon(vec![p]),
+            Ok(Some(geo::Geometry::MultiPolygon(m))) => m,
+            Ok(Some(_)) | Err(_) => return Err(PipelineError::new_err(format!(
+                "`neighbours`: feature {} is not a polygon; the coverage is a layer of polygons",
+                fid.map_or_else(|| i.to_string(), |f| f.to_string())
+            ))),
+        };
+        out.push(skeletonise::partition::Unit {
+            fid,
+            geometry,
+            attributes: Vec::new(),
+        });
+    }
+    Ok(skeletonise::partition::Coverage::new(out))
 }
 
 /// The line network of `input.connect` from WKB lines (any line or
@@ -361,51 +432,57 @@ fn network(
 /// `int32`, `int64`, `real`, `text`, and whether the layer carries the
 /// source's attributes; `collapse`: the pipeline has a `collapse` step.
 #[pyfunction]
-#[pyo3(signature = (layer, explode = false, collapse = false))]
+#[pyo3(signature = (layer, explode = false, collapse = false, partition = false))]
 fn columns(
     layer: &str,
     explode: bool,
     collapse: bool,
+    partition: bool,
 ) -> PyResult<(Vec<(&'static str, &'static str)>, bool)> {
-    let layer: &dyn Layer = match layer {
-        "skeletons" => &SKELETON_LAYER,
-        "candidates" => &CANDIDATE_LAYER,
-        "areas" => skeletonise::output::BUILTIN
-            .iter()
-            .copied()
-            .find(|l| l.name() == skeletonise::collapse::AREAS.name)
-            .expect("the areas layer is built in"),
-        other => {
-            return Err(PyValueError::new_err(format!(
-                "no layer `{other}`; the layers are `skeletons`, `candidates` and `areas`"
-            )))
-        }
+    let names = [
+        "skeletons",
+        "candidates",
+        "areas",
+        "coverage",
+        "boundaries",
+        "given",
+    ];
+    let Some(layer) = skeletonise::output::BUILTIN
+        .iter()
+        .copied()
+        .find(|l| l.name() == layer && names.contains(&layer))
+    else {
+        return Err(PyValueError::new_err(format!(
+            "no layer `{layer}`; the layers are {}",
+            names.map(|n| format!("`{n}`")).join(", ")
+        )));
     };
     let mut holds = if explode { vec![When::Explode] } else { vec![] };
-    if collapse {
-        holds.extend([When::Collapse, When::Areas]);
-    }
+    holds.extend(run::step_holds(collapse, partition));
     let plan = Plan::new(skeletonise::output::SKELETONS.name, holds, &[]);
     let cols = plan
         .columns(layer)
         .into_iter()
         .map(|(_, name, ty)| (name, type_name(ty)))
         .collect();
-    Ok((cols, layer.fields().is_some()))
+    Ok((
+        cols,
+        layer.fields() == Some(skeletonise::layer::Fields::Input),
+    ))
 }
 
 /// The names for which a source field is written as `src_<name>` (in every
 /// layer alike, as the command line's writer renames them), with or without
-/// a `collapse` step.
+/// a `collapse` or `partition` step.
 #[pyfunction]
-#[pyo3(signature = (collapse = false))]
-fn reserved(collapse: bool) -> Vec<&'static str> {
-    let holds = if collapse {
-        vec![When::Collapse, When::Areas]
-    } else {
-        vec![]
-    };
-    Plan::new(skeletonise::output::SKELETONS.name, holds, &[]).reserved_names()
+#[pyo3(signature = (collapse = false, partition = false))]
+fn reserved(collapse: bool, partition: bool) -> Vec<&'static str> {
+    Plan::new(
+        skeletonise::output::SKELETONS.name,
+        run::step_holds(collapse, partition),
+        &[],
+    )
+    .reserved_names()
 }
 
 pub(crate) fn type_name(t: ColumnType) -> &'static str {

@@ -28,8 +28,13 @@ pub struct Options {
     /// Return geometries as GeoArrow buffers (else WKB).
     pub geoarrow_out: bool,
     /// The pipeline has a `collapse` step: the skeletons have `collapsed`,
-    /// and the kept areas come back too (`areas`).
+    /// and the kept areas come back too (layer `areas`).
     pub collapse: bool,
+    /// The pipeline has a `partition` step (with the coverage in the
+    /// parameters): adjacent input polygons are merged exactly first, as
+    /// the command line's reader merges them, and the layers `coverage`,
+    /// `boundaries`, `given` and `areas` come back too.
+    pub partition: bool,
     /// Stop before the next feature once set (`Cancel`).
     pub cancel: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
     /// Another tool's skeletons to score, in place of the methods'.
@@ -143,16 +148,19 @@ struct Done {
     geometry: Encoded,
     counts: [u64; 4],
     timings: [f64; 3],
-    /// The `areas` layer (with a `collapse` step).
-    areas: Option<Areas>,
+    /// The other layers of the plan (`areas` with `collapse`; `coverage`,
+    /// `boundaries`, `given` and `areas` with `partition`).
+    layers: Vec<LayerOut>,
 }
 
-/// The rows of the `areas` layer: the input row of each, its columns and
-/// its polygon as WKB.
-struct Areas {
-    rows: Vec<i64>,
+/// The rows of a layer beside the skeletons: its columns, whose fields it
+/// carries (`input`, `neighbours` or none; the Python side joins them by
+/// `src_fid`) and its geometries as WKB (`None`: NULL, or a table).
+struct LayerOut {
+    name: &'static str,
+    fields: Option<&'static str>,
     columns: Vec<ColumnData>,
-    geometry: Vec<Vec<u8>>,
+    geometry: Vec<Option<Vec<u8>>>,
 }
 
 enum Encoded {
@@ -237,10 +245,24 @@ pub fn plan_of(opts: &Options) -> Plan {
     if opts.explode {
         holds.push(When::Explode);
     }
-    if opts.collapse {
-        holds.extend([When::Collapse, When::Areas]);
-    }
+    holds.extend(step_holds(opts.collapse, opts.partition));
     Plan::new(skeletonise::output::SKELETONS.name, holds, &[])
+}
+
+/// What the `collapse` and `partition` steps add to a plan (as the
+/// command line's `config::plan_of`).
+pub fn step_holds(collapse: bool, partition: bool) -> Vec<When> {
+    let mut holds = Vec::new();
+    if collapse {
+        holds.push(When::Collapse);
+    }
+    if partition {
+        holds.extend([When::Partition, When::Merge]);
+    }
+    if collapse || partition {
+        holds.push(When::Areas);
+    }
+    holds
 }
 
 fn work(
@@ -254,7 +276,24 @@ fn work(
     // a small polygon's work); a large one still splits its own work.
     let par = opts.threads != Some(1) && input.len() > 1;
     let t0 = Instant::now();
-    let feats = features(input, fids, repaired, par);
+    let mut feats = features(input, fids, repaired, par);
+    // The input row of every feature: merging (with `partition`) makes one
+    // feature of adjacent ones, which takes its smallest member's FID.
+    let mut input_rows: Option<Vec<i64>> = None;
+    if opts.partition {
+        let by_fid: std::collections::HashMap<u64, i64> = feats
+            .iter()
+            .enumerate()
+            .filter_map(|(i, f)| f.fid.map(|x| (x, i as i64)))
+            .collect();
+        feats = skeletonise::process::merge::merge_adjacent_exactly(feats, None);
+        input_rows = Some(
+            feats
+                .iter()
+                .map(|f| f.fid.and_then(|x| by_fid.get(&x).copied()).unwrap_or(-1))
+                .collect(),
+        );
+    }
     let t1 = Instant::now();
     let row_opts = RowOptions {
         explode: opts.explode,
@@ -298,27 +337,33 @@ fn work(
             )));
         }
     }
-    let mut counts = [feats.len() as u64, 0, 0, 0];
-    for r in &results {
+    let mut counts = [input.len() as u64, 0, 0, 0];
+    for (r, f) in results.iter().zip(&feats) {
+        let n = f.source_count();
         match r.status {
-            Status::Written(_) => counts[1] += 1,
-            Status::Rejected => counts[2] += 1,
-            Status::Filtered => counts[3] += 1,
+            Status::Written(_) => counts[1] += n,
+            Status::Rejected => counts[2] += n,
+            Status::Filtered => counts[3] += n,
         }
     }
     let plan = plan_of(opts);
-    // The input row of every kept area, before the rows are merged.
-    let area_rows: Vec<i64> = results
-        .iter()
-        .enumerate()
-        .flat_map(|(i, r)| std::iter::repeat_n(i as i64, r.rows.areas.len()))
-        .collect();
     let layer: &dyn Layer = if opts.candidates {
         &CANDIDATE_LAYER
     } else {
         &SKELETON_LAYER
     };
-    let (rows, all, items, rejected) = outputs(results, &feats, layer);
+    let (mut rows, mut all, items, rejected) = outputs(results, &feats, layer);
+    if let Some(input_rows) = &input_rows {
+        for r in &mut rows {
+            *r = input_rows[*r as usize];
+        }
+    }
+    if let (true, Some(cov)) = (opts.partition, &params.neighbours) {
+        // The partitioned coverage, once every polygon is done: every
+        // unit, grown by what it received.
+        all.coverage =
+            skeletonise::partition::assemble(cov.units(), std::mem::take(&mut all.grown));
+    }
     let columns = table::columns(layer, &plan, &all, &items);
     let lines = table::lines(layer, &all, &items);
     let geometry = if opts.geoarrow_out {
@@ -332,14 +377,18 @@ fn work(
             })
         }))
     };
-    let areas = (opts.collapse && !opts.candidates).then(|| areas_of(&plan, &all, area_rows));
+    let layers = if opts.candidates {
+        Vec::new()
+    } else {
+        other_layers(&plan, &all)
+    };
     let t3 = Instant::now();
     Ok(Done {
         rows,
         columns,
         rejected,
         geometry,
-        areas,
+        layers,
         counts,
         timings: [
             (t1 - t0).as_secs_f64(),
@@ -349,28 +398,51 @@ fn work(
     })
 }
 
-/// The `areas` layer of a call's rows (`rows`: the input row of each area).
-fn areas_of(plan: &Plan, all: &Rows, rows: Vec<i64>) -> Areas {
-    let layer = skeletonise::output::BUILTIN
-        .iter()
-        .copied()
-        .find(|l| l.name() == skeletonise::collapse::AREAS.name)
-        .expect("the areas layer is built in");
-    let items: Vec<Item> = (0..layer.count(all)).map(Item::Row).collect();
-    let geometry = (0..items.len())
-        .map(|i| {
-            let mut out = Vec::new();
-            if let Some(skeletonise::output::Shape::Polygon(p)) = layer.shape(all, i) {
-                wkb::write_polygon(p, &mut out);
-            }
-            out
+/// The layers of the plan beside the skeletons and candidates (and the
+/// `rejected` layer, whose reasons are the skeletons' `rejected`).
+fn other_layers(plan: &Plan, all: &Rows) -> Vec<LayerOut> {
+    use skeletonise::layer::Fields;
+    use skeletonise::output::Shape;
+    plan.layers()
+        .into_iter()
+        .filter(|l| {
+            ![
+                SKELETON_LAYER.name(),
+                CANDIDATE_LAYER.name(),
+                skeletonise::output::REJECTED.name,
+                skeletonise::output::RUNS.name,
+            ]
+            .contains(&l.name())
         })
-        .collect();
-    Areas {
-        rows,
-        columns: table::columns(layer, plan, all, &items),
-        geometry,
-    }
+        .map(|layer| {
+            let items: Vec<Item> = (0..layer.count(all)).map(Item::Row).collect();
+            let geometry = (0..items.len())
+                .map(|i| {
+                    let mut out = Vec::new();
+                    match layer.shape(all, i)? {
+                        Shape::Polygon(p) => wkb::write_polygon(p, &mut out),
+                        Shape::MultiPolygon(m) => wkb::write_polygons(m, &mut out),
+                        Shape::Lines(m) | Shape::LinesM(m, _) => wkb::write_lines(m, &mut out),
+                        Shape::Line(l) => {
+                            wkb::write_lines(&geo::MultiLineString(vec![l]), &mut out)
+                        }
+                        Shape::Wkb(w) => out.extend_from_slice(w),
+                        Shape::Geometry(_) => return None,
+                    }
+                    Some(out)
+                })
+                .collect();
+            LayerOut {
+                name: layer.name(),
+                fields: layer.fields().map(|f| match f {
+                    Fields::Input => "input",
+                    Fields::Neighbours => "neighbours",
+                }),
+                columns: table::columns(layer, plan, all, &items),
+                geometry,
+            }
+        })
+        .collect()
 }
 
 /// Runs with the GIL released, in a pool of `threads` when given: also for
@@ -619,20 +691,25 @@ fn to_python(py: Python<'_>, d: Done) -> PyResult<Bound<'_, PyAny>> {
     let (cols, reals) = columns_to_python(py, d.columns, n)?;
     out.set_item("columns", cols)?;
     out.set_item("reals", reals)?;
-    if let Some(a) = d.areas {
-        let areas = PyDict::new(py);
-        let n = a.rows.len();
-        areas.set_item("row", PyArray1::from_vec(py, a.rows))?;
-        let (cols, reals) = columns_to_python(py, a.columns, n)?;
-        areas.set_item("columns", cols)?;
-        areas.set_item("reals", reals)?;
+    let layers = PyDict::new(py);
+    for l in d.layers {
+        let layer = PyDict::new(py);
+        let n = l.geometry.len();
+        layer.set_item("fields", l.fields)?;
+        let (cols, reals) = columns_to_python(py, l.columns, n)?;
+        layer.set_item("columns", cols)?;
+        layer.set_item("reals", reals)?;
         let list = PyList::empty(py);
-        for g in a.geometry {
-            list.append(PyBytes::new(py, &g))?;
+        for g in l.geometry {
+            match g {
+                Some(b) => list.append(PyBytes::new(py, &b))?,
+                None => list.append(py.None())?,
+            }
         }
-        areas.set_item("geometry", ("wkb", list))?;
-        out.set_item("areas", areas)?;
+        layer.set_item("geometry", ("wkb", list))?;
+        layers.set_item(l.name, layer)?;
     }
+    out.set_item("layers", layers)?;
     out.set_item("rejected", text_buffers(py, &d.rejected)?)?;
     match d.geometry {
         Encoded::Ragged(r) => out.set_item(

@@ -189,6 +189,16 @@ pub fn write_lines(m: &MultiLineString<f64>, out: &mut Vec<u8>) {
     }
 }
 
+/// Writes a MULTIPOLYGON as little-endian ISO WKB, appending to `out`.
+pub fn write_polygons(m: &MultiPolygon<f64>, out: &mut Vec<u8>) {
+    out.push(1);
+    out.extend_from_slice(&6u32.to_le_bytes());
+    out.extend_from_slice(&(m.0.len() as u32).to_le_bytes());
+    for p in &m.0 {
+        write_polygon(p, out);
+    }
+}
+
 /// Writes a POLYGON as little-endian ISO WKB, appending to `out`.
 pub fn write_polygon(p: &Polygon<f64>, out: &mut Vec<u8>) {
     let rings: Vec<&geo::LineString<f64>> =
@@ -286,7 +296,11 @@ mod tests {
         );
         let mut out = Vec::new();
         write_polygon(&p, &mut out);
-        assert_eq!(read(&out).unwrap(), Geometry::Polygon(p));
+        assert_eq!(read(&out).unwrap(), Geometry::Polygon(p.clone()));
+        let m = MultiPolygon(vec![p.clone(), p]);
+        out.clear();
+        write_polygons(&m, &mut out);
+        assert_eq!(read(&out).unwrap(), Geometry::MultiPolygon(m));
     }
 
     #[test]

@@ -18,6 +18,7 @@ from qgis.core import (
     QgsFeatureSink,
     QgsProcessing,
     QgsProcessingAlgorithm,
+    QgsProcessingParameterDefinition,
     QgsProcessingException,
     QgsProcessingParameterBoolean,
     QgsProcessingParameterEnum,
@@ -40,6 +41,7 @@ EXTEND = ["centred", "ray", "nearest", "none"]
 SELECT = ["distortion", "deviation", "deviation_parts", "distortion_sum"]
 PARTS = ["each", "largest"]
 COLLAPSE_MODES = ["partial", "whole"]
+UNOWNED = ["keep", "nearest"]
 
 HELP_URL = "https://github.com/skeletonise/skeletonise#in-qgis"
 
@@ -116,42 +118,85 @@ class _Algorithm(QgsProcessingAlgorithm):
             wkbs.append(bytes(f.geometry().asWkb()) if f.hasGeometry() else None)
         return wkbs, fids
 
+    def _units(self, parameters, context, crs):
+        """The NEIGHBOURS coverage, in the polygons' CRS: (WKB polygons, FIDs, attributes by FID, source)."""
+        if parameters.get("NEIGHBOURS") is None:
+            raise QgsProcessingException(
+                "the pipeline has a `partition` step, which gives the polygons' area to the units of a coverage: "
+                "give that coverage as Neighbours (NEIGHBOURS)"
+            )
+        units = self.parameterAsSource(parameters, "NEIGHBOURS", context)
+        if units is None:
+            raise QgsProcessingException(self.invalidSourceError(parameters, "NEIGHBOURS"))
+        request = QgsFeatureRequest().setDestinationCrs(crs, context.transformContext())
+        wkbs, fids, attributes = [], [], {}
+        for f in units.getFeatures(request):
+            fids.append(int(f.id()))
+            attributes[int(f.id())] = f.attributes()
+            wkbs.append(bytes(f.geometry().asWkb()) if f.hasGeometry() else None)
+        return wkbs, fids, attributes, units
+
+    # The layers an algorithm can write beside the skeletons, by sink: (layer, geometry type).
+    LAYER_SINKS = {
+        "AREAS": ("areas", QgsWkbTypes.Polygon),
+        "COVERAGE": ("coverage", QgsWkbTypes.MultiPolygon),
+        "BOUNDARIES": ("boundaries", QgsWkbTypes.MultiLineString),
+    }
+
     def _pipeline_rows(self, pipeline, parameters, context, feedback, explode, snap=0.0):
-        """Runs ``pipeline`` on INPUT, writing OUTPUT, CANDIDATES when given and,
-        with a collapse step, AREAS (the kept areas)."""
+        """Runs ``pipeline`` on INPUT, writing OUTPUT (the skeletons), CANDIDATES
+        when given and the step's layers (AREAS with collapse; COVERAGE,
+        BOUNDARIES and AREAS with partition) where the algorithm has the sink."""
         source, skip = self._input(parameters, context)
         crs = source.sourceCrs()
         connect = self._connect(parameters, context, crs)
+        collapse, partition = pipeline.collapse, pipeline.partition
+        extra = {}
+        if connect is not None:
+            extra = {"connect": connect[0], "connect_fids": connect[1], "snap": snap}
+        unit_fields, unit_attributes, unit_skip = None, {}, set()
+        if partition:
+            if "NEIGHBOURS" not in [p.name() for p in self.parameterDefinitions()]:
+                raise QgsProcessingException(
+                    "the pipeline has a `partition` step, which gives the polygons' area to the units of a "
+                    "coverage: run it with Partition into neighbours (skeletonise:partition)"
+                )
+            wkbs, fids, unit_attributes, units = self._units(parameters, context, crs)
+            unit_fields = units.fields()
+            layer = self.parameterAsVectorLayer(parameters, "NEIGHBOURS", context)
+            if layer is not None:
+                unit_skip = {unit_fields.at(i).name() for i in layer.dataProvider().pkAttributeIndexes()}
+            extra.update(neighbours=wkbs, neighbour_fids=fids)
         features = bridge.read(source, pipeline.make_valid, feedback)
-        collapse = pipeline.collapse
         carried = bridge.source_fields(source.fields(), skip)
+        reserved = bridge.core().reserved(collapse, partition)
         names = [p.name() for p in self.parameterDefinitions()]
         sinks = [("OUTPUT", "skeletons", QgsWkbTypes.MultiLineString)]
         if "CANDIDATES" in names and parameters.get("CANDIDATES") is not None:
             sinks.append(("CANDIDATES", "candidates", QgsWkbTypes.MultiLineString))
-        if collapse and "AREAS" in names:
-            sinks.append(("AREAS", "areas", QgsWkbTypes.Polygon))
+        for key, (layer, kind) in self.LAYER_SINKS.items():
+            if key in names and (layer != "areas" or collapse or partition) and (layer == "areas" or partition):
+                sinks.append((key, layer, kind))
         results, outputs = {}, {}
         for key, layer, kind in sinks:
-            tool, carries = core_columns(layer, explode, collapse)
+            tool, carries = core_columns(layer, explode, collapse, partition)
+            if layer == "coverage":
+                fields_of, keep = unit_fields, bridge.source_fields(unit_fields, unit_skip)
+            else:
+                fields_of, keep = source.fields(), carried if carries else []
             fields = bridge.output_fields(
-                source.fields(),
-                carried if carries else [],
-                tool,
-                rejected=layer != "areas",
-                reserved=bridge.core().reserved(collapse),
+                fields_of, keep, tool, rejected=layer in ("skeletons", "candidates"), reserved=reserved
             )
             sink, dest = self.parameterAsSink(parameters, key, context, fields, kind, crs)
-            if sink is None and key == "OUTPUT":
+            if sink is None and self.parameterDefinition(key).flags() & QgsProcessingParameterDefinition.FlagOptional == 0:
                 raise QgsProcessingException(self.invalidSinkError(parameters, key))
             if sink is not None:
-                outputs[key] = (sink, layer, carried if carries else [])
+                outputs[key] = (sink, layer, keep)
                 results[key] = dest
-        extra = {}
-        if connect is not None:
-            extra = {"connect": connect[0], "connect_fids": connect[1], "snap": snap}
         counts = {"read": len(features), "written": 0, "rejected": 0}
-        parts = list(bridge.batches(features))
+        # A partition merges adjacent polygons and grows the coverage once all are done: one call.
+        parts = [(0, len(features))] if partition else list(bridge.batches(features))
+        by_fid = {fid: i for i, fid in enumerate(features.fids)}
         for k, (start, end) in enumerate(parts):
             done = {}
             try:
@@ -165,18 +210,23 @@ class _Algorithm(QgsProcessingAlgorithm):
             except bridge.Cancelled:
                 feedback.pushInfo(f"cancelled: the first {start} of {len(features)} features are written")
                 break
-            except bridge.core().RejectedError as e:
+            except (bridge.core().RejectedError, bridge.core().PipelineError) as e:
                 raise QgsProcessingException(str(e)) from None
-            for _key, (sink, layer, carried_here) in outputs.items():
-                if layer == "areas":
-                    bridge.write(sink, done["skeletons"]["areas"], features, start, carried_here, _Quiet())
+            for _key, (sink, layer, keep) in outputs.items():
+                if layer in ("skeletons", "candidates"):
+                    rejected = bridge.write(
+                        sink, done[layer], features, start, keep, feedback if layer == "skeletons" else _Quiet()
+                    )
+                    if layer == "skeletons":
+                        counts["written"] += done[layer]["counts"]["written"]
+                        counts["rejected"] += rejected
                     continue
-                rejected = bridge.write(
-                    sink, done[layer], features, start, carried_here, feedback if layer == "skeletons" else _Quiet()
-                )
-                if layer == "skeletons":
-                    counts["written"] += done[layer]["counts"]["written"]
-                    counts["rejected"] += rejected
+                rows_of = done["skeletons"]["layers"][layer]
+                if rows_of["fields"] == "neighbours":
+                    attributes = lambda fid: unit_attributes.get(fid)  # noqa: E731
+                else:
+                    attributes = lambda fid: features.attributes[by_fid[fid]] if fid in by_fid else None  # noqa: E731
+                bridge.write_layer(sink, rows_of, attributes, keep)
             feedback.setProgress(10 + 90 * (k + 1) / len(parts))
         feedback.pushInfo(
             f"{counts['read']} features read, {counts['written']} written, {counts['rejected']} rejected"
@@ -193,9 +243,9 @@ class _Quiet:
         pass
 
 
-def core_columns(layer, explode, collapse=False):
-    """The tool's columns of ``layer`` and whether it carries the source's fields."""
-    return bridge.core().columns(layer, explode, collapse)
+def core_columns(layer, explode, collapse=False, partition=False):
+    """The tool's columns of ``layer`` and whether it carries the input's fields."""
+    return bridge.core().columns(layer, explode, collapse, partition)
 
 
 def _sinks(alg, candidates=True):
@@ -417,8 +467,7 @@ class PipelineAlgorithm(_Algorithm):
     HELP = (
         "Runs the steps of a skeletonise pipeline file (YAML) on a polygon layer: the same file as "
         "`skeletonise run FILE.yaml` takes; its input and output sections are not used (the layers of "
-        "this dialog are), except output.explode and on_error. The partition step, which reads a "
-        "second coverage, runs from the command line only.\n\n"
+        "this dialog are), except output.explode and on_error.\n\n"
         "<b>Polygons</b>: a polygon layer in a projected CRS.\n"
         "<b>Pipeline file</b>: the YAML file; it is validated as `skeletonise validate` does, with the "
         "same messages.\n"
@@ -426,8 +475,11 @@ class PipelineAlgorithm(_Algorithm):
         "mode network, or legs to where the lines meet the polygons).\n"
         "<b>Overrides</b>: optional KEY=VALUE settings, as the command line's --set, separated by "
         "semicolons or new lines, e.g. steps.skeleton.methods=[MA]; steps.prune.mode=trunk.\n"
+        "<b>Neighbours</b>: the coverage of a partition step (input.neighbours).\n"
         "<b>Skeletons</b>, <b>Candidates</b>: as in Skeletonise polygons; <b>Kept areas</b>: with a "
-        "collapse step, as in Collapse narrow polygons."
+        "collapse step, as in Collapse narrow polygons, with a partition step its remainders; "
+        "<b>Grown coverage</b>, <b>New boundaries</b>: with a partition step, as in Partition into "
+        "neighbours."
     )
 
     def initAlgorithm(self, config=None):  # noqa: N802
@@ -441,8 +493,19 @@ class PipelineAlgorithm(_Algorithm):
             QgsProcessingParameterString("OVERRIDES", _tr("Overrides (KEY=VALUE; …)"), optional=True, multiLine=True)
         )
         _connect_parameters(self)
+        self.addParameter(
+            QgsProcessingParameterFeatureSource(
+                "NEIGHBOURS", _tr("Neighbours (the coverage of a partition step)"), [QgsProcessing.TypeVectorPolygon], optional=True
+            )
+        )
         _sinks(self)
         _areas_sink(self)
+        self.addParameter(
+            QgsProcessingParameterFeatureSink("COVERAGE", _tr("Grown coverage"), QgsProcessing.TypeVectorPolygon, optional=True, createByDefault=False)
+        )
+        self.addParameter(
+            QgsProcessingParameterFeatureSink("BOUNDARIES", _tr("New boundaries"), QgsProcessing.TypeVectorLine, optional=True, createByDefault=False)
+        )
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802
         path = self.parameterAsFile(parameters, "PIPELINE", context)
@@ -541,6 +604,80 @@ class LabelAlgorithm(_Algorithm):
                     feedback.reportError(f"feature {features.fids[i]} rejected: {rejected[j]}")
             feedback.setProgress(10 + 90 * (k + 1) / len(parts))
         return {"OUTPUT": dest, "FEATURES_READ": len(features), "FEATURES_REJECTED": rejected_count}
+
+
+class PartitionAlgorithm(_Algorithm):
+    """A collapsed polygon's area given to the units around it, along the centreline."""
+
+    NAME = "partition"
+    DISPLAY = "Partition into neighbours"
+    HELP = (
+        "Gives the area of polygons to be collapsed (rivers, roads, narrow land cover) to the units of a "
+        "coverage around them (municipalities, parcels, land-cover patches), the new boundary between two "
+        "units running down the middle, as the command line's partition step: every point of the polygon "
+        "goes to the unit whose bank is nearest, so the new boundary between two units is the medial axis "
+        "between their banks. Adjacent polygons (reaches of one river) are merged first, vertex for "
+        "vertex. The grown coverage stays a coverage: shared edges with identical vertices, no gap, no "
+        "overlap, area conserved.\n\n"
+        "<b>Polygons</b>: the polygons to give away, in a projected CRS.\n"
+        "<b>Neighbours</b>: the coverage of units around them (reprojected to the polygons' CRS when it "
+        "differs); their banks must lie on the polygons' boundary.\n"
+        "<b>Width</b>: give away only where the polygon is narrower than this (layer units; 0: the whole "
+        "polygon); wider parts stay polygons of their own (Remainders, kind = wide).\n"
+        "<b>Tolerance</b>: with a width, the band around it as a fraction of it, as in Collapse.\n"
+        "<b>Unowned area</b>: area nearest to bank no unit owns (the sea, the coverage's edge): keep (a "
+        "remainder, kind = unowned) or nearest (to the unit it borders along the longest stretch).\n"
+        "<b>Prune</b>, <b>Minimum leg length</b>, <b>Extend</b>: the medial axis written to Skeletons, as in "
+        "Skeletonise polygons.\n"
+        "<b>Grown coverage</b>: every unit with its fields, src_fid (its FID) and received (the area it "
+        "received).\n"
+        "<b>New boundaries</b>: the lines between two units that run through the polygons (left_fid, "
+        "right_fid, length).\n"
+        "<b>Remainders</b>: optional; the parts given to no unit (kind wide or unowned).\n"
+        "<b>Skeletons</b>: optional; the polygons' medial axes."
+    )
+
+    def initAlgorithm(self, config=None):  # noqa: N802
+        _polygons(self)
+        self.addParameter(
+            QgsProcessingParameterFeatureSource("NEIGHBOURS", _tr("Neighbours (a coverage of units)"), [QgsProcessing.TypeVectorPolygon])
+        )
+        number = QgsProcessingParameterNumber.Double
+        self.addParameter(QgsProcessingParameterNumber("WIDTH", _tr("Width (layer units; 0: the whole polygon)"), number, 0.0, minValue=0.0))
+        self.addParameter(QgsProcessingParameterNumber("TOLERANCE", _tr("Tolerance (fraction of the width)"), number, 0.2, minValue=0.0, maxValue=0.99))
+        self.addParameter(QgsProcessingParameterEnum("UNOWNED", _tr("Unowned area"), options=UNOWNED, defaultValue=0))
+        _method_parameters(self, choose=False)
+        self.addParameter(QgsProcessingParameterFeatureSink("COVERAGE", _tr("Grown coverage"), QgsProcessing.TypeVectorPolygon))
+        self.addParameter(QgsProcessingParameterFeatureSink("BOUNDARIES", _tr("New boundaries"), QgsProcessing.TypeVectorLine, optional=True))
+        self.addParameter(
+            QgsProcessingParameterFeatureSink("AREAS", _tr("Remainders"), QgsProcessing.TypeVectorPolygon, optional=True, createByDefault=False)
+        )
+        self.addParameter(
+            QgsProcessingParameterFeatureSink("OUTPUT", _tr("Skeletons"), QgsProcessing.TypeVectorLine, optional=True, createByDefault=False)
+        )
+
+    def processAlgorithm(self, parameters, context, feedback):  # noqa: N802
+        partition = {
+            "unowned": UNOWNED[self.parameterAsEnum(parameters, "UNOWNED", context)],
+            "tolerance": self.parameterAsDouble(parameters, "TOLERANCE", context),
+        }
+        width = self.parameterAsDouble(parameters, "WIDTH", context)
+        if width > 0:
+            partition["width"] = width
+        prune = {"mode": PRUNE[self.parameterAsEnum(parameters, "PRUNE", context)]}
+        min_length = self.parameterAsDouble(parameters, "MIN_LENGTH", context)
+        if min_length > 0:
+            prune["min_length"] = min_length
+        doc = {
+            "steps": [
+                {"skeleton": {"methods": ["MA"]}},
+                {"prune": prune},
+                {"extend": {"mode": EXTEND[self.parameterAsEnum(parameters, "EXTEND", context)]}},
+                {"partition": partition},
+            ]
+        }
+        pipeline = bridge.options_pipeline(doc, "skeletonise:partition")
+        return self._pipeline_rows(pipeline, parameters, context, feedback, False)
 
 
 def _key_text(value):
@@ -643,4 +780,11 @@ class ScoreAlgorithm(_Algorithm):
         return {"OUTPUT": dest, "FEATURES_READ": len(features), "FEATURES_REJECTED": rejected}
 
 
-ALGORITHMS = [SkeletoniseAlgorithm, CollapseAlgorithm, ScoreAlgorithm, PipelineAlgorithm, LabelAlgorithm]
+ALGORITHMS = [
+    SkeletoniseAlgorithm,
+    CollapseAlgorithm,
+    PartitionAlgorithm,
+    ScoreAlgorithm,
+    PipelineAlgorithm,
+    LabelAlgorithm,
+]

@@ -259,6 +259,25 @@ def write(sink, done, features, start, carried, feedback):
     return rejected
 
 
+def write_layer(sink, layer, attributes, carried):
+    """The rows of a layer beside the skeletons (``layers`` of a result) as
+    features of ``sink``: the source's fields of each row found by its
+    ``src_fid`` through ``attributes(fid)`` (a list, or None)."""
+    cols = columns(layer)
+    names = [name for name, _kind, _values in layer["columns"]]
+    fid_column = cols[names.index("src_fid")] if "src_fid" in names else None
+    for k, wkb in enumerate(layer["geometry"][1]):
+        source = attributes(fid_column[k]) if fid_column is not None and carried else None
+        attrs = [source[j] if source is not None else None for j in carried]
+        attrs.extend(c[k] for c in cols)
+        f = QgsFeature()
+        f.setAttributes(attrs)
+        if wkb is not None:
+            f.setGeometry(geometry(wkb))
+        if not sink.addFeature(f, QgsFeatureSink.FastInsert):
+            raise QgsProcessingException("could not write a feature to the output")
+
+
 def options_pipeline(doc, origin):
     """A pipeline from a steps document (the pipeline file's keys)."""
     try:

@@ -356,6 +356,67 @@ class Collapse(Case):
         self.assertTrue(any(r["_geom"].length() > plain[r["src_fid"]] + 1 for r in got))
 
 
+class Partition(Case):
+    def test_partition_gives_the_command_lines_coverage_and_boundaries(self):
+        cov = os.path.join(ROOT, "tests", "data", "coverage-train.gpkg")
+        cli("run", os.path.join(ROOT, "pipelines", "partition-rivers.yaml"), "-o", self.out("cli.gpkg"))
+        res = processing.run(
+            "skeletonise:partition",
+            {
+                "INPUT": f"{cov}|layername=rivers_danube",
+                "NEIGHBOURS": f"{cov}|layername=units_danube",
+                "COVERAGE": self.out("c.gpkg"),
+                "BOUNDARIES": self.out("b.gpkg"),
+                "AREAS": self.out("a.gpkg"),
+                "OUTPUT": self.out("s.gpkg"),
+            },
+        )
+        coverage = rows(res["COVERAGE"])
+        want = rows(self.out("cli.gpkg"), "coverage")
+        self.assertIn("landuse", want[0])
+        self.assertSameRows(coverage, want)
+        self.assertGreater(sum(1 for r in coverage if r["received"] > 0), 5)
+        self.assertSameRows(rows(res["BOUNDARIES"]), rows(self.out("cli.gpkg"), "boundaries"), key=("left_fid", "right_fid"))
+        skel = rows(res["OUTPUT"])
+        for r in skel:
+            del r["rejected"]
+        # The four reaches are merged into one river (members), as the command line merges them.
+        self.assertSameRows(skel, rows(self.out("cli.gpkg"), "skeletons"))
+        self.assertEqual(len(skel), 1)
+        self.assertEqual(res["FEATURES_READ"], 4)
+        # The grown coverage keeps the units' and the river's area (no gap, no overlap is the CLI's test).
+        units = QgsVectorLayer(f"{cov}|layername=units_danube", "u", "ogr")
+        river = QgsVectorLayer(f"{cov}|layername=rivers_danube", "r", "ogr")
+        total = sum(f.geometry().area() for f in units.getFeatures()) + sum(f.geometry().area() for f in river.getFeatures())
+        grown = sum(r["_geom"].area() for r in coverage) + sum(r["_geom"].area() for r in rows(res["AREAS"]))
+        self.assertAlmostEqual(grown, total, delta=1e-9 * total)
+
+    def test_a_pipeline_file_with_a_partition_step_needs_the_neighbours(self):
+        cov = os.path.join(ROOT, "tests", "data", "coverage-train.gpkg")
+        with self.assertRaises(QgsProcessingException) as e:
+            processing.run(
+                "skeletonise:pipeline",
+                {
+                    "INPUT": f"{cov}|layername=rivers_danube",
+                    "PIPELINE": os.path.join(ROOT, "pipelines", "partition-rivers.yaml"),
+                    "OUTPUT": self.out("s.gpkg"),
+                },
+            )
+        self.assertIn("Neighbours", str(e.exception))
+        res = processing.run(
+            "skeletonise:pipeline",
+            {
+                "INPUT": f"{cov}|layername=rivers_danube",
+                "NEIGHBOURS": f"{cov}|layername=units_danube",
+                "PIPELINE": os.path.join(ROOT, "pipelines", "partition-rivers.yaml"),
+                "OUTPUT": self.out("s.gpkg"),
+                "COVERAGE": self.out("c.gpkg"),
+            },
+        )
+        cli("run", os.path.join(ROOT, "pipelines", "partition-rivers.yaml"), "-o", self.out("cli.gpkg"))
+        self.assertSameRows(rows(res["COVERAGE"]), rows(self.out("cli.gpkg"), "coverage"))
+
+
 class Score(Case):
     def test_score_by_location_and_by_key_gives_the_command_lines_rows(self):
         cli("run", "-i", TRAIN, "-l", "lakes_scotland", "-o", self.out("run.gpkg"),
@@ -408,7 +469,7 @@ class Help(unittest.TestCase):
                     self.assertIn(f"<b>{name}</b>", text)
         self.assertEqual(
             {a.id() for a in PROVIDER.algorithms()},
-            {f"skeletonise:{n}" for n in ("skeletonise", "collapse", "score", "pipeline", "label")},
+            {f"skeletonise:{n}" for n in ("skeletonise", "collapse", "partition", "score", "pipeline", "label")},
         )
 
 
@@ -495,6 +556,9 @@ class QgisProcess(Case):
         self.same("skeletonise:pipeline", {"INPUT": lakes, "PIPELINE": os.path.join(ROOT, "pipelines", "collapse-rivers.yaml"),
                                            "OVERRIDES": "steps.collapse.width=300"}, ["OUTPUT", "AREAS"])
         self.same("skeletonise:label", {"INPUT": lakes, "PARTS": 1, "MIN_PIXELS": 32}, ["OUTPUT"])
+        cov = os.path.join(ROOT, "tests", "data", "coverage-train.gpkg")
+        self.same("skeletonise:partition", {"INPUT": f"{cov}|layername=rivers_lena", "NEIGHBOURS": f"{cov}|layername=units_lena",
+                                            "WIDTH": 1500}, ["COVERAGE", "BOUNDARIES", "AREAS"])
         self.same("skeletonise:skeletonise", {"INPUT": lakes, "METHODS": [0, 3], "PRUNE": 2}, ["OUTPUT", "CANDIDATES"])
 
 
