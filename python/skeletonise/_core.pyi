@@ -75,6 +75,7 @@ class Pipeline:
         snap: float = 0.0,
         neighbours: Optional[list[Optional[bytes]]] = None,
         neighbour_fids: Optional[Sequence[int]] = None,
+        with_candidates: bool = False,
     ) -> dict[str, Any]:
         """Runs the steps with the GIL released.
 
@@ -93,6 +94,8 @@ class Pipeline:
         ``connect_fids``) is the line network of ``input.connect``, ``snap``
         its snap distance; ``neighbours`` (WKB polygons, FIDs in
         ``neighbour_fids``) the coverage of ``input.neighbours``.
+        ``with_candidates``: the ``candidates`` layer among ``layers`` too,
+        from the same pass.
         Raises RejectedError under ``on_error: fail``, Cancelled once
         ``cancel`` is set.
         """

@@ -190,8 +190,9 @@ impl Pipeline {
     /// `input.connect`, `snap` its snap distance. With a `partition` step,
     /// `neighbours` (WKB polygons, with `neighbour_fids`) is the coverage of
     /// `input.neighbours`, and the result's `layers` hold `coverage`,
-    /// `boundaries`, `given` and `areas`.
-    #[pyo3(signature = (geometry, *, fids = None, repaired = None, candidates = false, explode = None, threads = None, output = "geoarrow", cancel = None, connect = None, connect_fids = None, snap = 0.0, neighbours = None, neighbour_fids = None))]
+    /// `boundaries`, `given` and `areas`. `with_candidates`: the
+    /// `candidates` layer too, among `layers`, from the same pass.
+    #[pyo3(signature = (geometry, *, fids = None, repaired = None, candidates = false, explode = None, threads = None, output = "geoarrow", cancel = None, connect = None, connect_fids = None, snap = 0.0, neighbours = None, neighbour_fids = None, with_candidates = false))]
     #[allow(clippy::too_many_arguments)]
     fn run<'py>(
         &self,
@@ -209,6 +210,7 @@ impl Pipeline {
         snap: f64,
         neighbours: Option<Vec<Option<Vec<u8>>>>,
         neighbour_fids: Option<Vec<i64>>,
+        with_candidates: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
         let mut params = self.steps.process_params();
         let partition = params.partition.is_some();
@@ -266,6 +268,7 @@ impl Pipeline {
             },
             collapse: params.collapse.is_some(),
             partition,
+            with_candidates,
             cancel: cancel.map(|c| c.0.clone()),
             given: None,
         };
@@ -346,6 +349,7 @@ fn score<'py>(
         geoarrow_out: output == "geoarrow",
         collapse: false,
         partition: false,
+        with_candidates: false,
         cancel: cancel.map(|c| c.0.clone()),
         given: Some(run::Given {
             label,
@@ -377,10 +381,12 @@ fn coverage(
             Ok(None) => geo::MultiPolygon(Vec::new()),
             Ok(Some(geo::Geometry::Polygon(p))) => geo::MultiPolygon(vec![p]),
             Ok(Some(geo::Geometry::MultiPolygon(m))) => m,
-            Ok(Some(_)) | Err(_) => return Err(PipelineError::new_err(format!(
+            Ok(Some(_)) | Err(_) => {
+                return Err(PipelineError::new_err(format!(
                 "`neighbours`: feature {} is not a polygon; the coverage is a layer of polygons",
                 fid.map_or_else(|| i.to_string(), |f| f.to_string())
-            ))),
+            )))
+            }
         };
         out.push(skeletonise::partition::Unit {
             fid,

@@ -35,6 +35,8 @@ pub struct Options {
     /// the command line's reader merges them, and the layers `coverage`,
     /// `boundaries`, `given` and `areas` come back too.
     pub partition: bool,
+    /// Also the `candidates` layer, among `layers` (one pass for both).
+    pub with_candidates: bool,
     /// Stop before the next feature once set (`Cancel`).
     pub cancel: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
     /// Another tool's skeletons to score, in place of the methods'.
@@ -297,7 +299,7 @@ fn work(
     let t1 = Instant::now();
     let row_opts = RowOptions {
         explode: opts.explode,
-        candidates: opts.candidates,
+        candidates: opts.candidates || opts.with_candidates,
         bars: false,
         widths: false,
         measures: false,
@@ -380,7 +382,7 @@ fn work(
     let layers = if opts.candidates {
         Vec::new()
     } else {
-        other_layers(&plan, &all)
+        other_layers(&plan, &all, opts.with_candidates)
     };
     let t3 = Instant::now();
     Ok(Done {
@@ -398,14 +400,17 @@ fn work(
     })
 }
 
-/// The layers of the plan beside the skeletons and candidates (and the
-/// `rejected` layer, whose reasons are the skeletons' `rejected`).
-fn other_layers(plan: &Plan, all: &Rows) -> Vec<LayerOut> {
+/// The layers of the plan beside the skeletons (and the `rejected` layer,
+/// whose reasons are the skeletons' `rejected`): the candidates when asked
+/// for, and the steps' layers.
+fn other_layers(plan: &Plan, all: &Rows, candidates: bool) -> Vec<LayerOut> {
     use skeletonise::layer::Fields;
     use skeletonise::output::Shape;
-    plan.layers()
-        .into_iter()
-        .filter(|l| {
+    let wanted: &[&dyn Layer] = if candidates { &[&CANDIDATE_LAYER] } else { &[] };
+    wanted
+        .iter()
+        .copied()
+        .chain(plan.layers().into_iter().filter(|l| {
             ![
                 SKELETON_LAYER.name(),
                 CANDIDATE_LAYER.name(),
@@ -413,7 +418,7 @@ fn other_layers(plan: &Plan, all: &Rows) -> Vec<LayerOut> {
                 skeletonise::output::RUNS.name,
             ]
             .contains(&l.name())
-        })
+        }))
         .map(|layer| {
             let items: Vec<Item> = (0..layer.count(all)).map(Item::Row).collect();
             let geometry = (0..items.len())

@@ -185,7 +185,7 @@ class _Algorithm(QgsProcessingAlgorithm):
             else:
                 fields_of, keep = source.fields(), carried if carries else []
             fields = bridge.output_fields(
-                fields_of, keep, tool, rejected=layer in ("skeletons", "candidates"), reserved=reserved
+                fields_of, keep, tool, rejected=layer == "skeletons", reserved=reserved
             )
             sink, dest = self.parameterAsSink(parameters, key, context, fields, kind, crs)
             if sink is None and self.parameterDefinition(key).flags() & QgsProcessingParameterDefinition.FlagOptional == 0:
@@ -200,26 +200,26 @@ class _Algorithm(QgsProcessingAlgorithm):
         for k, (start, end) in enumerate(parts):
             done = {}
             try:
+                # The candidates come from the same pass as the skeletons.
                 done["skeletons"] = bridge.run_pipeline(
-                    pipeline, features, (start, end), feedback, candidates=False, explode=explode, **extra
+                    pipeline,
+                    features,
+                    (start, end),
+                    feedback,
+                    candidates=False,
+                    explode=explode,
+                    with_candidates="CANDIDATES" in outputs,
+                    **extra,
                 )
-                if "CANDIDATES" in outputs:
-                    done["candidates"] = bridge.run_pipeline(
-                        pipeline, features, (start, end), feedback, candidates=True, explode=explode, **extra
-                    )
             except bridge.Cancelled:
                 feedback.pushInfo(f"cancelled: the first {start} of {len(features)} features are written")
                 break
             except (bridge.core().RejectedError, bridge.core().PipelineError) as e:
                 raise QgsProcessingException(str(e)) from None
             for _key, (sink, layer, keep) in outputs.items():
-                if layer in ("skeletons", "candidates"):
-                    rejected = bridge.write(
-                        sink, done[layer], features, start, keep, feedback if layer == "skeletons" else _Quiet()
-                    )
-                    if layer == "skeletons":
-                        counts["written"] += done[layer]["counts"]["written"]
-                        counts["rejected"] += rejected
+                if layer == "skeletons":
+                    counts["rejected"] += bridge.write(sink, done[layer], features, start, keep, feedback)
+                    counts["written"] += done[layer]["counts"]["written"]
                     continue
                 rows_of = done["skeletons"]["layers"][layer]
                 if rows_of["fields"] == "neighbours":
@@ -234,13 +234,6 @@ class _Algorithm(QgsProcessingAlgorithm):
         results["FEATURES_READ"] = counts["read"]
         results["FEATURES_REJECTED"] = counts["rejected"]
         return results
-
-
-class _Quiet:
-    """Feedback for the candidates' pass: the rejections were reported with the skeletons."""
-
-    def reportError(self, *_args):  # noqa: N802
-        pass
 
 
 def core_columns(layer, explode, collapse=False, partition=False):
