@@ -81,6 +81,21 @@ class _Algorithm(QgsProcessingAlgorithm):
     def icon(self):
         return QIcon(os.path.join(os.path.dirname(__file__), "icon.svg"))
 
+    def _tooltips(self):
+        """Each parameter's help (its tooltip in the dialog): its entry of the help text."""
+        import re
+
+        entries = {}
+        for line in self.HELP.split("\n"):
+            m = re.match(r"((?:<b>[^<]+</b>(?:, | and )?)+): (.*)", line)
+            if m:
+                for name in re.findall(r"<b>([^<]+)</b>", m.group(1)):
+                    entries[name] = m.group(2)
+        for p in self.parameterDefinitions():
+            text = entries.get(p.description().split(" (")[0])
+            if text and hasattr(p, "setHelp"):
+                p.setHelp(_tr(text))
+
     def canExecute(self):  # noqa: N802
         if bridge.version() is None:
             return False, f"The skeletonise Python package is missing: {bridge.INSTALL_HINT}."
@@ -303,6 +318,7 @@ class SkeletoniseAlgorithm(_Algorithm):
         _method_parameters(self)
         self.addParameter(QgsProcessingParameterBoolean("EXPLODE", _tr("One row per polygon part"), defaultValue=False))
         _sinks(self)
+        self._tooltips()
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802
         doc = {"steps": _method_steps(self, parameters, context)}
@@ -432,6 +448,7 @@ class CollapseAlgorithm(_Algorithm):
         _method_parameters(self, choose=False)
         _sinks(self, candidates=False)
         _areas_sink(self)
+        self._tooltips()
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802
         width = self.parameterAsDouble(parameters, "WIDTH", context)
@@ -469,8 +486,9 @@ class PipelineAlgorithm(_Algorithm):
         "<b>Overrides</b>: optional KEY=VALUE settings, as the command line's --set, separated by "
         "semicolons or new lines, e.g. steps.skeleton.methods=[MA]; steps.prune.mode=trunk.\n"
         "<b>Neighbours</b>: the coverage of a partition step (input.neighbours).\n"
-        "<b>Skeletons</b>, <b>Candidates</b>: as in Skeletonise polygons; <b>Kept areas</b>: with a "
-        "collapse step, as in Collapse narrow polygons, with a partition step its remainders; "
+        "<b>Skeletons</b>, <b>Candidates</b>: as in Skeletonise polygons.\n"
+        "<b>Kept areas</b>: with a collapse step, as in Collapse narrow polygons; with a partition step, "
+        "its remainders.\n"
         "<b>Grown coverage</b>, <b>New boundaries</b>: with a partition step, as in Partition into "
         "neighbours."
     )
@@ -499,6 +517,7 @@ class PipelineAlgorithm(_Algorithm):
         self.addParameter(
             QgsProcessingParameterFeatureSink("BOUNDARIES", _tr("New boundaries"), QgsProcessing.TypeVectorLine, optional=True, createByDefault=False)
         )
+        self._tooltips()
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802
         path = self.parameterAsFile(parameters, "PIPELINE", context)
@@ -544,6 +563,7 @@ class LabelAlgorithm(_Algorithm):
         self.addParameter(QgsProcessingParameterEnum("PARTS", _tr("Parts"), options=PARTS, defaultValue=0))
         self.addParameter(QgsProcessingParameterNumber("MIN_PIXELS", _tr("Minimum pixels (for minzoom)"), number, 64.0, minValue=0.0))
         self.addParameter(QgsProcessingParameterFeatureSink("OUTPUT", _tr("Labels"), QgsProcessing.TypeVectorAnyGeometry))
+        self._tooltips()
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802
         source, skip = self._input(parameters, context)
@@ -648,6 +668,7 @@ class PartitionAlgorithm(_Algorithm):
         self.addParameter(
             QgsProcessingParameterFeatureSink("OUTPUT", _tr("Skeletons"), QgsProcessing.TypeVectorLine, optional=True, createByDefault=False)
         )
+        self._tooltips()
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802
         partition = {
@@ -716,6 +737,7 @@ class ScoreAlgorithm(_Algorithm):
         )
         self.addParameter(QgsProcessingParameterString("LABEL", _tr("Label (the method column)"), defaultValue="external"))
         self.addParameter(QgsProcessingParameterFeatureSink("OUTPUT", _tr("Scores"), QgsProcessing.TypeVectorLine))
+        self._tooltips()
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802
         source, skip = self._input(parameters, context)

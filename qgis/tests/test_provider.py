@@ -465,6 +465,8 @@ class Help(unittest.TestCase):
                 name = p.description().split(" (")[0]
                 with self.subTest(algorithm=alg.id(), parameter=p.name()):
                     self.assertIn(f"<b>{name}</b>", text)
+                    # The dialog's tooltip: the parameter's own entry.
+                    self.assertGreater(len(p.help()), 20)
         self.assertEqual(
             {a.id() for a in PROVIDER.algorithms()},
             {f"skeletonise:{n}" for n in ("skeletonise", "collapse", "partition", "score", "pipeline", "label")},
