@@ -17,20 +17,14 @@ import time
 
 
 def qgis_runs(src, layer, runs):
-    from qgis.core import QgsApplication, QgsFeatureRequest, QgsVectorLayer
+    from qgis.core import QgsFeatureRequest, QgsVectorLayer
 
-    app = QgsApplication([], False)
-    app.initQgis()
-    sys.path.append("/usr/share/qgis/python/plugins")
-    import processing
-    from processing.core.Processing import Processing
-
-    Processing.initialize()
     sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "qgis"))
-    from skeletonise_qgis.provider import SkeletoniseProvider
+    from skeletonise_qgis.standalone import start
 
-    provider = SkeletoniseProvider()  # kept: the registry does not own a Python provider
-    QgsApplication.processingRegistry().addProvider(provider)
+    app, provider = start()  # both kept: the registry does not own a Python provider
+    import processing
+
     disk = QgsVectorLayer(f"{src}|layername={layer}", layer, "ogr")
     mem = disk.materialize(QgsFeatureRequest())
     times = []
@@ -38,7 +32,7 @@ def qgis_runs(src, layer, runs):
         t0 = time.perf_counter()
         out = processing.run("skeletonise:skeletonise", {"INPUT": mem, "OUTPUT": "memory:"})["OUTPUT"]
         times.append(time.perf_counter() - t0)
-    del provider
+    del provider, app
     return mem.featureCount(), out.featureCount(), times
 
 

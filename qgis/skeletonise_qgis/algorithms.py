@@ -351,6 +351,15 @@ def _method_parameters(alg, choose=True):
         alg.addParameter(QgsProcessingParameterEnum("SELECT", _tr("Select by"), options=SELECT, defaultValue=0))
 
 
+def _prune_extend(alg, parameters, context):
+    """The prune and extend steps of PRUNE, MIN_LENGTH and EXTEND, as the pipeline file's."""
+    prune = {"mode": PRUNE[alg.parameterAsEnum(parameters, "PRUNE", context)]}
+    min_length = alg.parameterAsDouble(parameters, "MIN_LENGTH", context)
+    if min_length > 0:
+        prune["min_length"] = min_length
+    return [{"prune": prune}, {"extend": {"mode": EXTEND[alg.parameterAsEnum(parameters, "EXTEND", context)]}}]
+
+
 def _method_steps(alg, parameters, context, collapse=None):
     """The steps of the method parameters (a collapse step after extend when given, with the
     medial axis alone, as the collapse step needs), as the pipeline file's."""
@@ -360,21 +369,26 @@ def _method_steps(alg, parameters, context, collapse=None):
         methods = [METHODS[i] for i in alg.parameterAsEnums(parameters, "METHODS", context)]
     if not methods:
         raise QgsProcessingException("`methods`: choose at least one method")
-    prune = {"mode": PRUNE[alg.parameterAsEnum(parameters, "PRUNE", context)]}
-    min_length = alg.parameterAsDouble(parameters, "MIN_LENGTH", context)
-    if min_length > 0:
-        prune["min_length"] = min_length
-    steps = [
-        {"prepare": {}},
-        {"skeleton": {"methods": methods}},
-        {"prune": prune},
-        {"extend": {"mode": EXTEND[alg.parameterAsEnum(parameters, "EXTEND", context)]}},
-    ]
+    steps = [{"prepare": {}}, {"skeleton": {"methods": methods}}] + _prune_extend(alg, parameters, context)
     if collapse is not None:
         steps += [{"collapse": collapse}, {"score": {}}, {"select": {}}]
     else:
         steps += [{"score": {}}, {"select": {"by": SELECT[alg.parameterAsEnum(parameters, "SELECT", context)]}}]
     return steps
+
+
+def _partition_sinks(alg, required):
+    """COVERAGE (required in Partition into neighbours), BOUNDARIES and AREAS: the partition's layers."""
+    alg.addParameter(
+        QgsProcessingParameterFeatureSink(
+            "COVERAGE", _tr("Grown coverage"), QgsProcessing.TypeVectorPolygon, optional=not required, createByDefault=required
+        )
+    )
+    alg.addParameter(
+        QgsProcessingParameterFeatureSink(
+            "BOUNDARIES", _tr("New boundaries"), QgsProcessing.TypeVectorLine, optional=True, createByDefault=required
+        )
+    )
 
 
 def _connect_parameters(alg):
@@ -511,12 +525,7 @@ class PipelineAlgorithm(_Algorithm):
         )
         _sinks(self)
         _areas_sink(self)
-        self.addParameter(
-            QgsProcessingParameterFeatureSink("COVERAGE", _tr("Grown coverage"), QgsProcessing.TypeVectorPolygon, optional=True, createByDefault=False)
-        )
-        self.addParameter(
-            QgsProcessingParameterFeatureSink("BOUNDARIES", _tr("New boundaries"), QgsProcessing.TypeVectorLine, optional=True, createByDefault=False)
-        )
+        _partition_sinks(self, required=False)
         self._tooltips()
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802
@@ -660,8 +669,7 @@ class PartitionAlgorithm(_Algorithm):
         self.addParameter(QgsProcessingParameterNumber("TOLERANCE", _tr("Tolerance (fraction of the width)"), number, 0.2, minValue=0.0, maxValue=0.99))
         self.addParameter(QgsProcessingParameterEnum("UNOWNED", _tr("Unowned area"), options=UNOWNED, defaultValue=0))
         _method_parameters(self, choose=False)
-        self.addParameter(QgsProcessingParameterFeatureSink("COVERAGE", _tr("Grown coverage"), QgsProcessing.TypeVectorPolygon))
-        self.addParameter(QgsProcessingParameterFeatureSink("BOUNDARIES", _tr("New boundaries"), QgsProcessing.TypeVectorLine, optional=True))
+        _partition_sinks(self, required=True)
         self.addParameter(
             QgsProcessingParameterFeatureSink("AREAS", _tr("Remainders"), QgsProcessing.TypeVectorPolygon, optional=True, createByDefault=False)
         )
@@ -678,18 +686,8 @@ class PartitionAlgorithm(_Algorithm):
         width = self.parameterAsDouble(parameters, "WIDTH", context)
         if width > 0:
             partition["width"] = width
-        prune = {"mode": PRUNE[self.parameterAsEnum(parameters, "PRUNE", context)]}
-        min_length = self.parameterAsDouble(parameters, "MIN_LENGTH", context)
-        if min_length > 0:
-            prune["min_length"] = min_length
-        doc = {
-            "steps": [
-                {"skeleton": {"methods": ["MA"]}},
-                {"prune": prune},
-                {"extend": {"mode": EXTEND[self.parameterAsEnum(parameters, "EXTEND", context)]}},
-                {"partition": partition},
-            ]
-        }
+        steps = [{"skeleton": {"methods": ["MA"]}}] + _prune_extend(self, parameters, context)
+        doc = {"steps": steps + [{"partition": partition}]}
         pipeline = bridge.options_pipeline(doc, "skeletonise:partition")
         return self._pipeline_rows(pipeline, parameters, context, feedback, False)
 

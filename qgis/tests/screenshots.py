@@ -30,18 +30,10 @@ TRAIN = os.path.join(ROOT, "tests", "data", "gshhg-train.gpkg")
 
 
 def start():
-    app = QgsApplication([], True)
-    app.initQgis()
-    sys.path.append("/usr/share/qgis/python/plugins")
-    from processing.core.Processing import Processing
-
-    Processing.initialize()
     sys.path.insert(0, os.path.join(ROOT, "qgis"))
-    from skeletonise_qgis.provider import SkeletoniseProvider
+    from skeletonise_qgis.standalone import start as start_qgis
 
-    provider = SkeletoniseProvider()
-    QgsApplication.processingRegistry().addProvider(provider)
-    return app, provider
+    return start_qgis(gui=True)
 
 
 def dialog(path):

@@ -19,7 +19,6 @@ import time
 import unittest
 
 from qgis.core import (
-    QgsApplication,
     QgsFeature,
     QgsGeometry,
     QgsPointXY,
@@ -31,18 +30,11 @@ from qgis.core import (
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 TRAIN = os.path.join(ROOT, "tests", "data", "gshhg-train.gpkg")
 
-APP = QgsApplication([], False)
-APP.initQgis()
-sys.path.append("/usr/share/qgis/python/plugins")
-import processing  # noqa: E402
-from processing.core.Processing import Processing  # noqa: E402
-
-Processing.initialize()
 sys.path.insert(0, os.path.join(ROOT, "qgis"))
-from skeletonise_qgis.provider import SkeletoniseProvider  # noqa: E402
+from skeletonise_qgis.standalone import start  # noqa: E402
 
-PROVIDER = SkeletoniseProvider()
-QgsApplication.processingRegistry().addProvider(PROVIDER)
+APP, PROVIDER = start()
+import processing  # noqa: E402
 
 
 def binary():
