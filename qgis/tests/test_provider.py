@@ -11,6 +11,7 @@ import json
 import math
 import os
 import random
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -203,6 +204,32 @@ class Skeletonise(Case):
         self.assertIn("skeletonise Python package", run.stdout + run.stderr)
         self.assertIn("pip install --no-deps", run.stdout + run.stderr)
         self.assertFalse(os.path.exists(self.out("x.gpkg")))
+
+    def test_the_packed_plugin_and_wheel_install_as_the_readme_says(self):
+        # scripts/package-qgis-plugin.sh's ZIP unpacked into a fresh profile's python/plugins (what
+        # "Install from ZIP" does), the wheel into its python folder; then qgis_process runs it.
+        p = subprocess.run([os.path.join(ROOT, "scripts", "package-qgis-plugin.sh")], capture_output=True, text=True, cwd=ROOT)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        zip_path, wheel = [os.path.join(ROOT, line) for line in p.stdout.strip().splitlines()[-2:]]
+        profile = os.path.join(self.dir, "profile")
+        python = os.path.join(profile, "profiles", "default", "python")
+        os.makedirs(os.path.join(python, "plugins"))
+        import zipfile
+
+        zipfile.ZipFile(zip_path).extractall(os.path.join(python, "plugins"))
+        zipfile.ZipFile(wheel).extractall(python)
+        env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "QGIS_PLUGINPATH")}
+        env.update(QGIS_CUSTOM_CONFIG_PATH=profile, QT_QPA_PLATFORM="offscreen")
+        qp = "qgis_process.bin" if shutil.which("qgis_process.bin") else "qgis_process"
+        subprocess.run([qp, "plugins", "enable", "skeletonise_qgis"], capture_output=True, env=env, check=True)
+        run = subprocess.run(
+            [qp, "--json", "run", "skeletonise:skeletonise", f"--INPUT={TRAIN}|layername=lakes_scotland",
+             f"--OUTPUT={self.out('z.gpkg')}"],
+            capture_output=True, text=True, env=env,
+        )
+        self.assertEqual(run.returncode, 0, run.stdout + run.stderr)
+        self.assertEqual(json.loads(run.stdout[run.stdout.index("{"):])["results"]["FEATURES_READ"], 18)
+        self.assertEqual(len(rows(self.out("z.gpkg"))), 18)
 
     def test_a_geographic_layer_is_refused_with_the_reprojection_hint(self):
         lonlat = processing.run(
