@@ -87,7 +87,9 @@ class Features:
 
 def read(source, make_valid, feedback, share=10.0):
     """Every feature of ``source`` (a QgsProcessingFeatureSource): invalid
-    polygons repaired (GEOS MakeValid, as the command line's reader) when the
+    polygons repaired by QGIS's makeValid (the algorithm GEOS MakeValid, which
+    the command line's reader uses, also comes from; on a repaired polygon the
+    two may differ in detail) when the
     pipeline's ``prepare.make_valid`` is on; curves segmentised; Z and M
     dropped by the reader in Rust. Progress runs to ``share`` percent."""
     out = Features()
