@@ -11,6 +11,9 @@ objects*, and the choice of the best method per feature.
   the columns of the ``skeletons`` layer out; options are the pipeline file's.
 - :func:`apply` — the steps of a pipeline file on a GeoDataFrame, keeping its
   columns and index: the function to ``map_partitions`` on a Dask cluster.
+- :func:`apply_layers` — the same with every layer of the output (the kept
+  areas of ``collapse``; the grown coverage and new boundaries of
+  ``partition``), as a dict of GeoDataFrames.
 
 Every input row gives an output row: a feature that cannot be processed has a
 NULL skeleton and its reason in ``rejected``; one skipped by ``min_area`` has a
@@ -451,6 +454,8 @@ def _run(
     output: str,
     attributes: pd.DataFrame | None = None,
     geometry_name: str = "geometry",
+    extra: Mapping[str, Any] | None = None,
+    with_done: bool = False,
 ):
     import geopandas as gpd
 
@@ -468,6 +473,7 @@ def _run(
         explode=explode,
         threads=threads,
         output=output,
+        **(extra or {}),
     )
     t2 = time.perf_counter()
     rows = done["row"]
@@ -481,7 +487,7 @@ def _run(
     if attributes is not None and len(attributes.columns) and _core.columns(layer, False)[1]:
         frame = pd.DataFrame(tool, index=out_index)
         # Source fields first, renamed where they clash with the tool's (as the writer does).
-        clash = {n.lower() for n, _ in _core.columns("skeletons", True)[0]} | {"rejected"}
+        clash = _clash(pipeline)
         source = attributes.iloc[rows]
         source.index = out_index
         source = source.rename(columns=lambda c: f"src_{c}" if str(c).lower() in clash else c)
@@ -514,7 +520,7 @@ def _run(
         },
         "exchange": "wkb" if isinstance(payload, list) else "geoarrow",
     }
-    return frame
+    return (frame, done) if with_done else frame
 
 
 def skeletonise(
@@ -668,14 +674,14 @@ def apply(
     if p.partition:
         raise PipelineError(
             "the `partition` step reads the coverage of `input.neighbours` and writes it grown once every "
-            "polygon is done, so it runs from the command line (`skeletonise run`) and in QGIS "
-            "(skeletonise:partition); leave it out of the pipeline given to Python"
+            "polygon is done, which one GeoDataFrame cannot hold: run it with skeletonise.apply_layers(gdf, "
+            "pipeline, neighbours=units), the command line (`skeletonise run`) or QGIS (skeletonise:partition)"
         )
     if p.collapse:
         raise PipelineError(
-            "the `collapse` step writes kept areas beside the lines, which a GeoDataFrame cannot hold: it runs "
-            "from the command line (`skeletonise run`) and in QGIS (skeletonise:collapse); leave it out of the "
-            "pipeline given to Python"
+            "the `collapse` step writes kept areas beside the lines, which one GeoDataFrame cannot hold: run it "
+            "with skeletonise.apply_layers(gdf, pipeline), the command line (`skeletonise run`) or QGIS "
+            "(skeletonise:collapse)"
         )
     geometry_name = gdf.geometry.name
     arr = np.asarray(gdf.geometry.values, dtype=object)
@@ -696,6 +702,113 @@ def apply(
 
 
 __all__.append("load_pipeline")
+
+
+def _clash(pipeline: "_core.Pipeline") -> set:
+    """The (lower-case) names for which a source column is renamed ``src_<name>``, in every
+    frame alike, as the command line's writer renames them."""
+    return {n.lower() for n in _core.reserved(pipeline.collapse, pipeline.partition)} | {"rejected"}
+
+
+def _side_input(gdf, crs: Any, what: str) -> tuple[list, np.ndarray]:
+    """A second input (``connect`` lines, ``neighbours`` polygons) as WKB in ``crs``, with its FIDs
+    (the index when it is an integer index, as pyogrio's ``fid_as_index`` gives them)."""
+    series = gdf.geometry if hasattr(gdf, "geometry") else gdf
+    if crs is not None and getattr(series, "crs", None) is not None and series.crs != crs:
+        series = series.to_crs(crs)
+    arr = np.asarray(series.values, dtype=object)
+    if len(arr) == 0:
+        raise PipelineError(f"`{what}` has no features")
+    return _encode(arr, "wkb"), _fids(series.index, len(arr))
+
+
+def _layer_frame(layer: dict, crs: Any, sources: Mapping[str, Any], clash: set) -> Any:
+    """A GeoDataFrame of one of the result's ``layers``: the fields of the frame it carries
+    (``input`` or ``neighbours``, joined by ``src_fid``), then its own columns, then its geometry."""
+    import geopandas as gpd
+
+    tool = {name: _column(kind, values, layer["reals"]) for name, kind, values in layer["columns"]}
+    frame = pd.DataFrame(tool)
+    carried = sources.get(layer["fields"]) if layer["fields"] else None
+    if carried is not None and "src_fid" in frame and len(carried.columns):
+        by_fid = pd.Series(np.arange(len(carried)), index=_fids(carried.index, len(carried)))
+        at = by_fid.reindex(frame["src_fid"].astype("Int64").to_numpy(na_value=-1)).to_numpy()
+        own = carried.iloc[np.where(np.isnan(at), 0, at).astype(np.int64)].reset_index(drop=True)
+        own.loc[np.isnan(at)] = None
+        own = own.rename(columns=lambda c: f"src_{c}" if str(c).lower() in clash else c)
+        frame = pd.concat([own, frame], axis=1)
+    geometry = [None if g is None else shapely.from_wkb(g) for g in layer["geometry"][1]]
+    return gpd.GeoDataFrame(frame, geometry=gpd.GeoSeries(geometry, crs=crs), crs=crs)
+
+
+def apply_layers(
+    gdf,
+    pipeline: Union[str, os.PathLike, "_core.Pipeline"],
+    *,
+    overrides: Sequence[str] = (),
+    connect=None,
+    snap: float = 0.0,
+    neighbours=None,
+    candidates: bool = False,
+    threads: int | None = None,
+) -> dict:
+    """Runs the steps of a pipeline file on a GeoDataFrame, every layer of the output included:
+    the function for pipelines with the ``collapse`` or ``partition`` step, which :func:`apply`
+    refuses (their layers do not fit in one frame).
+
+    Returns a dict of GeoDataFrames by the GeoPackage's layer names: ``skeletons`` (as
+    :func:`apply` returns it), ``candidates`` with ``candidates=True``, and the steps' layers —
+    ``areas`` (the kept areas of ``collapse``; a partition's remainders), ``coverage`` (the units
+    of ``neighbours`` grown by what they received, with their columns), ``boundaries`` (the new
+    boundaries) and ``given`` (what each unit received of each polygon). ``connect`` (a
+    GeoDataFrame or GeoSeries of lines: the line network of ``input.connect``, ``snap`` its snap
+    distance) and ``neighbours`` (a GeoDataFrame of polygons: the coverage of
+    ``input.neighbours``) are reprojected to ``gdf``'s CRS when theirs differs; their ``src_fid``
+    is their index where it is an integer index (pyogrio's ``fid_as_index=True``), else the
+    position. With a ``partition`` step, adjacent polygons of ``gdf`` are merged first, exactly,
+    as the command line's reader merges them (the skeleton row takes the index of the member
+    with the smallest FID).
+    """
+    _need_geo()
+    p = _load(pipeline, overrides)
+    extra: dict[str, Any] = {}
+    if connect is not None:
+        lines, fids = _side_input(connect, gdf.crs, "connect")
+        extra.update(connect=lines, connect_fids=fids.tolist(), snap=float(snap))
+    units = None
+    if neighbours is not None:
+        units, fids = _side_input(neighbours, gdf.crs, "neighbours")
+        extra.update(neighbours=units, neighbour_fids=fids.tolist())
+    if candidates:
+        extra["with_candidates"] = True
+    geometry_name = gdf.geometry.name
+    arr = np.asarray(gdf.geometry.values, dtype=object)
+    attributes = gdf.drop(columns=[geometry_name])
+    frame, done = _run(
+        p,
+        arr,
+        gdf.index,
+        gdf.crs,
+        candidates=False,
+        explode=None,
+        threads=threads,
+        exchange="wkb",
+        output="geoarrow",
+        attributes=attributes,
+        geometry_name=geometry_name,
+        extra=extra,
+        with_done=True,
+    )
+    sources: dict[str, Any] = {"input": attributes.set_axis(gdf.index)}
+    if neighbours is not None and hasattr(neighbours, "geometry"):
+        sources["neighbours"] = neighbours.drop(columns=[neighbours.geometry.name])
+    out = {"skeletons": frame}
+    for name, layer in done.get("layers", {}).items():
+        out[name] = _layer_frame(layer, gdf.crs, sources, _clash(p))
+    return out
+
+
+__all__.append("apply_layers")
 
 
 _LABEL_COLUMNS = ("polygon_part", "kind", "length", "max_width", "elongation", "minzoom", "rejected")

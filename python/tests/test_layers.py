@@ -1,0 +1,81 @@
+"""`skeletonise.apply_layers`: a pipeline with the collapse or partition step on GeoDataFrames,
+every layer of the output, row for row the command line's GeoPackage."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pyogrio
+import pytest
+import shapely
+
+import skeletonise
+from conftest import ROOT, TRAIN, run_cli
+
+COVERAGE = ROOT / "tests" / "data" / "coverage-train.gpkg"
+
+
+def same_rows(got, gpkg, layer, tol=1e-9):
+    """Every column and geometry of the command line's layer, in its order within a src_fid."""
+    want = pyogrio.read_dataframe(gpkg, layer=layer)
+    assert len(got) == len(want), (layer, len(got), len(want))
+    key = "src_fid"
+    got = got.sort_values(key, kind="stable").reset_index(drop=True)
+    want = want.sort_values(key, kind="stable").reset_index(drop=True)
+    for c in want.columns:
+        if c == want.geometry.name:
+            continue
+        assert c in got.columns, (layer, c, list(got.columns))
+        a, b = got[c], want[c]
+        if pd.api.types.is_float_dtype(b):
+            a, b = a.to_numpy(float), b.to_numpy(float)
+            assert np.allclose(a, b, rtol=tol, atol=tol, equal_nan=True), (layer, c)
+        else:
+            norm = lambda v: None if pd.isna(v) else (int(v) if isinstance(v, (int, np.integer)) else v)  # noqa: E731
+            assert [norm(v) for v in a] == [norm(v) for v in b], (layer, c)
+    assert shapely.equals_exact(got.geometry.values, want.geometry.values, tolerance=0).all(), layer
+
+
+def test_collapse_gives_the_command_lines_lines_and_kept_areas(tmp_path):
+    out = run_cli("collapse-rivers.yaml", tmp_path / "c.gpkg")
+    lena = pyogrio.read_dataframe(TRAIN, layer="river_lena", fid_as_index=True)
+    layers = skeletonise.apply_layers(lena, ROOT / "pipelines" / "collapse-rivers.yaml")
+    assert set(layers) == {"skeletons", "areas"}
+    skel = layers["skeletons"]
+    assert skel["collapsed"].notna().all()
+    same_rows(skel.drop(columns=["rejected"]), out, "skeletons")
+    assert len(layers["areas"]) > 3 and "src_kind" in layers["areas"]
+    same_rows(layers["areas"], out, "areas")
+
+
+def test_partition_gives_the_command_lines_coverage_and_boundaries(tmp_path):
+    import os
+    import subprocess
+
+    from conftest import cli_binary
+
+    out = tmp_path / "p.gpkg"
+    subprocess.run(
+        [str(cli_binary()), "run", str(ROOT / "pipelines" / "partition-rivers.yaml"), "-o", str(out), "-q"],
+        check=True, cwd=ROOT, env=dict(os.environ, SKELETONISE_SRC=str(COVERAGE)),
+    )
+    rivers = pyogrio.read_dataframe(COVERAGE, layer="rivers_danube", fid_as_index=True)
+    units = pyogrio.read_dataframe(COVERAGE, layer="units_danube", fid_as_index=True)
+    layers = skeletonise.apply_layers(rivers, ROOT / "pipelines" / "partition-rivers.yaml", neighbours=units)
+    assert {"skeletons", "areas", "coverage", "boundaries", "given"} <= set(layers)
+    # The four reaches merged into one river, as the command line's reader merges them.
+    assert len(layers["skeletons"]) == 1
+    same_rows(layers["skeletons"].drop(columns=["rejected"]), out, "skeletons")
+    cov = layers["coverage"]
+    assert "landuse" in cov and cov["received"].gt(0).sum() > 5
+    same_rows(cov, out, "coverage")
+    same_rows(layers["boundaries"], out, "boundaries")
+    assert shapely.coverage_is_valid(cov.geometry.values)
+    total = units.area.sum() + rivers.area.sum()
+    assert abs(cov.area.sum() + layers["areas"].area.sum() - total) <= 1e-9 * total
+
+
+def test_a_partition_without_neighbours_says_what_to_give():
+    rivers = pyogrio.read_dataframe(COVERAGE, layer="rivers_danube", fid_as_index=True)
+    with pytest.raises(skeletonise.PipelineError, match="neighbours"):
+        skeletonise.apply_layers(rivers, ROOT / "pipelines" / "partition-rivers.yaml")
