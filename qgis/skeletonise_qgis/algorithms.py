@@ -559,8 +559,12 @@ class LabelAlgorithm(_Algorithm):
         "<b>Parts</b>: each (a label per polygon part) or largest (one per feature).\n"
         "<b>Minimum pixels</b>: minzoom is the smallest web-map zoom at which the line is this many "
         "pixels long (a point's disc this wide) at its latitude.\n"
-        "<b>Labels</b>: the source's fields, src_fid, polygon_part, kind (line, point), length, "
-        "max_width, elongation, minzoom, rejected."
+        "<b>Label lines</b>: the parts labelled along a line (kind = line), and the parts without a "
+        "label (no geometry: kind = none for a part thinner than the axis's grid, or the reason in "
+        "rejected); columns: the source's fields, src_fid, polygon_part, kind, length, max_width, "
+        "elongation, minzoom, rejected.\n"
+        "<b>Label points</b>: the parts labelled at a point (kind = point), the same columns. Together "
+        "the two layers are the command line's labels layer: one row per polygon part."
     )
 
     def initAlgorithm(self, config=None):  # noqa: N802
@@ -571,7 +575,10 @@ class LabelAlgorithm(_Algorithm):
         self.addParameter(QgsProcessingParameterNumber("MIN_ELONGATION", _tr("Minimum elongation"), number, 3.0, minValue=0.0))
         self.addParameter(QgsProcessingParameterEnum("PARTS", _tr("Parts"), options=PARTS, defaultValue=0))
         self.addParameter(QgsProcessingParameterNumber("MIN_PIXELS", _tr("Minimum pixels (for minzoom)"), number, 64.0, minValue=0.0))
-        self.addParameter(QgsProcessingParameterFeatureSink("OUTPUT", _tr("Labels"), QgsProcessing.TypeVectorAnyGeometry))
+        # Two layers of one geometry type each: QGIS cannot make a temporary layer of mixed
+        # geometries, and lines and points are styled apart.
+        self.addParameter(QgsProcessingParameterFeatureSink("OUTPUT", _tr("Label lines"), QgsProcessing.TypeVectorLine))
+        self.addParameter(QgsProcessingParameterFeatureSink("POINTS", _tr("Label points"), QgsProcessing.TypeVectorPoint))
         self._tooltips()
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802
@@ -596,9 +603,12 @@ class LabelAlgorithm(_Algorithm):
         ]
         fields = bridge.output_fields(source.fields(), carried, tool)
         crs = source.sourceCrs()
-        sink, dest = self.parameterAsSink(parameters, "OUTPUT", context, fields, QgsWkbTypes.Unknown, crs)
-        if sink is None:
-            raise QgsProcessingException(self.invalidSinkError(parameters, "OUTPUT"))
+        sinks, results = {}, {}
+        for key, kind in (("OUTPUT", QgsWkbTypes.LineString), ("POINTS", QgsWkbTypes.Point)):
+            sink, dest = self.parameterAsSink(parameters, key, context, fields, kind, crs)
+            if sink is None:
+                raise QgsProcessingException(self.invalidSinkError(parameters, key))
+            sinks[key], results[key] = sink, dest
         core = bridge.core()
         parts = list(bridge.batches(features))
         rejected_count = 0
@@ -619,13 +629,14 @@ class LabelAlgorithm(_Algorithm):
                 attrs += [features.fids[i], part[j], kind[j], length[j], width[j], elong[j], z, rejected[j]]
                 f = QgsFeature()
                 f.setAttributes(attrs)
-                f.setGeometry(g)
-                sink.addFeature(f, QgsFeatureSink.FastInsert)
+                if not g.isNull():
+                    f.setGeometry(g)
+                sinks["POINTS" if kind[j] == "point" else "OUTPUT"].addFeature(f, QgsFeatureSink.FastInsert)
                 if rejected[j] is not None:
                     rejected_count += 1
                     feedback.reportError(f"feature {features.fids[i]} rejected: {rejected[j]}")
             feedback.setProgress(10 + 90 * (k + 1) / len(parts))
-        return {"OUTPUT": dest, "FEATURES_READ": len(features), "FEATURES_REJECTED": rejected_count}
+        return dict(results, FEATURES_READ=len(features), FEATURES_REJECTED=rejected_count)
 
 
 class PartitionAlgorithm(_Algorithm):

@@ -60,9 +60,11 @@ def canvas(path, out_dir):
     skel = processing.run(
         "skeletonise:skeletonise", {"INPUT": lakes, "OUTPUT": os.path.join(out_dir, "skeletons.gpkg")}
     )["OUTPUT"]
-    labels = processing.run(
-        "skeletonise:label", {"INPUT": lakes, "OUTPUT": os.path.join(out_dir, "labels.gpkg")}
-    )["OUTPUT"]
+    labelled = processing.run(
+        "skeletonise:label",
+        {"INPUT": lakes, "OUTPUT": os.path.join(out_dir, "labels.gpkg"), "POINTS": os.path.join(out_dir, "points.gpkg")},
+    )
+    labels = labelled["OUTPUT"]
     skel = QgsVectorLayer(skel, "skeletons", "ogr")
     labels_l = QgsVectorLayer(labels, "labels", "ogr")
     lakes.setRenderer(
@@ -72,8 +74,7 @@ def canvas(path, out_dir):
     labels_l.setRenderer(
         QgsSingleSymbolRenderer(QgsLineSymbol.createSimple({"color": "51,160,44", "width": "0.6", "line_style": "dash"}))
     )
-    points = QgsVectorLayer(labels + "|layername=labels", "points", "ogr")
-    points.setSubsetString("kind = 'point'")
+    points = QgsVectorLayer(labelled["POINTS"], "points", "ogr")
     points.setRenderer(QgsSingleSymbolRenderer(QgsMarkerSymbol.createSimple({"color": "51,160,44", "size": "2.5"})))
     settings = QgsMapSettings()
     settings.setLayers([points, labels_l, skel, lakes])

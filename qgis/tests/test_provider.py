@@ -20,10 +20,13 @@ import time
 import unittest
 
 from qgis.core import (
+    QgsApplication,
     QgsFeature,
     QgsGeometry,
     QgsPointXY,
+    QgsProcessingContext,
     QgsProcessingException,
+    QgsProcessingUtils,
     QgsProcessingFeedback,
     QgsVectorLayer,
 )
@@ -531,15 +534,18 @@ class Labels(Case):
     def test_labels_give_the_command_lines_rows_with_minzoom(self):
         cli("run", os.path.join(ROOT, "pipelines", "lake-labels.yaml"), "-o", self.out("cli.gpkg"))
         res = processing.run(
-            "skeletonise:label", {"INPUT": f"{TRAIN}|layername=lakes_scotland", "OUTPUT": self.out("q.gpkg")}
+            "skeletonise:label",
+            {"INPUT": f"{TRAIN}|layername=lakes_scotland", "OUTPUT": self.out("q.gpkg"), "POINTS": self.out("p.gpkg")},
         )
-        got = rows(res["OUTPUT"])
+        lines, points = rows(res["OUTPUT"]), rows(res["POINTS"])
+        self.assertEqual({r["kind"] for r in lines}, {"line"})
+        self.assertEqual({r["kind"] for r in points}, {"point"})
+        got = lines + points
         want = rows(self.out("cli.gpkg"), "labels")
         for r in got:
             del r["rejected"]
         self.assertIn("src_kind", want[0])
         self.assertSameRows(got, want, key=("src_fid", "polygon_part"))
-        self.assertEqual({r["kind"] for r in got}, {"line", "point"})
         self.assertTrue(all(r["minzoom"] is not None for r in got))
 
 
@@ -574,11 +580,42 @@ class QgisProcess(Case):
                                         "SKELETON_KEY": "src_fid", "LABEL": "vd"}, ["OUTPUT"])
         self.same("skeletonise:pipeline", {"INPUT": lakes, "PIPELINE": os.path.join(ROOT, "pipelines", "collapse-rivers.yaml"),
                                            "OVERRIDES": "steps.collapse.width=300"}, ["OUTPUT", "AREAS"])
-        self.same("skeletonise:label", {"INPUT": lakes, "PARTS": 1, "MIN_PIXELS": 32}, ["OUTPUT"])
+        self.same("skeletonise:label", {"INPUT": lakes, "PARTS": 1, "MIN_PIXELS": 32}, ["OUTPUT", "POINTS"])
         cov = os.path.join(ROOT, "tests", "data", "coverage-train.gpkg")
         self.same("skeletonise:partition", {"INPUT": f"{cov}|layername=rivers_lena", "NEIGHBOURS": f"{cov}|layername=units_lena",
                                             "WIDTH": 1500}, ["COVERAGE", "BOUNDARIES", "AREAS"])
         self.same("skeletonise:skeletonise", {"INPUT": lakes, "METHODS": [0, 3], "PRUNE": 2}, ["OUTPUT", "CANDIDATES"])
+
+
+class TemporaryOutputs(Case):
+    def test_every_algorithm_writes_temporary_layers(self):
+        # What the dialog does by default: "[Create temporary layer]" for every sink.
+        cov = os.path.join(ROOT, "tests", "data", "coverage-train.gpkg")
+        lakes = f"{TRAIN}|layername=lakes_scotland"
+        cli("run", "-i", TRAIN, "-l", "lakes_scotland", "-o", self.out("run.gpkg"), "--set", "steps.skeleton.methods=[CDT]")
+        cases = {
+            "skeletonise:skeletonise": {"INPUT": lakes},
+            "skeletonise:collapse": {"INPUT": lakes, "WIDTH": 400},
+            "skeletonise:partition": {"INPUT": f"{cov}|layername=rivers_danube", "NEIGHBOURS": f"{cov}|layername=units_danube"},
+            "skeletonise:score": {"INPUT": lakes, "SKELETONS": f"{self.out('run.gpkg')}|layername=skeletons"},
+            "skeletonise:pipeline": {"INPUT": lakes, "PIPELINE": os.path.join(ROOT, "pipelines", "collapse-rivers.yaml")},
+            "skeletonise:label": {"INPUT": lakes},
+        }
+        for alg_id, params in cases.items():
+            alg = QgsApplication.processingRegistry().algorithmById(alg_id)
+            for p in alg.destinationParameterDefinitions():
+                params[p.name()] = "TEMPORARY_OUTPUT"
+            with self.subTest(algorithm=alg_id):
+                context = QgsProcessingContext()
+                res = processing.run(alg_id, params, context=context)
+
+                def layer(v):
+                    return v if isinstance(v, QgsVectorLayer) else QgsProcessingUtils.mapLayerFromString(v, context)
+
+                # (The pipeline's partition sinks stay unwritten: its file has no partition step.)
+                counts = {p.name(): layer(res[p.name()]).featureCount()
+                          for p in alg.destinationParameterDefinitions() if p.name() in res}
+                self.assertGreater(max(counts.values()), 0, counts)
 
 
 class Screenshots(Case):
