@@ -683,12 +683,15 @@ def apply(
             "with skeletonise.apply_layers(gdf, pipeline), the command line (`skeletonise run`) or QGIS "
             "(skeletonise:collapse)"
         )
+    return _run_frame(gdf, p, candidates=candidates, threads=threads)
+
+
+def _run_frame(gdf, p: "_core.Pipeline", *, candidates: bool, threads: int | None, **more: Any):
+    """``_run`` on a GeoDataFrame: its geometry in, its other columns carried, its geometry's name kept."""
     geometry_name = gdf.geometry.name
-    arr = np.asarray(gdf.geometry.values, dtype=object)
-    attributes = gdf.drop(columns=[geometry_name])
     return _run(
         p,
-        arr,
+        np.asarray(gdf.geometry.values, dtype=object),
         gdf.index,
         gdf.crs,
         candidates=candidates,
@@ -696,8 +699,9 @@ def apply(
         threads=threads,
         exchange="wkb",
         output="geoarrow",
-        attributes=attributes,
+        attributes=gdf.drop(columns=[geometry_name]),
         geometry_name=geometry_name,
+        **more,
     )
 
 
@@ -781,25 +785,8 @@ def apply_layers(
         extra.update(neighbours=units, neighbour_fids=fids.tolist())
     if candidates:
         extra["with_candidates"] = True
-    geometry_name = gdf.geometry.name
-    arr = np.asarray(gdf.geometry.values, dtype=object)
-    attributes = gdf.drop(columns=[geometry_name])
-    frame, done = _run(
-        p,
-        arr,
-        gdf.index,
-        gdf.crs,
-        candidates=False,
-        explode=None,
-        threads=threads,
-        exchange="wkb",
-        output="geoarrow",
-        attributes=attributes,
-        geometry_name=geometry_name,
-        extra=extra,
-        with_done=True,
-    )
-    sources: dict[str, Any] = {"input": attributes.set_axis(gdf.index)}
+    frame, done = _run_frame(gdf, p, candidates=False, threads=threads, extra=extra, with_done=True)
+    sources: dict[str, Any] = {"input": gdf.drop(columns=[gdf.geometry.name])}
     if neighbours is not None and hasattr(neighbours, "geometry"):
         sources["neighbours"] = neighbours.drop(columns=[neighbours.geometry.name])
     out = {"skeletons": frame}

@@ -79,3 +79,16 @@ def test_a_partition_without_neighbours_says_what_to_give():
     rivers = pyogrio.read_dataframe(COVERAGE, layer="rivers_danube", fid_as_index=True)
     with pytest.raises(skeletonise.PipelineError, match="neighbours"):
         skeletonise.apply_layers(rivers, ROOT / "pipelines" / "partition-rivers.yaml")
+
+
+def test_bad_second_inputs_are_clear_errors():
+    rivers = pyogrio.read_dataframe(COVERAGE, layer="rivers_danube", fid_as_index=True)
+    units = pyogrio.read_dataframe(COVERAGE, layer="units_danube", fid_as_index=True)
+    lines = units.copy()
+    lines.geometry = units.boundary
+    with pytest.raises(skeletonise.PipelineError, match="not a polygon"):
+        skeletonise.apply_layers(rivers, ROOT / "pipelines" / "partition-rivers.yaml", neighbours=lines)
+    with pytest.raises(skeletonise.PipelineError, match="no features"):
+        skeletonise.apply_layers(rivers, ROOT / "pipelines" / "partition-rivers.yaml", neighbours=units.iloc[:0])
+    with pytest.raises(skeletonise.PipelineError, match="no lines"):
+        skeletonise.apply_layers(rivers, ROOT / "pipelines" / "collapse-rivers.yaml", connect=rivers.centroid)
