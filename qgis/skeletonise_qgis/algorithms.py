@@ -103,7 +103,35 @@ class _Algorithm(QgsProcessingAlgorithm):
 
     # --- shared steps -------------------------------------------------------
 
+    def _refuse_outputs_onto_inputs(self, parameters, context):
+        """No sink may be written into a file an input is read from (a GeoPackage output replaces
+        the whole file): the command line's rule, never an overwritten input."""
+        inputs = {}
+        for p in self.parameterDefinitions():
+            if p.isDestination() or p.name() not in parameters or parameters[p.name()] is None:
+                continue
+            if p.type() in ("source", "vector", "file"):
+                layer = self.parameterAsVectorLayer(parameters, p.name(), context) if p.type() != "file" else None
+                path = layer.source() if layer is not None else self.parameterAsString(parameters, p.name(), context)
+                path = path.split("|")[0]
+                if path and os.path.exists(path):
+                    inputs[os.path.realpath(path)] = p.name()
+        for p in self.destinationParameterDefinitions():
+            if parameters.get(p.name()) is None:
+                continue
+            dest = self.parameterAsOutputLayer(parameters, p.name(), context) or ""
+            dest = dest.split("|")[0]
+            if dest.startswith("ogr:") or not dest or dest.startswith("memory:"):
+                continue
+            real = os.path.realpath(dest)
+            if real in inputs:
+                raise QgsProcessingException(
+                    f"the output {p.name()} ({dest}) is the file the input {inputs[real]} is read from, and "
+                    "writing it would replace that file: choose another output file"
+                )
+
     def _input(self, parameters, context):
+        self._refuse_outputs_onto_inputs(parameters, context)
         source = self.parameterAsSource(parameters, "INPUT", context)
         if source is None:
             raise QgsProcessingException(self.invalidSourceError(parameters, "INPUT"))

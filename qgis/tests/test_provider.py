@@ -18,6 +18,7 @@ import tempfile
 import threading
 import time
 import unittest
+from pathlib import Path
 
 from qgis.core import (
     QgsApplication,
@@ -233,6 +234,21 @@ class Skeletonise(Case):
         self.assertEqual(run.returncode, 0, run.stdout + run.stderr)
         self.assertEqual(json.loads(run.stdout[run.stdout.index("{"):])["results"]["FEATURES_READ"], 18)
         self.assertEqual(len(rows(self.out("z.gpkg"))), 18)
+
+    def test_an_output_onto_an_input_file_is_refused_and_the_input_kept(self):
+        import hashlib
+
+        src = self.out("lakes.gpkg")
+        shutil.copy(TRAIN, src)
+        before = hashlib.sha256(Path(src).read_bytes()).hexdigest()
+        for alg, params in (
+            ("skeletonise:skeletonise", {"INPUT": f"{src}|layername=lakes_scotland", "OUTPUT": src}),
+            ("skeletonise:label", {"INPUT": f"{src}|layername=lakes_scotland", "OUTPUT": self.out("l.gpkg"), "POINTS": src}),
+        ):
+            with self.subTest(algorithm=alg), self.assertRaises(QgsProcessingException) as e:
+                processing.run(alg, params)
+            self.assertIn("choose another output file", str(e.exception))
+        self.assertEqual(hashlib.sha256(Path(src).read_bytes()).hexdigest(), before)
 
     def test_a_geographic_layer_is_refused_with_the_reprojection_hint(self):
         lonlat = processing.run(
