@@ -198,6 +198,23 @@ fn check_layer(layer: &str, max_z: f64) -> (usize, usize) {
             }
             other => panic!("{layer} {fid}: {other:?}"),
         }
+        // The run reuses the medial axis its `skeleton` step made; the
+        // library call makes its own: the same label.
+        let own = skeletonise::label::LabelParams::default().label(&p);
+        let own = match own.map(|l| l.label) {
+            Some(skeletonise::label::Label::Line(l)) => Geometry::LineString(l),
+            Some(skeletonise::label::Label::Point(c)) => Geometry::Point(c.into()),
+            None => panic!("{layer} {fid}: a label"),
+        };
+        let written = geometry(geoms[k].as_deref().unwrap());
+        let (a, b): (Vec<Coord<f64>>, Vec<Coord<f64>>) = {
+            use geo::CoordsIter;
+            (own.coords_iter().collect(), written.coords_iter().collect())
+        };
+        assert!(
+            a.len() == b.len() && a.iter().zip(&b).all(|(&a, &b)| dist(a, b) < 1e-6),
+            "{layer} {fid}: the run's label is the library's"
+        );
     }
     // Centred: the lines scored against their polygons.
     let lines_only = dir.path().join("lines.gpkg");

@@ -74,7 +74,6 @@ pub(super) fn label(
     o: Shape,
 ) -> Option<Labelled> {
     let b = p.boundary();
-    let radius = |c: Coord<f64>| b.nearest(c).map_or(0.0, |(_, _, d)| d);
     let (centre, r_max) = raw
         .nodes()
         .iter()
@@ -87,7 +86,7 @@ pub(super) fn label(
         max_width,
         elongation,
     };
-    let Some(path) = best_path(g, b) else {
+    let Some((path, radii)) = best_path(g, b) else {
         return Some(point(0.0));
     };
     let axis_length = length(&path);
@@ -95,7 +94,6 @@ pub(super) fn label(
     if elongation < o.min_elongation {
         return Some(point(elongation));
     }
-    let radii: Vec<f64> = path.iter().map(|&c| radius(c)).collect();
     let (path, radii) = trim(&path, &radii);
     if path.len() < 2 {
         return Some(point(elongation));
@@ -125,8 +123,9 @@ fn dedup(mut c: Vec<Coord<f64>>) -> Vec<Coord<f64>> {
     c
 }
 
-/// The leaf-to-leaf shortest path with the best `L / (1 + T / π)`.
-fn best_path(g: &SkeletonGraph, b: &Boundary) -> Option<Vec<Coord<f64>>> {
+/// The leaf-to-leaf shortest path with the best `L / (1 + T / π)`, and the
+/// local radius (distance to ∂P) at each of its points.
+fn best_path(g: &SkeletonGraph, b: &Boundary) -> Option<(Vec<Coord<f64>>, Vec<f64>)> {
     let m = g.merged();
     let deg = m.degrees();
     let leaves: Vec<NodeId> = (0..deg.len())
@@ -155,49 +154,70 @@ fn best_path(g: &SkeletonGraph, b: &Boundary) -> Option<Vec<Coord<f64>>> {
         leaves
     };
     let usable = vec![true; m.edges().len()];
-    let mut best: Option<(f64, Vec<Coord<f64>>)> = None;
+    // Every point's radius once: the pairs' paths share most of their edges.
+    let radii: Vec<Vec<f64>> = (0..m.edges().len())
+        .map(|e| {
+            m.edge_coords(EdgeId::from_index(e))
+                .into_iter()
+                .map(|c| b.nearest(c).map_or(0.0, |(_, _, d)| d))
+                .collect()
+        })
+        .collect();
+    let mut best: Option<(f64, Vec<Coord<f64>>, Vec<f64>)> = None;
     for (i, &a) in leaves.iter().enumerate() {
         for &z in &leaves[i + 1..] {
             let Some(edges) = crate::graph::prune::trunk::shortest_path(&m, &usable, a, z) else {
                 continue;
             };
-            let path = coords_of(&m, &edges, z);
-            let score = straightness_score(&path, b);
-            if best.as_ref().is_none_or(|(s, _)| score > *s) {
-                best = Some((score, path));
+            let (path, r) = coords_of(&m, &radii, &edges, z);
+            let score = straightness_score(&path, &r);
+            if best.as_ref().is_none_or(|(s, _, _)| score > *s) {
+                best = Some((score, path, r));
             }
         }
     }
-    best.map(|(_, p)| p)
+    best.map(|(_, p, r)| (p, r))
 }
 
 /// Leaves whose pairs are tried at most (the farthest apart).
 const MAX_LEAVES: usize = 12;
 
-/// The coordinates of a path given as edges walked back from `to`.
-fn coords_of(m: &SkeletonGraph, edges: &[EdgeId], to: NodeId) -> Vec<Coord<f64>> {
+/// The coordinates of a path given as edges walked back from `to`, with
+/// their radii (`radii`: each edge's, point by point).
+fn coords_of(
+    m: &SkeletonGraph,
+    radii: &[Vec<f64>],
+    edges: &[EdgeId],
+    to: NodeId,
+) -> (Vec<Coord<f64>>, Vec<f64>) {
     let mut out: Vec<Coord<f64>> = vec![m.node(to).pos];
+    let mut r_out: Vec<f64> = Vec::new();
     let mut at = to;
     for &e in edges {
         let mut c = m.edge_coords(e);
+        let mut r = radii[e.index()].clone();
         if c.first().copied() != Some(m.node(at).pos) {
             c.reverse();
+            r.reverse();
+        }
+        if r_out.is_empty() {
+            r_out.push(r[0]);
         }
         out.extend_from_slice(&c[1..]);
+        r_out.extend_from_slice(&r[1..]);
         at = m.opposite(e, at);
     }
-    out
+    (out, r_out)
 }
 
 /// `L / (1 + T / π)`: T the total turning of the path resampled one local
-/// width apart.
-fn straightness_score(path: &[Coord<f64>], b: &Boundary) -> f64 {
+/// width apart (`radii`: the local radius at each point of the path).
+fn straightness_score(path: &[Coord<f64>], radii: &[f64]) -> f64 {
     let l = length(path);
     let mut coarse: Vec<Coord<f64>> = vec![path[0]];
     let mut since = 0.0;
-    for w in path.windows(2) {
+    for (w, &r) in path.windows(2).zip(&radii[1..]) {
         since += hypot(w[1] - w[0]);
-        let r = b.nearest(w[1]).map_or(0.0, |(_, _, d)| d);
         if since >= (2.0 * r).max(l / 200.0) {
             coarse.push(w[1]);
             since = 0.0;

@@ -26,6 +26,7 @@ pub mod line;
 use crate::geometry::PreparedPolygon;
 use crate::graph::extend::{prune_and_extend, ExtendParams};
 use crate::graph::prune::PruneParams;
+use crate::graph::SkeletonGraph;
 use crate::layer::{Cell, ColumnType, GeometryKind, StepLayer, StepRow};
 use crate::methods::{MethodContext, MethodId, SkeletonParams};
 use crate::process::step::{FeatureStep, LonLat, OptionError, StepEntry, StepInput};
@@ -141,22 +142,35 @@ impl LabelParams {
     /// The label of one polygon part (`None` when it has no medial axis: a
     /// polygon thinner than the axis's grid).
     pub fn label(&self, p: &PreparedPolygon) -> Option<Labelled> {
-        let params = SkeletonParams {
-            methods: vec![MethodId::MA],
-            ..Default::default()
+        self.label_on(p, None)
+    }
+
+    /// The label of one polygon part from its medial axis's raw skeleton
+    /// `raw` (MA with its default options), made here when not given.
+    pub fn label_on(&self, p: &PreparedPolygon, raw: Option<&SkeletonGraph>) -> Option<Labelled> {
+        let made;
+        let raw = match raw {
+            Some(raw) => raw,
+            None => {
+                let params = SkeletonParams {
+                    methods: vec![MethodId::MA],
+                    ..Default::default()
+                };
+                made = crate::methods::build(MethodId::MA, &params)
+                    .skeletonise(p, &MethodContext::default())
+                    .ok()?;
+                &made
+            }
         };
-        let raw = crate::methods::build(MethodId::MA, &params)
-            .skeletonise(p, &MethodContext::default())
-            .ok()?;
         let g = prune_and_extend(
-            &raw,
+            raw,
             p,
             Some(&PruneParams::default()),
             Some(&ExtendParams::default()),
         );
         line::label(
             p,
-            &raw,
+            raw,
             &g,
             line::Shape {
                 smooth_deg: self.smooth,
@@ -187,7 +201,19 @@ impl LabelParams {
     /// largest by area), each with the part's index: `None` for a part with
     /// no medial axis (thinner than the axis's grid).
     pub fn labels(&self, parts: &[PreparedPolygon]) -> Vec<(usize, Option<Labelled>)> {
+        self.labels_on(parts, None)
+    }
+
+    /// [`Self::labels`] from the parts' medial axes' raw skeletons
+    /// (`medial_axis[i]` of part i, MA with its default options), made here
+    /// when not given.
+    pub fn labels_on(
+        &self,
+        parts: &[PreparedPolygon],
+        medial_axis: Option<&[Arc<SkeletonGraph>]>,
+    ) -> Vec<(usize, Option<Labelled>)> {
         use geo::Area;
+        let raw = |i: usize| medial_axis.and_then(|m| m.get(i)).map(|g| &**g);
         let mut parts: Vec<(usize, &PreparedPolygon)> = parts.iter().enumerate().collect();
         if self.parts == Parts::Largest {
             parts.sort_by(|a, b| {
@@ -197,7 +223,10 @@ impl LabelParams {
             });
             parts.truncate(1);
         }
-        parts.into_iter().map(|(i, p)| (i, self.label(p))).collect()
+        parts
+            .into_iter()
+            .map(|(i, p)| (i, self.label_on(p, raw(i))))
+            .collect()
     }
 
     /// A label's `minzoom` at its own latitude (`None`: no label, or no
@@ -215,7 +244,7 @@ impl LabelParams {
 
 impl FeatureStep for LabelParams {
     fn rows(&self, input: &StepInput<'_>) -> Vec<(&'static str, StepRow)> {
-        self.labels(input.parts)
+        self.labels_on(input.parts, input.medial_axis)
             .into_iter()
             .map(|(i, l)| {
                 let (geometry, kind) = match l.as_ref().map(|l| &l.label) {
@@ -239,6 +268,10 @@ impl FeatureStep for LabelParams {
                 ("labels", StepRow { geometry, cells })
             })
             .collect()
+    }
+
+    fn uses_medial_axis(&self) -> bool {
+        true
     }
 }
 

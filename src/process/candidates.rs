@@ -135,6 +135,7 @@ pub(super) fn given(
             graph: graph.clone(),
             legs_raw: legs,
             ctx: MethodContext::default(),
+            raw: None,
         })
         .collect();
     let parallel = worth_splitting(prepared);
@@ -156,6 +157,9 @@ pub(super) struct PartSkeleton {
     /// The method's budget on this part (its clock started with the raw
     /// skeleton); scoring is under it too.
     ctx: MethodContext,
+    /// The raw skeleton, when kept for a registered step (MA's, see
+    /// [`ProcessParams::keeps_raw_medial_axis`]).
+    raw: Option<std::sync::Arc<SkeletonGraph>>,
 }
 
 /// Every method's finished skeleton of one polygon part, in `methods`
@@ -481,6 +485,7 @@ impl<'a> PartWork<'a> {
         reference: Option<&Reference>,
     ) -> Vec<(Result<PartSkeleton, String>, StageTimes)> {
         let methods = &self.params.skeleton.methods;
+        let keep_ma = self.params.keeps_raw_medial_axis();
         map_in_order(&raws, self.parallel, |k, raw| {
             let mut stages = raw.stages;
             let result = stages.time(Stage::Prune, || {
@@ -490,10 +495,12 @@ impl<'a> PartWork<'a> {
                     Some((_, s, _)) => self.staged(methods[k], &raw.ctx, || self.conform(g, s)),
                     None => self.staged(methods[k], &raw.ctx, || self.finish(g)),
                 })?;
+                let kept = keep_ma && methods[k] == crate::methods::MethodId::MA;
                 Ok(PartSkeleton {
                     graph: finished,
                     legs_raw: g.leg_count(),
                     ctx: raw.ctx,
+                    raw: kept.then(|| std::sync::Arc::new(g.clone())),
                 })
             });
             (result, stages.times())
@@ -557,6 +564,7 @@ fn finish(
     let mut all_bars = Vec::new();
     let mut widths = Vec::new();
     let mut graphs = Vec::new();
+    let mut raw = Vec::new();
     let (mut components, mut legs_raw, mut legs, mut hooks) = (0, 0, 0, 0);
     let mut branch_offset = 0;
     for (k, (p, part)) in prepared.iter().zip(parts).enumerate() {
@@ -596,6 +604,7 @@ fn finish(
         {
             graphs.push(g.clone());
         }
+        raw.extend(part.raw.clone());
         // The branches as lines (`SkeletonGraph::to_multilinestring`).
         lines.extend(branches.into_iter().map(|b| LineString(b.coords)));
     }
@@ -613,6 +622,7 @@ fn finish(
         bars: all_bars,
         widths,
         graphs,
+        raw,
         note: None,
     };
     (c, cast_time + clock.elapsed().saturating_sub(in_casts))

@@ -72,10 +72,18 @@ pub fn process(geom: Option<&Geometry<f64>>, params: &ProcessParams) -> Processe
     }
     if let Processed::Done(o) = &mut processed {
         for e in &params.extra {
+            let medial_axis = o
+                .candidates
+                .iter()
+                .find(|c| c.method == MethodId::MA)
+                .and_then(|c| c.result.as_ref().ok())
+                .map(|c| c.raw.as_slice())
+                .filter(|raw| raw.len() == prepared.len());
             let rows = e.step.rows(&step::StepInput {
                 parts: &prepared,
                 outcome: o,
                 lonlat: params.lonlat.as_ref(),
+                medial_axis,
             });
             o.extra.extend(rows);
         }

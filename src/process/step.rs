@@ -57,6 +57,11 @@ pub struct StepInput<'a> {
     /// The run's coordinates as longitude and latitude (degrees), when the
     /// run knows its CRS (a GDAL source does; a library caller may not).
     pub lonlat: Option<&'a LonLat>,
+    /// The medial axis's raw skeleton of every polygon part, as the
+    /// `skeleton` step made it with MA's default options, when a step
+    /// [uses it](FeatureStep::uses_medial_axis) and MA succeeded; `None`
+    /// otherwise (the step makes its own).
+    pub medial_axis: Option<&'a [std::sync::Arc<crate::graph::SkeletonGraph>]>,
 }
 
 /// A map from the run's coordinates to longitude and latitude in degrees
@@ -107,6 +112,14 @@ impl PartialEq for LonLat {
 pub trait FeatureStep: Send + Sync + std::fmt::Debug + std::panic::RefUnwindSafe {
     /// The rows of the step's layers for one feature.
     fn rows(&self, input: &StepInput<'_>) -> Vec<(&'static str, StepRow)>;
+
+    /// True when the step reads the medial axis's raw skeleton
+    /// ([`StepInput::medial_axis`]): the `skeleton` step then keeps the one
+    /// it made (with MA among its methods and MA's default options) rather
+    /// than the step making it again.
+    fn uses_medial_axis(&self) -> bool {
+        false
+    }
 }
 
 /// Why a step's options are wrong: the key within the step and what to do.

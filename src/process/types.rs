@@ -55,6 +55,18 @@ pub struct ProcessParams {
 }
 
 impl ProcessParams {
+    /// True when the `skeleton` step keeps MA's raw skeleton for a
+    /// registered step that reads it (`label`): MA is among the methods and
+    /// has its default options (what the step would make itself).
+    pub fn keeps_raw_medial_axis(&self) -> bool {
+        self.extra.iter().any(|e| e.step.uses_medial_axis())
+            && self
+                .skeleton
+                .methods
+                .contains(&crate::methods::MethodId::MA)
+            && self.skeleton.medial_axis == Default::default()
+    }
+
     /// Every step with its defaults, as a pipeline file that lists
     /// `prepare`, `skeleton`, `prune`, `extend`, `score` and `select` with
     /// no options runs them.
@@ -104,6 +116,9 @@ pub struct CandidateSkeleton {
     /// The finished skeleton graph of every polygon part, when the pipeline
     /// collapses (the `collapse` step works on graphs).
     pub graphs: Vec<crate::graph::SkeletonGraph>,
+    /// The raw skeleton of every polygon part (before pruning), kept for MA
+    /// when a registered step reads it ([`ProcessParams::keeps_raw_medial_axis`]).
+    pub raw: Vec<std::sync::Arc<crate::graph::SkeletonGraph>>,
     /// Something the scores alone do not tell (e.g. a given skeleton that
     /// leaves its polygon), for the row's `note`.
     pub note: Option<String>,
