@@ -263,7 +263,80 @@ fn smooth_inside(path: &[Coord<f64>], radii: &[f64], b: &Boundary, o: Shape) -> 
     let at = resample(path, radii);
     let cur: Vec<Coord<f64>> = at.iter().map(|p| p.0).collect();
     let cur = smooth(cur, &at, o);
+    let cur = relax(cur, &at, o);
     keep_off_shore(&cur, &at, b, o.margin)
+}
+
+/// Each run of points that smoothing moved off the medial axis, moved back
+/// towards it as far as the turn allows: the points of the run keep the
+/// least fraction t of their move (the same for the whole run, found by
+/// bisection) with which no more points turn too much than with all of it.
+/// Smoothing averages over a whole window round after round; where a bend
+/// needed only part of that, the line returns to the centre.
+fn relax(mut cur: Vec<Coord<f64>>, at: &[(Coord<f64>, f64)], o: Shape) -> Vec<Coord<f64>> {
+    let max_turn = o.smooth_deg.to_radians();
+    let window = corridor_windows(at, o.margin);
+    let n = cur.len();
+    let reach = window.iter().cloned().fold(0.0, f64::max);
+    // The first (last) point from which a stretch `reach` long (along the
+    // axis) reaches point `from`.
+    let span = |from: usize, step: isize| -> usize {
+        let (mut k, mut along) = (from as isize, 0.0);
+        while along < reach && (0..n as isize).contains(&(k + step)) {
+            along += hypot(at[(k + step) as usize].0 - at[k as usize].0);
+            k += step;
+        }
+        k as usize
+    };
+    let mut i = 0;
+    while i < n {
+        if cur[i] == at[i].0 {
+            i += 1;
+            continue;
+        }
+        let s = i;
+        while i < n && cur[i] != at[i].0 {
+            i += 1;
+        }
+        let (lo, hi) = (span(s, -1), span(i - 1, 1) + 1);
+        let moved: Vec<Coord<f64>> = cur[s..i].to_vec();
+        let bad_with = |t: f64, line: &mut Vec<Coord<f64>>| -> usize {
+            for k in s..i {
+                line[k] = at[k].0 + (moved[k - s] - at[k].0) * t;
+            }
+            too_curved(&line[lo..hi], &window[lo..hi], max_turn)
+                .iter()
+                .filter(|&&x| x)
+                .count()
+        };
+        let allowed = bad_with(1.0, &mut cur);
+        let (mut t_lo, mut t_hi) = (0.0, 1.0);
+        if bad_with(0.0, &mut cur) <= allowed {
+            t_hi = 0.0;
+        } else {
+            for _ in 0..RELAX_STEPS {
+                let mid = 0.5 * (t_lo + t_hi);
+                if bad_with(mid, &mut cur) <= allowed {
+                    t_hi = mid;
+                } else {
+                    t_lo = mid;
+                }
+            }
+        }
+        bad_with(t_hi, &mut cur);
+    }
+    cur
+}
+
+/// Bisection steps of [`relax`] (the kept move to within 1/256).
+const RELAX_STEPS: usize = 8;
+
+/// The stretch over which the turn is judged while smoothing: a point
+/// within the corridor is at most (2 − margin) r from ∂P, so its stretch is
+/// judged over `2 (2 − margin) r` (no boundary query per point and round;
+/// the exact check follows in `gentlest_run`).
+fn corridor_windows(at: &[(Coord<f64>, f64)], margin: f64) -> Vec<f64> {
+    at.iter().map(|&(_, r)| 2.0 * (2.0 - margin) * r).collect()
 }
 
 /// The stretch over which the turn is judged at each point: `2 d`, d its
@@ -298,13 +371,7 @@ fn resample(path: &[Coord<f64>], radii: &[f64]) -> Vec<(Coord<f64>, f64)> {
 fn smooth(mut cur: Vec<Coord<f64>>, at: &[(Coord<f64>, f64)], o: Shape) -> Vec<Coord<f64>> {
     let half = 4usize;
     let max_turn = o.smooth_deg.to_radians();
-    // A point within the corridor is at most (2 − margin) r from ∂P: its
-    // stretch is judged over that much while smoothing (no boundary query
-    // per point and round); the exact check follows (`gentlest_run`).
-    let window: Vec<f64> = at
-        .iter()
-        .map(|&(_, r)| 2.0 * (2.0 - o.margin) * r)
-        .collect();
+    let window = corridor_windows(at, o.margin);
     let (mut fewest, mut since) = (usize::MAX, 0);
     for _ in 0..MAX_ROUNDS {
         let bad = too_curved(&cur, &window, max_turn);
