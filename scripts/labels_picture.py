@@ -29,6 +29,8 @@ def layer_of(spec):
 P = layer_of(polys)
 L = gpd.read_file(labels, layer="labels")
 O = layer_of(other) if other else None
+if O is not None and "src_fid" in O.columns:
+    O = O.set_index("src_fid")  # the other tool's lines by their polygon's FID
 cols = min(len(fids), 4)
 rows = (len(fids) + cols - 1) // cols
 fig, axes = plt.subplots(rows, cols, figsize=(4.5 * cols, 4.5 * rows), squeeze=False)

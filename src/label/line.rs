@@ -15,6 +15,10 @@
 //!    and averaged over a window one local width long, repeatedly, until no
 //!    stretch one local width long turns by more than `smooth` degrees (at
 //!    most 200 rounds).
+//!    Each run of points the smoothing moved then goes back towards the
+//!    axis by the least fraction of its move (one for the run, found by
+//!    bisection) that turns too much at no more points than all of it:
+//!    the averaging rounds off more than a bend needs.
 //! 4. **Margin.** A smoothed point closer to ∂P than `margin` × the local
 //!    radius is moved back towards its medial-axis point until it is not
 //!    (the medial-axis point itself is one local radius away).
