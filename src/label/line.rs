@@ -170,7 +170,9 @@ fn best_path(g: &SkeletonGraph, b: &Boundary) -> Option<(Vec<Coord<f64>>, Vec<f6
     let mut best: Option<(f64, Vec<Coord<f64>>, Vec<f64>)> = None;
     for (i, &a) in leaves.iter().enumerate() {
         for &z in &leaves[i + 1..] {
-            let Some(edges) = crate::graph::prune::trunk::shortest_path(&m, &usable, a, z) else {
+            let Some(edges) = crate::graph::prune::trunk::shortest_path(&m, &usable, a, z)
+                .filter(|e| !e.is_empty())
+            else {
                 continue;
             };
             let (path, r) = coords_of(&m, &radii, &edges, z);
@@ -281,14 +283,15 @@ fn relax(mut cur: Vec<Coord<f64>>, at: &[(Coord<f64>, f64)], o: Shape) -> Vec<Co
     let max_turn = o.smooth_deg.to_radians();
     let window = corridor_windows(at, o.margin);
     let n = cur.len();
-    let reach = window.iter().cloned().fold(0.0, f64::max);
-    // The first (last) point from which a stretch `reach` long (along the
-    // axis) reaches point `from`.
-    let span = |from: usize, step: isize| -> usize {
-        let (mut k, mut along) = (from as isize, 0.0);
+    // From `from`, the farthest point (a step of ±1 at a time) within the
+    // longest stretch of the points passed and `reach`: the points whose
+    // stretches can see a change at `from` (measured along the axis).
+    let span = |from: usize, step: isize, reach: f64| -> usize {
+        let (mut k, mut along, mut reach) = (from as isize, 0.0, reach);
         while along < reach && (0..n as isize).contains(&(k + step)) {
             along += hypot(at[(k + step) as usize].0 - at[k as usize].0);
             k += step;
+            reach = reach.max(window[k as usize]);
         }
         k as usize
     };
@@ -302,7 +305,8 @@ fn relax(mut cur: Vec<Coord<f64>>, at: &[(Coord<f64>, f64)], o: Shape) -> Vec<Co
         while i < n && cur[i] != at[i].0 {
             i += 1;
         }
-        let (lo, hi) = (span(s, -1), span(i - 1, 1) + 1);
+        let longest = window[s..i].iter().cloned().fold(0.0, f64::max);
+        let (lo, hi) = (span(s, -1, window[s]), span(i - 1, 1, longest) + 1);
         let moved: Vec<Coord<f64>> = cur[s..i].to_vec();
         let bad_with = |t: f64, line: &mut Vec<Coord<f64>>| -> usize {
             for k in s..i {
