@@ -10,24 +10,29 @@
 //!    than the lake does not count): the longest path that does not wind.
 //! 2. **Trim.** A label's letters need room: from each end the path is cut
 //!    back while the local radius is below half the path's median radius
-//!    (a narrow tip or outflow the text would stick out of).
-//! 3. **Smooth.** The path is resampled at a quarter of the local radius
-//!    and averaged over a window one local width long, repeatedly, until no
+//!    (a narrow tip or outflow the text would stick out of). Resampled at a
+//!    quarter of the local radius, it is then cut back at an end whose
+//!    stretch one local width long turns by more than `smooth` degrees, to
+//!    the first point within one local width of the end from which the
+//!    stretch does not (a label's end does not bend away).
+//! 3. **Smooth.** The path is averaged over a window one local width long, repeatedly, until no
 //!    stretch one local width long turns by more than `smooth` degrees (at
 //!    most 200 rounds).
 //!    Each run of points the smoothing moved then goes back towards the
 //!    axis by the least fraction of its move (one for the run, found by
-//!    bisection) that turns too much at no more points than all of it:
-//!    the averaging rounds off more than a bend needs.
+//!    bisection) with which no point turns too much that did not with all
+//!    of it: the averaging rounds off more than a bend needs.
 //! 4. **Margin.** A smoothed point closer to ∂P than `margin` × the local
 //!    radius is moved back towards its medial-axis point until it is not
 //!    (the medial-axis point itself is one local radius away).
 //! 5. **Gentle enough.** Where the smoothed line still turns by more than
 //!    `smooth` over a stretch one local width long (a bend sharper than the
 //!    corridor lets the smoothing round off), only the longest run without
-//!    such a stretch is kept.
+//!    such a stretch is kept — of the relaxed line, or of the line as
+//!    smoothed when more of that one is gentle enough.
 //! 6. **Line or point.** With length / max width ≥ `min_elongation` (of
-//!    the axis path, and of the kept run) the line is written; otherwise (a
+//!    the axis path, and of the kept run with the bent ends cut in 2) the
+//!    line is written; otherwise (a
 //!    round lake) the centre of the largest inscribed disc — the raw medial
 //!    axis' node of largest radius, the pole of inaccessibility.
 
@@ -102,12 +107,25 @@ pub(super) fn label(
     if path.len() < 2 {
         return Some(point(elongation));
     }
-    let line = dedup(smooth_inside(&path, &radii, b, o));
     // Where the corridor kept a bend too sharp for the letters, the label
     // runs along the longest stretch that is gentle enough, if that is
-    // still long enough for a line.
-    let line = LineString(gentlest_run(line, b, o.smooth_deg.to_radians()));
-    if line.0.len() < 2 || length(&line.0) / max_width < o.min_elongation {
+    // still long enough for a line (the bent ends cut before smoothing
+    // count: a part elongated enough keeps its line).
+    let max_turn = o.smooth_deg.to_radians();
+    let (smoothed, relaxed, bent) = smooth_inside(&path, &radii, b, o);
+    let relaxed = dedup(relaxed);
+    let whole = relaxed.len();
+    let mut line = gentlest_run(relaxed, b, max_turn);
+    if line.len() < whole {
+        // The exact check cut the relaxed line: the line as smoothed, when
+        // more of it is gentle enough.
+        let other = gentlest_run(dedup(smoothed), b, max_turn);
+        if length(&other) > length(&line) {
+            line = other;
+        }
+    }
+    let line = LineString(line);
+    if line.0.len() < 2 || (length(&line.0) + bent) / max_width < o.min_elongation {
         return Some(point(elongation));
     }
     Some(Labelled {
@@ -265,18 +283,75 @@ fn trim(path: &[Coord<f64>], radii: &[f64]) -> (Vec<Coord<f64>>, Vec<f64>) {
 /// towards the axis may make a kink again).
 /// The turn is judged over a stretch `2 d` long at each point, d its
 /// distance to ∂P: the local width 2r where the line is on the axis.
-fn smooth_inside(path: &[Coord<f64>], radii: &[f64], b: &Boundary, o: Shape) -> Vec<Coord<f64>> {
+/// The line smoothed and the line relaxed ([`relax`]), each kept off the
+/// shore, and the length [`straight_ends`] cut off.
+fn smooth_inside(
+    path: &[Coord<f64>],
+    radii: &[f64],
+    b: &Boundary,
+    o: Shape,
+) -> (Vec<Coord<f64>>, Vec<Coord<f64>>, f64) {
     let at = resample(path, radii);
-    let cur: Vec<Coord<f64>> = at.iter().map(|p| p.0).collect();
-    let cur = smooth(cur, &at, o);
-    let cur = relax(cur, &at, o);
-    keep_off_shore(&cur, &at, b, o.margin)
+    let (a, z) = straight_ends(&at, o);
+    let axis = |pts: &[(Coord<f64>, f64)]| pts.iter().map(|p| p.0).collect::<Vec<_>>();
+    let bent = length(&axis(&at[..=a])) + length(&axis(&at[z..]));
+    let at = &at[a..=z];
+    let smoothed = smooth(axis(at), at, o);
+    let relaxed = relax(smoothed.clone(), at, o);
+    (
+        keep_off_shore(&smoothed, at, b, o.margin),
+        keep_off_shore(&relaxed, at, b, o.margin),
+        bent,
+    )
+}
+
+/// The resampled axis cut back at an end where the stretch one local width
+/// long from the end inwards turns by more than `smooth` degrees: to the
+/// first point from which it does not, when that point is within one local
+/// width of the end (a bend further in is left to the smoothing). A
+/// label's end does not bend away (the letters there would leave the
+/// curve), and smoothing such a bend would pull the line off the axis for
+/// a width on either side of it.
+/// Returns the first and last point kept.
+fn straight_ends(at: &[(Coord<f64>, f64)], o: Shape) -> (usize, usize) {
+    let max_turn = o.smooth_deg.to_radians();
+    let window = corridor_windows(at, o.margin);
+    let line: Vec<Coord<f64>> = at.iter().map(|p| p.0).collect();
+    let n = line.len();
+    let forward = too_curved(&line, &window, max_turn);
+    let mut rev_line = line.clone();
+    rev_line.reverse();
+    let mut rev_window = window.clone();
+    rev_window.reverse();
+    let backward = too_curved(&rev_line, &rev_window, max_turn);
+    // From one end inwards: the first point whose stretch is gentle, or the
+    // end itself when none is within one local width of it.
+    let cut = |bad: &[bool], pts: &[Coord<f64>], w: &[f64]| -> usize {
+        let mut along = 0.0;
+        for k in 0..pts.len().saturating_sub(1) {
+            if !bad[k] {
+                return k;
+            }
+            along += hypot(pts[k + 1] - pts[k]);
+            if along > w[0] / (2.0 - o.margin) {
+                break;
+            }
+        }
+        0
+    };
+    let a = cut(&forward, &line, &window);
+    let z = n - 1 - cut(&backward, &rev_line, &rev_window);
+    if a + 1 >= z {
+        return (0, n - 1);
+    }
+    (a, z)
 }
 
 /// Each run of points that smoothing moved off the medial axis, moved back
 /// towards it as far as the turn allows: the points of the run keep the
 /// least fraction t of their move (the same for the whole run, found by
-/// bisection) with which no more points turn too much than with all of it.
+/// bisection) with which no point turns too much that did not with all of
+/// it.
 /// Smoothing averages over a whole window round after round; where a bend
 /// needed only part of that, the line returns to the centre.
 fn relax(mut cur: Vec<Coord<f64>>, at: &[(Coord<f64>, f64)], o: Shape) -> Vec<Coord<f64>> {
@@ -308,23 +383,22 @@ fn relax(mut cur: Vec<Coord<f64>>, at: &[(Coord<f64>, f64)], o: Shape) -> Vec<Co
         let longest = window[s..i].iter().cloned().fold(0.0, f64::max);
         let (lo, hi) = (span(s, -1, window[s]), span(i - 1, 1, longest) + 1);
         let moved: Vec<Coord<f64>> = cur[s..i].to_vec();
-        let bad_with = |t: f64, line: &mut Vec<Coord<f64>>| -> usize {
+        let bad_with = |t: f64, line: &mut Vec<Coord<f64>>| -> Vec<bool> {
             for k in s..i {
                 line[k] = at[k].0 + (moved[k - s] - at[k].0) * t;
             }
             too_curved(&line[lo..hi], &window[lo..hi], max_turn)
-                .iter()
-                .filter(|&&x| x)
-                .count()
         };
+        // No point turns too much that did not with all of the move.
         let allowed = bad_with(1.0, &mut cur);
+        let within = |bad: Vec<bool>| bad.iter().zip(&allowed).all(|(&b, &a)| !b || a);
         let (mut t_lo, mut t_hi) = (0.0, 1.0);
-        if bad_with(0.0, &mut cur) <= allowed {
+        if within(bad_with(0.0, &mut cur)) {
             t_hi = 0.0;
         } else {
             for _ in 0..RELAX_STEPS {
                 let mid = 0.5 * (t_lo + t_hi);
-                if bad_with(mid, &mut cur) <= allowed {
+                if within(bad_with(mid, &mut cur)) {
                     t_hi = mid;
                 } else {
                     t_lo = mid;
