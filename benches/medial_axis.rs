@@ -1,5 +1,7 @@
-//! Method MA on the training layers (serial over the polygons of a layer), and
-//! the arc discretisation cost on a shape dominated by parabolic arcs.
+//! Method MA on the training layers (serial over the polygons of a layer), the
+//! arc discretisation cost on a shape dominated by parabolic arcs, and the
+//! `label` step's labels (which make their own medial axis) of the training
+//! lochs and islands.
 //!
 //! `cargo bench --bench medial_axis`; the side-by-side comparison with PostGIS
 //! is `scripts/bench-ma.sh`.
@@ -81,5 +83,27 @@ fn arcs(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, layers, arcs);
+/// One label per polygon part, as `skeletonise.labels` makes them: the
+/// medial axis, its pruning and extension, and the label line or point.
+fn labels(c: &mut Criterion) {
+    let mut group = c.benchmark_group("labels");
+    group
+        .sample_size(10)
+        .measurement_time(Duration::from_secs(10));
+    let params = skeletonise::label::LabelParams::default();
+    for name in ["lakes_scotland", "islands_hebrides"] {
+        let polys = layer(name);
+        group.throughput(Throughput::Elements(polys.len() as u64));
+        group.bench_with_input(BenchmarkId::from_parameter(name), &polys, |b, polys| {
+            b.iter(|| {
+                for p in polys {
+                    black_box(params.label(p));
+                }
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, layers, arcs, labels);
 criterion_main!(benches);

@@ -24,6 +24,7 @@ NULL skeleton and no reason. Invalid polygons are repaired with shapely's
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 import time
@@ -850,7 +851,10 @@ def labels(
 
     attributes = None
     if isinstance(geometries, gpd.GeoDataFrame):
-        attributes = geometries.drop(columns=[geometries.geometry.name])
+        # A plain frame of the other columns (a GeoDataFrame's own `drop`
+        # costs more than the labels of a small lake).
+        name = geometries.geometry.name
+        attributes = pd.DataFrame(geometries, columns=[c for c in geometries.columns if c != name])
     arr, index, crs = _geometry_array(geometries)
     _check_call(crs, threads)
     arr, _, _ = _prepare(arr, make_valid)
@@ -879,7 +883,9 @@ def labels(
     )
     if attributes is not None and len(attributes.columns):
         own = attributes.iloc[row].set_axis(idx)
-        own = own.rename(columns={c: f"src_{c}" for c in own.columns if c in _LABEL_COLUMNS})
+        clash = {c: f"src_{c}" for c in own.columns if c in _LABEL_COLUMNS}
+        if clash:
+            own = own.rename(columns=clash)
         frame = pd.concat([own, frame], axis=1)
     geometry = shapely.from_wkb(np.asarray(wkb, dtype=object))
     frame.insert(frame.columns.get_loc("rejected"), "minzoom", _minzoom(geometry, np.asarray(length, dtype=float),
@@ -892,11 +898,18 @@ def labels(
 _EQUATOR_M_PER_PIXEL = 156_543.033928041
 
 
+@functools.lru_cache(maxsize=16)
+def _to_lonlat(crs: Any) -> Any:
+    """The transformer from ``crs`` to longitude and latitude (made once per CRS: a tile
+    pipeline calls :func:`labels` per tile)."""
+    import pyproj
+
+    return pyproj.Transformer.from_crs(crs, 4326, always_xy=True)
+
+
 def _minzoom(geometry: np.ndarray, length: np.ndarray, width: np.ndarray, crs: Any, pixels: float) -> Any:
     """The ``minzoom`` of each label: the smallest web-map zoom (0–24) at which a line is
     ``pixels`` long (a point's disc that wide) at the latitude of the line's middle (the point)."""
-    import geopandas as gpd
-
     out = pd.array([None] * len(geometry), dtype="Int32")
     present = ~shapely.is_missing(geometry)
     if crs is None or not present.any():
@@ -905,7 +918,8 @@ def _minzoom(geometry: np.ndarray, length: np.ndarray, width: np.ndarray, crs: A
     anchors = geometry.copy()
     anchors[lines] = shapely.line_interpolate_point(geometry[lines], 0.5, normalized=True)
     lat = np.full(len(geometry), np.nan)
-    lat[present] = gpd.GeoSeries(anchors[present], crs=crs).to_crs(4326).y.to_numpy()
+    x, y = shapely.get_x(anchors[present]), shapely.get_y(anchors[present])
+    lat[present] = _to_lonlat(crs).transform(x, y)[1]
     metres = np.where(lines, length, width)
     ok = present & np.isfinite(lat) & (metres > 0)
     z = np.ceil(np.log2(pixels * _EQUATOR_M_PER_PIXEL * np.cos(np.radians(lat[ok])) / metres[ok]))

@@ -112,13 +112,15 @@ pub(super) fn label(
     // still long enough for a line (the bent ends cut before smoothing
     // count: a part elongated enough keeps its line).
     let max_turn = o.smooth_deg.to_radians();
-    let (smoothed, relaxed, bent) = smooth_inside(&path, &radii, b, o);
-    let relaxed = dedup(relaxed);
+    let lines = smooth_inside(&path, &radii, o);
+    let bent = lines.bent;
+    let relaxed = dedup(keep_off_shore(&lines.relaxed, &lines.at, b, o.margin));
     let whole = relaxed.len();
     let mut line = gentlest_run(relaxed, b, max_turn);
     if line.len() < whole {
         // The exact check cut the relaxed line: the line as smoothed, when
         // more of it is gentle enough.
+        let smoothed = keep_off_shore(&lines.smoothed, &lines.at, b, o.margin);
         let other = gentlest_run(dedup(smoothed), b, max_turn);
         if length(&other) > length(&line) {
             line = other;
@@ -279,30 +281,33 @@ fn trim(path: &[Coord<f64>], radii: &[f64]) -> (Vec<Coord<f64>>, Vec<f64>) {
     (path[first..=last].to_vec(), radii[first..=last].to_vec())
 }
 
-/// Smoothing and keeping off the shore, alternately (a point moved back
-/// towards the axis may make a kink again).
-/// The turn is judged over a stretch `2 d` long at each point, d its
-/// distance to ∂P: the local width 2r where the line is on the axis.
-/// The line smoothed and the line relaxed ([`relax`]), each kept off the
-/// shore, and the length [`straight_ends`] cut off.
-fn smooth_inside(
-    path: &[Coord<f64>],
-    radii: &[f64],
-    b: &Boundary,
-    o: Shape,
-) -> (Vec<Coord<f64>>, Vec<Coord<f64>>, f64) {
+/// The path resampled and cut at bent ends, smoothed, and relaxed.
+struct Smoothed {
+    /// The resampled axis points kept, with their radii.
+    at: Vec<(Coord<f64>, f64)>,
+    /// The line smoothed, point by point of `at`.
+    smoothed: Vec<Coord<f64>>,
+    /// The line relaxed ([`relax`]), point by point of `at`.
+    relaxed: Vec<Coord<f64>>,
+    /// The length [`straight_ends`] cut off.
+    bent: f64,
+}
+
+/// The path smoothed and relaxed (neither yet kept off the shore).
+fn smooth_inside(path: &[Coord<f64>], radii: &[f64], o: Shape) -> Smoothed {
     let at = resample(path, radii);
     let (a, z) = straight_ends(&at, o);
     let axis = |pts: &[(Coord<f64>, f64)]| pts.iter().map(|p| p.0).collect::<Vec<_>>();
     let bent = length(&axis(&at[..=a])) + length(&axis(&at[z..]));
-    let at = &at[a..=z];
-    let smoothed = smooth(axis(at), at, o);
-    let relaxed = relax(smoothed.clone(), at, o);
-    (
-        keep_off_shore(&smoothed, at, b, o.margin),
-        keep_off_shore(&relaxed, at, b, o.margin),
+    let at = at[a..=z].to_vec();
+    let smoothed = smooth(axis(&at), &at, o);
+    let relaxed = relax(smoothed.clone(), &at, o);
+    Smoothed {
+        at,
+        smoothed,
+        relaxed,
         bent,
-    )
+    }
 }
 
 /// The resampled axis cut back at an end where the stretch one local width
