@@ -799,7 +799,9 @@ def apply_layers(
 __all__.append("apply_layers")
 
 
-_LABEL_COLUMNS = ("polygon_part", "kind", "length", "max_width", "elongation", "minzoom", "rejected")
+# The label's own columns (and the output's geometry column): a source column so named is
+# written as `src_<name>`.
+_LABEL_COLUMNS = ("polygon_part", "kind", "length", "max_width", "elongation", "minzoom", "rejected", "geometry")
 
 
 def labels(
@@ -848,13 +850,8 @@ def labels(
     Every input row gives at least one output row.
     """
     import geopandas as gpd
+    from geopandas.array import from_shapely
 
-    attributes = None
-    if isinstance(geometries, gpd.GeoDataFrame):
-        # A plain frame of the other columns (a GeoDataFrame's own `drop`
-        # costs more than the labels of a small lake).
-        name = geometries.geometry.name
-        attributes = pd.DataFrame(geometries, columns=[c for c in geometries.columns if c != name])
     arr, index, crs = _geometry_array(geometries)
     _check_call(crs, threads)
     arr, _, _ = _prepare(arr, make_valid)
@@ -868,29 +865,50 @@ def labels(
     row, part, kind, length, width, elong, wkb, rejected = _core.labels(
         _encode(arr, "wkb"), json.dumps(options, default=_json_default), threads
     )
-    row = np.asarray(row, dtype=np.int64)
+    row = np.asarray(row, dtype=np.intp)
     idx = (index if index is not None else pd.RangeIndex(len(arr)))[row]
-    frame = pd.DataFrame(
-        {
-            "polygon_part": pd.array(part, dtype="Int32"),
-            "kind": pd.array(kind, dtype="string"),
-            "length": pd.array(length, dtype="Float64"),
-            "max_width": pd.array(width, dtype="Float64"),
-            "elongation": pd.array(elong, dtype="Float64"),
-            "rejected": pd.array(rejected, dtype="string"),
-        },
-        index=idx,
-    )
-    if attributes is not None and len(attributes.columns):
-        own = attributes.iloc[row].set_axis(idx)
-        clash = {c: f"src_{c}" for c in own.columns if c in _LABEL_COLUMNS}
-        if clash:
-            own = own.rename(columns=clash)
-        frame = pd.concat([own, frame], axis=1)
+    columns = _source_columns(geometries, row) if isinstance(geometries, gpd.GeoDataFrame) else {}
+    length, width = _nullable(length, np.float64), _nullable(width, np.float64)
     geometry = shapely.from_wkb(np.asarray(wkb, dtype=object))
-    frame.insert(frame.columns.get_loc("rejected"), "minzoom", _minzoom(geometry, np.asarray(length, dtype=float),
-                 np.asarray(width, dtype=float), crs, min_pixels))
-    return gpd.GeoDataFrame(frame, geometry=geometry, crs=crs)
+    columns.update(
+        polygon_part=_nullable(part, np.int32),
+        kind=pd.array(kind, dtype="string"),
+        length=length,
+        max_width=width,
+        elongation=_nullable(elong, np.float64),
+        minzoom=_minzoom(geometry, length.to_numpy(np.float64, na_value=np.nan),
+                         width.to_numpy(np.float64, na_value=np.nan), crs, min_pixels),
+        rejected=pd.array(rejected, dtype="string"),
+        geometry=from_shapely(geometry, crs=crs),
+    )
+    return _geo_frame(columns, idx)
+
+
+def _source_columns(frame: Any, row: np.ndarray) -> dict[str, Any]:
+    """A GeoDataFrame's own columns (not its active geometry) at the rows ``row``, each
+    renamed ``src_<name>`` where it is named like a column of the label's own (as the
+    command line's ``labels`` layer does)."""
+    name = frame.geometry.name
+    # pandas' own accessor of a column's array (no Series made: half the time of `items()`).
+    column = getattr(frame, "_get_column_array", None) or (lambda i: frame.iloc[:, i].array)
+    taken = {}
+    for i, c in enumerate(frame.columns):
+        if c == name:
+            continue
+        out = c
+        while out in _LABEL_COLUMNS or out in taken:
+            out = f"src_{out}"
+        taken[out] = column(i).take(row)
+    return taken
+
+
+def _nullable(values: list[Any], dtype: Any) -> Any:
+    """A pandas nullable array (``Float64``, ``Int32``) of a list with ``None``s."""
+    raw = np.array(values, dtype=np.float64)
+    missing = np.isnan(raw)
+    if np.dtype(dtype).kind == "f":
+        return pd.arrays.FloatingArray(raw, missing)
+    return pd.arrays.IntegerArray(np.where(missing, 0, raw).astype(dtype), missing)
 
 
 # Metres per pixel at zoom 0 on the equator (256-pixel tiles, 2π · 6 378 137 m / 256), as the
@@ -910,21 +928,22 @@ def _to_lonlat(crs: Any) -> Any:
 def _minzoom(geometry: np.ndarray, length: np.ndarray, width: np.ndarray, crs: Any, pixels: float) -> Any:
     """The ``minzoom`` of each label: the smallest web-map zoom (0–24) at which a line is
     ``pixels`` long (a point's disc that wide) at the latitude of the line's middle (the point)."""
-    out = pd.array([None] * len(geometry), dtype="Int32")
+    zoom = np.zeros(len(geometry), dtype=np.int32)
+    missing = np.ones(len(geometry), dtype=bool)
     present = ~shapely.is_missing(geometry)
-    if crs is None or not present.any():
-        return out
-    lines = present & (shapely.get_type_id(geometry) == int(shapely.GeometryType.LINESTRING))
-    anchors = geometry.copy()
-    anchors[lines] = shapely.line_interpolate_point(geometry[lines], 0.5, normalized=True)
-    lat = np.full(len(geometry), np.nan)
-    x, y = shapely.get_x(anchors[present]), shapely.get_y(anchors[present])
-    lat[present] = _to_lonlat(crs).transform(x, y)[1]
-    metres = np.where(lines, length, width)
-    ok = present & np.isfinite(lat) & (metres > 0)
-    z = np.ceil(np.log2(pixels * _EQUATOR_M_PER_PIXEL * np.cos(np.radians(lat[ok])) / metres[ok]))
-    out[ok] = np.clip(z, 0, 24).astype(np.int64)
-    return out
+    if crs is not None and present.any():
+        lines = present & (shapely.get_type_id(geometry) == int(shapely.GeometryType.LINESTRING))
+        anchors = geometry.copy()
+        anchors[lines] = shapely.line_interpolate_point(geometry[lines], 0.5, normalized=True)
+        lat = np.full(len(geometry), np.nan)
+        x, y = shapely.get_x(anchors[present]), shapely.get_y(anchors[present])
+        lat[present] = _to_lonlat(crs).transform(x, y)[1]
+        metres = np.where(lines, length, width)
+        ok = present & np.isfinite(lat) & (metres > 0)
+        z = np.ceil(np.log2(pixels * _EQUATOR_M_PER_PIXEL * np.cos(np.radians(lat[ok])) / metres[ok]))
+        zoom[ok] = np.clip(z, 0, 24)
+        missing[ok] = False
+    return pd.arrays.IntegerArray(zoom, missing)
 
 
 __all__.append("labels")

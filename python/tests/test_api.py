@@ -374,3 +374,45 @@ def test_labels_give_every_lake_part_a_line_or_its_largest_disc():
     odd = gpd.GeoSeries([None, shapely.LineString([(0, 0), (1, 1)])], crs=lakes.crs)
     rows = skeletonise.labels(odd)
     assert len(rows) == 2 and rows.rejected.notna().all()
+
+
+def test_labels_keep_the_source_columns_row_by_row_under_their_own_names():
+    """The source columns come with every label row, repeated for each part of a
+    multipolygon, in the frame's order; one named like a label column (or ``geometry``
+    while the active geometry is another) becomes ``src_<name>``, and never overwrites
+    another source column."""
+    src = ROOT / "tests" / "data" / "gshhg-train.gpkg"
+    islands = gpd.read_file(src, layer="islands_hebrides", fid_as_index=True).head(40)
+    parts = shapely.get_parts(np.asarray(islands.geometry.values))
+    frame = gpd.GeoDataFrame(
+        {
+            "name": ["one part", "three parts", None],
+            "kind": ["a", "b", "c"],
+            "src_kind": [1.5, 2.5, 3.5],
+            "geometry": ["x", "y", "z"],
+            "rank": pd.array([1, None, 3], dtype="Int64"),
+            "shape": [parts[0], shapely.MultiPolygon(list(parts[1:4])), parts[4]],
+        },
+        geometry="shape",
+        crs=islands.crs,
+        index=pd.Index([10, 20, 30], name="id"),
+    )
+    got = skeletonise.labels(frame)
+    assert list(got.columns) == [
+        "name", "src_kind", "src_src_kind", "src_geometry", "rank",
+        "polygon_part", "kind", "length", "max_width", "elongation", "minzoom", "rejected", "geometry",
+    ]
+    assert got.geometry.name == "geometry" and got.crs == islands.crs
+    assert list(got.index) == [10, 20, 20, 20, 30] and got.index.name == "id"
+    assert list(got.polygon_part) == [0, 0, 1, 2, 0]
+    assert list(got.src_kind) == ["a", "b", "b", "b", "c"]
+    assert list(got.src_src_kind) == [1.5, 2.5, 2.5, 2.5, 3.5]
+    assert list(got.src_geometry) == ["x", "y", "y", "y", "z"]
+    assert got["name"].isna().tolist() == [False, False, False, False, True]
+    assert str(got["rank"].dtype) == "Int64" and got["rank"].isna().tolist() == [False, True, True, True, False]
+    assert {str(got[c].dtype) for c in ("length", "max_width", "elongation")} == {"Float64"}
+    assert str(got.minzoom.dtype) == "Int32" and str(got.polygon_part.dtype) == "Int32"
+    assert set(got.kind) <= {"line", "point"}
+    # Each label lies in its own part.
+    for (_, row), part in zip(got.iterrows(), parts[:5]):
+        assert part.contains(row.geometry)
