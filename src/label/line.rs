@@ -30,11 +30,16 @@
 //!    corridor lets the smoothing round off), only the longest run without
 //!    such a stretch is kept — of the relaxed line, or of the line as
 //!    smoothed when more of that one is gentle enough.
-//! 6. **Line or point.** With length / max width ≥ `min_elongation` (of
-//!    the axis path, and of the kept run with the bent ends cut in 2) the
-//!    line is written; otherwise (a
-//!    round lake) the centre of the largest inscribed disc — the raw medial
-//!    axis' node of largest radius, the pole of inaccessibility.
+//! 6. **Line or point.** The line is written when the axis path is at
+//!    least `min_elongation` times the part's largest width, and so is the
+//!    kept run (with the bent ends cut in 2) — or, when the run still keeps
+//!    at least half of the axis path, at least `min_elongation` times the
+//!    widest local width along it (its own corridor: a run cut at a bend too
+//!    sharp for the letters may have left the widest basin behind, as on a
+//!    crescent lake with a round bay at one horn; a shorter run is one arm
+//!    of the lake). Otherwise (a round lake) the label is the centre of the
+//!    largest inscribed disc — the raw medial axis' node of largest radius,
+//!    the pole of inaccessibility.
 
 use crate::geometry::vector::hypot;
 use crate::geometry::{Boundary, PreparedPolygon};
@@ -116,18 +121,26 @@ pub(super) fn label(
     let bent = lines.bent;
     let relaxed = dedup(keep_off_shore(&lines.relaxed, &lines.at, b, o.margin));
     let whole = relaxed.len();
-    let mut line = gentlest_run(relaxed, b, max_turn);
-    if line.len() < whole {
+    let mut run = gentlest_run(relaxed, b, max_turn);
+    if run.line.len() < whole {
         // The exact check cut the relaxed line: the line as smoothed, when
         // more of it is gentle enough.
         let smoothed = keep_off_shore(&lines.smoothed, &lines.at, b, o.margin);
         let other = gentlest_run(dedup(smoothed), b, max_turn);
-        if length(&other) > length(&line) {
-            line = other;
+        if length(&other.line) > length(&run.line) {
+            run = other;
         }
     }
-    let line = LineString(line);
-    if line.0.len() < 2 || (length(&line.0) + bent) / max_width < o.min_elongation {
+    // Long enough for the part's largest width; or, when it still keeps
+    // most of the axis path, for its own corridor (a run cut at a sharp
+    // bend may have left the widest basin, and the largest disc, behind).
+    let kept = length(&run.line) + bent;
+    let long_enough = |width: f64| width > 0.0 && kept / width >= o.min_elongation;
+    let line = LineString(run.line);
+    if line.0.len() < 2
+        || !(long_enough(max_width)
+            || (kept >= MAIN_SHARE * axis_length && long_enough(run.width)))
+    {
         return Some(point(elongation));
     }
     Some(Labelled {
@@ -558,12 +571,27 @@ fn too_curved(line: &[Coord<f64>], window: &[f64], max_turn: f64) -> Vec<bool> {
     bad
 }
 
+/// The share of the axis path a line cut at a sharp bend must keep to be
+/// judged by its own corridor's width: more than that labels the lake, less
+/// one of its arms (which a point at the largest disc labels better).
+const MAIN_SHARE: f64 = 0.5;
+
+/// A stretch of a label line and the widest local width along it.
+struct Run {
+    line: Vec<Coord<f64>>,
+    /// The largest `2 d` over its points, d the distance to ∂P.
+    width: f64,
+}
+
 /// The longest run of `line` in which no stretch one local width long
 /// turns by more than `max_turn` (the whole line when none does).
-fn gentlest_run(line: Vec<Coord<f64>>, b: &Boundary, max_turn: f64) -> Vec<Coord<f64>> {
-    let bad = too_curved(&line, &windows(&line, b), max_turn);
+fn gentlest_run(line: Vec<Coord<f64>>, b: &Boundary, max_turn: f64) -> Run {
+    let window = windows(&line, b);
+    let bad = too_curved(&line, &window, max_turn);
+    let widest = |w: &[f64]| w.iter().copied().fold(0.0, f64::max);
     if !bad.iter().any(|&x| x) {
-        return line;
+        let width = widest(&window);
+        return Run { line, width };
     }
     // Runs of good points: no stretch starting in one turns too much
     // within it.
@@ -583,7 +611,10 @@ fn gentlest_run(line: Vec<Coord<f64>>, b: &Boundary, max_turn: f64) -> Vec<Coord
             _ => {}
         }
     }
-    line[best.0..=best.1].to_vec()
+    Run {
+        line: line[best.0..=best.1].to_vec(),
+        width: widest(&window[best.0..=best.1]),
+    }
 }
 
 /// Each point moved back towards its medial-axis point until it is at least
