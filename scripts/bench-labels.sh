@@ -7,7 +7,8 @@
 # tool, lakes, lakes with a line, wall seconds of the whole run (start-up included), seconds per
 # lake (label_centerlines: the median of its per-lake get_centerline times; skeletonise: whole run
 # / lakes), Z mean (over the lakes that got a score) and worst, coverage mean (over all lakes,
-# a lake without a line counting 0), and the whole-run time ratio label_centerlines / skeletonise.
+# a lake without a line counting 0), curvature (each line's worst turn over a stretch one local
+# width long: mean and worst), and the whole-run time ratio label_centerlines / skeletonise.
 #
 #   scripts/bench-labels.sh
 #   DATA=…/gshhg-train.gpkg LAYER=lakes_scotland BIN=…/skeletonise scripts/bench-labels.sh
@@ -77,18 +78,58 @@ def rows(path, sql):
 lakes = rows(data, f'select count(*) from "{layer}"')[0][0]
 summary = dict(re.findall(r"(\w+)=(\S+)", open(f"{out}/lc-lakes.log").read()))
 
+import math
+
+import geopandas as gpd
+import shapely
+
+polygons = gpd.read_file(data, layer=layer, fid_as_index=True).geometry
+
+
+def worst_turn(line, polygon):
+    """The most the line turns (degrees) over any stretch one local width long: from each
+    vertex, the signed turns summed over the next 2 d of line, d the vertex's distance to the
+    shore (the bound a label's letters need; the label step holds it to `smooth`, 60)."""
+    pts = [p for i, p in enumerate(line.coords) if i == 0 or p != line.coords[i - 1]]
+    seg = [(b[0] - a[0], b[1] - a[1]) for a, b in zip(pts, pts[1:])]
+    length = [math.hypot(*d) for d in seg]
+    into = [0.0] + [math.atan2(u[0] * v[1] - u[1] * v[0], u[0] * v[0] + u[1] * v[1])
+                    for u, v in zip(seg, seg[1:])]
+    shore = polygon.boundary
+    worst = 0.0
+    for i in range(len(pts) - 2):
+        window = 2 * shore.distance(shapely.Point(pts[i]))
+        along, total, j = 0.0, 0.0, i + 1
+        while j < len(seg) and along < window:
+            total += into[j]
+            worst = max(worst, abs(total))
+            along += length[j]
+            j += 1
+    return math.degrees(worst)
+
+
 def stats(scored, lines_gpkg):
     # one row per polygon that has a line; Z is NULL where the score could not be made
     r = rows(scored, "select src_fid, distortion, coverage from skeletons")
     z = [d for _, d, _ in r if d is not None]
     cov = {f: c or 0.0 for f, _, c in r}
     with_line = rows(lines_gpkg, "select count(distinct src_fid) from lines where geom is not null")[0][0]
+    lines = gpd.read_file(lines_gpkg, layer="lines")
+    turns = [
+        worst_turn(part, polygons[fid])
+        for fid, g in zip(lines["src_fid"], lines.geometry)
+        if g is not None and not g.is_empty
+        for part in getattr(g, "geoms", [g])
+        if len(part.coords) > 1
+    ]
     return dict(
         with_line=with_line,
         z_n=len(z),
         z_mean=statistics.fmean(z) if z else float("nan"),
         z_max=max(z) if z else float("nan"),
         cov=sum(cov.values()) / lakes,  # lakes without a line count 0
+        turn_mean=statistics.fmean(turns) if turns else float("nan"),
+        turn_max=max(turns) if turns else float("nan"),
     )
 
 wall = {t: float(open(f"{out}/{t}.time").read().split()[-1]) for t in ("lc-lakes", "sk-labels")}
@@ -98,16 +139,19 @@ tools = [
 ]
 print(f"\n{layer}: {lakes} lakes\n")
 print("| tool | lakes | lakes with a line | wall s | s per lake | Z mean (scored) | Z worst "
-      "| coverage mean | wall ratio lc / sk |")
-print("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
+      "| coverage mean | turn ° per local width: mean, worst | wall ratio lc / sk |")
+print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
 ratio = wall["lc-lakes"] / wall["sk-labels"]
 for name, t, per in tools:
     lines = "lc-lakes" if t == "lc-lakes" else "sk-label-lines"
     s = stats(f"{out}/{lines}-scored.gpkg", f"{out}/{lines}.gpkg")
     r = f"{ratio:.1f}" if t == "lc-lakes" else "1.0"
     print(f"| {name} | {lakes} | {s['with_line']} | {wall[t]:.2f} | {per:.3f} "
-          f"| {s['z_mean']:.3f} ({s['z_n']}) | {s['z_max']:.3f} | {s['cov']:.3f} | {r} |")
+          f"| {s['z_mean']:.3f} ({s['z_n']}) | {s['z_max']:.3f} | {s['cov']:.3f} "
+          f"| {s['turn_mean']:.0f}, {s['turn_max']:.0f} | {r} |")
 print("\nlabel_centerlines s per lake: median of its get_centerline calls; skeletonise: wall / lakes.")
+print("Turn: each line's worst turn over a stretch one local width long (twice the distance to the "
+      "shore); the mean of those and the worst.")
 PY
 
 # Per lake, library call against library call: skeletonise.labels on one lake at a time, one thread
