@@ -610,6 +610,19 @@ impl Boundary {
         self.tree().pairs(|i, j| f(i as usize, j as usize))
     }
 
+    /// The pair of segments `(i, j)`, `i < j`, whose boxes meet, first in
+    /// `(i, j)` order among those for which `f` gives a value, with that
+    /// value (every meeting pair is tested, on every core for a long
+    /// boundary).
+    pub fn first_segment_pair<T: Send>(
+        &self,
+        f: impl Fn(usize, usize) -> Option<T> + Sync,
+    ) -> Option<(usize, usize, T)> {
+        self.tree()
+            .first_pair(|i, j| f(i as usize, j as usize))
+            .map(|(i, j, v)| (i as usize, j as usize, v))
+    }
+
     /// Crossing parity of the ray from `p` towards +x against the segments of
     /// the rings for which `ring` is true: `p` is inside the region those rings bound.
     pub fn contains_with_rings(&self, p: Coord<f64>, ring: impl Fn(u32) -> bool) -> bool {

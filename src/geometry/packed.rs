@@ -30,6 +30,14 @@ const NODE_SIZE: usize = 8;
 /// the skeletons and rings of most islands.
 const FEW_PAIRED: usize = 48;
 
+/// [`PackedTree::first_pair`] shares out this many node pairs at least…
+const SHARED_NODE_PAIRS: usize = 256;
+
+/// …on trees of at least this many items (a smaller one is checked on one
+/// thread: the boundary of most polygons, in a run that has a thread per
+/// feature already).
+const PAIRED_IN_PARALLEL: usize = 1 << 15;
+
 /// Depth-first stack entries a query can need: one node's children per
 /// level, and a tree over 2^32 items has 11 levels.
 const STACK: usize = NODE_SIZE * 12;
@@ -385,6 +393,89 @@ impl PackedTree {
             }
         }
         None
+    }
+
+    /// The pair `(i, j)`, `i < j`, of items whose boxes meet that is first
+    /// in `(i, j)` order among those for which `pair` gives a value, with
+    /// that value: a check every pair must pass (every meeting pair is
+    /// tested). The self-join of [`Self::pairs`], with the node pairs a few
+    /// levels below the root shared out over rayon's threads: one polygon
+    /// of a million vertices is checked on every core, not one.
+    pub(crate) fn first_pair<T: Send>(
+        &self,
+        pair: impl Fn(u32, u32) -> Option<T> + Sync,
+    ) -> Option<(u32, u32, T)> {
+        use rayon::prelude::*;
+        fn earlier<T>(a: Option<(u32, u32, T)>, b: Option<(u32, u32, T)>) -> Option<(u32, u32, T)> {
+            match (a, b) {
+                (Some(a), Some(b)) => Some(if (b.0, b.1) < (a.0, a.1) { b } else { a }),
+                (a, b) => a.or(b),
+            }
+        }
+        if self.len() < 2 {
+            return None;
+        }
+        let found = |local: &mut Option<(u32, u32, T)>, i: u32, j: u32| {
+            if local.as_ref().is_none_or(|f| (i, j) < (f.0, f.1)) {
+                if let Some(v) = pair(i, j) {
+                    *local = Some((i, j, v));
+                }
+            }
+        };
+        // Breadth first until there are node pairs enough to share.
+        let root = self.boxes.len() - 1;
+        let mut todo = vec![(root, root)];
+        let mut first = None;
+        while !todo.is_empty() && todo.len() < SHARED_NODE_PAIRS {
+            let mut next = Vec::with_capacity(todo.len() * NODE_SIZE);
+            for (a, b) in todo {
+                self.node_pairs(a, b, &mut next, |i, j| found(&mut first, i, j));
+            }
+            todo = next;
+        }
+        let below = |start: (usize, usize)| {
+            let mut local = None;
+            let mut stack = vec![start];
+            while let Some((a, b)) = stack.pop() {
+                self.node_pairs(a, b, &mut stack, |i, j| found(&mut local, i, j));
+            }
+            local
+        };
+        let rest = if self.len() < PAIRED_IN_PARALLEL {
+            todo.into_iter().map(below).fold(None, earlier)
+        } else {
+            todo.into_par_iter().map(below).reduce(|| None, earlier)
+        };
+        earlier(first, rest)
+    }
+
+    /// One step of the self-join: the children of nodes `a` and `b` (`a`
+    /// with itself when they are the same) whose boxes meet, as node pairs
+    /// pushed on `todo` or, on the items' level, item pairs `(i, j)`, `i < j`,
+    /// given to `item`.
+    fn node_pairs(
+        &self,
+        a: usize,
+        b: usize,
+        todo: &mut Vec<(usize, usize)>,
+        mut item: impl FnMut(u32, u32),
+    ) {
+        let n = self.len();
+        let (ka, kb) = (self.children(a), self.children(b));
+        for ca in ka {
+            let first = if a == b { ca } else { kb.start };
+            for cb in first..kb.end {
+                if !boxes_meet(&self.boxes[ca], &self.boxes[cb]) {
+                    continue;
+                }
+                if ca >= n {
+                    todo.push((ca, cb));
+                } else if ca != cb {
+                    let (i, j) = (self.ids[ca], self.ids[cb]);
+                    item(i.min(j), i.max(j));
+                }
+            }
+        }
     }
 
     /// Branch and bound: visits items in roughly increasing `bound` order
@@ -887,6 +978,30 @@ mod tests {
             assert_eq!(got, want, "n = {n}");
             let stop = PackedTree::pairs_of(&boxes, |i, j| ControlFlow::Break((i, j)));
             assert_eq!(stop.is_some(), !want.is_empty(), "n = {n}");
+        }
+    }
+
+    /// The first pair a check rejects is the first in `(i, j)` order among
+    /// the tree's pairs it rejects, on one thread and on many.
+    #[test]
+    fn first_pair_is_the_first_rejected_pair_in_order() {
+        for n in [0, 1, 2, 300, 5000, PAIRED_IN_PARALLEL + 1000] {
+            let boxes = grid(n);
+            let t = PackedTree::new(&boxes);
+            let mut all = Vec::new();
+            t.pairs(|i, j| {
+                all.push((i, j));
+                ControlFlow::<()>::Continue(())
+            });
+            all.sort_unstable();
+            // Every pair, then only every 7th by a rule on both numbers.
+            let every = t.first_pair(|i, j| Some(i + j));
+            assert_eq!(every, all.first().map(|&(i, j)| (i, j, i + j)), "n = {n}");
+            let rule = |i: u32, j: u32| (i * 31 + j) % 7 == 3 && i > n as u32 / 3;
+            let want = all.iter().find(|&&(i, j)| rule(i, j)).copied();
+            let got = t.first_pair(|i, j| rule(i, j).then_some(()));
+            assert_eq!(got.map(|(i, j, _)| (i, j)), want, "n = {n}");
+            assert!(n < 300 || want.is_some(), "the grid's boxes overlap");
         }
     }
 

@@ -13,7 +13,6 @@ use super::segment::{on_segment, orient, BoundarySegment};
 use super::vector::{cross, dot};
 use super::PreparedPolygon;
 use geo::Coord;
-use std::ops::ControlFlow;
 
 fn at(c: Coord<f64>) -> String {
     format!("({}, {})", c.x, c.y)
@@ -117,17 +116,9 @@ pub fn problem(p: &PreparedPolygon) -> Option<String> {
         pair_problem(s, t)
     };
     // The first problem along the boundary: of the pair (i, j) first in
-    // segment order, so the report does not depend on the tree's layout.
-    let mut first: Option<(usize, usize, String)> = None;
-    b.visit_segment_pairs(|i, j| {
-        if first.as_ref().is_none_or(|f| (i, j) < (f.0, f.1)) {
-            if let Some(m) = check(i, j) {
-                first = Some((i, j, m));
-            }
-        }
-        ControlFlow::<()>::Continue(())
-    });
-    if let Some((_, _, m)) = first {
+    // segment order, so the report does not depend on the tree's layout
+    // (nor on the threads that share a long boundary's pairs).
+    if let Some((_, _, m)) = b.first_segment_pair(check) {
         return Some(m);
     }
     // With no crossings, a hole lies wholly inside or outside every other ring:

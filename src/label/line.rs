@@ -138,8 +138,7 @@ pub(super) fn label(
     let long_enough = |width: f64| width > 0.0 && kept / width >= o.min_elongation;
     let line = LineString(run.line);
     if line.0.len() < 2
-        || !(long_enough(max_width)
-            || (kept >= MAIN_SHARE * axis_length && long_enough(run.width)))
+        || !(long_enough(max_width) || (kept >= MAIN_SHARE * axis_length && long_enough(run.width)))
     {
         return Some(point(elongation));
     }
