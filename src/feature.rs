@@ -60,6 +60,10 @@ pub struct Feature {
     pub source_wkb: Option<Vec<u8>>,
     /// Set when MakeValid changed the geometry.
     pub repaired: bool,
+    /// Set when the reader found the geometry valid by the check `prepare`
+    /// makes (a polygon without holes, `make_valid` on), which then does not
+    /// make it again.
+    pub checked: bool,
     /// The source FIDs dissolved into this feature by `input.merge_adjacent`
     /// (empty: the feature is only itself).
     pub members: Vec<u64>,
@@ -82,6 +86,7 @@ impl Feature {
             geometry_error: None,
             source_wkb: None,
             repaired: false,
+            checked: false,
             members: Vec::new(),
         }
     }

@@ -189,6 +189,7 @@ fn features(
             geometry_error: None,
             source_wkb: None,
             repaired,
+            checked: false,
             members: Vec::new(),
         };
         match input.geometry(i) {

@@ -349,6 +349,7 @@ impl Reader {
             geometry_error: None,
             source_wkb: None,
             repaired: false,
+            checked: false,
             members: Vec::new(),
         };
         // gdal hands out a wrapper around a null handle for NULL geometries.
@@ -358,10 +359,11 @@ impl Reader {
             .filter(|g| unsafe { !g.c_geometry().is_null() });
         if let Some(g) = geometry {
             match convert(g, transform, make_valid) {
-                Ok((geom, wkb, repaired)) => {
-                    feat.geometry = geom;
-                    feat.source_wkb = wkb;
-                    feat.repaired = repaired;
+                Ok(c) => {
+                    feat.geometry = c.geometry;
+                    feat.source_wkb = c.wkb;
+                    feat.repaired = c.repaired;
+                    feat.checked = c.checked;
                 }
                 Err(e) => feat.geometry_error = Some(e),
             }
@@ -390,7 +392,16 @@ pub(super) fn value(v: Option<FieldValue>) -> Value {
     }
 }
 
-type Converted = (Option<geo::Geometry<f64>>, Option<Vec<u8>>, bool);
+/// A source geometry as the per-feature path takes it.
+struct Converted {
+    geometry: Option<geo::Geometry<f64>>,
+    /// The 2D source WKB, for the `rejected` layer.
+    wkb: Option<Vec<u8>>,
+    /// MakeValid changed it.
+    repaired: bool,
+    /// Found valid by the crate's own check ([`checked_polygon`]).
+    checked: bool,
+}
 
 /// 2D, linear, reprojected, optionally repaired `geo` geometry (plus the 2D
 /// source WKB for the `rejected` layer).
@@ -402,11 +413,12 @@ fn convert(
     let mut g = g.clone();
     if g.is_empty() {
         let wkb = g.wkb().ok();
-        return Ok((
-            Some(geo::Geometry::GeometryCollection(Default::default())),
+        return Ok(Converted {
+            geometry: Some(geo::Geometry::GeometryCollection(Default::default())),
             wkb,
-            false,
-        ));
+            repaired: false,
+            checked: false,
+        });
     }
     g.flatten_to_2d();
     // SAFETY: the handle is valid for the lifetime of `g`.
@@ -421,6 +433,16 @@ fn convert(
             .map_err(|e| format!("reprojection failed: {e}"))?;
     }
     let wkb = g.wkb().ok();
+    if make_valid {
+        if let Some(polygon) = checked_polygon(&g) {
+            return Ok(Converted {
+                geometry: Some(geo::Geometry::Polygon(polygon)),
+                wkb,
+                repaired: false,
+                checked: true,
+            });
+        }
+    }
     let mut repaired = false;
     if make_valid && !g.is_valid() {
         let fixed = g
@@ -432,7 +454,51 @@ fn convert(
     let geo = g
         .to_geo()
         .map_err(|e| format!("unsupported geometry: {e}"))?;
-    Ok((Some(geo), wkb, repaired))
+    Ok(Converted {
+        geometry: Some(geo),
+        wkb,
+        repaired,
+        checked: false,
+    })
+}
+
+/// `g` as a `geo` polygon when it is a polygon without holes that the
+/// crate's own validity check (the one `prepare` makes) finds valid: for
+/// such a polygon that check decides what GEOS's IsValid would (finite
+/// coordinates, a closed ring of at least three distinct points, no
+/// crossing, overlap, self-touch or spike; the checks GEOS adds concern
+/// holes and parts), in a fraction of its time and on every core — GEOS's
+/// took 5 of the 25 s of a million-vertex polygon, on one thread. Anything
+/// else (`None`) goes through GEOS's IsValid and MakeValid as before.
+fn checked_polygon(g: &Geometry) -> Option<geo::Polygon<f64>> {
+    use gdal_sys::OGRwkbGeometryType as T;
+    if gdal::vector::geometry_type_flatten(g.geometry_type()) != T::wkbPolygon
+        || g.geometry_count() != 1
+    {
+        return None;
+    }
+    let geo::Geometry::Polygon(p) = g.to_geo().ok()? else {
+        return None;
+    };
+    let ring = &p.exterior().0;
+    // geo closes an open ring; GEOS calls it invalid (MakeValid closes it).
+    let (first, last) = (g.get_geometry(0).get_point(0), {
+        let r = g.get_geometry(0);
+        r.get_point(r.point_count().checked_sub(1)? as i32)
+    });
+    let mut distinct = ring.clone();
+    distinct.dedup();
+    if first != last
+        || distinct.len() < 4
+        || !p.interiors().is_empty()
+        || ring.iter().any(|c| !c.x.is_finite() || !c.y.is_finite())
+    {
+        return None;
+    }
+    let prepared = crate::geometry::PreparedPolygon::new(&p).ok()?;
+    crate::geometry::validity::problem(&prepared)
+        .is_none()
+        .then_some(p)
 }
 
 fn linearise(g: &Geometry) -> Result<Geometry, String> {

@@ -162,6 +162,7 @@ fn merged_feature(mut group: Vec<Feature>, merged: Vec<Polygon<f64>>) -> Feature
     });
     first.source_wkb = None;
     first.repaired = repaired;
+    first.checked = false;
     first.members = members;
     first
 }

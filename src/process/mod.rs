@@ -18,9 +18,9 @@ pub mod step;
 mod types;
 
 pub use candidates::map_in_order;
-pub use outcome::{process, process_given};
+pub use outcome::{process, process_checked, process_given};
 pub(crate) use prepare::part_reason;
-pub use prepare::{polygon_parts, prepare, NotPrepared, PrepareParams};
+pub use prepare::{polygon_parts, prepare, prepare_checked, NotPrepared, PrepareParams};
 pub use rows::{feature_rows, FeatureRows, RowOptions, Skeletons, Status};
 pub use types::{
     Candidate, CandidateSkeleton, FeatureOutcome, ProcessParams, Processed, StageTimes, StepTime,

@@ -2,7 +2,7 @@
 //! the steps after selection add to it (connection legs, collapse, local
 //! widths, registered steps' rows); or its rejection.
 
-use super::prepare::prepare;
+use super::prepare::prepare_checked;
 use super::types::{Candidate, FeatureOutcome, ProcessParams, Processed, StageTimes};
 use super::{candidates, step};
 use crate::collapse::collapse;
@@ -15,7 +15,17 @@ use geo::{Geometry, MultiLineString};
 
 /// Processes one feature's geometry through every step.
 pub fn process(geom: Option<&Geometry<f64>>, params: &ProcessParams) -> Processed {
-    let prepared = match prepare(geom, &params.prepare) {
+    process_checked(geom, params, false)
+}
+
+/// [`process`] of a geometry the reader found valid already (`checked`:
+/// [`crate::feature::Feature::checked`]; see [`prepare_checked`]).
+pub fn process_checked(
+    geom: Option<&Geometry<f64>>,
+    params: &ProcessParams,
+    checked: bool,
+) -> Processed {
+    let prepared = match prepare_checked(geom, &params.prepare, checked) {
         Ok(p) => p,
         Err(other) => return other.into(),
     };
@@ -148,7 +158,7 @@ pub fn process_given(
     label: &str,
     params: &ProcessParams,
 ) -> Processed {
-    let prepared = match prepare(geom, &params.prepare) {
+    let prepared = match prepare_checked(geom, &params.prepare, false) {
         Ok(p) => p,
         Err(other) => return other.into(),
     };

@@ -125,6 +125,17 @@ pub fn prepare(
     geom: Option<&Geometry<f64>>,
     params: &PrepareParams,
 ) -> Result<Vec<PreparedPolygon>, NotPrepared> {
+    prepare_checked(geom, params, false)
+}
+
+/// [`prepare`] of a geometry the reader already found valid by the same
+/// check (`checked`: [`crate::feature::Feature::checked`]), which is then
+/// not made again.
+pub fn prepare_checked(
+    geom: Option<&Geometry<f64>>,
+    params: &PrepareParams,
+    checked: bool,
+) -> Result<Vec<PreparedPolygon>, NotPrepared> {
     let parts = polygon_parts(geom).map_err(NotPrepared::Rejected)?;
     let parts: Vec<Polygon<f64>> = parts
         .into_iter()
@@ -150,8 +161,10 @@ pub fn prepare(
             Err(e) => return Err(NotPrepared::Rejected(part_reason(i, parts.len(), &e))),
         }
     }
-    if let Some(reason) = invalidity(&prepared, params.make_valid) {
-        return Err(NotPrepared::Rejected(reason));
+    if !checked {
+        if let Some(reason) = invalidity(&prepared, params.make_valid) {
+            return Err(NotPrepared::Rejected(reason));
+        }
     }
     Ok(prepared)
 }

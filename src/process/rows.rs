@@ -3,7 +3,7 @@
 //! `score` takes them from another tool's lines ([`Skeletons`]); both go
 //! through the same steps from `score` on and give the same rows.
 
-use super::{process, process_given, FeatureOutcome, ProcessParams, Processed, StageTimes};
+use super::{process_checked, process_given, FeatureOutcome, ProcessParams, Processed, StageTimes};
 use crate::collapse::AreaRow;
 use crate::connect::ConnectionRow;
 use crate::feature::Feature;
@@ -85,13 +85,16 @@ pub struct FeatureRows {
 /// One polygon (or polygon part) through the per-feature path, its
 /// skeletons computed or given. A panic is a bug; it must cost this
 /// feature, never the run.
+/// `checked`: the reader found the geometry valid already
+/// ([`Feature::checked`]).
 fn fenced(
     geom: Option<&Geometry<f64>>,
+    checked: bool,
     skeletons: Skeletons<'_>,
     params: &ProcessParams,
 ) -> Processed {
     std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| match skeletons {
-        Skeletons::Computed => process(geom, params),
+        Skeletons::Computed => process_checked(geom, params, checked),
         Skeletons::Given { label, lines } => match lines {
             Some(l) => process_given(geom, l, label, params),
             None => Processed::Rejected(format!(
@@ -127,7 +130,7 @@ pub fn feature_rows(
     let mut times: Vec<(MethodId, StageTimes)> = Vec::new();
     let mut partition_time = std::time::Duration::ZERO;
     for (part, geom) in units(f.geometry.as_ref(), opts.explode) {
-        let processed = fenced(geom.as_ref(), skeletons, params);
+        let processed = fenced(geom.as_ref(), f.checked, skeletons, params);
         let label = match skeletons {
             Skeletons::Computed => None,
             Skeletons::Given { label, .. } => Some(label),
