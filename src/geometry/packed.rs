@@ -449,6 +449,22 @@ impl PackedTree {
         earlier(first, rest)
     }
 
+    /// [`Self::first_pair`] of the tree over `boxes`, without building one
+    /// for a few boxes (every pair in turn, in order, as
+    /// [`Self::pairs_of`]).
+    pub(crate) fn first_pair_of<T: Send>(
+        boxes: &[Bbox],
+        pair: impl Fn(u32, u32) -> Option<T> + Sync,
+    ) -> Option<(u32, u32, T)> {
+        if boxes.len() > FEW_PAIRED {
+            return Self::new(boxes).first_pair(pair);
+        }
+        Self::pairs_of(boxes, |i, j| match pair(i, j) {
+            Some(v) => ControlFlow::Break((i, j, v)),
+            None => ControlFlow::Continue(()),
+        })
+    }
+
     /// One step of the self-join: the children of nodes `a` and `b` (`a`
     /// with itself when they are the same) whose boxes meet, as node pairs
     /// pushed on `todo` or, on the items' level, item pairs `(i, j)`, `i < j`,
@@ -985,7 +1001,16 @@ mod tests {
     /// the tree's pairs it rejects, on one thread and on many.
     #[test]
     fn first_pair_is_the_first_rejected_pair_in_order() {
-        for n in [0, 1, 2, 300, 5000, PAIRED_IN_PARALLEL + 1000] {
+        for n in [
+            0,
+            1,
+            2,
+            40,
+            FEW_PAIRED,
+            300,
+            5000,
+            PAIRED_IN_PARALLEL + 1000,
+        ] {
             let boxes = grid(n);
             let t = PackedTree::new(&boxes);
             let mut all = Vec::new();
@@ -1001,6 +1026,9 @@ mod tests {
             let want = all.iter().find(|&&(i, j)| rule(i, j)).copied();
             let got = t.first_pair(|i, j| rule(i, j).then_some(()));
             assert_eq!(got.map(|(i, j, _)| (i, j)), want, "n = {n}");
+            // Without a tree for a few boxes: the same pair.
+            let few = PackedTree::first_pair_of(&boxes, |i, j| rule(i, j).then_some(()));
+            assert_eq!(few.map(|(i, j, _)| (i, j)), want, "n = {n}");
             assert!(n < 300 || want.is_some(), "the grid's boxes overlap");
         }
     }

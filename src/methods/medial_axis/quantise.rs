@@ -186,6 +186,11 @@ pub(super) fn segments<'a>(
     Ok(segs)
 }
 
+/// [`split_at_touches`] looks a boundary of at least this many vertices up
+/// on every core (a smaller one on one: most polygons, in a run that has a
+/// thread per feature already).
+const SPLIT_IN_PARALLEL: usize = 1 << 15;
+
 /// Splits every segment whose interior passes within [`SNAP`] of a vertex.
 fn split_at_touches(segs: Vec<Seg>) -> Vec<Seg> {
     let tree = PackedTree::new(&boxes(&segs, SNAP as f64));
@@ -193,8 +198,8 @@ fn split_at_touches(segs: Vec<Seg>) -> Vec<Seg> {
     vertices.sort_unstable_by_key(|v| v.0);
     vertices.dedup_by_key(|v| v.0);
     // (segment, position along it, vertex, its world coordinates)
-    let mut splits: Vec<(usize, i128, Pt, Coord<f64>)> = Vec::new();
-    for &(v, wv) in &vertices {
+    let splits_at = |&(v, wv): &(Pt, Coord<f64>)| {
+        let mut splits: Vec<(usize, i128, Pt, Coord<f64>)> = Vec::new();
         let p = [v[0] as f64, v[1] as f64];
         let holds = |b: &Bbox| b[0] <= p[0] && p[0] <= b[2] && b[1] <= p[1] && p[1] <= b[3];
         tree.visit(holds, |i| {
@@ -214,7 +219,15 @@ fn split_at_touches(segs: Vec<Seg>) -> Vec<Seg> {
             }
             ControlFlow::Continue(())
         });
-    }
+        splits
+    };
+    // A long boundary's vertices are looked up on every core (sorted below).
+    let mut splits: Vec<(usize, i128, Pt, Coord<f64>)> = if vertices.len() >= SPLIT_IN_PARALLEL {
+        use rayon::prelude::*;
+        vertices.par_iter().flat_map_iter(splits_at).collect()
+    } else {
+        vertices.iter().flat_map(splits_at).collect()
+    };
     if splits.is_empty() {
         return segs;
     }
@@ -321,15 +334,11 @@ fn bad_pair(s: Seg, t: Seg) -> bool {
 /// The first segment (in order) that meets another one anywhere but at one
 /// shared endpoint is reported, at its start.
 fn check_no_crossing(segs: &[Seg]) -> Result<(), Crossing> {
-    let mut first: Option<u32> = None;
-    PackedTree::pairs_of(&boxes(segs, 0.0), |i, j| {
-        if first.is_none_or(|f| i < f) && bad_pair(segs[i as usize], segs[j as usize]) {
-            first = Some(i);
-        }
-        ControlFlow::<()>::Continue(())
+    let first = PackedTree::first_pair_of(&boxes(segs, 0.0), |i, j| {
+        bad_pair(segs[i as usize], segs[j as usize]).then_some(())
     });
     match first {
-        Some(i) => Err(Crossing {
+        Some((i, _, ())) => Err(Crossing {
             at: segs[i as usize].a,
         }),
         None => Ok(()),
