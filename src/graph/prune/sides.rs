@@ -100,9 +100,10 @@ pub(super) fn prune_sides(w: &mut Work, params: &PruneParams, collapsed: &mut Ve
     for &v in order.iter().rev() {
         hand_down(w, v, &mut below);
     }
+    let thickets = thickets(w, params, &order, &below);
     let mut touched = Vec::new();
     for &v in &order {
-        if let Some(removed) = judge(w, params, v, &below) {
+        if let Some(removed) = judge(w, params, v, &below, thickets.as_deref()) {
             touched.push((v, removed));
         }
     }
@@ -112,6 +113,36 @@ pub(super) fn prune_sides(w: &mut Work, params: &PruneParams, collapsed: &mut Ve
     for (v, removed) in touched {
         w.settle(v, removed, params, collapsed);
     }
+}
+
+/// [`thickets`] are found for every junction at once, on every core, from
+/// this many skeleton nodes on (fewer: one by one as they are judged — most
+/// skeletons, in a run that has a thread per feature already).
+const THICKETS_IN_PARALLEL: usize = 1 << 14;
+
+/// On a large skeleton, [`terminal_thicket`] of every junction, by node:
+/// it reads only what judging leaves alone (the pieces, `below`, ∂P), so
+/// the answers are those the judging would find. `None` on a small one.
+fn thickets(
+    w: &Work,
+    params: &PruneParams,
+    order: &[NodeId],
+    below: &[Below],
+) -> Option<Vec<bool>> {
+    use rayon::prelude::*;
+    if order.len() < THICKETS_IN_PARALLEL {
+        return None;
+    }
+    let found: Vec<usize> = order
+        .par_iter()
+        .filter(|&&v| w.deg(v) >= 3 && terminal_thicket(w, params, v, below))
+        .map(|v| v.index())
+        .collect();
+    let mut is = vec![false; below.len()];
+    for i in found {
+        is[i] = true;
+    }
+    Some(is)
 }
 
 /// Peels the skeleton from its leaves: the nodes in peeling order (then the
@@ -255,7 +286,13 @@ fn two_largest(xs: &[f64]) -> (f64, f64) {
 /// Judges the peeled sides of `v` and removes the insignificant ones that
 /// contain a junction, least significant first, while `v` keeps two
 /// branches and the rest of the skeleton seen from `v` is significant.
-fn judge(w: &mut Work, params: &PruneParams, v: NodeId, below: &[Below]) -> Option<f64> {
+fn judge(
+    w: &mut Work,
+    params: &PruneParams,
+    v: NodeId,
+    below: &[Below],
+    thickets: Option<&[bool]>,
+) -> Option<f64> {
     if w.deg(v) < 3 {
         return None;
     }
@@ -311,7 +348,9 @@ fn judge(w: &mut Work, params: &PruneParams, v: NodeId, below: &[Below]) -> Opti
         remove_side(w, below, (p, c));
         removed = Some(removed.map_or(extent, |r: f64| r.max(extent)));
     }
-    if w.deg(v) >= 3 && terminal_thicket(w, params, v, below) {
+    if w.deg(v) >= 3
+        && thickets.map_or_else(|| terminal_thicket(w, params, v, below), |t| t[v.index()])
+    {
         for &side in &b.children {
             remove_side(w, below, side);
         }
