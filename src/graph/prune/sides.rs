@@ -100,10 +100,11 @@ pub(super) fn prune_sides(w: &mut Work, params: &PruneParams, collapsed: &mut Ve
     for &v in order.iter().rev() {
         hand_down(w, v, &mut below);
     }
-    let thickets = thickets(w, params, &order, &below);
+    let ascent = Ascent::new(w, &order, &below);
+    let thickets = thickets(w, params, &order, &below, &ascent);
     let mut touched = Vec::new();
     for &v in &order {
-        if let Some(removed) = judge(w, params, v, &below, thickets.as_deref()) {
+        if let Some(removed) = judge(w, params, v, &below, &ascent, thickets.as_deref()) {
             touched.push((v, removed));
         }
     }
@@ -128,6 +129,7 @@ fn thickets(
     params: &PruneParams,
     order: &[NodeId],
     below: &[Below],
+    ascent: &Ascent,
 ) -> Option<Vec<bool>> {
     use rayon::prelude::*;
     if order.len() < THICKETS_IN_PARALLEL {
@@ -135,7 +137,7 @@ fn thickets(
     }
     let found: Vec<usize> = order
         .par_iter()
-        .filter(|&&v| w.deg(v) >= 3 && terminal_thicket(w, params, v, below))
+        .filter(|&&v| w.deg(v) >= 3 && terminal_thicket(w, params, v, below, ascent))
         .map(|v| v.index())
         .collect();
     let mut is = vec![false; below.len()];
@@ -291,6 +293,7 @@ fn judge(
     params: &PruneParams,
     v: NodeId,
     below: &[Below],
+    ascent: &Ascent,
     thickets: Option<&[bool]>,
 ) -> Option<f64> {
     if w.deg(v) < 3 {
@@ -349,7 +352,10 @@ fn judge(
         removed = Some(removed.map_or(extent, |r: f64| r.max(extent)));
     }
     if w.deg(v) >= 3
-        && thickets.map_or_else(|| terminal_thicket(w, params, v, below), |t| t[v.index()])
+        && thickets.map_or_else(
+            || terminal_thicket(w, params, v, below, ascent),
+            |t| t[v.index()],
+        )
     {
         for &side in &b.children {
             remove_side(w, below, side);
@@ -367,11 +373,17 @@ fn judge(
 /// extension finishes it: seen from the line's own width a little way back
 /// the thicket is the bank's roughness. A blunt end (two legs into corners,
 /// no junction beyond) and a cut end of real width are never thickets.
-fn terminal_thicket(w: &Work, params: &PruneParams, v: NodeId, below: &[Below]) -> bool {
+fn terminal_thicket(
+    w: &Work,
+    params: &PruneParams,
+    v: NodeId,
+    below: &[Below],
+    ascent: &Ascent,
+) -> bool {
     let b = &below[v.index()];
-    let Some(up) = b.up else {
+    if b.up.is_none() {
         return false;
-    };
+    }
     let kids = b.children.iter().map(|&(_, c)| &below[c.index()]);
     if !kids.clone().any(|c| c.has_junction) {
         return false;
@@ -384,26 +396,107 @@ fn terminal_thicket(w: &Work, params: &PruneParams, v: NodeId, below: &[Below]) 
     if !(e.is_finite() && e > 0.0) {
         return false;
     }
-    // Walk back towards the root, piece by piece, trying q at e, 2e, 4e.
-    let (mut node, mut piece, mut walked, mut s) = (v, up, 0.0, e);
+    // Back towards the root, trying q at e, 2e, 4e along the way.
+    let mut s = e;
     while s <= 4.0 * e {
-        let len = w.pieces[piece as usize].len;
-        if s <= walked + len {
-            let rq = w.boundary.distance(w.point_at(piece, node, s - walked));
-            if (1.0 + params.ratio) * rq >= s + e && tiny < params.arm_width * rq {
-                return true;
-            }
-            s *= 2.0;
-            continue;
+        let Some((node, walked)) = ascent.piece_at(v, s) else {
+            return false;
+        };
+        let piece = below[node.index()]
+            .up
+            .expect("a node below a root has a piece up");
+        let rq = w.boundary.distance(w.point_at(piece, node, s - walked));
+        if (1.0 + params.ratio) * rq >= s + e && tiny < params.arm_width * rq {
+            return true;
         }
-        walked += len;
-        node = w.other(piece, node);
-        match below[node.index()].up {
-            Some(next) => piece = next,
-            None => return false,
-        }
+        s *= 2.0;
     }
     false
+}
+
+/// Every node's way up towards its root (the parent of a peeled node is
+/// across its piece up), for finding in O(log n) the piece a given length up
+/// from a node: walking it piece by piece cost O(depth) per junction, and a
+/// staircase rim's skeleton is deep in pieces a metre long under a disc a
+/// kilometre wide (the rasterised Lena: 5 of its 20 s).
+struct Ascent {
+    /// The parent's index (the node's own at a root and on cycles).
+    parent: Vec<u32>,
+    /// Length along the pieces up to the root.
+    from_root: Vec<f64>,
+    /// Pieces up to the root.
+    depth: Vec<u32>,
+    /// A farther ancestor (Myers' skew-binary jump pointers: every way up is
+    /// O(log n) jumps and steps).
+    jump: Vec<u32>,
+}
+
+impl Ascent {
+    /// Built from the root down (`order`: the peeling order, all nodes).
+    fn new(w: &Work, order: &[NodeId], below: &[Below]) -> Self {
+        Self::build(below.len(), order.iter().rev().map(|v| v.index()), |i| {
+            let up = below[i].up?;
+            Some((
+                w.other(up, NodeId::from_index(i)).index(),
+                w.pieces[up as usize].len,
+            ))
+        })
+    }
+
+    /// Of `n` nodes visited parents first (`top_down`), each with its
+    /// parent and the length up to it (`up`; `None` at a root).
+    fn build(
+        n: usize,
+        top_down: impl Iterator<Item = usize>,
+        up: impl Fn(usize) -> Option<(usize, f64)>,
+    ) -> Self {
+        let mut a = Ascent {
+            parent: (0..n as u32).collect(),
+            from_root: vec![0.0; n],
+            depth: vec![0; n],
+            jump: (0..n as u32).collect(),
+        };
+        for i in top_down {
+            let Some((p, len)) = up(i) else {
+                continue;
+            };
+            a.parent[i] = p as u32;
+            a.from_root[i] = a.from_root[p] + len;
+            a.depth[i] = a.depth[p] + 1;
+            let (j, jj) = (a.jump[p] as usize, a.jump[a.jump[p] as usize] as usize);
+            a.jump[i] = if a.depth[p] - a.depth[j] == a.depth[j] - a.depth[jj] {
+                jj as u32
+            } else {
+                p as u32
+            };
+        }
+        a
+    }
+
+    /// The first node x on the way up from `v` (v itself included) whose
+    /// piece up reaches `s` from v, with the length from v to x: `None`
+    /// when the way ends (a root) first.
+    fn piece_at(&self, v: NodeId, s: f64) -> Option<(NodeId, f64)> {
+        let start = self.from_root[v.index()];
+        // How far up from v the top of x's piece is.
+        let reach = |x: usize| start - self.from_root[self.parent[x] as usize];
+        let is_root = |x: usize| self.parent[x] as usize == x;
+        let mut x = v.index();
+        loop {
+            if is_root(x) {
+                return None;
+            }
+            if s <= reach(x) {
+                return Some((NodeId::from_index(x), start - self.from_root[x]));
+            }
+            let y = self.jump[x] as usize;
+            x = if y != x && !is_root(y) && reach(y) < s {
+                y
+            } else {
+                self.parent[x] as usize
+            };
+        }
+    }
 }
 
 /// Distance to ∂P where the side `(p, c)` of `v`, followed towards its
@@ -450,5 +543,62 @@ fn remove_side(w: &mut Work, below: &[Below], side: Side) {
             w.remove(p);
         }
         stack.extend(below[c.index()].children.iter().copied());
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Ascent;
+    use crate::graph::NodeId;
+
+    /// The jumps find the piece a walk up, piece by piece, finds.
+    #[test]
+    fn the_piece_a_length_up_is_the_walks() {
+        // A random forest: node i's parent among the nodes before it (or none),
+        // pieces of random length, long chains among them.
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed
+        };
+        let n = 3000;
+        let up: Vec<Option<(usize, f64)>> = (0..n)
+            .map(|i| {
+                let r = next();
+                match (i, r % 50) {
+                    (0, _) | (_, 0) => None,
+                    (_, 1..=40) => Some((i - 1, (r % 1000) as f64 / 100.0)),
+                    _ => Some(((r / 64) as usize % i, (r % 7) as f64 + 0.5)),
+                }
+            })
+            .collect();
+        let a = Ascent::build(n, 0..n, |i| up[i]);
+        let walk = |v: usize, s: f64| {
+            let (mut x, mut walked) = (v, 0.0);
+            loop {
+                let (p, len) = up[x]?;
+                if s <= walked + len {
+                    return Some((x, walked));
+                }
+                walked += len;
+                x = p;
+            }
+        };
+        for _ in 0..20_000 {
+            let v = next() as usize % n;
+            // Off the pieces' ends by far more than the rounding of their
+            // sums (the jumps add up lengths from the root, the walk from v).
+            let s = (next() % 40_000) as f64 / 100.0 + 0.004_321;
+            let got = a
+                .piece_at(NodeId::from_index(v), s)
+                .map(|(x, w)| (x.index(), w));
+            let want = walk(v, s);
+            assert_eq!(got.map(|g| g.0), want.map(|w| w.0), "v {v}, s {s}");
+            if let (Some(g), Some(w)) = (got, want) {
+                assert!((g.1 - w.1).abs() <= 1e-9 * (1.0 + w.1), "v {v}, s {s}");
+            }
+        }
     }
 }
