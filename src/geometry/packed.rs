@@ -374,22 +374,8 @@ impl PackedTree {
         // itself included: their children's pairs are still to be met.
         let mut todo = vec![(self.boxes.len() - 1, self.boxes.len() - 1)];
         while let Some((a, b)) = todo.pop() {
-            let (ka, kb) = (self.children(a), self.children(b));
-            for ca in ka {
-                let first = if a == b { ca } else { kb.start };
-                for cb in first..kb.end {
-                    if !boxes_meet(&self.boxes[ca], &self.boxes[cb]) {
-                        continue;
-                    }
-                    if ca >= n {
-                        todo.push((ca, cb));
-                    } else if ca != cb {
-                        let (i, j) = (self.ids[ca], self.ids[cb]);
-                        if let ControlFlow::Break(x) = pair(i.min(j), i.max(j)) {
-                            return Some(x);
-                        }
-                    }
-                }
+            if let Some(x) = self.node_pairs(a, b, &mut todo, &mut pair) {
+                return Some(x);
             }
         }
         None
@@ -421,6 +407,7 @@ impl PackedTree {
                     *local = Some((i, j, v));
                 }
             }
+            ControlFlow::<()>::Continue(())
         };
         // Breadth first until there are node pairs enough to share.
         let root = self.boxes.len() - 1;
@@ -468,14 +455,14 @@ impl PackedTree {
     /// One step of the self-join: the children of nodes `a` and `b` (`a`
     /// with itself when they are the same) whose boxes meet, as node pairs
     /// pushed on `todo` or, on the items' level, item pairs `(i, j)`, `i < j`,
-    /// given to `item`.
-    fn node_pairs(
+    /// given to `item` until it breaks.
+    fn node_pairs<B>(
         &self,
         a: usize,
         b: usize,
         todo: &mut Vec<(usize, usize)>,
-        mut item: impl FnMut(u32, u32),
-    ) {
+        mut item: impl FnMut(u32, u32) -> ControlFlow<B>,
+    ) -> Option<B> {
         let n = self.len();
         let (ka, kb) = (self.children(a), self.children(b));
         for ca in ka {
@@ -488,10 +475,13 @@ impl PackedTree {
                     todo.push((ca, cb));
                 } else if ca != cb {
                     let (i, j) = (self.ids[ca], self.ids[cb]);
-                    item(i.min(j), i.max(j));
+                    if let ControlFlow::Break(x) = item(i.min(j), i.max(j)) {
+                        return Some(x);
+                    }
                 }
             }
         }
+        None
     }
 
     /// Branch and bound: visits items in roughly increasing `bound` order
