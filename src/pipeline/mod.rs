@@ -310,8 +310,19 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
         let (info_tx, info_rx) = mpsc::sync_channel::<Result<SourceInfo, IoError>>(1);
         let (batch_tx, batch_rx) = mpsc::sync_channel::<Batch>(QUEUE);
         let merge = merge_of(job);
-        let reader = scope
-            .spawn(move || read_batches(job.input, merge, batch, make_valid, info_tx, batch_tx));
+        // The reader checks a large polygon's validity on several threads
+        // (`PackedTree::first_pair`): as many as the run's, in a pool of its
+        // own (the workers' pool waits on the reader's batches), so that a
+        // run with `--threads 1` stays on one core.
+        let reader_pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .thread_name(|i| format!("skeletonise-read-{i}"))
+            .build()
+            .map_err(|_| RunError::Threads(threads))?;
+        let reader = scope.spawn(move || {
+            reader_pool
+                .install(|| read_batches(job.input, merge, batch, make_valid, info_tx, batch_tx))
+        });
         let info = match info_rx.recv() {
             Ok(Ok(info)) => info,
             Ok(Err(e)) => return Err(e.into()),
