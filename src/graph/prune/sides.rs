@@ -101,10 +101,9 @@ pub(super) fn prune_sides(w: &mut Work, params: &PruneParams, collapsed: &mut Ve
         hand_down(w, v, &mut below);
     }
     let ascent = Ascent::new(w, &order, &below);
-    let thickets = thickets(w, params, &order, &below, &ascent);
     let mut touched = Vec::new();
     for &v in &order {
-        if let Some(removed) = judge(w, params, v, &below, &ascent, thickets.as_deref()) {
+        if let Some(removed) = judge(w, params, v, &below, &ascent) {
             touched.push((v, removed));
         }
     }
@@ -114,37 +113,6 @@ pub(super) fn prune_sides(w: &mut Work, params: &PruneParams, collapsed: &mut Ve
     for (v, removed) in touched {
         w.settle(v, removed, params, collapsed);
     }
-}
-
-/// [`thickets`] are found for every junction at once, on every core, from
-/// this many skeleton nodes on (fewer: one by one as they are judged — most
-/// skeletons, in a run that has a thread per feature already).
-const THICKETS_IN_PARALLEL: usize = 1 << 14;
-
-/// On a large skeleton, [`terminal_thicket`] of every junction, by node:
-/// it reads only what judging leaves alone (the pieces, `below`, ∂P), so
-/// the answers are those the judging would find. `None` on a small one.
-fn thickets(
-    w: &Work,
-    params: &PruneParams,
-    order: &[NodeId],
-    below: &[Below],
-    ascent: &Ascent,
-) -> Option<Vec<bool>> {
-    use rayon::prelude::*;
-    if order.len() < THICKETS_IN_PARALLEL {
-        return None;
-    }
-    let found: Vec<usize> = order
-        .par_iter()
-        .filter(|&&v| w.deg(v) >= 3 && terminal_thicket(w, params, v, below, ascent))
-        .map(|v| v.index())
-        .collect();
-    let mut is = vec![false; below.len()];
-    for i in found {
-        is[i] = true;
-    }
-    Some(is)
 }
 
 /// Peels the skeleton from its leaves: the nodes in peeling order (then the
@@ -294,7 +262,6 @@ fn judge(
     v: NodeId,
     below: &[Below],
     ascent: &Ascent,
-    thickets: Option<&[bool]>,
 ) -> Option<f64> {
     if w.deg(v) < 3 {
         return None;
@@ -351,12 +318,7 @@ fn judge(
         remove_side(w, below, (p, c));
         removed = Some(removed.map_or(extent, |r: f64| r.max(extent)));
     }
-    if w.deg(v) >= 3
-        && thickets.map_or_else(
-            || terminal_thicket(w, params, v, below, ascent),
-            |t| t[v.index()],
-        )
-    {
+    if w.deg(v) >= 3 && terminal_thicket(w, params, v, below, ascent) {
         for &side in &b.children {
             remove_side(w, below, side);
         }
