@@ -12,6 +12,7 @@ use crate::graph::SkeletonGraph;
 use crate::methods::budget::{self, MethodContext};
 use crate::score::{metrics, BarRays};
 use geo::{LineString, MultiLineString};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 /// Every method's candidate for the polygon parts `prepared`, in `methods`
@@ -41,9 +42,17 @@ pub(super) fn computed(
     // The bars' rays depend on the polygon alone: found while the methods
     // work (on one huge polygon they fill a core the methods leave idle).
     let (per_part, (rays, rays_time)) = if parallel {
-        rayon::join(skeletons, || bar_rays(prepared, params, true))
+        let done = AtomicBool::new(false);
+        rayon::join(
+            || {
+                let s = skeletons();
+                done.store(true, Ordering::Relaxed);
+                s
+            },
+            || bar_rays(prepared, params, Some(&done)),
+        )
     } else {
-        (skeletons(), bar_rays(prepared, params, false))
+        (skeletons(), bar_rays(prepared, params, None))
     };
     // The shared rays, split evenly between the methods.
     let rays_share = rays_time / params.skeleton.methods.len().max(1) as u32;
@@ -139,7 +148,9 @@ pub(super) fn given(
         })
         .collect();
     let parallel = worth_splitting(prepared);
-    let rays = bar_rays(prepared, params, parallel).0;
+    // Nothing is made beside the rays here: every core on them at once.
+    let nothing_beside = AtomicBool::new(true);
+    let rays = bar_rays(prepared, params, parallel.then_some(&nothing_beside)).0;
     let (mut c, _) = finish(prepared, &rays, &parts, params, parallel);
     // The lines once, not once per polygon part.
     c.geometry = lines.clone();
@@ -528,17 +539,24 @@ fn guarded<T>(
 
 /// Every part's bars when the run scores (shared by all candidates), and
 /// the time they took over all threads (on the feature's [`Stopwatch`]).
+/// With `beside`, the feature's work is split between threads and the
+/// rays are found beside its skeletons until that flag is set
+/// ([`BarRays::timed_beside`]); without, on the calling thread.
 fn bar_rays(
     prepared: &[PreparedPolygon],
     params: &ProcessParams,
-    parallel: bool,
+    beside: Option<&AtomicBool>,
 ) -> (Vec<BarRays>, Duration) {
     if params.score.is_none() {
         return (Vec::new(), Duration::ZERO);
     }
+    let parallel = beside.is_some();
     let timed = map_in_order(prepared, parallel, |_, p| {
         let clock = Stopwatch::start(parallel);
-        let (rays, time) = BarRays::timed(p);
+        let (rays, time) = match beside {
+            Some(done) => BarRays::timed_beside(p, done),
+            None => BarRays::timed(p),
+        };
         (rays, time.unwrap_or_else(|| clock.elapsed()))
     });
     let time = timed.iter().map(|(_, t)| *t).sum();

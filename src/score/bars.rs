@@ -9,6 +9,7 @@ use crate::geometry::{Boundary, BoundarySegment, PreparedPolygon};
 use crate::graph::{Branch, SkeletonGraph};
 use geo::{Coord, MultiLineString};
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Bars per parallel task: a polygon with fewer is scored on one thread.
 pub(crate) const PAR_BARS: usize = 4096;
@@ -161,6 +162,28 @@ impl BarRays {
     /// threads; `None` when all was done on the calling thread, whose own
     /// clock then counts it.
     pub fn timed(polygon: &PreparedPolygon) -> (Self, Option<std::time::Duration>) {
+        Self::found(polygon, None)
+    }
+
+    /// [`BarRays::timed`] for a large polygon whose skeletons are being made
+    /// at the same time on the same threads: the exits are found chunk by
+    /// chunk on the calling thread, which first helps with any work the
+    /// skeletons have queued on the pool, until `skeletons_done` is set;
+    /// the rest then on every core. A huge polygon's medial axis queues
+    /// its boundary's checks on the pool and then runs its Voronoi sweep
+    /// on one core: the exits done at once would hold a core through the
+    /// checks and leave it idle through the sweep.
+    pub(crate) fn timed_beside(
+        polygon: &PreparedPolygon,
+        skeletons_done: &AtomicBool,
+    ) -> (Self, Option<std::time::Duration>) {
+        Self::found(polygon, Some(skeletons_done))
+    }
+
+    fn found(
+        polygon: &PreparedPolygon,
+        beside: Option<&AtomicBool>,
+    ) -> (Self, Option<std::time::Duration>) {
         // At most three bars per vertex: no clock for a polygon that cannot
         // have enough of them to be split.
         let clock = (3 * polygon.vertex_count() > PAR_BARS).then(CpuClock::start);
@@ -211,7 +234,18 @@ impl BarRays {
             }
         };
         let mut time = clock.elapsed();
-        time += rays
+        let mut rest: &mut [Ray] = &mut rays;
+        if let Some(done) = beside {
+            while !rest.is_empty() && !done.load(Ordering::Relaxed) {
+                while let Some(rayon::Yield::Executed) = rayon::yield_now() {}
+                let (chunk, tail) = rest.split_at_mut(PAR_BARS.min(rest.len()));
+                let clock = CpuClock::start();
+                exits(chunk);
+                time += clock.elapsed();
+                rest = tail;
+            }
+        }
+        time += rest
             .par_chunks_mut(PAR_BARS)
             .map(|chunk| {
                 let clock = CpuClock::start();
