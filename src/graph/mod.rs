@@ -126,6 +126,12 @@ impl SkeletonGraph {
         Self::default()
     }
 
+    /// Makes room for `nodes` more nodes and `edges` more edges.
+    pub fn reserve(&mut self, nodes: usize, edges: usize) {
+        self.nodes.reserve(nodes);
+        self.edges.reserve(edges);
+    }
+
     /// Adds a node.
     pub fn add_node(&mut self, pos: Coord<f64>, radius: f64, time: Option<f64>) -> NodeId {
         self.nodes.push(Node { pos, radius, time });
@@ -449,6 +455,9 @@ impl SkeletonGraph {
 
     /// Number of legs ([`SkeletonGraph::legs`]): the `legs` column.
     pub fn leg_count(&self) -> usize {
+        if self.nodes.len() >= LEGS_IN_PARALLEL {
+            return self.leg_count_from_leaves();
+        }
         // The legs of `legs()`, counted without building their lines.
         let deg = self.degrees();
         let mut n = 0;
@@ -456,6 +465,32 @@ impl SkeletonGraph {
             n += usize::from(start != end && (deg[start.index()] == 1 || deg[end.index()] == 1));
         });
         n
+    }
+
+    /// [`SkeletonGraph::leg_count`] walked from every leaf on every core: a
+    /// leg is the branch from a leaf through degree-2 nodes to the first
+    /// other node, counted once when that is a leaf too (a lone path).
+    fn leg_count_from_leaves(&self) -> usize {
+        use rayon::prelude::*;
+        let adj = Adjacency::of(self, |_| true);
+        (0..self.nodes.len())
+            .into_par_iter()
+            .filter(|&i| {
+                let a = &adj[i];
+                if a.len() != 1 {
+                    return false;
+                }
+                let (mut e, mut cur) = (a[0], self.opposite(a[0], NodeId::from_index(i)));
+                while adj[cur.index()].len() == 2 {
+                    let Some(&next) = adj[cur.index()].iter().find(|&&x| x != e) else {
+                        break;
+                    };
+                    e = next;
+                    cur = self.opposite(next, cur);
+                }
+                adj[cur.index()].len() != 1 || i < cur.index()
+            })
+            .count()
     }
 
     /// [`SkeletonGraph::leg_count`] from the graph's branches
@@ -469,6 +504,11 @@ impl SkeletonGraph {
             .count()
     }
 }
+
+/// [`SkeletonGraph::leg_count`] walks the legs on every core from this many
+/// nodes on (a rough rim's raw medial axis has millions; most skeletons, in
+/// a run that has a thread per feature already, are walked on one).
+const LEGS_IN_PARALLEL: usize = 1 << 16;
 
 /// The nodes of a graph copied into a new one, numbered in the order they
 /// are first met.
@@ -735,6 +775,7 @@ mod tests {
         assert_eq!(g.legs().len(), 3);
         assert_eq!(g.leg_count(), g.legs().len());
         assert_eq!(g.leg_count_in(&g.branches()), g.legs().len());
+        assert_eq!(g.leg_count_from_leaves(), g.legs().len());
         // Every branch's line is its edges' lines joined end to end.
         for b in g.branches() {
             let mut at = b.start;
@@ -748,5 +789,52 @@ mod tests {
         }
         let lengths: f64 = g.branches().iter().map(Branch::length).sum();
         assert!((lengths - g.total_length()).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_large_graphs_legs_are_walked_from_its_leaves_as_counted_by_branches() {
+        // Combs of several sizes (legs of 1–4 pieces on a spine), lone
+        // paths, lassos, cycles and double edges: above the parallel
+        // threshold, the leaf walk counts what the branch walk counts.
+        let mut g = SkeletonGraph::new();
+        let mut rng = 7u64;
+        let mut next = |m: u64| {
+            rng = rng
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (rng >> 33) % m
+        };
+        while g.nodes().len() < LEGS_IN_PARALLEL + 1000 {
+            let spine: Vec<NodeId> = (0..1 + next(8))
+                .map(|_| g.add_node(c(0.0, 0.0), 1.0, None))
+                .collect();
+            for w in spine.windows(2) {
+                g.add_edge(w[0], w[1], vec![]);
+            }
+            for &s in &spine {
+                match next(6) {
+                    0 => {
+                        g.add_edge(s, s, vec![]);
+                    }
+                    1 => {
+                        let t = g.add_node(c(1.0, 0.0), 1.0, None);
+                        g.add_edge(s, t, vec![]);
+                        g.add_edge(t, s, vec![]);
+                    }
+                    _ => {
+                        let mut at = s;
+                        for _ in 0..next(5) {
+                            let t = g.add_node(c(1.0, 1.0), 1.0, None);
+                            g.add_edge(at, t, vec![]);
+                            at = t;
+                        }
+                    }
+                }
+            }
+        }
+        assert!(g.nodes().len() >= LEGS_IN_PARALLEL);
+        let by_branches = g.leg_count_in(&g.branches());
+        assert!(by_branches > 10_000, "{by_branches}");
+        assert_eq!(g.leg_count(), by_branches);
     }
 }

@@ -68,7 +68,7 @@ use crate::geometry::PreparedPolygon;
 /// is [`crate::graph::widths`].
 #[doc(no_inline)]
 use crate::graph::{NodeId, SkeletonGraph};
-use arc::Parabola;
+use arc::{Parabola, Sample};
 use boostvoronoi::prelude::{Builder, Cell, Diagram, SourceCategory, VertexIndex};
 use quantise::{orient, Grid, Pt, Seg};
 use schemars::JsonSchema;
@@ -359,19 +359,51 @@ impl<'a> Extractor<'a> {
     fn run(mut self) -> Result<SkeletonGraph, MethodError> {
         let kept = self.inside_edges(false)?;
         let mut rep = self.representatives(&kept);
-        for k in &kept {
-            let (r0, r1) = (find(&mut rep, k.v0.usize()), find(&mut rep, k.v1.usize()));
-            if r0 == r1 {
-                continue;
+        // The kept edges between two clusters, with their ends.
+        let joined: Vec<Joined> = kept
+            .iter()
+            .filter_map(|k| {
+                let (r0, r1) = (find(&mut rep, k.v0.usize()), find(&mut rep, k.v1.usize()));
+                (r0 != r1).then(|| Joined {
+                    r: [r0, r1],
+                    p: [self.vertex_at(r0), self.vertex_at(r1)],
+                    kept: *k,
+                })
+            })
+            .collect();
+        // The arcs' samples first (on every core for a large diagram: a
+        // rough rim's medial axis has millions of them), then the graph in
+        // the edges' order, with room for all of it.
+        let (segs, grid, tolerance) = (self.segs, self.grid, self.tolerance);
+        let sample = |j: &Joined| {
+            j.kept
+                .curved
+                .then(|| arc_samples(segs, grid, tolerance, j.p, j.kept.s0, j.kept.s1))
+                .flatten()
+        };
+        let arcs: Vec<Option<Vec<Sample>>> = if joined.len() >= ARCS_IN_PARALLEL {
+            use rayon::prelude::*;
+            joined.par_iter().map(sample).collect()
+        } else {
+            joined.iter().map(sample).collect()
+        };
+        let inner: usize = arcs.iter().flatten().map(Vec::len).sum();
+        self.graph.reserve(
+            (2 * joined.len()).min(self.node_of.len()) + inner,
+            joined.len() + inner,
+        );
+        for (j, arc) in joined.iter().zip(arcs) {
+            let n0 = self.node(j.r[0], j.kept.s0);
+            let n1 = self.node(j.r[1], j.kept.s0);
+            let mut prev = n0;
+            for smp in arc.into_iter().flatten() {
+                let n = self
+                    .graph
+                    .add_node(grid.world(smp.x, smp.y), grid.length(smp.r), None);
+                self.graph.add_edge(prev, n, Vec::new());
+                prev = n;
             }
-            let n0 = self.node(r0, k.s0);
-            let n1 = self.node(r1, k.s0);
-            if k.curved {
-                let (p0, p1) = (self.vertex_at(r0), self.vertex_at(r1));
-                self.add_arc(n0, n1, p0, p1, k.s0, k.s1);
-            } else {
-                self.graph.add_edge(n0, n1, Vec::new());
-            }
+            self.graph.add_edge(prev, n1, Vec::new());
         }
         Ok(self.graph)
     }
@@ -529,33 +561,41 @@ impl<'a> Extractor<'a> {
         self.node_of[v] = Some(n);
         n
     }
+}
 
-    /// A parabolic edge as a chain of nodes on the exact arc.
-    fn add_arc(&mut self, n0: NodeId, n1: NodeId, p0: [f64; 2], p1: [f64; 2], s0: Site, s1: Site) {
-        let (point, seg) = match (s0, s1) {
-            (Site::Point(p), Site::Segment(s)) | (Site::Segment(s), Site::Point(p)) => (p, s),
-            _ => {
-                self.graph.add_edge(n0, n1, Vec::new());
-                return;
-            }
-        };
-        let s = self.segs[seg];
-        let Some(par) = Parabola::new(fpt(point), fpt(s.a), fpt(s.b)) else {
-            self.graph.add_edge(n0, n1, Vec::new());
-            return;
-        };
-        let (grid, tol) = (*self.grid, self.tolerance);
-        let samples = par.samples(par.abscissa(p0), par.abscissa(p1), |r| tol.at(r, &grid));
-        let mut prev = n0;
-        for smp in samples {
-            let n = self
-                .graph
-                .add_node(grid.world(smp.x, smp.y), grid.length(smp.r), None);
-            self.graph.add_edge(prev, n, Vec::new());
-            prev = n;
-        }
-        self.graph.add_edge(prev, n1, Vec::new());
-    }
+/// A kept edge of the Voronoi diagram between the clusters `r` (their
+/// representatives, at `p`).
+struct Joined {
+    r: [usize; 2],
+    p: [[f64; 2]; 2],
+    kept: Kept,
+}
+
+/// [`Extractor::run`] samples the arcs on every core from this many edges
+/// on (fewer: on the calling thread — most polygons, in a run that has a
+/// thread per feature already).
+const ARCS_IN_PARALLEL: usize = 1 << 15;
+
+/// The interior samples of the parabolic edge from `p[0]` to `p[1]`
+/// between sites `s0` and `s1` (grid units), or `None` when it is drawn
+/// straight (not between a point and a segment, or degenerate).
+fn arc_samples(
+    segs: &[Seg],
+    grid: &Grid,
+    tolerance: ArcTolerance,
+    p: [[f64; 2]; 2],
+    s0: Site,
+    s1: Site,
+) -> Option<Vec<Sample>> {
+    let (point, seg) = match (s0, s1) {
+        (Site::Point(p), Site::Segment(s)) | (Site::Segment(s), Site::Point(p)) => (p, s),
+        _ => return None,
+    };
+    let s = segs[seg];
+    let par = Parabola::new(fpt(point), fpt(s.a), fpt(s.b))?;
+    Some(par.samples(par.abscissa(p[0]), par.abscissa(p[1]), |r| {
+        tolerance.at(r, grid)
+    }))
 }
 
 #[cfg(test)]
