@@ -264,7 +264,9 @@ impl<'a> Work<'a> {
         if params_may_need_mouth(&leg) {
             let len = self.pieces[p as usize].len;
             leg.r_mouth = if len > rj {
-                self.boundary.distance(self.point_at(p, j, rj))
+                // rj along the leg from j: within 2 rj of ∂P.
+                self.boundary
+                    .distance_within(self.point_at(p, j, rj), rj + rj)
             } else {
                 self.radius(leaf).max(self.reach[leaf.index()])
             };

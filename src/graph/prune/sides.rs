@@ -367,7 +367,12 @@ fn terminal_thicket(
         let piece = below[node.index()]
             .up
             .expect("a node below a root has a piece up");
-        let rq = w.boundary.distance(w.point_at(piece, node, s - walked));
+        // q is `s - walked` along the piece from `node`: no farther from
+        // ∂P than that plus `node`'s radius, which bounds the search.
+        let along = s - walked;
+        let rq = w
+            .boundary
+            .distance_within(w.point_at(piece, node, along), w.radius(node) + along);
         if (1.0 + params.ratio) * rq >= s + e && tiny < params.arm_width * rq {
             return true;
         }
@@ -469,7 +474,9 @@ fn mouth(w: &Work, below: &[Below], v: NodeId, (p, c): Side, rv: f64) -> f64 {
     loop {
         let len = w.pieces[piece as usize].len;
         if len >= s {
-            return w.boundary.distance(w.point_at(piece, from, s));
+            return w
+                .boundary
+                .distance_within(w.point_at(piece, from, s), w.radius(from) + s);
         }
         s -= len;
         match below[to.index()].deepest {
