@@ -98,6 +98,16 @@ impl EventQueue {
         self.heap.pop()
     }
 
+    /// Puts an event in place of the earliest one (which must exist): one
+    /// sift down the heap instead of a pop and a push.
+    pub fn replace_head(&mut self, t: f64, kind: EventKind) {
+        self.seq += 1;
+        let seq = self.seq;
+        if let Some(mut head) = self.heap.peek_mut() {
+            *head = Event { t, seq, kind };
+        }
+    }
+
     /// Events queued (stale ones included).
     pub fn len(&self) -> usize {
         self.heap.len()

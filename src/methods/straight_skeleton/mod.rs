@@ -342,7 +342,7 @@ impl<'a> Propagation<'a> {
 
     fn run(mut self) -> Result<(Vec<Arc>, Stats), MethodError> {
         self.drain_work()?;
-        while let Some(ev) = self.next_event() {
+        while let Some((ev, queued)) = self.next_event() {
             self.stats.pops += 1;
             if self.stats.pops.is_multiple_of(4096) {
                 self.ctx.check(MethodId::STSK)?;
@@ -356,6 +356,7 @@ impl<'a> Propagation<'a> {
             }
             match ev.kind {
                 EventKind::Edge { x, y } => {
+                    self.take(queued);
                     if !self.edge_valid(x, y) {
                         self.stats.stale += 1;
                         continue;
@@ -364,6 +365,7 @@ impl<'a> Propagation<'a> {
                 }
                 EventKind::Split { v, candidate } => {
                     if !self.w.v(v).active {
+                        self.take(queued);
                         self.stats.stale += 1;
                         continue;
                     }
@@ -371,10 +373,21 @@ impl<'a> Propagation<'a> {
                     let c = self.candidates[v.index()][candidate as usize];
                     if self.find_piece(v, c.line).is_none() {
                         self.stats.missed += 1;
-                        self.push_candidate(v, candidate + 1)?;
+                        // The vertex's next candidate takes the missed one's
+                        // place at the head of the queue (one sift instead of
+                        // a pop and a push: on a staircase most events are
+                        // such misses).
+                        let next = self.next_candidate(v, candidate + 1)?;
+                        match (queued, next) {
+                            (true, Some((t, i))) => self.q.replace_head(t, split(v, i)),
+                            (true, None) => self.take(true),
+                            (false, Some((t, i))) => self.q.push(t, split(v, i)),
+                            (false, None) => {}
+                        }
                         self.drain_work()?;
                         continue;
                     }
+                    self.take(queued);
                 }
             }
             self.event_group(ev)?;
@@ -397,13 +410,22 @@ impl<'a> Propagation<'a> {
         Ok((self.arcs, self.stats))
     }
 
-    /// The next event: the earlier of the queue's and the held events'.
-    fn next_event(&mut self) -> Option<events::Event> {
+    /// The next event: the earlier of the queue's and the held events'. A
+    /// held event is taken; the queue's is left at its head (`true`), to
+    /// be taken ([`Self::take`]) or replaced.
+    fn next_event(&mut self) -> Option<(events::Event, bool)> {
         let queued = self.q.peek().copied();
         match (queued, self.held.peek().copied()) {
-            (Some(a), Some(b)) if b > a => self.held.pop(),
-            (None, Some(_)) => self.held.pop(),
-            _ => self.q.pop(),
+            (Some(a), Some(b)) if b > a => self.held.pop().map(|e| (e, false)),
+            (None, Some(_)) => self.held.pop().map(|e| (e, false)),
+            (a, _) => a.map(|e| (e, true)),
+        }
+    }
+
+    /// Takes the queue's head when the event being handled is it.
+    fn take(&mut self, queued: bool) {
+        if queued {
+            self.q.pop();
         }
     }
 
@@ -1038,26 +1060,31 @@ impl<'a> Propagation<'a> {
     /// whose line is still in the wavefront (on a staircase most original
     /// edges are gone before a vertex's candidate on them comes up).
     fn push_candidate(&mut self, v: VertexId, i: u32) -> Result<(), MethodError> {
+        if let Some((t, i)) = self.next_candidate(v, i)? {
+            self.q.push(t, split(v, i));
+        }
+        Ok(())
+    }
+
+    /// The time and index of the candidate [`Self::push_candidate`] queues.
+    fn next_candidate(&mut self, v: VertexId, i: u32) -> Result<Option<(f64, u32)>, MethodError> {
         let mut i = i as usize;
         loop {
             self.reach_candidate(v, i)?;
             let Some(c) = self.candidates[v.index()].get(i) else {
-                return Ok(());
+                return Ok(None);
             };
             if self.w.line_alive(c.line) {
-                let t = c.t.max(self.now);
-                self.q.push(
-                    t,
-                    EventKind::Split {
-                        v,
-                        candidate: i as u32,
-                    },
-                );
-                return Ok(());
+                return Ok(Some((c.t.max(self.now), i as u32)));
             }
             i += 1;
         }
     }
+}
+
+/// The split event of reflex vertex `v`'s candidate `candidate`.
+fn split(v: VertexId, candidate: u32) -> EventKind {
+    EventKind::Split { v, candidate }
 }
 
 /// One propagation with the given split-candidate search, verified.
