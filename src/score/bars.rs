@@ -433,6 +433,47 @@ mod tests {
     }
 
     #[test]
+    fn rays_found_beside_other_work_are_the_rays_found_at_once() {
+        // A wavy ring of 4 000 vertices: about 12 000 rays, several chunks.
+        let n = 4000;
+        let ring: Vec<Coord<f64>> = (0..n)
+            .map(|i| {
+                let t = i as f64 / n as f64 * std::f64::consts::TAU;
+                let r = 1000.0 * (1.0 + 0.3 * (5.0 * t).sin()) + 7.0 * ((i * 7919) % 13) as f64;
+                Coord {
+                    x: r * t.cos(),
+                    y: r * t.sin(),
+                }
+            })
+            .collect();
+        let p = PreparedPolygon::new(&geo::Polygon::new(geo::LineString(ring), vec![])).unwrap();
+        let (at_once, _) = BarRays::timed(&p);
+        assert!(at_once.len() > 2 * PAR_BARS);
+        let exits = |r: &BarRays| r.rays.iter().map(|r| r.exit).collect::<Vec<f64>>();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
+        for already_done in [false, true] {
+            let done = AtomicBool::new(already_done);
+            // Other work queued on the pool meanwhile, which the rays'
+            // thread may take on first.
+            let (beside, others) = pool.install(|| {
+                rayon::join(
+                    || BarRays::timed_beside(&p, &done).0,
+                    || {
+                        let sum: f64 = (0..200_000).into_par_iter().map(|i| i as f64).sum();
+                        done.store(true, Ordering::Relaxed);
+                        sum
+                    },
+                )
+            });
+            assert_eq!(others, 199_999.0 * 100_000.0);
+            assert_eq!(exits(&beside), exits(&at_once));
+        }
+    }
+
+    #[test]
     fn square_has_only_midpoint_bars() {
         let p = PreparedPolygon::new(&polygon![
             (x: 0., y: 0.), (x: 4., y: 0.), (x: 4., y: 4.), (x: 0., y: 4.)
