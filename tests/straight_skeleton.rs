@@ -509,3 +509,56 @@ fn a_polygon_beyond_the_budget_is_declined_up_front_with_the_reason() {
         assert!(g.edges().len() > 400);
     }
 }
+
+/// A meandering river as a raster vectorises it: columns of 10 m pixels,
+/// each from `floor(60 sin(x / 40))` up, 14 pixels deep, traced along the
+/// pixel edges (every vertex a right angle, half of them reflex), with two
+/// square islands of 3 × 3 pixels.
+fn pixel_river(columns: usize) -> Polygon<f64> {
+    let px = 10.0;
+    let low = |i: usize| (6.0 * (i as f64 / 4.0).sin()).floor() * px;
+    let depth = 14.0 * px;
+    let mut ring: Vec<(f64, f64)> = Vec::new();
+    for i in 0..columns {
+        let (x0, x1) = (i as f64 * px, (i + 1) as f64 * px);
+        ring.push((x0, low(i)));
+        ring.push((x1, low(i)));
+    }
+    for i in (0..columns).rev() {
+        let (x0, x1) = (i as f64 * px, (i + 1) as f64 * px);
+        ring.push((x1, low(i) + depth));
+        ring.push((x0, low(i) + depth));
+    }
+    ring.dedup();
+    ring.push(ring[0]);
+    let island = |i: usize| {
+        let (x, y) = (i as f64 * px, low(i) + 5.0 * px);
+        vec![
+            (x, y),
+            (x, y + 3.0 * px),
+            (x + 3.0 * px, y + 3.0 * px),
+            (x + 3.0 * px, y),
+            (x, y),
+        ]
+    };
+    poly(&ring, &[island(columns / 3), island(2 * columns / 3)])
+}
+
+/// A raster staircase puts thousands of split candidates at each multiple
+/// of half a pixel, nearly all of them on pixel edges elsewhere; they are
+/// passed over as they come up, and the skeleton still satisfies every
+/// invariant in the first, local search pass (a real split passed over as
+/// a miss leaves a trace that crosses another, and a later pass would be
+/// needed).
+#[test]
+fn a_pixel_staircase_is_skeletonised_in_the_first_pass() {
+    let p = pixel_river(600);
+    let (g, pp) = check(&p);
+    let (_, stats) = straight_skeleton_with_stats(&pp, &MethodContext::default()).unwrap();
+    assert_eq!(stats.passes, 1, "{stats:?}");
+    assert!(
+        stats.missed > stats.input_vertices,
+        "a staircase misses many candidates: {stats:?}"
+    );
+    assert_eq!(g.components(), 1, "the islands' rings join the river's");
+}

@@ -132,6 +132,9 @@ pub struct Stats {
     /// The cost predicted before the propagation: edges to try, and split
     /// candidates to keep.
     pub predicted: (f64, f64),
+    /// Search passes run (1 when the first, local one gave a skeleton that
+    /// passed verification; see the module documentation).
+    pub passes: usize,
 }
 
 /// One traced arc: a wavefront vertex's path from creation to its end.
@@ -478,6 +481,9 @@ impl<'a> Propagation<'a> {
         };
         let mut group = vec![ev];
         while self.q.peek_time().is_some_and(|t| t <= t0 + self.tol) {
+            if self.head_missed(t0 + self.tol)? {
+                continue;
+            }
             let Some(e) = self.q.pop() else { break };
             let Some((p, r)) = self.event_place(&e) else {
                 continue;
@@ -520,6 +526,65 @@ impl<'a> Propagation<'a> {
                 match self.find_piece(v, c.line) {
                     Some(x) => self.split_event(v, x, c.line),
                     None => self.push_candidate(v, candidate + 1),
+                }
+            }
+        }
+    }
+
+    /// Takes the queue's head when it is a split candidate of an active
+    /// vertex that finds no piece of its line at its time, and queues the
+    /// vertex's next candidate in its place; `true` when it did. The
+    /// vertex's next candidates up to time `until` (the end of the events
+    /// being pulled) are checked at once, the same way.
+    ///
+    /// Called on the events of the time being handled before they are held
+    /// by place: on a raster staircase nearly all of them are such misses
+    /// (a vertex on the pixel grid reaches the lines of the pixel edges
+    /// across the river at multiples of half a pixel, and most of those
+    /// edges are elsewhere), and holding each by place only to find later
+    /// that it misses cost more than the propagation's real events. Deciding
+    /// the miss now rather than when the event's turn comes is the same
+    /// answer: at one time, the events handled in between change the points
+    /// covered by a line's pieces only at their own points (a cut piece
+    /// still covers its point, a new piece starts at its event's point), and
+    /// a candidate at such a point is in that event's group, where it is
+    /// checked before the group changes anything.
+    fn head_missed(&mut self, until: f64) -> Result<bool, MethodError> {
+        let Some(&events::Event {
+            t,
+            kind: EventKind::Split { v, candidate },
+            ..
+        }) = self.q.peek()
+        else {
+            return Ok(false);
+        };
+        if !self.w.v(v).active {
+            return Ok(false);
+        }
+        let (mut t, mut i) = (t, candidate);
+        loop {
+            let c = self.candidates[v.index()][i as usize];
+            if self.find_piece_at(v, c.line, self.now.max(t)).is_some() {
+                if i == candidate {
+                    return Ok(false);
+                }
+                // Pulled in its turn, found again and held.
+                self.q.replace_head(t, split(v, i));
+                return Ok(true);
+            }
+            self.stats.pops += 1;
+            self.stats.missed += 1;
+            match self.next_candidate(v, i + 1)? {
+                // Its turn comes in this same pull, with the wavefront as it
+                // is now: checked at once, without a trip through the queue.
+                Some((next, j)) if next <= until => (t, i) = (next, j),
+                Some((next, j)) => {
+                    self.q.replace_head(next, split(v, j));
+                    return Ok(true);
+                }
+                None => {
+                    self.take(true);
+                    return Ok(true);
                 }
             }
         }
@@ -834,7 +899,12 @@ impl<'a> Propagation<'a> {
     /// The start vertex of the piece of `line`'s wavefront that reflex
     /// vertex `v` touches now, if any.
     fn find_piece(&mut self, v: VertexId, line: LineId) -> Option<VertexId> {
-        let t = self.now;
+        self.find_piece_at(v, line, self.now)
+    }
+
+    /// [`Self::find_piece`] at time `t` (the wavefront as it is now, the
+    /// points where they are at `t`).
+    fn find_piece_at(&mut self, v: VertexId, line: LineId, t: f64) -> Option<VertexId> {
         let p = self.w.pos(v, t);
         let l = *self.w.line(line);
         let sp = dot(l.dir, p);
@@ -849,6 +919,9 @@ impl<'a> Propagation<'a> {
             }
             let (px, py) = (w.pos(x, t), w.pos(y, t));
             let (sx, sy) = (dot(l.dir, px), dot(l.dir, py));
+            if !(sx - tol <= sp && sp <= sy + tol) {
+                return false;
+            }
             let at_x = within_hypot(px - p, tol);
             let at_y = within_hypot(py - p, tol);
             // Touching a zero-length piece, or a piece end that already
@@ -862,10 +935,7 @@ impl<'a> Propagation<'a> {
                 } else {
                     at_x && w.v(x).left == w.v(v).left
                 };
-            if no_op {
-                return false;
-            }
-            sx - tol <= sp && sp <= sy + tol
+            !no_op
         });
         w.pieces[line.index()] = pieces;
         found
@@ -1211,7 +1281,9 @@ pub fn straight_skeleton_with_stats(
     ctx: &MethodContext,
 ) -> Result<(SkeletonGraph, Stats), MethodError> {
     let mut result = Err(fail("no search pass"));
+    let mut passes = 0;
     for search in SEARCH_PASSES {
+        passes += 1;
         let t = std::time::Instant::now();
         result = propagate(polygon, search, ctx);
         tracing::debug!(
@@ -1224,7 +1296,8 @@ pub fn straight_skeleton_with_stats(
             break;
         }
     }
-    let (arcs, stats) = result?;
+    let (arcs, mut stats) = result?;
+    stats.passes = passes;
     let mut b = GraphBuilder::new();
     for a in &arcs {
         if b.segment(a.from, a.to).is_some() {
