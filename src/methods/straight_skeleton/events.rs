@@ -175,7 +175,7 @@ pub fn split_candidates(
             (t <= t_max + tol).then_some(SplitCandidate { t, line: l })
         })
         .collect();
-    out.sort_by(|a, b| a.t.total_cmp(&b.t).then(a.line.cmp(&b.line)));
+    out.sort_unstable_by(|a, b| a.t.total_cmp(&b.t).then(a.line.cmp(&b.line)));
     out
 }
 
