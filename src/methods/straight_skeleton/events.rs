@@ -149,14 +149,26 @@ pub struct SplitCandidate {
     pub line: LineId,
 }
 
+impl SplitCandidate {
+    /// Whether this candidate comes after `other` in a vertex's list
+    /// (by time, then by line).
+    pub fn follows(&self, other: &SplitCandidate) -> bool {
+        self.t.total_cmp(&other.t).then(self.line.cmp(&other.line)) == Ordering::Greater
+    }
+}
+
 /// Split candidates of reflex vertex `v` against the given lines, sorted by
-/// time; only times up to `t_max` (when the vertex's ray leaves P) count.
+/// time; only times up to `t_max` (when the vertex's ray leaves P) count,
+/// and only candidates that come after `after` in that order (a band of
+/// the vertex's ray searched after another finds the earlier band's lines
+/// again: they are dropped before the sort).
 pub fn split_candidates(
     w: &Wavefront,
     v: VertexId,
     lines: impl Iterator<Item = LineId>,
     t_max: f64,
     tol: f64,
+    after: Option<SplitCandidate>,
 ) -> Vec<SplitCandidate> {
     let vx = w.v(v);
     let Some(s) = vx.vel else {
@@ -172,7 +184,8 @@ pub fn split_candidates(
                 return None;
             }
             let t = vx.t0 + ahead.max(0.0) / closing;
-            (t <= t_max + tol).then_some(SplitCandidate { t, line: l })
+            let c = SplitCandidate { t, line: l };
+            (t <= t_max + tol && after.is_none_or(|a| c.follows(&a))).then_some(c)
         })
         .collect();
     out.sort_unstable_by(|a, b| a.t.total_cmp(&b.t).then(a.line.cmp(&b.line)));

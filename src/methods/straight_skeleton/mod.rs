@@ -219,6 +219,8 @@ struct Propagation<'a> {
     candidates: Vec<Vec<SplitCandidate>>,
     /// Per vertex, how far its ray has been searched for split candidates.
     bands: Vec<Band>,
+    /// The lines of the band being searched (a buffer kept between bands).
+    scratch: Vec<LineId>,
     arcs: Vec<Arc>,
     work: Vec<VertexId>,
     now: f64,
@@ -269,6 +271,7 @@ impl<'a> Propagation<'a> {
             ctx,
             candidates: vec![Vec::new(); w.vertices.len()],
             bands: vec![Band::default(); w.vertices.len()],
+            scratch: Vec::new(),
             w,
             q: EventQueue::default(),
             held: Held::default(),
@@ -976,7 +979,14 @@ impl<'a> Propagation<'a> {
     /// The original edges reflex vertex `z`'s split candidates up to
     /// distance `upto` along its ray are taken from (all, or those near
     /// that part of the ray), and the latest time such a candidate may have.
-    fn candidate_lines(&self, z: VertexId, upto: f64) -> Option<(Vec<LineId>, f64)> {
+    /// The lines are written into `into` (cleared first; a buffer reused
+    /// from band to band).
+    fn candidate_lines(
+        &self,
+        z: VertexId,
+        upto: f64,
+        into: Vec<LineId>,
+    ) -> Option<(Vec<LineId>, f64)> {
         let vx = *self.w.v(z);
         let s = vx.vel?;
         let speed = hypot(s);
@@ -995,7 +1005,8 @@ impl<'a> Propagation<'a> {
                     vx.start.y.max(end.y) + m,
                 ];
                 // In any order: the candidates are sorted.
-                let mut lines = Vec::new();
+                let mut lines = into;
+                lines.clear();
                 self.tree.visit(
                     |b| boxes_meet(b, &env),
                     |i| {
@@ -1005,7 +1016,12 @@ impl<'a> Propagation<'a> {
                 );
                 lines
             }
-            Search::All => (0..self.w.lines.len()).map(LineId::from_index).collect(),
+            Search::All => {
+                let mut lines = into;
+                lines.clear();
+                lines.extend((0..self.w.lines.len()).map(LineId::from_index));
+                lines
+            }
         };
         Some((lines, t_max))
     }
@@ -1039,19 +1055,16 @@ impl<'a> Propagation<'a> {
             }
         };
         band.searched = upto;
-        let Some((lines, t_max)) = self.candidate_lines(z, upto) else {
+        let scratch = std::mem::take(&mut self.scratch);
+        let Some((lines, t_max)) = self.candidate_lines(z, upto, scratch) else {
             return Ok(false);
         };
         self.ctx.check(MethodId::STSK)?;
         self.stats.tried += lines.len();
-        let mut c = split_candidates(&self.w, z, lines.into_iter(), t_max, self.tol);
+        let last = self.candidates[z.index()].last().copied();
+        let c = split_candidates(&self.w, z, lines.iter().copied(), t_max, self.tol, last);
+        self.scratch = lines;
         let list = &mut self.candidates[z.index()];
-        if let Some(&last) = list.last() {
-            let after = |x: &SplitCandidate| {
-                x.t.total_cmp(&last.t).then(x.line.cmp(&last.line)) == std::cmp::Ordering::Greater
-            };
-            c.retain(after);
-        }
         self.stats.candidates += c.len();
         list.extend(c);
         if self.stats.candidates > self.max_candidates {
@@ -1111,9 +1124,9 @@ impl<'a> Propagation<'a> {
             let Some((upto, _)) = self.ray_reach(z) else {
                 continue;
             };
-            if let Some((lines, t_max)) = self.candidate_lines(z, upto) {
+            if let Some((lines, t_max)) = self.candidate_lines(z, upto, Vec::new()) {
                 tried += lines.len();
-                kept += split_candidates(&self.w, z, lines.into_iter(), t_max, self.tol).len();
+                kept += split_candidates(&self.w, z, lines.into_iter(), t_max, self.tol, None).len();
             }
             sampled += 1;
             if sampled == first_count && sampled < sample.len() {
