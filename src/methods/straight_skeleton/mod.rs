@@ -45,7 +45,13 @@
 //!   point only: a raster staircase has thousands of events at one time
 //!   (every pixel edge collapses at half a pixel), and scanning them all
 //!   for each one was quadratic (31 s → 3 s on a 57 000-vertex rasterised
-//!   river). The cost is about O(n log n) on real data.
+//!   river). A split candidate that finds no piece of its line is passed
+//!   over as the events of its time are pulled, before it is held: on a
+//!   pixel grid nearly all of them miss (the rasterised Lena: 6.8 M of 6.9 M
+//!   events; 12.9 s → 7.3 s). The cost is about O(n log n) on smooth real
+//!   data; on a staircase each reflex corner still tries the candidates of
+//!   the rows and columns of pixels it passes, a number that grows with the
+//!   width of the polygon in pixels.
 //! * "Near its ray" is not a proven bound: a face widens without limit
 //!   next to a fast reflex vertex (nearly parallel banks), so a split can
 //!   come from an edge far from the ray. Every result is therefore
@@ -1126,7 +1132,8 @@ impl<'a> Propagation<'a> {
             };
             if let Some((lines, t_max)) = self.candidate_lines(z, upto, Vec::new()) {
                 tried += lines.len();
-                kept += split_candidates(&self.w, z, lines.into_iter(), t_max, self.tol, None).len();
+                kept +=
+                    split_candidates(&self.w, z, lines.into_iter(), t_max, self.tol, None).len();
             }
             sampled += 1;
             if sampled == first_count && sampled < sample.len() {
