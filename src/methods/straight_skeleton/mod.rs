@@ -556,8 +556,8 @@ impl<'a> Propagation<'a> {
     /// answer: at one time, the events handled in between change the points
     /// covered by a line's pieces only at their own points (a cut piece
     /// still covers its point, a new piece starts at its event's point), and
-    /// a candidate at such a point is in that event's group, where it is
-    /// checked before the group changes anything.
+    /// a candidate at such a point was checked in that event's group before
+    /// the group changed anything — on the same wavefront as now.
     fn head_missed(&mut self, until: f64) -> Result<bool, MethodError> {
         let Some(&events::Event {
             t,
