@@ -11,7 +11,8 @@
 //! every training layer and writes `docs/quality.md`. Prints one markdown
 //! table row per method and one for the chosen skeleton:
 //! `| layer | skeleton | features | mean Z | mean coverage | legs | ends | hooks | hook % |
-//! crossing skeletons | extra pieces | sharp turns / km | chosen |`, then the
+//! crossing skeletons | extra pieces | sharp turns / km | chosen | failed |`
+//! (*failed*: features the method gave no candidate of), then the
 //! trunk check line (`one line per polygon part`) when pruning is `trunk`.
 
 use rayon::prelude::*;
@@ -19,6 +20,7 @@ use skeletonise::geometry::PreparedPolygon;
 use skeletonise::graph::planar::crossings;
 use skeletonise::graph::prune::PruneMode;
 use skeletonise::graph::SkeletonGraph;
+use skeletonise::io::{InputSpec, Reader};
 use skeletonise::process::{polygon_parts, process, Processed};
 use skeletonise::score::defects::{end_turns, sharp_turns, HOOK_DEG};
 
@@ -38,6 +40,8 @@ struct Tally {
     chosen: usize,
     one_line: usize,
     parts: usize,
+    /// Features the method gave no candidate of (its error).
+    failed: usize,
 }
 
 impl Tally {
@@ -56,6 +60,7 @@ impl Tally {
         self.chosen += o.chosen;
         self.one_line += o.one_line;
         self.parts += o.parts;
+        self.failed += o.failed;
     }
 }
 
@@ -161,21 +166,39 @@ fn main() {
         });
     let params = pipeline.process_params();
     let layer = &args[3];
-    let feats = skeletonise::io::read_layer_polygons(&args[2], layer).unwrap_or_else(|e| {
-        eprintln!("{e}");
-        std::process::exit(1)
-    });
+    // Read as `run` reads: repaired by GDAL when the pipeline's `prepare`
+    // says `make_valid` (a `gdal_polygonize` ring touching itself is
+    // invalid until then).
+    let mut feats = Vec::new();
+    Reader::open(&InputSpec::layer(&args[2], layer))
+        .and_then(|mut r| {
+            r.read(1024, params.prepare.make_valid, |batch| {
+                feats.extend(batch.into_iter().map(|f| (f.fid, f.geometry)));
+                Ok(())
+            })
+        })
+        .unwrap_or_else(|e: skeletonise::io::IoError| {
+            eprintln!("{e}");
+            std::process::exit(1)
+        });
     let methods = params.skeleton.methods.clone();
     let list_hooks = args.iter().any(|a| a == "--hooks");
     let results: Vec<(Vec<Tally>, Tally)> = feats
         .par_iter()
         .filter_map(|(fid, g)| {
-            let parts: Vec<PreparedPolygon> = polygon_parts(Some(g))
-                .ok()?
+            let Some(g) = g else {
+                eprintln!("{layer}: feature {fid:?} not measured: no geometry");
+                return None;
+            };
+            let parts = polygon_parts(Some(g))
+                .map_err(|e| eprintln!("{layer}: feature {fid:?} not measured: {e}"))
+                .ok()?;
+            let parts: Vec<PreparedPolygon> = parts
                 .iter()
                 .filter_map(|p| PreparedPolygon::new(p).ok())
                 .collect();
             let Processed::Done(o) = process(Some(g), &params) else {
+                eprintln!("{layer}: feature {fid:?} not measured: the pipeline rejects it");
                 return None;
             };
             let per: Vec<Tally> = o
@@ -187,7 +210,10 @@ fn main() {
                         t.chosen = 0;
                         t
                     }
-                    Err(_) => Tally::default(),
+                    Err(_) => Tally {
+                        failed: 1,
+                        ..Default::default()
+                    },
                 })
                 .collect();
             let (_, s) = o.chosen();
@@ -211,7 +237,7 @@ fn main() {
     }
     let row = |name: &str, t: &Tally| {
         println!(
-            "| {layer} | {name} | {} | {:.5} | {:.3} | {} | {} | {} | {:.1} % | {} | {} | {:.2} | {} |",
+            "| {layer} | {name} | {} | {:.5} | {:.3} | {} | {} | {} | {:.1} % | {} | {} | {:.2} | {} | {} |",
             t.features,
             t.z_sum / t.z_n.max(1) as f64,
             t.cov_sum / t.features.max(1) as f64,
@@ -222,7 +248,8 @@ fn main() {
             t.crossing,
             t.extra_pieces,
             t.sharp as f64 / t.km.max(1e-9),
-            t.chosen
+            t.chosen,
+            t.failed
         );
     };
     for (m, t) in methods.iter().zip(&per) {

@@ -14,8 +14,8 @@ LAYERS=${LAYERS:-"islands_hebrides lakes_scotland river_st_lawrence river_danube
 OUT=${OUT:-docs/quality.md}
 cargo build --release -q --example quality
 Q=target/release/examples/quality
-HEAD="| layer | skeleton | features | mean Z | mean coverage | legs | ends | hooks | hook % | crossing skeletons | extra pieces | sharp turns / km | chosen |
-|---|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|"
+HEAD="| layer | skeleton | features | mean Z | mean coverage | legs | ends | hooks | hook % | crossing skeletons | extra pieces | sharp turns / km | chosen | failed |
+|---|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|"
 {
   echo "# Defects on the training layers"
   echo
@@ -23,7 +23,8 @@ HEAD="| layer | skeleton | features | mean Z | mean coverage | legs | ends | hoo
   echo "in-process on every feature). *hooks*: line ends whose last segment turns by more than 60° against the"
   echo "line's course one local width back (\`skeletonise::score::defects\`); *crossing skeletons*: skeletons"
   echo "with two pieces crossing without a node; *extra pieces*: connected pieces beyond one per polygon part;"
-  echo "*sharp turns*: vertices where the line turns by more than 45°, per km of line."
+  echo "*sharp turns*: vertices where the line turns by more than 45°, per km of line; *failed*: features the"
+  echo "method gave no candidate of (its error is in the \`candidates\` layer of a run)."
   for variant in default independent trunk; do
     case $variant in
       default) set -- ; title="Default pipeline (every method pruned to the medial axis's legs, centred ends)";;
