@@ -1161,6 +1161,35 @@ geometry_case!(
     "part 1: MA gives no skeleton of this polygon part"
 );
 
+/// A river from a water mask (`gdal_polygonize -8`, repaired): a reach
+/// 3 km by 300 m traced along 30 m pixels, and a one-pixel piece touching
+/// its end at a corner.
+fn river_and_pixel() -> String {
+    let bottom = (0..=100).map(|i| format!("{} 0", 30 * i));
+    let top = (0..=100).rev().map(|i| format!("{} 300", 30 * i));
+    let ring: Vec<String> = bottom.chain(top).chain(["0 0".to_string()]).collect();
+    format!(
+        "MULTIPOLYGON((({})),((3000 300,3030 300,3030 330,3000 330,3000 300)))",
+        ring.join(",")
+    )
+}
+
+// VD has no skeleton of the pixel, so with VD alone the feature is
+// rejected; the reason gives the piece's area and the fixes, and the
+// `min_area` it suggests lets the river through.
+#[test]
+fn a_pixel_vd_cannot_skeletonise_is_named_with_its_area_and_the_fixes() {
+    let wkt = river_and_pixel();
+    let vd = ["--set", "steps.skeleton.methods=[VD]"];
+    let (_d, out) = case("pixel", 3035, &[Some(&wkt)], &vd, ok(1, 0, 1));
+    assert_eq!(
+        rejected_reason(&out),
+        "VD: part 1: VD gives no skeleton of this polygon part (too thin or too small for the method): it has 900.0 CRS units² of the feature's 900900; skip parts that small with `prepare: { min_area: 909.0 }`, or list another method in `skeleton.methods` (e.g. MA)"
+    );
+    let skip = [vd[0], vd[1], "--set", "steps.prepare.min_area=909.0"];
+    case("pixel skipped", 3035, &[Some(&wkt)], &skip, ok(1, 1, 0));
+}
+
 #[test]
 fn the_method_chosen_for_a_multipolygon_has_a_skeleton_of_every_part() {
     let (_d, out) = case(

@@ -65,7 +65,7 @@ pub(super) fn computed(
             .iter()
             .map(|r| r[k].0.clone())
             .collect::<Result<_, _>>()
-            .and_then(|parts| every_part_has_a_skeleton(parts, m));
+            .and_then(|parts| every_part_has_a_skeleton(parts, m, prepared));
         let result = parts.and_then(|parts| {
             scoring_budget(m, &parts, &rays, params)?;
             let (c, t) = finish(prepared, &rays, &parts, params, parallel);
@@ -93,23 +93,47 @@ pub(super) fn computed(
 /// The skeletons of a multipolygon's parts, or the error naming a part
 /// that `m` has no skeleton of while it has one of others: a candidate
 /// that lost a polygon part is no candidate of the feature (alone, the
-/// part would be rejected with the reason).
+/// part would be rejected with the reason). The reason gives the part's
+/// area and the two ways out: skipping parts that small, or a method that
+/// gives one (a one-pixel piece of a vectorised water mask has no Voronoi
+/// skeleton, and with VD alone it would cost the whole river).
 fn every_part_has_a_skeleton(
     parts: Vec<PartSkeleton>,
     m: crate::methods::MethodId,
+    prepared: &[PreparedPolygon],
 ) -> Result<Vec<PartSkeleton>, String> {
     let n = parts.len();
     let empty = parts.iter().position(|p| p.graph.is_empty());
     match empty {
-        Some(i) if parts.iter().any(|p| !p.graph.is_empty()) => Err(part_reason(
-            i,
-            n,
-            &format!(
-                "{m} gives no skeleton of this polygon part (too thin or too small for the method)"
-            ),
-        )),
+        Some(i) if parts.iter().any(|p| !p.graph.is_empty()) => {
+            let area = |p: &PreparedPolygon| geo::Area::unsigned_area(p.polygon());
+            let part = prepared.get(i).map_or(f64::NAN, area);
+            let whole: f64 = prepared.iter().map(area).sum();
+            Err(part_reason(
+                i,
+                n,
+                &format!(
+                    "{m} gives no skeleton of this polygon part (too thin or too small for the \
+                     method): it has {} CRS units² of the feature's {}; skip parts that small \
+                     with `prepare: {{ min_area: {} }}`, or list another method in \
+                     `skeleton.methods` (e.g. MA)",
+                    significant(part),
+                    significant(whole),
+                    significant(part * 1.01)
+                ),
+            ))
+        }
         _ => Ok(parts),
     }
+}
+
+/// `x` with four significant digits, without an exponent for everyday sizes.
+fn significant(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let digits = (3 - x.abs().log10().floor() as i32).max(0) as usize;
+    format!("{x:.digits$}")
 }
 
 /// A feature of at most this many boundary vertices is worked on one
