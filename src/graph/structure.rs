@@ -113,17 +113,19 @@ pub fn conform(
     }
     let tol = ON_BOUNDARY_END * polygon.extent();
     let tree = NodeIndex::new(&g);
-    let served: Vec<Option<(NodeId, bool)>> = structure
+    let serve = |c: &Contact, allowed: &dyn Fn(usize) -> bool| {
+        // A node on ∂P away from c would join c along or across the
+        // shoreline (a coarse polygon's CDT leaf on the next vertex):
+        // such nodes serve c only when no node inside P can.
+        terminal(&g, &tree, c, polygon, tol, false, allowed)
+            .or_else(|| terminal(&g, &tree, c, polygon, tol, true, allowed))
+    };
+    let mut served: Vec<Option<(NodeId, bool)>> = structure
         .contacts
         .iter()
-        .map(|c| {
-            // A node on ∂P away from c would join c along or across the
-            // shoreline (a coarse polygon's CDT leaf on the next vertex):
-            // such nodes serve c only when no node inside P can.
-            terminal(&g, &tree, c, polygon, tol, false)
-                .or_else(|| terminal(&g, &tree, c, polygon, tol, true))
-        })
+        .map(|c| serve(c, &|_| true))
         .collect();
+    rejoin_stranded(&g, structure, &mut served, &serve);
     let terminals: Vec<Option<NodeId>> = served.iter().map(|t| t.map(|t| t.0)).collect();
     let mut is_terminal = vec![false; g.nodes().len()];
     for t in terminals.iter().flatten() {
@@ -149,6 +151,63 @@ pub fn conform(
         .collect();
     let out = assemble(&g, &keep, &segments);
     super::planar::node_crossings(out, polygon.boundary()).0
+}
+
+/// Finds the node serving a contact among the nodes a filter allows, and
+/// whether it sees the contact (see [`terminal`]).
+type ServeContact<'a> = dyn Fn(&Contact, &dyn Fn(usize) -> bool) -> Option<(NodeId, bool)> + 'a;
+
+/// Serves again, from the method's piece that serves the others, each
+/// contact whose terminal lies alone on a piece of the method's skeleton
+/// while the reference joins it to other contacts. Peeling would leave such
+/// a terminal without a line, and the reference's line to it would be
+/// lost: on a river vectorised from a raster, DVD's leaf nearest a tip can
+/// sit on a crumb of a few metres beside the skeleton (the 180 km line
+/// became 76 m). The piece kept is the one serving the most contacts of
+/// that reference component (the longer on a tie); a contact that no node
+/// of it sees (the segment to the contact would leave P) keeps its
+/// terminal. A method whose skeleton falls apart into
+/// pieces that each serve several contacts is left as it is.
+fn rejoin_stranded(
+    g: &SkeletonGraph,
+    structure: &Structure,
+    served: &mut [Option<(NodeId, bool)>],
+    serve: &ServeContact<'_>,
+) {
+    let label = g.component_labels();
+    let mut length = vec![0.0; g.nodes().len()];
+    for (i, e) in g.edges().iter().enumerate() {
+        length[label[e.a.index()]] += g.edge_length(EdgeId::from_index(i));
+    }
+    // Per reference component: terminals per piece of the method's skeleton.
+    let mut count: std::collections::BTreeMap<(usize, usize), usize> = Default::default();
+    for (c, t) in structure.contacts.iter().zip(served.iter()) {
+        if let Some((t, _)) = t {
+            *count.entry((c.component, label[t.index()])).or_default() += 1;
+        }
+    }
+    let main = |k: usize| {
+        count
+            .iter()
+            .filter(|((rk, _), _)| *rk == k)
+            .max_by(|((_, a), na), ((_, b), nb)| {
+                na.cmp(nb)
+                    .then(length[*a].total_cmp(&length[*b]))
+                    .then(b.cmp(a))
+            })
+            .map(|((_, piece), _)| *piece)
+    };
+    for (i, c) in structure.contacts.iter().enumerate() {
+        let Some((t, _)) = served[i] else { continue };
+        let piece = label[t.index()];
+        let Some(m) = main(c.component) else { continue };
+        if piece == m || count[&(c.component, piece)] > 1 {
+            continue;
+        }
+        if let Some(again @ (_, true)) = serve(c, &|n| label[n] == m) {
+            served[i] = Some(again);
+        }
+    }
 }
 
 /// The nodes of a graph by position, for the searches around each contact.
@@ -211,6 +270,7 @@ fn terminal(
     polygon: &PreparedPolygon,
     tol: f64,
     on_boundary: bool,
+    allowed: &dyn Fn(usize) -> bool,
 ) -> Option<(NodeId, bool)> {
     let b = polygon.boundary();
     let limit = 4.0 * polygon.extent();
@@ -224,7 +284,7 @@ fn terminal(
         tol,
         &score,
         b,
-        on_boundary,
+        (on_boundary, allowed),
     ) {
         return Some((n, true));
     }
@@ -244,7 +304,7 @@ fn terminal(
             tol,
             &near,
             b,
-            on_boundary,
+            (on_boundary, allowed),
         ) {
             return Some((n, false));
         }
@@ -256,7 +316,8 @@ fn terminal(
 /// The node with the smallest `score(distance, radius)` among those that see
 /// `q` (the segment to it stays in P), searched within `start` of `q` and
 /// four times farther each round up to `limit`; without `on_boundary`,
-/// nodes on ∂P farther than `tol` from `q` are passed over.
+/// nodes on ∂P farther than `tol` from `q` are passed over, and so are the
+/// nodes `allowed` refuses.
 #[allow(clippy::too_many_arguments)]
 fn best_seeing(
     g: &SkeletonGraph,
@@ -267,7 +328,7 @@ fn best_seeing(
     tol: f64,
     score: &dyn Fn(f64, f64) -> f64,
     b: &crate::geometry::Boundary,
-    on_boundary: bool,
+    (on_boundary, allowed): (bool, &dyn Fn(usize) -> bool),
 ) -> Option<NodeId> {
     let mut reach = start;
     loop {
@@ -278,6 +339,9 @@ fn best_seeing(
         let r2 = reach * reach;
         let mut keys: Vec<(f64, f64, u32)> = Vec::new();
         tree.within(q, r2, |n| {
+            if !allowed(n as usize) {
+                return;
+            }
             let node = g.node(NodeId::from_index(n as usize));
             let d = hypot(node.pos - q);
             keys.push((score(d, node.radius), d, n));
@@ -373,6 +437,54 @@ fn trunk_paths(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A river reach from a cut end at x = 0 to a tip at x = 1000, and a
+    /// method's skeleton of it: a line from x = 20 to 700, and a crumb of
+    /// 2 m beside the tip, too far to be bridged. The crumb's node comes
+    /// closest to the tip's contact, but the reference joins the tip to the
+    /// cut end: the tip is served from the line, which reaches both ends
+    /// as one piece (before, each end kept only its end segment).
+    #[test]
+    fn a_crumb_beside_a_tip_does_not_cost_the_line() {
+        let c = |x: f64, y: f64| Coord { x, y };
+        let ring = [(0., 0.), (900., 0.), (1000., 50.), (900., 100.), (0., 100.)];
+        let ring: Vec<Coord<f64>> = ring.iter().map(|&(x, y)| c(x, y)).collect();
+        let polygon = PreparedPolygon::new(&geo::Polygon::new(ring.into(), vec![])).unwrap();
+        let b = polygon.boundary();
+        let mut raw = SkeletonGraph::new();
+        let node =
+            |g: &mut SkeletonGraph, x: f64| g.add_node(c(x, 50.), b.distance(c(x, 50.)), None);
+        let (l0, l1, l2) = (
+            node(&mut raw, 20.),
+            node(&mut raw, 400.),
+            node(&mut raw, 700.),
+        );
+        raw.add_edge(l0, l1, vec![]);
+        raw.add_edge(l1, l2, vec![]);
+        let (k0, k1) = (node(&mut raw, 984.), node(&mut raw, 986.));
+        raw.add_edge(k0, k1, vec![]);
+        let contact = |x: f64, radius: f64| Contact {
+            point: c(x, 50.),
+            radius,
+            on_boundary: true,
+            component: 0,
+            approach: vec![c(x, 50.), c(1000. - x, 50.)],
+        };
+        let structure = Structure {
+            contacts: vec![contact(0., 50.), contact(1000., 30.)],
+            trunk: false,
+        };
+        let out = conform(&raw, &structure, &polygon);
+        assert_eq!(out.components(), 1);
+        let len = out.total_length();
+        assert!((len - 1000.).abs() < 1e-6, "{len}");
+        for x in [0., 1000.] {
+            assert!(
+                out.nodes().iter().any(|n| hypot(n.pos - c(x, 50.)) < 1e-9),
+                "no end at x = {x}"
+            );
+        }
+    }
 
     /// The nodes around a point are the same whether scanned (a small
     /// graph) or found through the tree (a large one).
