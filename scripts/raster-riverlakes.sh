@@ -34,7 +34,7 @@ layers=()
 for id in $ids; do
   ogr2ogr -f GPKG -update -append "$DATA" "$LAKES" lakes -where "id = $id" -nln "vector_$id" \
     -nlt POLYGON 2>&1 | quiet
-  gdal_rasterize -q -burn 1 -tr $CELL $CELL -ot Byte -a_nodata 0 -l "vector_$id" "$DATA" "$WORK/$id.tif" 2>&1 | quiet
+  gdal_rasterize -q -burn 1 -tr "$CELL" "$CELL" -ot Byte -a_nodata 0 -l "vector_$id" "$DATA" "$WORK/$id.tif" 2>&1 | quiet
   gdal_polygonize.py -q -8 "$WORK/$id.tif" -f GPKG "$WORK/$id-poly.gpkg" poly v 2>&1 | quiet
   ogr2ogr -f GPKG -update -append "$DATA" "$WORK/$id-poly.gpkg" -nln "raster_$id" -nlt POLYGON \
     -sql "SELECT * FROM poly WHERE v = 1 ORDER BY ST_Area(geom) DESC LIMIT 1" 2>&1 | quiet
@@ -69,7 +69,7 @@ times=$WORK/times.md
   echo "# Raster staircases on river-lakes the project was not tuned to"
   echo
   echo "Made by \`scripts/raster-riverlakes.sh\`: the five largest GSHHG river-lakes that fit in 250 km ×"
-  echo "250 km (ids $(echo $ids | tr ' ' ',') of \`target/bench/gshhg-lakes.gpkg\`), each as \`vector_ID\` and as"
+  echo "250 km (ids $(paste -sd, <<<"$ids") of \`target/bench/gshhg-lakes.gpkg\`), each as \`vector_ID\` and as"
   echo "\`raster_ID\` (rasterised at $CELL m, \`gdal_polygonize -8\`, the largest piece, repaired by"
   echo "\`prepare: { make_valid: true }\`). GSHHG: Wessel, P., and W. H. F. Smith, A Global Self-consistent,"
   echo "Hierarchical, High-resolution Shoreline Database, J. Geophys. Res., 101, 8741–8743, 1996 (LGPL)."
