@@ -24,7 +24,10 @@
 //!    contact inside P (no extension) it is the nearest node. A node on ∂P
 //!    serves only the contact it lies on, unless no node inside P sees c: on
 //!    a coarse polygon a CDT leaf on the next vertex would otherwise be
-//!    joined to c along the shoreline.
+//!    joined to c along the shoreline. A terminal alone on its piece of the
+//!    method's skeleton while the reference joins c to other contacts (a
+//!    crumb beside a tip) is chosen again on the piece that serves the most
+//!    of them, when a node there sees c (`rejoin_stranded`).
 //! 3. **Peel.** Leaves that are not terminals are removed until none is
 //!    left: what stays is the method's own skeleton between its terminals,
 //!    with its cycles (holes). With `trunk`, the two terminals of a
@@ -162,7 +165,7 @@ type ServeContact<'a> = dyn Fn(&Contact, &dyn Fn(usize) -> bool) -> Option<(Node
 /// while the reference joins it to other contacts. Peeling would leave such
 /// a terminal without a line, and the reference's line to it would be
 /// lost: on a river vectorised from a raster, DVD's leaf nearest a tip can
-/// sit on a crumb of a few metres beside the skeleton (the 180 km line
+/// sit on a crumb of a few metres beside the skeleton (the 193 km line
 /// became 76 m). The piece kept is the one serving the most contacts of
 /// that reference component (the longer on a tie); a contact that no node
 /// of it sees (the segment to the contact would leave P) keeps its
@@ -186,21 +189,24 @@ fn rejoin_stranded(
             *count.entry((c.component, label[t.index()])).or_default() += 1;
         }
     }
-    let main = |k: usize| {
-        count
-            .iter()
-            .filter(|((rk, _), _)| *rk == k)
-            .max_by(|((_, a), na), ((_, b), nb)| {
-                na.cmp(nb)
-                    .then(length[*a].total_cmp(&length[*b]))
-                    .then(b.cmp(a))
-            })
-            .map(|((_, piece), _)| *piece)
-    };
+    // Per reference component: the piece serving the most of its contacts
+    // (the longer, then the lower label, on a tie).
+    let mut main: std::collections::BTreeMap<usize, usize> = Default::default();
+    for (&(k, piece), &n) in &count {
+        let better = main.get(&k).is_none_or(|&m| {
+            (n, length[piece]).partial_cmp(&(count[&(k, m)], length[m]))
+                == Some(std::cmp::Ordering::Greater)
+        });
+        if better {
+            main.insert(k, piece);
+        }
+    }
     for (i, c) in structure.contacts.iter().enumerate() {
         let Some((t, _)) = served[i] else { continue };
         let piece = label[t.index()];
-        let Some(m) = main(c.component) else { continue };
+        let Some(&m) = main.get(&c.component) else {
+            continue;
+        };
         if piece == m || count[&(c.component, piece)] > 1 {
             continue;
         }
