@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Sets up a fresh Debian/Ubuntu machine (with Rust) and runs every test: unit tests,
-# end-to-end tests through the real binary on real GeoPackage files, doc tests, the
+# end-to-end tests through the real binary on real GeoPackage files, doc tests (and the API
+# documentation built without warnings), the
 # core's tests once more without GDAL (`--no-default-features`), the Python package's
 # tests (scripts/test-python.sh: the wheel, pytest, a two-worker Dask cluster on loopback)
 # and the QGIS plugin's (scripts/test-qgis.sh: a real, headless QGIS 3.22).
@@ -13,6 +14,8 @@ scripts/test-deps.sh
 export SKELETONISE_REQUIRE_POSTGIS=1
 cargo test --all-targets "$@"
 cargo test --doc
+# The API documentation builds without a warning (no link to a private or missing item).
+RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --quiet
 # The patched dependency's own unit tests (vendor/boostvoronoi/PATCHES.md).
 CARGO_TARGET_DIR=$PWD/target/vendor cargo test --quiet --manifest-path vendor/boostvoronoi/Cargo.toml --lib
 # The core without GDAL, as the Python binding builds it (the GDAL-only targets are skipped).

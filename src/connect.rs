@@ -189,7 +189,7 @@ pub fn add_legs(
 /// skeleton of `p`) between the connection `points` — a leg to each (see
 /// [`add_legs`]; on a raw skeleton it is short, since the skeleton reaches
 /// near every boundary vertex), then the union of the shortest paths
-/// between them along the skeleton ([`crate::graph::prune::network`]). The
+/// between them along the skeleton (`graph::prune::network`). The
 /// result's leaves are the connection points (with one point: it and the
 /// farthest tip); a point no straight leg inside P reaches keeps the leaf
 /// nearest to it instead. Nothing is extended.

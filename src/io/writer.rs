@@ -316,7 +316,7 @@ impl Writer {
     }
 
     /// Writes one batch of rows, in the transaction open since the last
-    /// commit (one commit every [`ROWS_PER_COMMIT`] rows and at the end).
+    /// commit (one commit every `ROWS_PER_COMMIT` rows and at the end).
     pub fn write_batch(&mut self, rows: &Rows) -> Result<(), IoError> {
         let ds = self.ds.take().expect("open until finish/abort");
         let r = (|| {

@@ -1,7 +1,7 @@
 //! The `label` step: one label per polygon part, ready for a curved lake or
 //! region name — a smooth line along the medial axis where the part is
 //! elongated enough, otherwise a point at the centre of its largest
-//! inscribed disc (see [`line`] for the algorithm). The step uses the
+//! inscribed disc (see [`mod@line`] for the algorithm). The step uses the
 //! medial axis whether or not `MA` is among the pipeline's methods, and
 //! writes the layer `labels`:
 //!

@@ -30,7 +30,7 @@ pub fn merge_adjacent(features: Vec<Feature>, by: Option<usize>) -> Vec<Feature>
 }
 
 /// [`merge_adjacent`] with each group's union made exactly
-/// ([`crate::geometry::arrangement::coverage_union`]: the shared edges
+/// (`geometry::arrangement::coverage_union`: the shared edges
 /// dropped, every other vertex kept bit for bit), for polygons that share
 /// their edges vertex for vertex (reaches cut from one river) — what a
 /// partition needs, whose pieces must keep the source's vertices.

@@ -41,7 +41,7 @@
 //!   event naming an inactive vertex is dropped). A candidate whose line
 //!   has left the wavefront is skipped when queued. The events within `tol`
 //!   of the time being handled are held in a grid by place
-//!   ([`events::Held`]), so that a group is found among the events at its
+//!   (`events::Held`), so that a group is found among the events at its
 //!   point only: a raster staircase has thousands of events at one time
 //!   (every pixel edge collapses at half a pixel), and scanning them all
 //!   for each one was quadratic (31 s → 3 s on a 57 000-vertex rasterised
