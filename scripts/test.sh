@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
 # Sets up a fresh Debian/Ubuntu machine (with Rust) and runs every test: unit tests,
 # end-to-end tests through the real binary on real GeoPackage files, doc tests (and the API
-# documentation built without warnings), the
-# core's tests once more without GDAL (`--no-default-features`), the Python package's
-# tests (scripts/test-python.sh: the wheel, pytest, a two-worker Dask cluster on loopback)
-# and the QGIS plugin's (scripts/test-qgis.sh: a real, headless QGIS 3.22).
+# documentation, built without a warning), the core's tests once more without GDAL
+# (`--no-default-features`), the Python package's tests (scripts/test-python.sh: the wheel,
+# pytest, a two-worker Dask cluster on loopback) and the QGIS plugin's (scripts/test-qgis.sh:
+# a real, headless QGIS 3.22).
 # The test data lives in tests/data (GSHHG, Wessel & Smith), so a fresh clone needs nothing beside it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
