@@ -1184,9 +1184,9 @@ fn a_pixel_vd_cannot_skeletonise_is_named_with_its_area_and_the_fixes() {
     let (_d, out) = case("pixel", 3035, &[Some(&wkt)], &vd, ok(1, 0, 1));
     assert_eq!(
         rejected_reason(&out),
-        "VD: part 1: VD gives no skeleton of this polygon part (too thin or too small for the method): it has 900.0 CRS units² of the feature's 900900; skip parts that small with `prepare: { min_area: 909.0 }`, or list another method in `skeleton.methods` (e.g. MA)"
+        "VD: part 1: VD gives no skeleton of this polygon part (too thin or too small for the method): it has 900 CRS units² of the feature's 900900; skip parts that small with `prepare: { min_area: 909 }`, or list another method in `skeleton.methods` (e.g. MA)"
     );
-    let skip = [vd[0], vd[1], "--set", "steps.prepare.min_area=909.0"];
+    let skip = [vd[0], vd[1], "--set", "steps.prepare.min_area=909"];
     case("pixel skipped", 3035, &[Some(&wkt)], &skip, ok(1, 1, 0));
 }
 

@@ -10,6 +10,7 @@ use crate::graph::prune::PruneParams;
 use crate::graph::widths::medial_axis_transform;
 use crate::graph::SkeletonGraph;
 use crate::methods::budget::{self, MethodContext};
+use crate::report::sig;
 use crate::score::{metrics, BarRays};
 use geo::{LineString, MultiLineString};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -117,23 +118,14 @@ fn every_part_has_a_skeleton(
                      method): it has {} CRS units² of the feature's {}; skip parts that small \
                      with `prepare: {{ min_area: {} }}`, or list another method in \
                      `skeleton.methods` (e.g. MA)",
-                    significant(part),
-                    significant(whole),
-                    significant(part * 1.01)
+                    sig(part, 4),
+                    sig(whole, 4),
+                    sig(part * 1.01, 4)
                 ),
             ))
         }
         _ => Ok(parts),
     }
-}
-
-/// `x` with four significant digits, without an exponent for everyday sizes.
-fn significant(x: f64) -> String {
-    if x == 0.0 || !x.is_finite() {
-        return format!("{x}");
-    }
-    let digits = (3 - x.abs().log10().floor() as i32).max(0) as usize;
-    format!("{x:.digits$}")
 }
 
 /// A feature of at most this many boundary vertices is worked on one
