@@ -451,3 +451,33 @@ fn a_stars_line_runs_from_lobe_tip_to_lobe_tip() {
         }
     }
 }
+
+#[test]
+fn the_straight_skeleton_of_a_rough_rim_fits_a_small_memory_budget() {
+    use skeletonise::methods::budget::{with_budget, Budget};
+    use skeletonise::methods::straight_skeleton::straight_skeleton_with_stats;
+    // 50 000 vertices every 1.3 m with up to 30 m of roughness: a rim of
+    // needles. Each reflex vertex looks for the wavefront edges it may split
+    // along its ray; nearly all of the rim's edges near it have left the
+    // wavefront by the time it gets there, and those are no longer looked
+    // at. The split events then need about 3 MB (they needed 140 MB when the
+    // gone edges were kept), so a `max_memory_mb` of 16 lets it through, in
+    // the first, local search pass.
+    let p = rough_lobes(50_000, 10_000.0, 30.0);
+    let budget = Budget {
+        time: None,
+        memory: Some(16_000_000),
+    };
+    let (g, stats) = with_budget(MethodId::STSK, budget, |ctx| {
+        straight_skeleton_with_stats(&p, ctx)
+    })
+    .unwrap_or_else(|e| panic!("declined or failed: {e}"));
+    g.check_invariants().unwrap();
+    assert_eq!(stats.passes, 1);
+    assert!(g.edges().len() > 50_000, "{} edges", g.edges().len());
+    assert!(
+        stats.candidates < 10 * 50_000,
+        "{} split candidates kept",
+        stats.candidates
+    );
+}

@@ -482,12 +482,12 @@ fn a_polygon_beyond_the_budget_is_declined_up_front_with_the_reason() {
             other.map(|g| g.edges().len())
         ),
     }
-    // Memory: ten megabytes cannot hold this polygon's split events either.
-    let ten_megabytes = Budget {
+    // Memory: one megabyte cannot hold this polygon's split events either.
+    let one_megabyte = Budget {
         time: None,
-        memory: Some(10_000_000),
+        memory: Some(1_000_000),
     };
-    match with_budget(MethodId::STSK, ten_megabytes, |ctx| {
+    match with_budget(MethodId::STSK, one_megabyte, |ctx| {
         StraightSkeleton.skeletonise(&pp, ctx)
     }) {
         Err(MethodError::OverBudget { reason, .. }) => {
@@ -500,7 +500,7 @@ fn a_polygon_beyond_the_budget_is_declined_up_front_with_the_reason() {
     }
     // The same budgets leave a small polygon alone.
     let small = PreparedPolygon::new(&noisy_circle(400)).unwrap();
-    for b in [one_second, ten_megabytes] {
+    for b in [one_second, one_megabyte] {
         let g = with_budget(MethodId::STSK, b, |ctx| {
             StraightSkeleton.skeletonise(&small, ctx)
         })

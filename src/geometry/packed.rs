@@ -277,6 +277,44 @@ impl PackedTree {
         tree
     }
 
+    /// The position of every item (indexed by item number), for
+    /// [`PackedTree::remove_at`].
+    pub(crate) fn item_positions(&self) -> Vec<u32> {
+        let n = self.len();
+        let mut pos = vec![0u32; n];
+        for (p, &i) in self.ids[..n].iter().enumerate() {
+            pos[i as usize] = p as u32;
+        }
+        pos
+    }
+
+    /// Takes the item at position `pos` out of every later query: its box
+    /// becomes empty (it meets no box) and each ancestor's box shrinks to
+    /// the union of its children's, so that a subtree whose items are all
+    /// removed is no longer entered. O(node size · depth). Oriented boxes,
+    /// if any, are left as they were (still bounds).
+    pub(crate) fn remove_at(&mut self, pos: usize) {
+        const EMPTY: Bbox = [
+            f64::INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NEG_INFINITY,
+        ];
+        self.boxes[pos] = EMPTY;
+        let (mut pos, mut start) = (pos, 0);
+        for w in self.level_ends.windows(2) {
+            let (end, parent) = (w[0], w[0] + (pos - start) / NODE_SIZE);
+            let b = self
+                .children(parent)
+                .fold(EMPTY, |acc, c| union(acc, self.boxes[c]));
+            if b == self.boxes[parent] {
+                break;
+            }
+            self.boxes[parent] = b;
+            (pos, start) = (parent, end);
+        }
+    }
+
     /// Number of items.
     pub(crate) fn len(&self) -> usize {
         self.level_ends.first().copied().unwrap_or(0)
@@ -920,6 +958,43 @@ mod tests {
                 .filter(|&i| meets(&boxes[i as usize]))
                 .collect();
             assert_eq!(got, want, "n = {n}");
+        }
+    }
+
+    #[test]
+    fn removed_items_are_found_no_more_and_their_empty_subtrees_not_entered() {
+        let everywhere = [f64::MIN, f64::MIN, f64::MAX, f64::MAX];
+        for n in [1, 2, 7, 8, 9, 64, 65, 5000] {
+            let boxes = grid(n);
+            let mut t = PackedTree::new(&boxes);
+            let pos = t.item_positions();
+            let found = |t: &PackedTree| {
+                let (mut items, nodes) = (Vec::new(), std::cell::Cell::new(0));
+                t.visit(
+                    |b| {
+                        nodes.set(nodes.get() + 1);
+                        boxes_meet(b, &everywhere)
+                    },
+                    |i| {
+                        items.push(i);
+                        ControlFlow::<()>::Continue(())
+                    },
+                );
+                items.sort_unstable();
+                (items, nodes.get())
+            };
+            // Every item but each seventh removed: the others are found.
+            for i in (0..n).filter(|i| i % 7 != 0) {
+                t.remove_at(pos[i] as usize);
+            }
+            let want: Vec<u32> = (0..n as u32).filter(|i| i % 7 == 0).collect();
+            assert_eq!(found(&t).0, want, "n = {n}");
+            // All removed: the root's box meets nothing, and nothing under
+            // it is looked at.
+            for i in (0..n).filter(|i| i % 7 == 0) {
+                t.remove_at(pos[i] as usize);
+            }
+            assert_eq!(found(&t), (Vec::new(), 1), "n = {n}");
         }
     }
 

@@ -48,10 +48,20 @@
 //!   river). A split candidate that finds no piece of its line is passed
 //!   over as the events of its time are pulled, before it is held: on a
 //!   pixel grid nearly all of them miss (the rasterised Lena: 6.8 M of 6.9 M
-//!   events; 12.9 s → 7.3 s). The cost is about O(n log n) on smooth real
-//!   data; on a staircase each reflex corner still tries the candidates of
-//!   the rows and columns of pixels it passes, a number that grows with the
-//!   width of the polygon in pixels.
+//!   events; 12.9 s → 7.3 s). A ray is searched in bands, and the next band
+//!   only when the vertex lives to reach the end of the searched part (a
+//!   queued *deferred search*, not at once when the band's candidates are
+//!   used up); an edge that has left the wavefront is taken out of the
+//!   R-tree between events (it never comes back, so its candidates could
+//!   only be skipped). On a rough rim of needles 9 in 10 edges a reflex
+//!   vertex tried were gone: without them StSk takes 0.44× the time on the
+//!   100 000-vertex rough polygon, and 37 s → 11 s and 2.7 GB → 0.24 GB at
+//!   200 000, the same skeleton. The cost is about O(n log n) on smooth
+//!   real data; on a staircase each reflex corner still tries the
+//!   candidates of the rows and columns of pixels it passes, a number that
+//!   grows with the width of the polygon in pixels, and on a rim of needles
+//!   of a fixed depth the live edges a vertex passes grow with their
+//!   density (4× the edges tried per doubling of the vertices).
 //! * "Near its ray" is not a proven bound: a face widens without limit
 //!   next to a fast reflex vertex (nearly parallel banks), so a split can
 //!   come from an edge far from the ray. Every result is therefore
@@ -164,8 +174,16 @@ fn fail(reason: impl Into<String>) -> MethodError {
 const CANDIDATE_BYTES: usize = std::mem::size_of::<SplitCandidate>();
 
 /// The share of the predicted cost taken as the likely cost (see
-/// [`propagate`]): the prediction is an upper estimate.
-const LIKELY_SHARE: f64 = 0.25;
+/// [`propagate`]). The prediction is an upper estimate: it counts every
+/// edge near a sampled ray, as at the start. The edges actually tried were
+/// 86–120 % of it on rasterised rivers (staircases, whose edges stay in the
+/// wavefront), 0.3–12 % on a smooth wavy ellipse and 1.1–1.3 % on the rough
+/// polygon of `scripts/make_rough_polygon.py` (most of its edges leave the
+/// wavefront before a vertex gets near them). The share is about the
+/// lowest of those: a polygon is declined up front only when it would pass
+/// the budget even then; any other is stopped by the deadline if it costs
+/// more after all.
+const LIKELY_SHARE: f64 = 1.0 / 64.0;
 
 /// Reflex vertices sampled to predict the propagation's cost.
 const PREDICTION_SAMPLE: usize = 64;
@@ -217,8 +235,13 @@ struct Propagation<'a> {
     q: EventQueue,
     /// Events within `tol` of the time being handled, by place.
     held: Held,
-    /// The original edges, item `i` being `LineId(i)`.
+    /// The original edges, item `i` being `LineId(i)`; a line that has
+    /// left the wavefront is removed ([`Self::drop_gone_lines`]).
     tree: PackedTree,
+    /// Each line's position in `tree` (`u32::MAX` once removed).
+    tree_pos: Vec<u32>,
+    /// Lines of vertices ended since the last [`Self::drop_gone_lines`].
+    ended_lines: Vec<LineId>,
     search: Search,
     boundary: &'a Boundary,
     origin: Coord<f64>,
@@ -273,6 +296,7 @@ impl<'a> Propagation<'a> {
             }
         }
         work.reverse();
+        let tree = PackedTree::new(&entries);
         Self {
             ctx,
             candidates: vec![Vec::new(); w.vertices.len()],
@@ -281,7 +305,9 @@ impl<'a> Propagation<'a> {
             w,
             q: EventQueue::default(),
             held: Held::default(),
-            tree: PackedTree::new(&entries),
+            tree_pos: tree.item_positions(),
+            tree,
+            ended_lines: Vec::new(),
             search,
             boundary: polygon.boundary(),
             origin,
@@ -331,6 +357,24 @@ impl<'a> Propagation<'a> {
             to_t: self.now,
         });
         self.w.kill(v);
+        self.ended_lines.extend([l, r]);
+    }
+
+    /// Takes the lines that have left the wavefront out of the split
+    /// search's tree. Called between events (during one, a line can be
+    /// without a piece until the event's new vertices take it up). A line
+    /// without a piece never gets one back, so its split candidates could
+    /// only be skipped; on a rough rim most original edges are gone long
+    /// before the reflex vertices that search past them (9 in 10 edges
+    /// tried on the rough polygon of `scripts/make_rough_polygon.py`).
+    fn drop_gone_lines(&mut self) {
+        while let Some(l) = self.ended_lines.pop() {
+            let pos = self.tree_pos[l.index()];
+            if pos != u32::MAX && !self.w.line_alive(l) {
+                self.tree.remove_at(pos as usize);
+                self.tree_pos[l.index()] = u32::MAX;
+            }
+        }
     }
 
     fn new_vertex(
@@ -382,6 +426,9 @@ impl<'a> Propagation<'a> {
                         continue;
                     }
                     self.now = self.now.max(ev.t);
+                    if self.searched_on(queued, v, candidate)? {
+                        continue;
+                    }
                     let c = self.candidates[v.index()][candidate as usize];
                     if self.find_piece(v, c.line).is_none() {
                         self.stats.missed += 1;
@@ -404,6 +451,7 @@ impl<'a> Propagation<'a> {
             }
             self.event_group(ev)?;
             self.drain_work()?;
+            self.drop_gone_lines();
             if let Some(p) = self.inconsistent {
                 return Err(fail(format!(
                     "straight skeleton event off its offset lines near ({}, {}) (degenerate simultaneous events)",
@@ -570,6 +618,9 @@ impl<'a> Propagation<'a> {
         if !self.w.v(v).active {
             return Ok(false);
         }
+        if self.searched_on(true, v, candidate)? {
+            return Ok(true);
+        }
         let (mut t, mut i) = (t, candidate);
         loop {
             let c = self.candidates[v.index()][i as usize];
@@ -585,8 +636,13 @@ impl<'a> Propagation<'a> {
             self.stats.missed += 1;
             match self.next_candidate(v, i + 1)? {
                 // Its turn comes in this same pull, with the wavefront as it
-                // is now: checked at once, without a trip through the queue.
-                Some((next, j)) if next <= until => (t, i) = (next, j),
+                // is now: checked at once, without a trip through the queue
+                // (a deferred search goes back to the queue).
+                Some((next, j))
+                    if next <= until && (j as usize) < self.candidates[v.index()].len() =>
+                {
+                    (t, i) = (next, j)
+                }
                 Some((next, j)) => {
                     self.q.replace_head(next, split(v, j));
                     return Ok(true);
@@ -651,7 +707,7 @@ impl<'a> Propagation<'a> {
                     let mut i = candidate as usize;
                     let mut hit = false;
                     loop {
-                        self.reach_candidate(v, i)?;
+                        self.reach_candidate(v, i, t0 + self.tol)?;
                         let Some(&c) = self.candidates[v.index()].get(i) else {
                             break;
                         };
@@ -1037,8 +1093,11 @@ impl<'a> Propagation<'a> {
     /// been searched to its end. Bands double in length from twice the
     /// vertex's shorter edge (the exhaustive search has one band, the whole
     /// ray), and a band is searched only when the vertex has tried every
-    /// candidate of the bands before: most reflex vertices of a rough rim
-    /// end within their first band, so their search stays local where a
+    /// candidate of the bands before and lives to reach the end of the
+    /// part searched ([`Propagation::next_candidate`]; the candidates on
+    /// edges gone from the wavefront do not count): most reflex vertices of
+    /// a rough rim end within their first bands, so their search stays
+    /// local where a
     /// search of the whole ray (which can cross the polygon) made the
     /// propagation quadratic. A band keeps the candidates that come after
     /// the list's last in time order (earlier ones are past). Fails when all
@@ -1085,20 +1144,26 @@ impl<'a> Propagation<'a> {
         Ok(true)
     }
 
-    /// Makes reflex vertex `v`'s candidate `i` known if its ray has one,
-    /// searching further bands as needed.
-    fn reach_candidate(&mut self, v: VertexId, i: usize) -> Result<(), MethodError> {
-        while i >= self.candidates[v.index()].len() && self.search_band(v)? {}
+    /// Makes reflex vertex `v`'s candidate `i` known if its ray has one up
+    /// to time `until`, searching further bands as needed (a band whose
+    /// part of the ray the vertex reaches after `until` holds no candidate
+    /// before it).
+    fn reach_candidate(&mut self, v: VertexId, i: usize, until: f64) -> Result<(), MethodError> {
+        while i >= self.candidates[v.index()].len()
+            && self.band_end(v).is_none_or(|t| t <= until)
+            && self.search_band(v)?
+        {}
         Ok(())
     }
 
     /// The cost of the propagation, predicted from a sample of the input's
     /// reflex vertices: (edges to try, candidates to keep) over all of them,
-    /// each as if it searched its whole ray. That is an upper estimate: a
-    /// vertex searches band after band only while it lives (on a rough rim
-    /// it ends early: 6× fewer tries than predicted on the rough polygon of
-    /// `scripts/make_rough_polygon.py`; about as predicted on a raster
-    /// staircase).
+    /// each as if it searched its whole ray among every edge. That is an
+    /// upper estimate: a vertex searches band after band only while it
+    /// lives, among the edges still in the wavefront (on a rough rim it ends
+    /// early and most edges near it are gone: about 80× fewer tries than
+    /// predicted on the rough polygon of `scripts/make_rough_polygon.py`;
+    /// about as predicted on a raster staircase; see [`LIKELY_SHARE`]).
     /// The first eighth of the sample is spread over the whole polygon;
     /// when its estimate already makes `hopeless` true (far beyond the
     /// budget), that estimate is returned without the rest — on a huge
@@ -1157,18 +1222,67 @@ impl<'a> Propagation<'a> {
     }
 
     /// The time and index of the candidate [`Self::push_candidate`] queues.
+    /// When the candidates of the bands searched so far are used up and the
+    /// vertex reaches the end of the searched part of its ray only later,
+    /// the index is one past the list and the time is that later time: the
+    /// next band is searched then, if the vertex still lives
+    /// ([`Self::searched_on`]), not now.
     fn next_candidate(&mut self, v: VertexId, i: u32) -> Result<Option<(f64, u32)>, MethodError> {
         let mut i = i as usize;
         loop {
-            self.reach_candidate(v, i)?;
-            let Some(c) = self.candidates[v.index()].get(i) else {
-                return Ok(None);
-            };
+            if i >= self.candidates[v.index()].len() {
+                if let Some(t) = self.band_end(v).filter(|&t| t > self.now) {
+                    return Ok(Some((t, i as u32)));
+                }
+                if !self.search_band(v)? {
+                    return Ok(None);
+                }
+                continue;
+            }
+            let c = self.candidates[v.index()][i];
             if self.w.line_alive(c.line) {
                 return Ok(Some((c.t.max(self.now), i as u32)));
             }
             i += 1;
         }
+    }
+
+    /// When reflex vertex `v` reaches the end of the part of its ray
+    /// searched so far (`None` before the first band).
+    fn band_end(&self, v: VertexId) -> Option<f64> {
+        let band = self.bands[v.index()];
+        let vx = self.w.v(v);
+        let speed = hypot(vx.vel?);
+        (band.searched > 0.0).then(|| vx.t0 + band.searched / speed)
+    }
+
+    /// Whether the queue's head is a vertex's deferred search (see
+    /// [`Self::next_candidate`]); if so, searches the vertex's next band now
+    /// and puts its next candidate in the head's place (or takes the head),
+    /// and returns `true`. A deferred search is never held or grouped.
+    fn searched_on(
+        &mut self,
+        queued: bool,
+        v: VertexId,
+        candidate: u32,
+    ) -> Result<bool, MethodError> {
+        if (candidate as usize) < self.candidates[v.index()].len() {
+            return Ok(false);
+        }
+        // Its time has come (it may be up to `tol` after `now` while the
+        // events of a time are pulled).
+        let next = if self.search_band(v)? {
+            self.next_candidate(v, candidate)?
+        } else {
+            None
+        };
+        match (queued, next) {
+            (true, Some((t, i))) => self.q.replace_head(t, split(v, i)),
+            (true, None) => self.take(true),
+            (false, Some((t, i))) => self.q.push(t, split(v, i)),
+            (false, None) => {}
+        }
+        Ok(true)
     }
 }
 
@@ -1185,11 +1299,12 @@ fn propagate(
 ) -> Result<(Vec<Arc>, Stats), MethodError> {
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         let p = Propagation::new(polygon, search, ctx);
-        // The prediction assumes every ray searched to its exit; the bands
-        // stop where the vertex ends, which on a rough rim is 6–8× sooner
-        // in time (about as predicted on a staircase) and 50× in memory.
-        // The likely time is taken as a quarter of the prediction; more
-        // than the budget declines the polygon up front, and the deadline
+        // The prediction assumes every ray searched to its exit among every
+        // edge; the bands stop where the vertex ends and skip the edges
+        // gone from the wavefront, which on a rough rim is about 80× fewer
+        // edges tried (about as predicted on a staircase). The likely time
+        // is taken as `LIKELY_SHARE` of the prediction; more than the
+        // budget declines the polygon up front, and the deadline
         // stops a run that costs more after all. Memory is not judged up
         // front (the prediction is too far off): the split candidates are
         // counted as they are found, and the run stops with the reason the
