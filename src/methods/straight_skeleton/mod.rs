@@ -437,12 +437,7 @@ impl<'a> Propagation<'a> {
                         // a pop and a push: on a staircase most events are
                         // such misses).
                         let next = self.next_candidate(v, candidate + 1)?;
-                        match (queued, next) {
-                            (true, Some((t, i))) => self.q.replace_head(t, split(v, i)),
-                            (true, None) => self.take(true),
-                            (false, Some((t, i))) => self.q.push(t, split(v, i)),
-                            (false, None) => {}
-                        }
+                        self.follow_with(queued, v, next);
                         self.drain_work()?;
                         continue;
                     }
@@ -1276,13 +1271,21 @@ impl<'a> Propagation<'a> {
         } else {
             None
         };
+        self.follow_with(queued, v, next);
+        Ok(true)
+    }
+
+    /// Queues vertex `v`'s `next` split candidate (time, index) in place of
+    /// the event just handled: at the queue's head when that event is
+    /// there (`queued`: one sift instead of a pop and a push), else pushed;
+    /// with no next candidate the head is taken.
+    fn follow_with(&mut self, queued: bool, v: VertexId, next: Option<(f64, u32)>) {
         match (queued, next) {
             (true, Some((t, i))) => self.q.replace_head(t, split(v, i)),
             (true, None) => self.take(true),
             (false, Some((t, i))) => self.q.push(t, split(v, i)),
             (false, None) => {}
         }
-        Ok(true)
     }
 }
 
