@@ -566,10 +566,11 @@ fn a_pixel_staircase_is_skeletonised_in_the_first_pass() {
 /// A known failure, found by `stars_with_vertices_on_common_circles` on
 /// 2026-12-06 and failing before and after the split search's changes of
 /// that day: 36 vertices on circles of radius 4, 7 and 9, with runs of up
-/// to ten consecutive vertices on the inner circle (their edges reach the
-/// centre at one instant). Every search pass ends with a six-vertex
-/// wavefront loop of four reflex vertices left ("did not collapse"): a
-/// degenerate simultaneous event is resolved wrongly before it. In a run
+/// to ten consecutive vertices on the inner circle (their edges are tangent
+/// to one circle, so many events fall at one instant). Every search pass
+/// ends with a six-vertex wavefront loop of four reflex vertices left at
+/// time 3.81 ("did not collapse"): a loop that cannot close, so an earlier
+/// degenerate event was resolved wrongly. In a run
 /// StSk fails for such a polygon with that reason in `candidates.error`, and
 /// the other methods go on. Run with `--ignored` to work on it.
 #[test]
