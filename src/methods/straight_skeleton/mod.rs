@@ -55,8 +55,8 @@
 //!   R-tree between events (it never comes back, so its candidates could
 //!   only be skipped). On a rough rim of needles 9 in 10 edges a reflex
 //!   vertex tried were gone: without them StSk takes 0.44× the time on the
-//!   100 000-vertex rough polygon, and 37 s → 11 s and 2.7 GB → 0.24 GB at
-//!   200 000, the same skeleton. The cost is about O(n log n) on smooth
+//!   100 000-vertex rough polygon, and 37 s → 11–14 s and 2.7 GB → 0.24 GB
+//!   at 200 000, the same skeleton. The cost is about O(n log n) on smooth
 //!   real data; on a staircase each reflex corner still tries the
 //!   candidates of the rows and columns of pixels it passes, a number that
 //!   grows with the width of the polygon in pixels, and on a rim of needles
@@ -1092,9 +1092,8 @@ impl<'a> Propagation<'a> {
     /// part searched ([`Propagation::next_candidate`]; the candidates on
     /// edges gone from the wavefront do not count): most reflex vertices of
     /// a rough rim end within their first bands, so their search stays
-    /// local where a
-    /// search of the whole ray (which can cross the polygon) made the
-    /// propagation quadratic. A band keeps the candidates that come after
+    /// local where a search of the whole ray (which can cross the polygon)
+    /// made the propagation quadratic. A band keeps the candidates that come after
     /// the list's last in time order (earlier ones are past). Fails when all
     /// the polygon's candidates together pass the memory budget.
     fn search_band(&mut self, z: VertexId) -> Result<bool, MethodError> {
