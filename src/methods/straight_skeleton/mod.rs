@@ -34,6 +34,18 @@
 //!   strip's centre line; a list of two vertices is a collapsed segment and
 //!   one of three a collapsing triangle (also when a vertex event leaves a
 //!   single vertex between its two lines: it ends at the event point).
+//!   A lone split event whose point is at an end of the wavefront piece it
+//!   reaches is a vertex event too (the reflex vertex meets a vertex; cut
+//!   there, the piece left a zero-length edge between two vertices moving
+//!   as one, whose arcs overlapped). Around an event, an arriving and a
+//!   leaving ray in one direction (antiparallel lines meeting along a
+//!   segment) are a tie, whatever their rounded angles say. Ring vertices
+//!   within `tol` of the vertex before them are dropped first: an edge
+//!   that short has no direction (buffers from GEOS hold vertices 3e-15
+//!   apart, and the velocities next to them came out NaN). On 6 000
+//!   buffered lines (`scripts/make_buffered_lines.py`, seeds 7 and 11)
+//!   these took the skeletons with two arcs on top of each other from 115
+//!   to none longer than a micrometre.
 //! * Split candidates of a reflex vertex are looked up in an R-tree of the
 //!   original edges near its ray (bounded by where the ray leaves P),
 //!   sorted by time and validated against the current wavefront when
@@ -120,7 +132,7 @@ use crate::graph::{GraphBuilder, SkeletonGraph};
 use events::{edge_collapse_time, split_candidates, EventKind, EventQueue, Held, SplitCandidate};
 use geo::Coord;
 use std::ops::ControlFlow;
-use wavefront::{Line, LineId, VertexId, Wavefront};
+use wavefront::{Line, LineId, VertexId, Wavefront, FOLD_EPS};
 
 /// The straight-skeleton method.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -271,8 +283,10 @@ impl<'a> Propagation<'a> {
         let mut w = Wavefront::default();
         let mut entries = Vec::with_capacity(n);
         let mut work = Vec::with_capacity(n);
+        let tol = SAME_POINT * extent;
         for ring in polygon.rings() {
-            let abs = &ring.0[..ring.0.len() - 1];
+            let abs = distinct_vertices(&ring.0[..ring.0.len() - 1], tol);
+            let abs = &abs[..];
             let pts: Vec<Coord<f64>> = abs.iter().map(|&p| p - origin).collect();
             let m = pts.len();
             let base = w.lines.len();
@@ -314,7 +328,7 @@ impl<'a> Propagation<'a> {
             arcs: Vec::with_capacity(2 * n),
             work,
             now: 0.0,
-            tol: SAME_POINT * extent,
+            tol,
             extent,
             max_pops: 1000 * n + 10_000,
             max_candidates: ctx
@@ -563,7 +577,7 @@ impl<'a> Propagation<'a> {
                 self.held.put_back(&e);
             }
         }
-        if group.len() > 1 && self.vertex_event(&group, p0)? {
+        if (group.len() > 1 || self.meets_a_vertex(&ev, p0)) && self.vertex_event(&group, p0)? {
             return Ok(());
         }
         // A single event, or a group whose wavefront pieces do not form a
@@ -581,6 +595,20 @@ impl<'a> Propagation<'a> {
                 }
             }
         }
+    }
+
+    /// Whether `ev`, a lone split event at `p0`, reaches its wavefront
+    /// piece at one of the piece's ends: then the reflex vertex meets a
+    /// vertex, which is a vertex event (cutting the piece there would leave
+    /// a zero-length piece between two vertices moving as one, and their
+    /// arcs would overlap all the way to their next event).
+    fn meets_a_vertex(&mut self, ev: &events::Event, p0: Coord<f64>) -> bool {
+        let EventKind::Split { v, candidate } = ev.kind else {
+            return false;
+        };
+        let c = self.candidates[v.index()][candidate as usize];
+        self.find_piece(v, c.line)
+            .is_some_and(|x| self.at(x, p0) || self.at(self.w.v(x).next, p0))
     }
 
     /// Takes the queue's head when it is a split candidate of an active
@@ -778,17 +806,50 @@ impl<'a> Propagation<'a> {
 
     /// Pairs each chain's arriving ray with the chain whose leaving ray comes
     /// next by angle around the event (`None` when they do not alternate).
+    ///
+    /// Rays in one direction (within [`FOLD_EPS`], the test for
+    /// antiparallel lines) are tied whatever their rounded angles say, and
+    /// a tie is tried with its leaving rays first, then last: where two
+    /// antiparallel lines meet along a segment (a star's opposite edges
+    /// tangent to one circle), the arriving ray of one and the leaving ray
+    /// of the other point the same way, and only one order alternates —
+    /// the one that joins the two lines into a fold.
     fn pair_rays(
         &self,
         chains: &[(LineId, LineId, VertexId, VertexId)],
     ) -> Option<Vec<(usize, usize)>> {
         let angle = |d: Coord<f64>| d.y.atan2(d.x);
-        // (angle, leaving, chain)
-        let mut rays: Vec<(f64, bool, usize)> = Vec::with_capacity(2 * chains.len());
+        // (angle, leaving, chain, direction)
+        let mut rays: Vec<(f64, bool, usize, Coord<f64>)> = Vec::with_capacity(2 * chains.len());
         for (i, &(a, b, _, _)) in chains.iter().enumerate() {
-            rays.push((angle(self.w.line(a).dir * -1.0), false, i));
-            rays.push((angle(self.w.line(b).dir), true, i));
+            let arriving = self.w.line(a).dir * -1.0;
+            let leaving = self.w.line(b).dir;
+            rays.push((angle(arriving), false, i, arriving));
+            rays.push((angle(leaving), true, i, leaving));
         }
+        rays.sort_by(|r, s| r.0.total_cmp(&s.0));
+        let m = rays.len();
+        // Each ray's key: the angle of the first ray of its run of rays in
+        // one direction; a run at the end that points where the first ray
+        // does (across ±π) joins the first run.
+        let same = |r: &(f64, bool, usize, Coord<f64>), s: &(f64, bool, usize, Coord<f64>)| {
+            1.0 - dot(r.3, s.3) < FOLD_EPS
+        };
+        let mut key = vec![0.0; m];
+        let mut first = 0;
+        for i in 0..m {
+            if !same(&rays[first], &rays[i]) {
+                first = i;
+            }
+            key[i] = rays[first].0;
+        }
+        let mut last = m;
+        while last > 0 && same(&rays[last - 1], &rays[0]) && key[last - 1] != key[0] {
+            last -= 1;
+            key[last] = key[0];
+        }
+        let mut rays: Vec<(f64, bool, usize)> =
+            (0..m).map(|i| (key[i], rays[i].1, rays[i].2)).collect();
         for leaving_first in [true, false] {
             rays.sort_by(|r, s| {
                 r.0.total_cmp(&s.0).then(if leaving_first {
@@ -797,7 +858,6 @@ impl<'a> Propagation<'a> {
                     r.1.cmp(&s.1)
                 })
             });
-            let m = rays.len();
             if (0..m).all(|i| rays[i].1 != rays[(i + 1) % m].1) {
                 return Some(
                     (0..m)
@@ -1286,6 +1346,28 @@ impl<'a> Propagation<'a> {
             (false, None) => {}
         }
     }
+}
+
+/// A ring's vertices without those within `tol` of the vertex kept before
+/// them (the last also not within `tol` of the first): an edge shorter than
+/// `tol` has no direction to move in — a buffer's output can hold two
+/// vertices 3e-15 apart, and the velocities of their neighbours came out
+/// NaN, so the wavefront never collapsed. A ring with fewer than three
+/// vertices left is kept as it is (and fails as degenerate).
+fn distinct_vertices(ring: &[Coord<f64>], tol: f64) -> Vec<Coord<f64>> {
+    let mut kept: Vec<Coord<f64>> = Vec::with_capacity(ring.len());
+    for &p in ring {
+        if kept.last().is_none_or(|&q| !within_hypot(p - q, tol)) {
+            kept.push(p);
+        }
+    }
+    while kept.len() > 1 && within_hypot(kept[kept.len() - 1] - kept[0], tol) {
+        kept.pop();
+    }
+    if kept.len() < 3 {
+        return ring.to_vec();
+    }
+    kept
 }
 
 /// The split event of reflex vertex `v`'s candidate `candidate`.
