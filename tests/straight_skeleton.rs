@@ -411,6 +411,52 @@ fn buffered_lines_give_no_arcs_on_top_of_each_other() {
     );
 }
 
+/// A segment buffered 40 m with square caps: a rectangle 80 m wide whose
+/// long sides carry a vertex 40 m before each far corner (collinear with its
+/// side). Everything collapses at t = 40: the skeleton is the centre segment
+/// (the long side less 80 m), four corner legs of 40√2 and the collinear
+/// vertices' arcs, perpendicular to their sides and 40 long. CGAL 5.5's
+/// `create_interior_straight_skeleton_2` (Epick) draws those two arcs
+/// skewed, 564.271 in all; the exact answer is 557.568.
+#[test]
+fn a_square_capped_buffer_with_collinear_vertices() {
+    let v = [
+        (-185.0053399948134, 184.78349432021506),
+        (-217.35085154897564, 208.3157675274417),
+        (-170.28630513452237, 273.00679063576615),
+        (65.26480546129463, 101.6367048813754),
+        (97.61031701545687, 78.10443167414876),
+        (50.54577060100361, 13.413408565824273),
+    ];
+    let (g, _) = check(&poly(&v, &[]));
+    let side = (v[4].0 - v[2].0).hypot(v[4].1 - v[2].1);
+    let exact = 4.0 * 40.0 * 2f64.sqrt() + 2.0 * 40.0 + (side - 80.0);
+    assert!(
+        (g.total_length() - exact).abs() < 1e-6,
+        "{} against {exact}",
+        g.total_length()
+    );
+    // The collinear vertices' arcs: 40 long, perpendicular to their sides.
+    for (p, q) in [(v[0], v[1]), (v[3], v[4])] {
+        let n = g
+            .nodes()
+            .iter()
+            .position(|n| (n.pos.x - p.0).hypot(n.pos.y - p.1) < 1e-9)
+            .expect("a node at the collinear vertex");
+        let e = g
+            .edges()
+            .iter()
+            .find(|e| e.a.index() == n || e.b.index() == n)
+            .unwrap();
+        let (a, b) = (g.node(e.a).pos, g.node(e.b).pos);
+        let d = b - a;
+        let len = d.x.hypot(d.y);
+        assert!((len - 40.0).abs() < 1e-6, "arc {len} long");
+        let side_dir = ((q.0 - p.0) / 40.0, (q.1 - p.1) / 40.0);
+        assert!((d.x * side_dir.0 + d.y * side_dir.1).abs() / len < 1e-9);
+    }
+}
+
 /// A buffer whose ring holds two vertices 3e-15 m apart (GEOS's output): the
 /// edge between them had no direction, its vertices' velocities came out
 /// NaN and the wavefront never collapsed. Vertices within the tolerance of
