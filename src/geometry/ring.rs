@@ -22,13 +22,20 @@ pub fn signed_area2(ring: &[Coord<f64>]) -> f64 {
 /// Cleans one ring: drops repeated consecutive vertices (also across the
 /// closing point) and returns the distinct vertices, *not* closed.
 pub fn distinct_vertices(ring: &LineString<f64>) -> Vec<Coord<f64>> {
-    let mut out: Vec<Coord<f64>> = Vec::with_capacity(ring.0.len());
-    for &c in &ring.0 {
-        if out.last() != Some(&c) {
+    distinct_vertices_within(&ring.0, 0.0)
+}
+
+/// [`distinct_vertices`] of a ring's vertices (closed or not), where a
+/// vertex within `tol` of the one kept before it (in x, y and distance) is
+/// a repeat; `tol = 0` is exact equality.
+pub fn distinct_vertices_within(ring: &[Coord<f64>], tol: f64) -> Vec<Coord<f64>> {
+    let mut out: Vec<Coord<f64>> = Vec::with_capacity(ring.len());
+    for &c in ring {
+        if out.last().is_none_or(|&q| !super::within_hypot(c - q, tol)) {
             out.push(c);
         }
     }
-    while out.len() > 1 && out.first() == out.last() {
+    while out.len() > 1 && super::within_hypot(out[out.len() - 1] - out[0], tol) {
         out.pop();
     }
     out

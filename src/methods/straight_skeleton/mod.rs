@@ -124,6 +124,7 @@ pub(crate) mod wavefront;
 
 use super::{MethodContext, MethodError, MethodId, SkeletonMethod};
 use crate::geometry::packed::{boxes_meet, Bbox, PackedTree};
+use crate::geometry::ring::distinct_vertices_within;
 use crate::geometry::segment::{lines_meet, properly_cross};
 use crate::geometry::tolerance::{SAME_POINT, TRACE_CROSSING};
 use crate::geometry::vector::{cross, dot, hypot, within_hypot};
@@ -577,7 +578,18 @@ impl<'a> Propagation<'a> {
                 self.held.put_back(&e);
             }
         }
-        if (group.len() > 1 || self.meets_a_vertex(&ev, p0)) && self.vertex_event(&group, p0)? {
+        // A lone split's piece, found once: whether it meets a vertex, and
+        // the piece it cuts when it does not (a refused vertex event changes
+        // nothing).
+        let lone_piece = match ev.kind {
+            EventKind::Split { v, candidate } if group.len() == 1 => {
+                let line = self.candidates[v.index()][candidate as usize].line;
+                self.find_piece(v, line)
+            }
+            _ => None,
+        };
+        let meets_a_vertex = lone_piece.is_some_and(|x| self.at_piece_end(x, p0));
+        if (group.len() > 1 || meets_a_vertex) && self.vertex_event(&group, p0)? {
             return Ok(());
         }
         // A single event, or a group whose wavefront pieces do not form a
@@ -589,7 +601,12 @@ impl<'a> Propagation<'a> {
             EventKind::Edge { x, y } => self.edge_event(x, y),
             EventKind::Split { v, candidate } => {
                 let c = self.candidates[v.index()][candidate as usize];
-                match self.find_piece(v, c.line) {
+                let piece = if group.len() == 1 {
+                    lone_piece
+                } else {
+                    self.find_piece(v, c.line)
+                };
+                match piece {
                     Some(x) => self.split_event(v, x, c.line),
                     None => self.push_candidate(v, candidate + 1),
                 }
@@ -597,18 +614,13 @@ impl<'a> Propagation<'a> {
         }
     }
 
-    /// Whether `ev`, a lone split event at `p0`, reaches its wavefront
-    /// piece at one of the piece's ends: then the reflex vertex meets a
-    /// vertex, which is a vertex event (cutting the piece there would leave
-    /// a zero-length piece between two vertices moving as one, and their
-    /// arcs would overlap all the way to their next event).
-    fn meets_a_vertex(&mut self, ev: &events::Event, p0: Coord<f64>) -> bool {
-        let EventKind::Split { v, candidate } = ev.kind else {
-            return false;
-        };
-        let c = self.candidates[v.index()][candidate as usize];
-        self.find_piece(v, c.line)
-            .is_some_and(|x| self.at(x, p0) || self.at(self.w.v(x).next, p0))
+    /// Whether the wavefront piece starting at `x` has an end at `p0`: a
+    /// lone split there is a reflex vertex meeting a vertex, which is a
+    /// vertex event (cutting the piece there would leave a zero-length
+    /// piece between two vertices moving as one, and their arcs would
+    /// overlap all the way to their next event).
+    fn at_piece_end(&self, x: VertexId, p0: Coord<f64>) -> bool {
+        self.at(x, p0) || self.at(self.w.v(x).next, p0)
     }
 
     /// Takes the queue's head when it is a split candidate of an active
@@ -1349,21 +1361,13 @@ impl<'a> Propagation<'a> {
 }
 
 /// A ring's vertices without those within `tol` of the vertex kept before
-/// them (the last also not within `tol` of the first): an edge shorter than
-/// `tol` has no direction to move in — a buffer's output can hold two
-/// vertices 3e-15 apart, and the velocities of their neighbours came out
-/// NaN, so the wavefront never collapsed. A ring with fewer than three
-/// vertices left is kept as it is (and fails as degenerate).
+/// them: an edge shorter than `tol` has no direction to move in — a
+/// buffer's output can hold two vertices 3e-15 apart, and the velocities of
+/// their neighbours came out NaN, so the wavefront never collapsed. A ring
+/// with fewer than three vertices left is kept as it is (and fails as
+/// degenerate).
 fn distinct_vertices(ring: &[Coord<f64>], tol: f64) -> Vec<Coord<f64>> {
-    let mut kept: Vec<Coord<f64>> = Vec::with_capacity(ring.len());
-    for &p in ring {
-        if kept.last().is_none_or(|&q| !within_hypot(p - q, tol)) {
-            kept.push(p);
-        }
-    }
-    while kept.len() > 1 && within_hypot(kept[kept.len() - 1] - kept[0], tol) {
-        kept.pop();
-    }
+    let kept = distinct_vertices_within(ring, tol);
     if kept.len() < 3 {
         return ring.to_vec();
     }
