@@ -32,6 +32,7 @@
 //! at 200 000, and the straight skeleton takes 0.6–0.75× the time; smooth
 //! polygons have few edges near their bands and are searched as before.
 
+use super::segment_box;
 use super::wavefront::{Line, LineId};
 use crate::geometry::packed::{boxes_meet, Bbox, PackedTree};
 use crate::geometry::vector::{cross, dot, hypot};
@@ -185,17 +186,7 @@ impl Classes {
 impl LineIndex {
     /// Indexes `lines` (each edge runs from its line's `a` to `b`).
     pub fn new(lines: &[Line]) -> Self {
-        let boxes: Vec<Bbox> = lines
-            .iter()
-            .map(|l| {
-                [
-                    l.a.x.min(l.b.x),
-                    l.a.y.min(l.b.y),
-                    l.a.x.max(l.b.x),
-                    l.a.y.max(l.b.y),
-                ]
-            })
-            .collect();
+        let boxes: Vec<Bbox> = lines.iter().map(|l| segment_box(l.a, l.b)).collect();
         let all = PackedTree::new(&boxes);
         Self {
             all_pos: all.item_positions(),
@@ -349,6 +340,17 @@ mod tests {
         Coord { x, y }
     }
 
+    /// `n` vertices around the origin, counter-clockwise, vertex `i` at
+    /// radius `r(i)`.
+    fn jagged(n: usize, r: impl Fn(usize) -> f64) -> Vec<Coord<f64>> {
+        (0..n)
+            .map(|i| {
+                let t = i as f64 / n as f64 * 2.0 * PI;
+                c(r(i) * t.cos(), r(i) * t.sin())
+            })
+            .collect()
+    }
+
     /// Edges in every direction around a fast vertex: the edges of
     /// `near_ray` are a subset of `near`'s, and both give the same split
     /// candidates.
@@ -357,13 +359,7 @@ mod tests {
         use crate::methods::straight_skeleton::wavefront::Wavefront;
         // A ring of short edges: a jagged circle of radius 100.
         let n = 720;
-        let pts: Vec<Coord<f64>> = (0..n)
-            .map(|i| {
-                let t = i as f64 / n as f64 * 2.0 * PI;
-                let r = 100.0 + if i % 2 == 0 { 0.0 } else { 7.0 };
-                c(r * t.cos(), r * t.sin())
-            })
-            .collect();
+        let pts = jagged(n, |i| 100.0 + if i % 2 == 0 { 0.0 } else { 7.0 });
         let mut w = Wavefront::default();
         for i in 0..n {
             w.lines.push(Line::new(pts[i], pts[(i + 1) % n]));
@@ -405,13 +401,7 @@ mod tests {
     #[test]
     fn a_removed_edge_is_found_by_neither_search() {
         let n = 600;
-        let pts: Vec<Coord<f64>> = (0..n)
-            .map(|i| {
-                let t = i as f64 / n as f64 * 2.0 * PI;
-                let r = 50.0 + 3.0 * (i % 3) as f64;
-                c(r * t.cos(), r * t.sin())
-            })
-            .collect();
+        let pts = jagged(n, |i| 50.0 + 3.0 * (i % 3) as f64);
         let lines: Vec<Line> = (0..n)
             .map(|i| Line::new(pts[i], pts[(i + 1) % n]))
             .collect();
