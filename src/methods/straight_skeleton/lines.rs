@@ -215,13 +215,27 @@ impl LineIndex {
 
     /// Appends to `out` every edge (not removed) whose box meets `env`.
     pub fn near(&self, env: &Bbox, out: &mut Vec<LineId>) {
-        self.all.visit(
+        self.near_at_most(env, usize::MAX, out);
+    }
+
+    /// [`Self::near`] when it finds at most `cap` edges (`true`); else
+    /// appends nothing and returns `false`.
+    fn near_at_most(&self, env: &Bbox, cap: usize, out: &mut Vec<LineId>) -> bool {
+        let before = out.len();
+        let over = self.all.visit(
             |b| boxes_meet(b, env),
             |i| {
+                if out.len() - before == cap {
+                    return ControlFlow::Break(());
+                }
                 out.push(LineId::from_index(i as usize));
-                ControlFlow::<()>::Continue(())
+                ControlFlow::Continue(())
             },
         );
+        if over.is_some() {
+            out.truncate(before);
+        }
+        over.is_none()
     }
 
     /// Appends to `out` the edges of [`Self::near`] that can be split
@@ -237,32 +251,19 @@ impl LineIndex {
         tol: f64,
         out: &mut Vec<LineId>,
     ) {
-        // Few edges near: the one tree's answer costs less than a search
-        // of every class.
-        let mut few = 0;
-        let more = self.all.visit(
-            |b| boxes_meet(b, env),
-            |i| {
-                if few == FEW_NEAR {
-                    return ControlFlow::Break(());
-                }
-                few += 1;
-                out.push(LineId::from_index(i as usize));
-                ControlFlow::Continue(())
-            },
-        );
-        if more.is_none() {
-            return;
-        }
-        out.truncate(out.len() - few);
-        let classes = &self
-            .classes
-            .get_or_init(|| Classes::new(lines, &self.all_pos))
-            .classes;
         let speed = hypot(band.vel);
         if speed.is_nan() || speed <= 0.0 {
             return self.near(env, out);
         }
+        // Few edges near: the one tree's answer costs less than a search
+        // of every class.
+        if self.near_at_most(env, FEW_NEAR, out) {
+            return;
+        }
+        let classes = &self
+            .classes
+            .get_or_init(|| Classes::new(lines, &self.all_pos))
+            .classes;
         let dir = band.vel / speed;
         let corners = [(0, 1), (2, 1), (0, 3), (2, 3)].map(|(i, j)| Coord {
             x: env[i],
