@@ -75,10 +75,11 @@
 //!   of a fixed depth the live edges a vertex passes grow with their
 //!   density (4× the edges tried per doubling of the vertices). Most of
 //!   those edges move away faster than the vertex or are reached only
-//!   after the band: a band whose box holds many edges takes them from
-//!   trees by the direction of their normals, which skip such edges by a
-//!   bound on their distance from the vertex (module `lines`; the same
-//!   candidates from 7× fewer edges at 200 000 vertices).
+//!   after the band: a band whose box holds many edges (and every later
+//!   band of its vertex) takes them from trees by the direction of their
+//!   normals, which skip such edges by a bound on their distance from the
+//!   vertex (module `lines`; the same candidates from 7× fewer edges at
+//!   200 000 vertices).
 //! * "Near its ray" is not a proven bound: a face widens without limit
 //!   next to a fast reflex vertex (nearly parallel banks), so a split can
 //!   come from an edge far from the ray. Every result is therefore
@@ -253,6 +254,10 @@ struct Band {
     reach: f64,
     /// The first band's length.
     first: f64,
+    /// Whether the last band searched held many edges in its box (the
+    /// next one, whose box holds that box, is taken by direction at once;
+    /// see [`LineIndex::near_ray`]).
+    dense: bool,
 }
 
 struct Propagation<'a> {
@@ -968,6 +973,7 @@ impl<'a> Propagation<'a> {
                     searched: 0.0,
                     reach,
                     first,
+                    dense: false,
                 };
             }
             self.push_candidate(z, 0)?;
@@ -1114,16 +1120,16 @@ impl<'a> Propagation<'a> {
 
     /// The original edges reflex vertex `z`'s split candidates up to
     /// distance `upto` along its ray are taken from (all, or those near
-    /// that part of the ray; `directed`: without those near it that cannot
-    /// be candidates, see [`LineIndex::near_ray`]), and the latest time such
-    /// a candidate may have.
+    /// that part of the ray; with `directed`: without those near it that
+    /// cannot be candidates, see [`LineIndex::near_ray`], whose `dense` it
+    /// is), and the latest time such a candidate may have.
     /// The lines are written into `into` (cleared first; a buffer reused
     /// from band to band).
     fn candidate_lines(
         &self,
         z: VertexId,
         upto: f64,
-        directed: bool,
+        directed: Option<&mut bool>,
         into: Vec<LineId>,
     ) -> Option<(Vec<LineId>, f64)> {
         let vx = *self.w.v(z);
@@ -1146,15 +1152,21 @@ impl<'a> Propagation<'a> {
                 // In any order: the candidates are sorted.
                 let mut lines = into;
                 lines.clear();
-                if directed {
+                if let Some(dense) = directed {
                     let band = lines::Band {
                         start: vx.start,
                         t0: vx.t0,
                         vel: s,
                         t_max,
                     };
-                    self.index
-                        .near_ray(&self.w.lines, &env, &band, self.tol, &mut lines);
+                    *dense = self.index.near_ray(
+                        &self.w.lines,
+                        &env,
+                        &band,
+                        self.tol,
+                        *dense,
+                        &mut lines,
+                    );
                 } else {
                     self.index.near(&env, &mut lines);
                 }
@@ -1201,8 +1213,11 @@ impl<'a> Propagation<'a> {
             }
         };
         band.searched = upto;
+        let mut dense = band.dense;
         let scratch = std::mem::take(&mut self.scratch);
-        let Some((lines, t_max)) = self.candidate_lines(z, upto, true, scratch) else {
+        let found = self.candidate_lines(z, upto, Some(&mut dense), scratch);
+        self.bands[z.index()].dense = dense;
+        let Some((lines, t_max)) = found else {
             return Ok(false);
         };
         self.ctx.check(MethodId::STSK)?;
@@ -1278,7 +1293,7 @@ impl<'a> Propagation<'a> {
             let Some((upto, _)) = self.ray_reach(z) else {
                 continue;
             };
-            if let Some((lines, t_max)) = self.candidate_lines(z, upto, false, Vec::new()) {
+            if let Some((lines, t_max)) = self.candidate_lines(z, upto, None, Vec::new()) {
                 tried += lines.len();
                 kept +=
                     split_candidates(&self.w, z, lines.into_iter(), t_max, self.tol, None).len();
