@@ -348,6 +348,7 @@ impl LineIndex {
 mod tests {
     use super::*;
     use crate::methods::straight_skeleton::events::split_candidates;
+    use crate::methods::straight_skeleton::wavefront::Wavefront;
 
     fn c(x: f64, y: f64) -> Coord<f64> {
         Coord { x, y }
@@ -364,21 +365,28 @@ mod tests {
             .collect()
     }
 
-    /// Edges in every direction around a fast vertex: the edges of
-    /// `near_ray` are a subset of `near`'s, and both give the same split
-    /// candidates.
-    #[test]
-    fn the_ray_search_finds_the_same_candidates_among_fewer_edges() {
-        use crate::methods::straight_skeleton::wavefront::Wavefront;
-        // A ring of short edges: a jagged circle of radius 100.
-        let n = 720;
-        let pts = jagged(n, |i| 100.0 + if i % 2 == 0 { 0.0 } else { 7.0 });
+    /// The wavefront of the ring through `pts`, one line per edge, and the
+    /// index of its edges.
+    fn ring_wavefront(pts: &[Coord<f64>]) -> (Wavefront, LineIndex) {
+        let n = pts.len();
         let mut w = Wavefront::default();
         for i in 0..n {
             w.lines.push(Line::new(pts[i], pts[(i + 1) % n]));
             w.pieces.push(Vec::new());
         }
         let index = LineIndex::new(&w.lines);
+        (w, index)
+    }
+
+    /// Edges in every direction around a fast vertex: the edges of
+    /// `near_ray` are a subset of `near`'s, and both give the same split
+    /// candidates.
+    #[test]
+    fn the_ray_search_finds_the_same_candidates_among_fewer_edges() {
+        // A ring of short edges: a jagged circle of radius 100.
+        let n = 720;
+        let pts = jagged(n, |i| 100.0 + if i % 2 == 0 { 0.0 } else { 7.0 });
+        let (mut w, index) = ring_wavefront(&pts);
         let mut fewer = 0;
         for (k, speed) in [(0usize, 1.5), (5, 40.0), (77, 3.0), (301, 400.0)] {
             for angle in [0.3, 1.9, 3.5, 5.0] {
@@ -415,15 +423,9 @@ mod tests {
     /// holds few edges (they were removed since), with the same candidates.
     #[test]
     fn a_band_known_dense_finds_the_same_candidates() {
-        use crate::methods::straight_skeleton::wavefront::Wavefront;
         let n = 400;
         let pts = jagged(n, |i| 60.0 + if i % 2 == 0 { 0.0 } else { 4.0 });
-        let mut w = Wavefront::default();
-        for i in 0..n {
-            w.lines.push(Line::new(pts[i], pts[(i + 1) % n]));
-            w.pieces.push(Vec::new());
-        }
-        let index = LineIndex::new(&w.lines);
+        let (mut w, index) = ring_wavefront(&pts);
         let (left, right) = (LineId::from_index(n - 1), LineId::from_index(0));
         let vel = c(-30.0, 2.0);
         let v = w.add_vertex(pts[0] * 0.9, 0.1, left, right, None);
