@@ -21,7 +21,7 @@ static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 /// zeroes all of it. On the 1 000 000-vertex rough polygon through MA that
 /// took 5.9–7.3 s of system time and the run 20.9–21.8 s; with 4 KiB pages
 /// 1.6–1.8 s and 17.1–17.5 s, for 2 % more user time. Elsewhere it is
-/// about even (0.97–1.00× on the rough polygon at 100 000 and 200 000
+/// about even (0.96–1.03× on the rough polygon at 100 000 and 200 000
 /// vertices, the rasterised Lena and the GSHHG lakes; BENCHMARKS.md).
 /// `MIMALLOC_ALLOW_THP=0` does the same from outside. A kernel without
 /// the setting changes nothing but speed.
