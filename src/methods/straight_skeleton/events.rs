@@ -216,14 +216,11 @@ pub struct Held {
     live: FxHashSet<u64>,
     cells: FxHashMap<(i64, i64), Vec<Placed>>,
     wide: Vec<Placed>,
-    /// Events taken by [`Held::take_at`], by `seq`, with their place, for
-    /// [`Held::put_back`].
-    taken: FxHashMap<u64, Placed>,
     cell: f64,
 }
 
 /// A held event, its point and its reach.
-type Placed = (Event, [f64; 2], f64);
+pub type Placed = (Event, [f64; 2], f64);
 
 impl Held {
     /// Holds `e`, which happens within `r` of `p`; the grid's cell size is
@@ -233,7 +230,6 @@ impl Held {
             self.heap.clear();
             self.cells.clear();
             self.wide.clear();
-            self.taken.clear();
             self.cell = cell.max(f64::MIN_POSITIVE);
         }
         self.live.insert(e.seq);
@@ -276,13 +272,14 @@ impl Held {
         Some(e)
     }
 
-    /// Takes every live held event whose reach holds `p`, in queue order.
-    pub fn take_at(&mut self, p: [f64; 2]) -> Vec<Event> {
+    /// Takes every live held event whose reach holds `p`, with its place
+    /// (for [`Self::put_back`]), in queue order.
+    pub fn take_at(&mut self, p: [f64; 2]) -> Vec<Placed> {
         let near = |q: &[f64; 2], r: f64| (q[0] - p[0]).hypot(q[1] - p[1]) <= r;
         let key = self.key(p);
-        let (live, taken) = (&mut self.live, &mut self.taken);
+        let live = &mut self.live;
         // The events found leave the list, and so do those gone since.
-        let mut found = |list: &mut Vec<Placed>, out: &mut Vec<Event>| {
+        let mut found = |list: &mut Vec<Placed>, out: &mut Vec<Placed>| {
             list.retain(|&placed| {
                 let (e, q, r) = placed;
                 if !live.contains(&e.seq) {
@@ -290,14 +287,13 @@ impl Held {
                 }
                 if near(&q, r) {
                     live.remove(&e.seq);
-                    taken.insert(e.seq, placed);
-                    out.push(e);
+                    out.push(placed);
                     return false;
                 }
                 true
             });
         };
-        let mut out: Vec<Event> = Vec::new();
+        let mut out: Vec<Placed> = Vec::new();
         if let Some((i, j)) = key {
             for k in [
                 (i - 1, j - 1),
@@ -316,16 +312,15 @@ impl Held {
         }
         found(&mut self.wide, &mut out);
         // Greatest first is earliest first (the order is reversed for the heap).
-        out.sort_by(|a, b| b.cmp(a));
+        out.sort_by_key(|&(e, _, _)| std::cmp::Reverse(e));
         out
     }
 
-    /// Puts back an event taken by [`Self::take_at`] and not used.
-    pub fn put_back(&mut self, e: &Event) {
-        if let Some(placed) = self.taken.remove(&e.seq) {
-            self.live.insert(e.seq);
-            self.place(placed);
-        }
+    /// Puts back an event taken by [`Self::take_at`] and not used, in its
+    /// place.
+    pub fn put_back(&mut self, placed: Placed) {
+        self.live.insert(placed.0.seq);
+        self.place(placed);
     }
 }
 
@@ -359,14 +354,14 @@ mod tests {
         }
         h.hold(edge(15.0, 5, 2000), [15_000.5, 0.0], 0.6, 4e-3);
         let here = h.take_at([15_000.0, 0.0]);
-        let seqs: Vec<u64> = here.iter().map(|e| e.seq).collect();
+        let seqs: Vec<u64> = here.iter().map(|(e, _, _)| e.seq).collect();
         assert_eq!(seqs, vec![5, 510], "the earliest-queued first");
         assert!(
             h.take_at([15_000.0, 0.0]).is_empty(),
             "taken events are gone"
         );
         // Put back, an event is live again, in its old place in the order.
-        h.put_back(&here[1]);
+        h.put_back(here[1]);
         assert_eq!(h.pop().map(|e| e.seq), Some(10));
         assert_eq!(h.take_at([15_000.0, 0.0]).len(), 1);
         // Nothing between places.
@@ -391,13 +386,13 @@ mod tests {
             h.hold(edge(1.0, 2 + i, 2), p, 0.5, 4e-3);
             let taken = h.take_at(p);
             assert_eq!(taken.len(), 1);
-            assert_eq!(taken[0].seq, 2 + i);
+            assert_eq!(taken[0].0.seq, 2 + i);
         }
         assert!(h.wide.len() <= 1, "{}", h.wide.len());
         // One put back stays, and is found again.
         h.hold(edge(1.0, 20_000, 2), [0.0, 5.0], 0.5, 4e-3);
         let taken = h.take_at([0.0, 5.0]);
-        h.put_back(&taken[0]);
+        h.put_back(taken[0]);
         assert_eq!(h.take_at([0.2, 5.0]).len(), 1);
         assert_eq!(h.pop().map(|e| e.seq), Some(1));
     }

@@ -210,7 +210,7 @@ const CANDIDATE_BYTES: usize = std::mem::size_of::<SplitCandidate>();
 /// it keeps, and on the rough polygon it is 0.6× for 0.14× the edges). The
 /// share was left as it was, since it stands for the time, which fell far
 /// less than the edges tried (StSk fits the default 120 s at 400 000
-/// vertices, in 40 s, and is not declined there).
+/// vertices, in 15 s, and is not declined there).
 const LIKELY_SHARE: f64 = 1.0 / 64.0;
 
 /// Reflex vertices sampled to predict the propagation's cost.
@@ -569,7 +569,8 @@ impl<'a> Propagation<'a> {
             };
             self.held.hold(e, [p.x, p.y], r, 16.0 * self.tol);
         }
-        for e in self.held.take_at([p0.x, p0.y]) {
+        for placed in self.held.take_at([p0.x, p0.y]) {
+            let e = placed.0;
             let here = match e.kind {
                 EventKind::Edge { x, y } => {
                     if !self.edge_valid(x, y) {
@@ -587,7 +588,7 @@ impl<'a> Propagation<'a> {
             if here {
                 group.push(e);
             } else {
-                self.held.put_back(&e);
+                self.held.put_back(placed);
             }
         }
         // A lone split's piece, found once: whether it meets a vertex, and
