@@ -17,7 +17,15 @@ same data:
   banks, z = |d_l − d_r| / (d_l + d_r) at 49 points evenly spread along
   each line, mean over the points.
 
-    scripts/partition_quality.py IN.gpkg RIVERS UNITS OUT.gpkg [--peer]
+    scripts/partition_quality.py IN.gpkg RIVERS UNITS OUT.gpkg [--peer] [--covering]
+
+With --covering the units cover the collapsed polygons (real administrative
+units, `partition: {overlap: cut}`): each unit's *land* (the unit minus the
+collapsed polygons) stands for the unit — its bank, the area in — and
+"unchanged" means: outside the collapsed polygons every unit is its land
+(what differs by more than the snap, 1e-7 × the waters' extent, at most
+1e-9 of its area), and units that touch no collapsed polygon are bit for
+bit the input's.
 
 prints one line of measures (JSON); with --peer a second for CoverageCleaner.
 """
@@ -45,14 +53,21 @@ def as_multi(geoms):
     return np.array([shapely.MultiPolygon([g]) if g.geom_type == "Polygon" else g for g in geoms])
 
 
-def banks(rivers, units):
+def banks(rivers, units, near=0.0):
     """Each unit's bank: the part of the collapsed polygons' boundary that lies
-    on its boundary (shared edges have identical vertices, so it is exact)."""
+    on its boundary (shared edges have identical vertices, so it is exact).
+    With `near` > 0, the part within that distance of it (a unit's land,
+    computed by GEOS, whose noding of the shore can differ from ours by
+    round-off)."""
     edge = shapely.union_all(rivers.geometry.boundary.values)
     shapely.prepare(edge)
     out = {}
     for fid, g in zip(units.index, units.geometry):
-        if shapely.intersects(edge, g):
+        if near > 0 and shapely.distance(edge, g) <= near:
+            b = shapely.line_merge(shapely.intersection(edge, shapely.buffer(g.boundary, near)))
+            if not b.is_empty and b.length > 0:
+                out[fid] = b
+        elif shapely.intersects(edge, g):
             b = shapely.line_merge(shapely.intersection(edge, g.boundary))
             if not b.is_empty and b.length > 0:
                 out[fid] = b
@@ -119,9 +134,21 @@ def boundary_z(lines, left, right, bank):
     return (float(z.mean()) if len(z) else float("nan")), int(len(z))
 
 
-def measure_ours(src, rivers_layer, units_layer, out, samples=20000):
+def land_of(units, rivers):
+    """The units less the collapsed polygons (their land), and the units that
+    touch none (written bit for bit)."""
+    water = shapely.union_all(rivers.geometry.values)
+    land = units.copy()
+    land["geometry"] = shapely.difference(units.geometry.values, water)
+    untouched = set(units.index[~shapely.intersects(units.geometry.values, water)])
+    return land, untouched, water
+
+
+def measure_ours(src, rivers_layer, units_layer, out, samples=20000, covering=False, units_crs_layer=None):
     units = read(src, units_layer)
     rivers = read(src, rivers_layer)
+    if covering:
+        original, (units, untouched, water) = units, land_of(units, rivers)
     cov = pyogrio.read_dataframe(out, layer="coverage")
     layers = {n for n, _ in pyogrio.list_layers(out)}
     areas = pyogrio.read_dataframe(out, layer="areas") if "areas" in layers else None
@@ -135,9 +162,30 @@ def measure_ours(src, rivers_layer, units_layer, out, samples=20000):
     orig = as_multi(units.geometry.loc[cov.src_fid].values)
     same = shapely.equals_exact(orig, out_geoms, tolerance=0)
     unchanged_ok = bool(all(s for s, f in zip(same, cov.src_fid) if f not in received))
+    if covering:
+        first = as_multi(original.geometry.loc[cov.src_fid].values)
+        same = shapely.equals_exact(first, out_geoms, tolerance=0)
+        outside = shapely.difference(out_geoms, water)
+        # What the snap moved (vertices and edges within `snap`, 1e-7 ×
+        # the water's extent by default, of its bank, each by less than
+        # `snap`) is not a change.
+        x0, y0, x1, y1 = shapely.total_bounds(rivers.geometry.values)
+        band = shapely.buffer(shapely.boundary(orig), 1e-7 * max(x1 - x0, y1 - y0))
+        changed = shapely.symmetric_difference(outside, orig)
+        moved = shapely.area(shapely.difference(changed, band))
+        unchanged_ok = bool(
+            all(s for s, f in zip(same, cov.src_fid) if f in untouched)
+            and (moved <= 1e-9 * np.maximum(shapely.area(orig), 1.0)).all()
+        )
     lost = shapely.area(shapely.difference(orig, out_geoms))
+    if covering:
+        m_held = float(given.held.sum()) if given is not None and "held" in given else 0.0
     shrunk = int((lost > 1e-9 * np.maximum(shapely.area(orig), 1.0)).sum())
-    bank = banks(rivers, units)
+    if covering:
+        x0, y0, x1, y1 = shapely.total_bounds(rivers.geometry.values)
+        bank = banks(rivers, units, near=1e-8 * max(x1 - x0, y1 - y0))
+    else:
+        bank = banks(rivers, units)
     m = {
         "units": len(cov),
         "grown": int((~same).sum()),
@@ -148,7 +196,9 @@ def measure_ours(src, rivers_layer, units_layer, out, samples=20000):
         "shrunk": shrunk,
         "same_order": list(cov.src_fid) == sorted(cov.src_fid),
     }
-    if given is not None:
+    if covering:
+        m["held"] = m_held
+    if given is not None and not covering:
         gained = shapely.area(out_geoms) - shapely.area(orig)
         by = given.groupby("unit_fid")["area"].sum()
         want = np.array([by.get(f, 0.0) for f in cov.src_fid])
@@ -224,8 +274,9 @@ def main():
     p.add_argument("out")
     p.add_argument("--peer", action="store_true")
     p.add_argument("--samples", type=int, default=20000, help="random points (0: no nearest-bank measure)")
+    p.add_argument("--covering", action="store_true", help="the units cover the collapsed polygons")
     o = p.parse_args()
-    print(json.dumps({"tool": "skeletonise", **measure_ours(o.src, o.rivers, o.units, o.out, o.samples)}))
+    print(json.dumps({"tool": "skeletonise", **measure_ours(o.src, o.rivers, o.units, o.out, o.samples, o.covering)}))
     if o.peer:
         print(json.dumps({"tool": "CoverageCleaner", **measure_peer(o.src, o.rivers, o.units)}))
 

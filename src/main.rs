@@ -364,7 +364,7 @@ fn init_logging(cli: &Cli) {
 fn run_error(e: RunError) -> ExitCode {
     tracing::error!("{e}");
     match e {
-        RunError::Rejected { .. } => ExitCode::from(EXIT_REJECTED),
+        RunError::Rejected { .. } | RunError::Coverage(_) => ExitCode::from(EXIT_REJECTED),
         _ => ExitCode::from(EXIT_RUNTIME),
     }
 }

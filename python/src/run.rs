@@ -58,6 +58,9 @@ enum Stop {
     Rejected(String),
     /// The cancel flag was set.
     Cancelled,
+    /// A unit of the partitioned coverage could not be made valid: the
+    /// command line's text.
+    Coverage(String),
 }
 
 /// The geometries as handed over.
@@ -365,7 +368,8 @@ fn work(
         // The partitioned coverage, once every polygon is done: every
         // unit, grown by what it received.
         all.coverage =
-            skeletonise::partition::assemble(cov.units(), std::mem::take(&mut all.grown));
+            skeletonise::partition::assemble(cov.units(), std::mem::take(&mut all.grown))
+                .map_err(|e| Stop::Coverage(format!("partition: {e}")))?;
     }
     let columns = table::columns(layer, &plan, &all, &items);
     let lines = table::lines(layer, &all, &items);
@@ -610,6 +614,7 @@ pub fn run<'py>(
     let done = detached(py, &input, fids, repaired, params, opts)?.map_err(|e| match e {
         Stop::Rejected(text) => RejectedError::new_err(text),
         Stop::Cancelled => Cancelled::new_err("cancelled"),
+        Stop::Coverage(text) => crate::PipelineError::new_err(text),
     })?;
     to_python(py, done)
 }

@@ -68,6 +68,9 @@ pub struct NeighboursSpec {
     /// OGR SQL attribute filter: only these units are read, written and own bank.
     #[serde(default, rename = "where")]
     pub where_: Option<String>,
+    /// Unit vertices and edges within this distance of a collapsed polygon's bank are moved onto it exactly, and gaps narrower than it closed (CRS units of the polygons). Default: 1e-7 × each polygon's extent (1 cm on a 100 km river), above the round-off of a reprojection.
+    #[serde(default)]
+    pub snap: Option<f64>,
 }
 
 impl NeighboursSpec {
@@ -150,6 +153,12 @@ impl InputSpec {
                 return Err((
                     "neighbours.source".into(),
                     "give the coverage's data source".into(),
+                ));
+            }
+            if n.snap.is_some_and(|s| !(s.is_finite() && s >= 0.0)) {
+                return Err((
+                    "neighbours.snap".into(),
+                    "snap must be ≥ 0 (CRS units of the polygons); leave it out for 1e-7 × each polygon's extent".into(),
                 ));
             }
         }

@@ -213,6 +213,22 @@ fn split_with(
 /// none is added. (River reaches cut from one river, a neighbour grown by
 /// the pieces of a partition.)
 pub fn coverage_union(polygons: &[Polygon<f64>]) -> Vec<Polygon<f64>> {
+    let mut edges = Vec::new();
+    for p in polygons {
+        let p = super::ring::normalise_polygon(p).unwrap_or_else(|_| p.clone());
+        for ring in std::iter::once(p.exterior()).chain(p.interiors()) {
+            edges.extend(ring.0.windows(2).map(|w| (w[0], w[1])));
+        }
+    }
+    polygons_of_edges(&edges)
+}
+
+/// The polygons bounded by directed edges (the area on each edge's left):
+/// an edge met both ways is counted against its reverse and drops out where
+/// they cancel; the rest is walked into rings, shells with their holes,
+/// exactly — no vertex moves, none is added. The edges must be noded (two
+/// edges meet only at shared end points).
+pub fn polygons_of_edges(edges: &[(Coord<f64>, Coord<f64>)]) -> Vec<Polygon<f64>> {
     let mut g = Graph {
         pos: Vec::new(),
         ids: FxHashMap::default(),
@@ -222,24 +238,19 @@ pub fn coverage_union(polygons: &[Polygon<f64>]) -> Vec<Polygon<f64>> {
     // Directed edges with their multiplicity: an edge met in both directions
     // is between two of the polygons.
     let mut count: FxHashMap<(VertexId, VertexId), i64> = FxHashMap::default();
-    for p in polygons {
-        let p = super::ring::normalise_polygon(p).unwrap_or_else(|_| p.clone());
-        for ring in std::iter::once(p.exterior()).chain(p.interiors()) {
-            for w in ring.0.windows(2) {
-                let (u, v) = (g.vertex(w[0]), g.vertex(w[1]));
-                if u != v {
-                    *count.entry((u, v)).or_default() += 1;
-                }
-            }
+    for &(a, b) in edges {
+        let (u, v) = (g.vertex(a), g.vertex(b));
+        if u != v {
+            *count.entry((u, v)).or_default() += 1;
         }
     }
-    let mut edges: Vec<(VertexId, VertexId)> = count
+    let mut kept: Vec<(VertexId, VertexId)> = count
         .iter()
         .filter(|&(&(u, v), &n)| n > count.get(&(v, u)).copied().unwrap_or(0))
         .map(|(&e, _)| e)
         .collect();
-    edges.sort_unstable();
-    for (u, v) in edges {
+    kept.sort_unstable();
+    for (u, v) in kept {
         g.half.push(HalfEdge {
             from: u,
             to: v,

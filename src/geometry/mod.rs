@@ -18,6 +18,7 @@ pub(crate) mod arrangement;
 pub mod boundary;
 pub mod densify;
 pub(crate) mod lanes;
+pub mod overlay;
 pub(crate) mod packed;
 pub(crate) mod ring;
 pub mod segment;

@@ -50,7 +50,7 @@ pub struct Rows {
     pub coverage: Vec<CoverageRow>,
     /// The pieces given to each unit (its FID): not a layer, but what the
     /// `coverage` rows are made of at the end of a run.
-    pub grown: Vec<(Option<u64>, geo::Polygon<f64>)>,
+    pub grown: Vec<(Option<u64>, crate::partition::Growth)>,
     /// `rejected` rows.
     pub rejected: Vec<RejectedRow>,
     /// Rows of registered steps' layers, by layer name.

@@ -8,39 +8,120 @@
 
 use super::layer::CoverageRow;
 use super::owners::{with_inserted, Inserts, Unit};
+use crate::geometry::overlay::{self, signed_union, Edits};
 use crate::geometry::tolerance::SAME_POINT;
 use crate::geometry::vector::norm;
-use crate::geometry::Boundary;
+use crate::geometry::{Boundary, PreparedPolygon};
 use geo::{Area, BoundingRect, Coord, MultiPolygon, Polygon};
 use rustc_hash::FxHashMap;
 
-/// The `coverage` rows: every unit, in the order given, grown by the pieces
-/// `grown` gives it (by FID).
-pub fn assemble(units: &[Unit], grown: Vec<(Option<u64>, Polygon<f64>)>) -> Vec<CoverageRow> {
-    let mut by_fid: FxHashMap<u64, Vec<Polygon<f64>>> = FxHashMap::default();
-    for (fid, p) in grown {
-        if let Some(f) = fid {
-            by_fid.entry(f).or_default().push(p);
+/// What a collapsed polygon does to a unit of the coverage.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Growth {
+    /// A piece given to it.
+    Given(Polygon<f64>),
+    /// A piece it held, cut out of it (`overlap: cut`).
+    Held(Polygon<f64>),
+    /// How it was snapped onto a bank.
+    Snapped(Edits),
+}
+
+/// Everything done to one unit.
+#[derive(Default)]
+struct Changes {
+    given: Vec<Polygon<f64>>,
+    held: Vec<Polygon<f64>>,
+    edits: Edits,
+}
+
+/// The `coverage` rows: every unit, in the order given, snapped, with what
+/// it held cut out and grown by the pieces `grown` gives it (by FID); or
+/// the first unit that could not be made valid, with the reason.
+pub fn assemble(
+    units: &[Unit],
+    grown: Vec<(Option<u64>, Growth)>,
+) -> Result<Vec<CoverageRow>, String> {
+    let mut by_fid: FxHashMap<u64, Changes> = FxHashMap::default();
+    for (fid, g) in grown {
+        let Some(f) = fid else { continue };
+        let c = by_fid.entry(f).or_default();
+        match g {
+            Growth::Given(p) => c.given.push(p),
+            Growth::Held(p) => c.held.push(p),
+            Growth::Snapped(e) => c.edits.merge(&e),
         }
     }
     units
         .iter()
         .map(|u| {
-            let pieces = u.fid.and_then(|f| by_fid.remove(&f)).unwrap_or_default();
-            let received: f64 = pieces.iter().map(|p| p.unsigned_area()).sum();
-            let geometry = if pieces.is_empty() {
+            let changes = u.fid.and_then(|f| by_fid.remove(&f)).unwrap_or_default();
+            let received = overlay::area(&changes.given);
+            let held = overlay::area(&changes.held);
+            let geometry = if changes.given.is_empty()
+                && changes.held.is_empty()
+                && changes.edits.is_empty()
+            {
                 u.geometry.clone()
+            } else if changes.held.is_empty() && changes.edits.is_empty() {
+                grow(&u.geometry, &changes.given)
             } else {
-                grow(&u.geometry, &pieces)
+                let g = changed(&u.geometry, &changes);
+                checked(u, &g, &changes)?;
+                g
             };
-            CoverageRow {
+            Ok(CoverageRow {
                 src_fid: u.fid,
                 attributes: u.attributes.clone(),
                 geometry,
                 received,
-            }
+                held,
+            })
         })
         .collect()
+}
+
+/// A unit snapped, what it held cut out, what it was given put in.
+fn changed(unit: &MultiPolygon<f64>, c: &Changes) -> MultiPolygon<f64> {
+    let snapped = c.edits.apply(unit);
+    let mut plus = snapped.0;
+    plus.extend(c.given.iter().cloned());
+    let tol = SAME_POINT * extent(&plus);
+    MultiPolygon(signed_union(&plus, &c.held, tol))
+}
+
+/// The larger side of the box around polygons.
+fn extent(ps: &[Polygon<f64>]) -> f64 {
+    MultiPolygon(ps.to_vec())
+        .bounding_rect()
+        .map_or(0.0, |r| r.width().max(r.height()))
+}
+
+/// Why a changed unit cannot be written: a part that is not a valid
+/// polygon, or an area other than the unit's, less what it held, plus what
+/// it was given.
+fn checked(u: &Unit, g: &MultiPolygon<f64>, c: &Changes) -> Result<(), String> {
+    let fid = u.fid.map_or_else(|| "(no fid)".into(), |f| f.to_string());
+    for p in &g.0 {
+        let problem = match PreparedPolygon::new(p) {
+            Ok(pp) => crate::geometry::validity::problem(&pp),
+            Err(e) => Some(e.to_string()),
+        };
+        if let Some(why) = problem {
+            return Err(format!(
+                "unit {fid} of `input.neighbours` is not valid once the collapsed polygons' areas are cut out of it and given to it ({why}); check that the units form a coverage (no overlap between units) and that `input.neighbours.snap` is below the narrowest part of the units"
+            ));
+        }
+    }
+    let want = c.edits.apply(&u.geometry).unsigned_area() - overlay::area(&c.held)
+        + overlay::area(&c.given);
+    let got = g.unsigned_area();
+    let scale = u.geometry.unsigned_area() + overlay::area(&c.given);
+    if (got - want).abs() > 1e-9 * scale.max(f64::MIN_POSITIVE) {
+        return Err(format!(
+            "unit {fid} of `input.neighbours` would be written with an area of {got}, not {want} (its area less what it held of the collapsed polygons plus what it was given); please report this with the data"
+        ));
+    }
+    Ok(())
 }
 
 /// `unit` and `pieces` as one, exactly.

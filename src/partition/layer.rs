@@ -21,6 +21,9 @@ pub struct CoverageRow {
     pub geometry: MultiPolygon<f64>,
     /// The area it received (0 for none).
     pub received: f64,
+    /// The area of the collapsed polygons it held before (`overlap: cut`;
+    /// 0 for none): cut out of it and given by the rule.
+    pub held: f64,
 }
 
 /// The `coverage` layer.
@@ -33,6 +36,7 @@ pub const COVERAGE: LayerDef<CoverageRow> = LayerDef {
     columns: &[
         col("src_fid", ColumnType::Int64, |r| fid(r.src_fid)),
         col("received", ColumnType::Real, |r| Cell::Real(r.received)),
+        col("held", ColumnType::Real, |r| Cell::Real(r.held)),
     ],
 };
 
@@ -76,6 +80,9 @@ pub struct GivenRow {
     pub unit_fid: Option<u64>,
     /// The area given.
     pub area: f64,
+    /// The area of the polygon the unit held before (`overlap: cut`): how
+    /// far the cartographic boundary moved from the legal one.
+    pub held: f64,
 }
 
 /// The `given` layer (an attribute table).
@@ -89,5 +96,6 @@ pub const GIVEN: LayerDef<GivenRow> = LayerDef {
         col("src_fid", ColumnType::Int64, |r| fid(r.src_fid)),
         col("unit_fid", ColumnType::Int64, |r| fid(r.unit_fid)),
         col("area", ColumnType::Real, |r| real(Some(r.area))),
+        col("held", ColumnType::Real, |r| real(Some(r.held))),
     ],
 };

@@ -31,14 +31,15 @@
 //! medial axis nor exactly shared, and the step would no longer be exact.
 
 mod assemble;
+mod cut;
 mod layer;
 mod narrow;
 mod owners;
 mod split;
 
-pub use assemble::assemble;
+pub use assemble::{assemble, Growth};
 pub use layer::{BoundaryRow, CoverageRow, GivenRow, BOUNDARIES, COVERAGE, GIVEN};
-pub use owners::{Coverage, Unit};
+pub use owners::{Coverage, Unit, DEFAULT_SNAP};
 pub use split::Owner;
 
 use crate::collapse::CollapseParams;
@@ -62,10 +63,26 @@ pub enum Unowned {
     Nearest,
 }
 
+/// What happens where a unit overlaps a collapsed polygon.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "lowercase")]
+pub enum Overlap {
+    /// The polygon is cut out of the unit first, and what the unit held of
+    /// it is given by the rule like the rest of the polygon (units that
+    /// contain their share of a river, as administrative data have them).
+    #[default]
+    Cut,
+    /// The polygon is rejected, with the place and the unit.
+    Reject,
+}
+
 /// Options of the `partition` step.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct PartitionParams {
+    /// Units that overlap a collapsed polygon (real administrative units contain their share of the river or lake): `cut` (default) cuts the polygon out of them first and gives its area by the rule, so the new boundary runs down the middle of the water whatever the legal line inside it; `reject` rejects such a polygon, naming the unit and the place.
+    #[serde(default)]
+    pub overlap: Overlap,
     /// What happens to area nearest to bank no unit owns (the sea, the coverage's edge, holes that are no unit): `keep` (default) makes it a remainder polygon in `areas` (`kind = unowned`); `nearest` gives it to the owned part it borders along the longest stretch.
     #[serde(default)]
     pub unowned: Unowned,
@@ -87,6 +104,7 @@ fn default_tolerance() -> f64 {
 impl Default for PartitionParams {
     fn default() -> Self {
         Self {
+            overlap: Overlap::Cut,
             unowned: Unowned::Keep,
             width: None,
             tolerance: default_tolerance(),
@@ -148,9 +166,25 @@ pub struct NewBoundary {
     pub lines: MultiLineString<f64>,
 }
 
+/// A unit changed by a collapsed polygon beside what it was given: snapped
+/// onto its bank, or cut where it held some of it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct UnitChange {
+    /// The unit (an index into the coverage).
+    pub unit: u32,
+    /// The unit's FID.
+    pub fid: Option<u64>,
+    /// How it was snapped onto the bank.
+    pub edits: crate::geometry::overlay::Edits,
+    /// What it held of the polygon (cut out of it).
+    pub held: Vec<Polygon<f64>>,
+}
+
 /// One collapsed polygon part, partitioned.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct PartPartition {
+    /// The units snapped or cut (`overlap: cut`) by this part.
+    pub units: Vec<UnitChange>,
     /// The pieces given to units.
     pub given: Vec<Given>,
     /// The new boundaries, one per pair of owners.
@@ -181,12 +215,63 @@ pub fn partition(
     ma: Option<&SkeletonGraph>,
 ) -> Result<PartPartition, String> {
     let tol = SAME_POINT * p.extent();
+    let near = cut::Near::of(p, cov, cov.snap_for(p.extent()), tol);
+    if params.overlap == Overlap::Reject {
+        if let Some((k, area, at)) = near.first_overlap(tol) {
+            let fid = cov.units()[k as usize]
+                .fid
+                .map_or_else(|| "(no fid)".into(), |f| f.to_string());
+            return Err(format!(
+                "the polygon overlaps unit {fid} of `input.neighbours` ({} CRS units² of it lie inside the unit) near ({:.3}, {:.3}); with `partition: {{overlap: cut}}` (the default) the unit's share is cut out of it and given by the rule, or remove the overlap from the coverage",
+                crate::report::sig(area, 4),
+                at.x,
+                at.y
+            ));
+        }
+    }
+    let local = near.coverage(cov);
+    let snapped = match near.polygon == *p.polygon() {
+        true => None,
+        false => Some(PreparedPolygon::new(&near.polygon).map_err(|e| e.to_string())?),
+    };
+    let mut out = partition_cut(snapped.as_ref().unwrap_or(p), p, &local, params, ma)?;
+    let global = |o: Owner| o.map(|i| near.units[i as usize].index);
+    for g in &mut out.given {
+        g.unit = near.units[g.unit as usize].index;
+    }
+    for b in &mut out.boundaries {
+        (b.left, b.right) = (global(b.left), global(b.right));
+    }
+    out.units = near
+        .units
+        .into_iter()
+        .filter(|u| !u.edits.is_empty() || !u.held.is_empty())
+        .map(|u| UnitChange {
+            unit: u.index,
+            fid: cov.units()[u.index as usize].fid,
+            edits: u.edits,
+            held: u.held,
+        })
+        .collect();
+    Ok(out)
+}
+
+/// [`partition`] of `p` (`original`, snapped) between the units of `cov`,
+/// which meet it along its bank.
+fn partition_cut(
+    p: &PreparedPolygon,
+    original: &PreparedPolygon,
+    cov: &Coverage,
+    params: &PartitionParams,
+    ma: Option<&SkeletonGraph>,
+) -> Result<PartPartition, String> {
+    let tol = SAME_POINT * p.extent();
     let mut owned = owners::owned(p, cov, tol)?;
     let mut cuts: Vec<Vec<Coord<f64>>> = Vec::new();
     let mut wide_parts: Vec<Polygon<f64>> = Vec::new();
     if let Some(c) = params.narrow() {
         let ma = ma.ok_or("a partition with `width` needs the part's medial axis")?;
-        let n = crate::collapse::collapse(ma, p, &c, &[]);
+        let n = crate::collapse::collapse(ma, original, &c, &[]);
         if n.collapsed.is_empty() {
             // Wide everywhere: nothing is given away.
             return Ok(PartPartition {
@@ -566,13 +651,82 @@ mod tests {
     }
 
     #[test]
-    fn a_polygon_over_a_unit_is_refused() {
+    fn a_polygon_over_a_unit_is_refused_with_overlap_reject() {
         let (p, _) = canal();
         let cov = Coverage::new(vec![unit(
             9,
             polygon![(x: 50., y: 2.), (x: 60., y: 2.), (x: 60., y: 20.), (x: 50., y: 20.)],
         )]);
-        let e = partition(&p, &cov, &PartitionParams::default(), None).unwrap_err();
-        assert!(e.contains("overlaps the interior of unit 9"), "{e}");
+        let reject = PartitionParams {
+            overlap: Overlap::Reject,
+            ..PartitionParams::default()
+        };
+        let e = partition(&p, &cov, &reject, None).unwrap_err();
+        assert!(e.contains("overlaps unit 9"), "{e}");
+        assert!(e.contains("80 CRS units²"), "{e}");
+    }
+
+    /// The canal's units with the legal line inside the water, at y = 3.
+    fn covering_units() -> Coverage {
+        Coverage::new(vec![
+            unit(
+                1,
+                polygon![(x: 0., y: -20.), (x: 100., y: -20.), (x: 100., y: 3.), (x: 0., y: 3.)],
+            ),
+            unit(
+                2,
+                polygon![(x: 0., y: 3.), (x: 100., y: 3.), (x: 100., y: 30.), (x: 0., y: 30.)],
+            ),
+            unit(
+                3,
+                polygon![(x: -20., y: -20.), (x: 0., y: -20.), (x: 0., y: 30.), (x: -20., y: 30.)],
+            ),
+            unit(
+                4,
+                polygon![(x: 100., y: -20.), (x: 120., y: -20.), (x: 120., y: 30.), (x: 100., y: 30.)],
+            ),
+        ])
+    }
+
+    #[test]
+    fn units_that_cover_the_canal_are_cut_and_share_it_down_the_middle() {
+        let (p, _) = canal();
+        let cov = covering_units();
+        let r = partition(&p, &cov, &PartitionParams::default(), None).unwrap();
+        let areas = given_area(&r);
+        assert_eq!(areas.len(), 4, "{areas:?}");
+        for (unit, area) in areas {
+            let want = if unit < 2 { 475.0 } else { 25.0 };
+            assert!((area - want).abs() < 1e-6, "unit {unit}: {area}");
+        }
+        let held: Vec<(u32, f64)> = r
+            .units
+            .iter()
+            .filter(|u| !u.held.is_empty())
+            .map(|u| (u.unit, crate::geometry::overlay::area(&u.held)))
+            .collect();
+        assert_eq!(held.len(), 2, "{held:?}");
+        assert!((held[0].1 - 300.0).abs() < 1e-9 && (held[1].1 - 700.0).abs() < 1e-9);
+        let ab = r
+            .boundaries
+            .iter()
+            .find(|b| (b.left, b.right) == (Some(0), Some(1)))
+            .expect("a boundary between the two sides");
+        assert!(ab.lines.0[0].0.iter().all(|c| (c.y - 5.0).abs() < 1e-9));
+        // The coverage: the units' land and their shares, area conserved.
+        let mut grown = Vec::new();
+        for g in &r.given {
+            grown.push((g.fid, Growth::Given(g.polygon.clone())));
+        }
+        for u in &r.units {
+            grown.extend(u.held.iter().map(|h| (u.fid, Growth::Held(h.clone()))));
+        }
+        let rows = assemble(cov.units(), grown).unwrap();
+        let area: Vec<f64> = rows.iter().map(|c| c.geometry.unsigned_area()).collect();
+        for (got, want) in area.iter().zip([2475.0, 2475.0, 1025.0, 1025.0]) {
+            assert!((got - want).abs() < 1e-9, "{area:?}");
+        }
+        assert_eq!(rows[0].held, 300.0);
+        assert!(rows.iter().all(|c| c.geometry.0.len() == 1));
     }
 }

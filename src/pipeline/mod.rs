@@ -114,6 +114,10 @@ pub enum RunError {
         /// Cores of this machine.
         cores: usize,
     },
+    /// A unit of the partitioned coverage could not be written valid (exit
+    /// 65: the output is not written).
+    #[error("partition: {0}")]
+    Coverage(String),
     /// The run's output was written but its report was not.
     #[error("the report failed ({0}); the GeoPackage was written, `skeletonise report` makes the report from it")]
     Report(#[from] ReportError),
@@ -379,11 +383,13 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
         let grown = gathered.grown;
         // The partitioned coverage: every unit, grown by what it received.
         if let (Ok(()), Some(cov)) = (&result, &params.neighbours) {
-            if rows_tx
-                .send(grown_coverage(cov, grown, &mut counts))
-                .is_err()
-            {
-                result = Ok(());
+            match grown_coverage(cov, grown, &mut counts) {
+                Ok(rows) => {
+                    if rows_tx.send(rows).is_err() {
+                        result = Ok(());
+                    }
+                }
+                Err(e) => result = Err(e),
             }
         }
         // Stop the reader (if still reading) and let the writer drain.
@@ -467,11 +473,11 @@ fn log_start(job: &Job<'_>, info: &SourceInfo, threads: usize) {
 /// by what it received (counted and logged).
 fn grown_coverage(
     cov: &crate::partition::Coverage,
-    grown: Vec<(Option<u64>, geo::Polygon<f64>)>,
+    grown: Vec<(Option<u64>, crate::partition::Growth)>,
     counts: &mut Counts,
-) -> Rows {
+) -> Result<Rows, RunError> {
     let clock = crate::clock::CpuClock::start();
-    let coverage = crate::partition::assemble(cov.units(), grown);
+    let coverage = crate::partition::assemble(cov.units(), grown).map_err(RunError::Coverage)?;
     counts.partition_time += clock.elapsed();
     counts.units = Some(coverage.len() as u64);
     let grew: Vec<f64> = coverage
@@ -488,10 +494,24 @@ fn grown_coverage(
         coverage.len(),
         grew.iter().sum::<f64>()
     );
-    Rows {
+    let held: Vec<f64> = coverage
+        .iter()
+        .map(|c| c.held)
+        .filter(|&a| a > 0.0)
+        .collect();
+    if !held.is_empty() {
+        tracing::info!(
+            units_held = held.len(),
+            area_held = held.iter().sum::<f64>(),
+            "partition: {} units held {:.6e} (CRS units²) of the collapsed polygons before: cut out of them and given by the rule (`held` in layers `given` and `coverage`)",
+            held.len(),
+            held.iter().sum::<f64>()
+        );
+    }
+    Ok(Rows {
         coverage,
         ..Rows::default()
-    }
+    })
 }
 
 /// What the run gathers from every feature for the rows written once,
@@ -499,7 +519,7 @@ fn grown_coverage(
 #[derive(Default)]
 struct Gathered {
     /// The pieces given to each unit of the partitioned coverage.
-    grown: Vec<(Option<u64>, geo::Polygon<f64>)>,
+    grown: Vec<(Option<u64>, crate::partition::Growth)>,
     /// The connection points met by each network line (its FID).
     met: Vec<(Option<u64>, geo::Coord<f64>)>,
 }

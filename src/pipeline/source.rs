@@ -212,7 +212,10 @@ pub(super) fn read_neighbours(
     }
     units.sort_by_key(|u| u.fid);
     tracing::info!(source = %n.source, layer = %reader.info().layer, units = units.len(), "partition: coverage read");
-    Ok((Coverage::new(units), reader.info().clone()))
+    Ok((
+        Coverage::new(units).with_snap(n.snap),
+        reader.info().clone(),
+    ))
 }
 
 /// Why the reader thread stops before the end of the source.

@@ -374,9 +374,10 @@ fn partition_rows(
     parts: &[crate::partition::PartPartition],
     rows: &mut Rows,
 ) {
-    use crate::partition::{BoundaryRow, GivenRow};
-    use geo::{Euclidean, Length};
-    let mut given: std::collections::BTreeMap<Option<u64>, f64> = Default::default();
+    use crate::partition::{BoundaryRow, GivenRow, Growth};
+    use geo::{Area, Euclidean, Length};
+    // (area given, area held) by unit.
+    let mut given: std::collections::BTreeMap<Option<u64>, (f64, f64)> = Default::default();
     for p in parts {
         for b in &p.boundaries {
             rows.boundaries.push(BoundaryRow {
@@ -387,12 +388,21 @@ fn partition_rows(
                 geometry: b.lines.clone(),
             });
         }
-        for (unit, area) in crate::partition::given_area(p) {
-            let fid = p.given.iter().find(|g| g.unit == unit).and_then(|g| g.fid);
-            *given.entry(fid).or_default() += area;
+        for g in &p.given {
+            given.entry(g.fid).or_default().0 += g.polygon.unsigned_area();
+            rows.grown.push((g.fid, Growth::Given(g.polygon.clone())));
         }
-        rows.grown
-            .extend(p.given.iter().map(|g| (g.fid, g.polygon.clone())));
+        for u in &p.units {
+            let held: f64 = u.held.iter().map(|h| h.unsigned_area()).sum();
+            if !u.held.is_empty() {
+                given.entry(u.fid).or_default().1 += held;
+            }
+            rows.grown
+                .extend(u.held.iter().map(|h| (u.fid, Growth::Held(h.clone()))));
+            if !u.edits.is_empty() {
+                rows.grown.push((u.fid, Growth::Snapped(u.edits.clone())));
+            }
+        }
         let kept = p.wide.iter().map(|(w, cuts)| (w, *cuts, "wide"));
         let remainders = p.remainders.iter().map(|r| (r, 0, "unowned"));
         rows.areas
@@ -407,10 +417,11 @@ fn partition_rows(
             }));
     }
     rows.given
-        .extend(given.into_iter().map(|(unit_fid, area)| GivenRow {
+        .extend(given.into_iter().map(|(unit_fid, (area, held))| GivenRow {
             src_fid: f.fid,
             unit_fid,
             area,
+            held,
         }));
 }
 
