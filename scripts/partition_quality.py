@@ -135,16 +135,38 @@ def boundary_z(lines, left, right, bank):
 
 
 def land_of(units, rivers):
-    """The units less the collapsed polygons (their land), and the units that
-    touch none (written bit for bit)."""
+    """The units less the collapsed polygons (their land), and the units
+    farther than the default snap (1e-7 × the waters' extent) from all of
+    them (written bit for bit)."""
     water = shapely.union_all(rivers.geometry.values)
     land = units.copy()
     land["geometry"] = shapely.difference(units.geometry.values, water)
-    untouched = set(units.index[~shapely.intersects(units.geometry.values, water)])
+    x0, y0, x1, y1 = shapely.total_bounds(rivers.geometry.values)
+    far = shapely.distance(units.geometry.values, water) > 1e-7 * max(x1 - x0, y1 - y0)
+    untouched = set(units.index[far])
     return land, untouched, water
 
 
-def measure_ours(src, rivers_layer, units_layer, out, samples=20000, covering=False, units_crs_layer=None):
+def legal_offset(units, water, bnd):
+    """How far the legal lines inside the water (the boundaries two covering
+    units share there) lie from the new boundaries: at 2 000 points along
+    them, the distance to the nearest new boundary between two units, as a
+    share of the local width (twice the distance to the shore): median, and
+    the largest distance (CRS units)."""
+    g = units.geometry.values
+    shared = [shapely.intersection(shapely.boundary(g[i]), shapely.boundary(g[j]))
+              for i in range(len(g)) for j in range(i + 1, len(g))]
+    legal = shapely.intersection(shapely.union_all(shared), water) if shared else None
+    inner = bnd[bnd.left_fid.notna() & bnd.right_fid.notna()] if bnd is not None else None
+    if legal is None or legal.is_empty or legal.length == 0 or inner is None or not len(inner):
+        return None, None
+    pts = shapely.line_interpolate_point(legal, np.linspace(0, legal.length, 2002)[1:-1])
+    d = shapely.distance(pts, shapely.union_all(inner.geometry.values))
+    w = 2 * shapely.distance(pts, water.boundary)
+    return float(np.median(d[w > 0] / w[w > 0])), float(d.max())
+
+
+def measure_ours(src, rivers_layer, units_layer, out, samples=20000, covering=False):
     units = read(src, units_layer)
     rivers = read(src, rivers_layer)
     if covering:
@@ -198,6 +220,7 @@ def measure_ours(src, rivers_layer, units_layer, out, samples=20000, covering=Fa
     }
     if covering:
         m["held"] = m_held
+        m["legal_offset_median"], m["legal_offset_max"] = legal_offset(original, water, bnd)
     if given is not None and not covering:
         gained = shapely.area(out_geoms) - shapely.area(orig)
         by = given.groupby("unit_fid")["area"].sum()

@@ -80,12 +80,17 @@ impl Network {
     /// end outside P within `snap` of ∂P connects at its nearest boundary
     /// point unless a touch or crossing of the same line lies within `snap`
     /// of that point (it already serves the end). An end inside P never
-    /// snaps: the line entered P where it crossed ∂P.
+    /// snaps: the line entered P where it crossed ∂P. Whatever `snap`, an
+    /// end within the round-off of a reprojection
+    /// ([`ROUND_OFF`](crate::geometry::tolerance::ROUND_OFF) × extent)
+    /// outside ∂P connects: lines from another CRS connect as in theirs.
     pub fn points(&self, p: &PreparedPolygon) -> Vec<(Option<u64>, Coord<f64>)> {
         let b = p.boundary();
         let (lo, hi) = (b.bbox_min(), b.bbox_max());
         let eps = 1e-9 * p.extent();
-        let snap = self.snap.max(eps);
+        let snap = self
+            .snap
+            .max(crate::geometry::tolerance::ROUND_OFF * p.extent());
         let mut out: Vec<(Option<u64>, Coord<f64>)> = Vec::new();
         for l in &self.lines {
             let (a, z) = (l.bbox.min(), l.bbox.max());

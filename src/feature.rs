@@ -67,6 +67,9 @@ pub struct Feature {
     /// The source FIDs dissolved into this feature by `input.merge_adjacent`
     /// (empty: the feature is only itself).
     pub members: Vec<u64>,
+    /// The source geometries of `members`, in the same order, kept for
+    /// the `rejected` layer (a rejected group lists every member).
+    pub member_wkb: Vec<Option<Vec<u8>>>,
 }
 
 impl Feature {
@@ -88,6 +91,7 @@ impl Feature {
             repaired: false,
             checked: false,
             members: Vec::new(),
+            member_wkb: Vec::new(),
         }
     }
 }

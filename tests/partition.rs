@@ -189,3 +189,129 @@ fn the_neighbours_source_is_never_the_output() {
         assert_eq!(std::fs::read(&units).unwrap(), before);
     }
 }
+
+const BORDER: &str = "tests/data/border-waters.gpkg";
+
+/// The areas of the `coverage` rows of a partition run on a real border
+/// water of `tests/data/border-waters.gpkg`, with the units of `units`,
+/// and the run's stderr.
+fn border_run(dir: &std::path::Path, water: &str, units: &str) -> (Vec<f64>, String) {
+    let out = dir.join(format!("{units}.gpkg"));
+    let (code, err) = code_and_err(&skeletonise(&[
+        "run",
+        "pipelines/partition-border-waters.yaml",
+        "--set",
+        &format!("input.source={BORDER}"),
+        "--set",
+        &format!("input.neighbours.source={BORDER}"),
+        "--set",
+        &format!("input.layer={water}"),
+        "--set",
+        &format!("input.neighbours.layer={units}"),
+        "-o",
+        out.to_str().unwrap(),
+    ]));
+    assert_eq!(code, 0, "{err}");
+    let ds = open(&out);
+    assert!(
+        ds.layer_by_name("rejected").is_err() || common::count(&ds, "rejected") == 0,
+        "{err}"
+    );
+    let mut cov = ds.layer_by_name("coverage").unwrap();
+    let areas = cov
+        .features()
+        .map(|f| f.geometry().map_or(0.0, |g| g.area()))
+        .collect();
+    (areas, err)
+}
+
+#[test]
+fn units_that_cover_a_real_lake_are_cut_and_the_same_in_longitude_latitude() {
+    // Switzerland and France (DCW) around Lake Geneva (GSHHG): the border
+    // runs inside the lake, the countries' coasts are not its shore.
+    let dir = tmp();
+    let (utm, err) = border_run(dir.path(), "waters_geneva", "units_geneva");
+    assert!(err.contains("units held"), "{err}");
+    let out = open(&dir.path().join("units_geneva.gpkg"));
+    let held: f64 = reals(&out, "given", "held").iter().flatten().sum();
+    let given: f64 = reals(&out, "given", "area").iter().flatten().sum();
+    // The lake is 538 km²: held before (but for slivers of it outside both
+    // countries), given again whole.
+    assert!((given - 538.2e6).abs() < 0.1e6, "{given}");
+    assert!(
+        held <= given * (1.0 + 1e-9) && held > 0.99 * given,
+        "{given} {held}"
+    );
+    assert!(reals(&out, "coverage", "held")
+        .iter()
+        .all(|h| h.unwrap() > 0.0));
+    let (lonlat, _) = border_run(dir.path(), "waters_geneva", "units_geneva_4326");
+    assert_eq!(utm.len(), lonlat.len());
+    for (a, b) in utm.iter().zip(&lonlat) {
+        assert!((a - b).abs() <= 1e-6 * a, "{a} {b}");
+    }
+}
+
+#[test]
+fn a_unit_with_a_nan_coordinate_is_named_and_nothing_panics() {
+    let dir = tmp();
+    let src = dir.path().join("case.gpkg");
+    common::make_layer(
+        &src,
+        "rivers",
+        3857,
+        &[Some("POLYGON((0 0,100 0,100 10,0 10,0 0))")],
+    );
+    common::make_layer(
+        &src,
+        "units",
+        3857,
+        &[
+            Some("POLYGON((0 -20,100 -20,100 0,0 0,0 -20))"),
+            Some("POLYGON((0 10,100 10,100 30,7 30,0 10))"),
+        ],
+    );
+    // The second unit's 7 made NaN (WKT has no NaN): an UPDATE of its WKB.
+    let mut wkb: Vec<u8> = vec![1, 3, 0, 0, 0, 1, 0, 0, 0, 5, 0, 0, 0];
+    for (x, y) in [
+        (0.0, 10.0),
+        (100.0, 10.0),
+        (100.0, 30.0),
+        (f64::NAN, 30.0),
+        (0.0, 10.0),
+    ] {
+        wkb.extend(f64::to_le_bytes(x));
+        wkb.extend(f64::to_le_bytes(y));
+    }
+    {
+        let ds = gdal::Dataset::open_ex(
+            &src,
+            gdal::DatasetOptions {
+                open_flags: gdal::GdalOpenFlags::GDAL_OF_UPDATE
+                    | gdal::GdalOpenFlags::GDAL_OF_VECTOR,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let l = ds.layer_by_name("units").unwrap();
+        let mut f = l.feature(2).unwrap();
+        f.set_geometry(gdal::vector::Geometry::from_wkb(&wkb).unwrap())
+            .unwrap();
+        l.set_feature(f).unwrap();
+    }
+    let out = dir.path().join("o.gpkg");
+    let text = format!(
+        "input: {{ source: {s}, layer: rivers, neighbours: {{ source: {s}, layer: units }} }}\nsteps: [ {{ skeleton: {{ methods: [MA] }} }}, {{ partition: {{}} }} ]\noutput: {{ path: {} }}\n",
+        out.display(),
+        s = src.display()
+    );
+    let p = pipeline(dir.path(), "p.yaml", &text);
+    let (code, err) = code_and_err(&skeletonise(&["run", p.to_str().unwrap()]));
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("feature 2 has a coordinate that is not a finite number"),
+        "{err}"
+    );
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(!out.exists());
+}

@@ -754,6 +754,7 @@ def apply_layers(
     connect=None,
     snap: float = 0.0,
     neighbours=None,
+    neighbour_snap: float | None = None,
     candidates: bool = False,
     threads: int | None = None,
 ) -> dict:
@@ -768,7 +769,9 @@ def apply_layers(
     boundaries) and ``given`` (what each unit received of each polygon). ``connect`` (a
     GeoDataFrame or GeoSeries of lines: the line network of ``input.connect``, ``snap`` its snap
     distance) and ``neighbours`` (a GeoDataFrame of polygons: the coverage of
-    ``input.neighbours``) are reprojected to ``gdf``'s CRS when theirs differs; their ``src_fid``
+    ``input.neighbours``; ``neighbour_snap`` its ``snap``: unit vertices and edges within it of a
+    polygon's bank are moved onto it, default the pipeline file's ``input.neighbours.snap`` or 1e-7 ×
+    each polygon's extent) are reprojected to ``gdf``'s CRS when theirs differs; their ``src_fid``
     is their index where it is an integer index (pyogrio's ``fid_as_index=True``), else the
     position. With a ``partition`` step, adjacent polygons of ``gdf`` are merged first, exactly,
     as the command line's reader merges them (the skeleton row takes the index of the member
@@ -784,6 +787,8 @@ def apply_layers(
     if neighbours is not None:
         units, fids = _side_input(neighbours, gdf.crs, "neighbours")
         extra.update(neighbours=units, neighbour_fids=fids.tolist())
+        if neighbour_snap is not None:
+            extra["neighbour_snap"] = float(neighbour_snap)
     if candidates:
         extra["with_candidates"] = True
     frame, done = _run_frame(gdf, p, candidates=False, threads=threads, extra=extra, with_done=True)

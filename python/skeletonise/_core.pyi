@@ -75,6 +75,7 @@ class Pipeline:
         snap: float = 0.0,
         neighbours: Optional[list[Optional[bytes]]] = None,
         neighbour_fids: Optional[Sequence[int]] = None,
+        neighbour_snap: Optional[float] = None,
         with_candidates: bool = False,
     ) -> dict[str, Any]:
         """Runs the steps with the GIL released.

@@ -189,10 +189,11 @@ impl Pipeline {
     /// (WKB lines, with `connect_fids`) is the line network of
     /// `input.connect`, `snap` its snap distance. With a `partition` step,
     /// `neighbours` (WKB polygons, with `neighbour_fids`) is the coverage of
-    /// `input.neighbours`, and the result's `layers` hold `coverage`,
+    /// `input.neighbours` (`neighbour_snap` its `snap`, default the pipeline
+    /// file's), and the result's `layers` hold `coverage`,
     /// `boundaries`, `given` and `areas`. `with_candidates`: the
     /// `candidates` layer too, among `layers`, from the same pass.
-    #[pyo3(signature = (geometry, *, fids = None, repaired = None, candidates = false, explode = None, threads = None, output = "geoarrow", cancel = None, connect = None, connect_fids = None, snap = 0.0, neighbours = None, neighbour_fids = None, with_candidates = false))]
+    #[pyo3(signature = (geometry, *, fids = None, repaired = None, candidates = false, explode = None, threads = None, output = "geoarrow", cancel = None, connect = None, connect_fids = None, snap = 0.0, neighbours = None, neighbour_fids = None, neighbour_snap = None, with_candidates = false))]
     #[allow(clippy::too_many_arguments)]
     fn run<'py>(
         &self,
@@ -210,16 +211,30 @@ impl Pipeline {
         snap: f64,
         neighbours: Option<Vec<Option<Vec<u8>>>>,
         neighbour_fids: Option<Vec<i64>>,
+        neighbour_snap: Option<f64>,
         with_candidates: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
         let mut params = self.steps.process_params();
         let partition = params.partition.is_some();
         match (partition, neighbours) {
             (true, Some(units)) => {
-                params.neighbours = Some(std::sync::Arc::new(coverage(
-                    &units,
-                    neighbour_fids.as_deref(),
-                )?));
+                // `neighbour_snap`, else the pipeline file's `input.neighbours.snap`.
+                let from_file = self
+                    .steps
+                    .file
+                    .input
+                    .as_ref()
+                    .and_then(|i| i.neighbours.as_ref())
+                    .and_then(|n| n.snap);
+                let snap = neighbour_snap.or(from_file);
+                if snap.is_some_and(|s| !(s.is_finite() && s >= 0.0)) {
+                    return Err(PipelineError::new_err(
+                        "`neighbour_snap` must be ≥ 0 (CRS units of the polygons); leave it out for 1e-7 × each polygon's extent",
+                    ));
+                }
+                params.neighbours = Some(std::sync::Arc::new(
+                    coverage(&units, neighbour_fids.as_deref())?.with_snap(snap),
+                ));
             }
             (true, None) => {
                 return Err(PipelineError::new_err(
@@ -377,17 +392,14 @@ fn coverage(
     let mut out = Vec::with_capacity(units.len());
     for (i, w) in units.iter().enumerate() {
         let fid = fids.map_or(Some(i as u64), |f| u64::try_from(f[i]).ok());
-        let geometry = match w.as_deref().map(wkb::read).transpose() {
-            Ok(None) => geo::MultiPolygon(Vec::new()),
-            Ok(Some(geo::Geometry::Polygon(p))) => geo::MultiPolygon(vec![p]),
-            Ok(Some(geo::Geometry::MultiPolygon(m))) => m,
-            Ok(Some(_)) | Err(_) => {
-                return Err(PipelineError::new_err(format!(
+        let read = w.as_deref().map(wkb::read).transpose().map_err(|_| {
+            PipelineError::new_err(format!(
                 "`neighbours`: feature {} is not a polygon; the coverage is a layer of polygons",
                 fid.map_or_else(|| i.to_string(), |f| f.to_string())
-            )))
-            }
-        };
+            ))
+        })?;
+        let geometry = skeletonise::partition::unit_geometry(fid, read.as_ref())
+            .map_err(|e| PipelineError::new_err(format!("`neighbours`: {e}")))?;
         out.push(skeletonise::partition::Unit {
             fid,
             geometry,

@@ -194,6 +194,7 @@ fn features(
             repaired,
             checked: false,
             members: Vec::new(),
+            member_wkb: Vec::new(),
         };
         match input.geometry(i) {
             Ok(Some(g)) if repaired => match wkb::areal_parts(g) {

@@ -42,6 +42,7 @@ SELECT = ["distortion", "deviation", "deviation_parts", "distortion_sum"]
 PARTS = ["each", "largest"]
 COLLAPSE_MODES = ["partial", "whole"]
 UNOWNED = ["keep", "nearest"]
+OVERLAP = ["cut", "reject"]
 
 HELP_URL = "https://github.com/skeletonise/skeletonise#in-qgis"
 
@@ -210,6 +211,10 @@ class _Algorithm(QgsProcessingAlgorithm):
             if layer is not None:
                 unit_skip = {unit_fields.at(i).name() for i in layer.dataProvider().pkAttributeIndexes()}
             extra.update(neighbours=wkbs, neighbour_fids=fids)
+            if "SNAP" in [p.name() for p in self.parameterDefinitions()]:
+                neighbour_snap = self.parameterAsDouble(parameters, "SNAP", context)
+                if neighbour_snap > 0:
+                    extra["neighbour_snap"] = neighbour_snap
         features = bridge.read(source, pipeline.make_valid, feedback)
         carried = bridge.source_fields(source.fields(), skip)
         reserved = bridge.core().reserved(collapse, partition)
@@ -682,7 +687,13 @@ class PartitionAlgorithm(_Algorithm):
         "overlap, area conserved.\n\n"
         "<b>Polygons</b>: the polygons to give away, in a projected CRS.\n"
         "<b>Neighbours</b>: the coverage of units around them (reprojected to the polygons' CRS when it "
-        "differs); their banks must lie on the polygons' boundary.\n"
+        "differs). Real administrative units may contain their share of the water (the legal boundary "
+        "inside it) or come from another source: see Overlap and Snap.\n"
+        "<b>Overlap</b>: where a unit overlaps a polygon: cut (the polygon is cut out of the unit and its "
+        "area given by the rule; the result is a cartographic boundary down the middle, not the legal one) "
+        "or reject (the polygon is rejected, naming the unit).\n"
+        "<b>Snap</b>: unit vertices and edges within this distance of a polygon's bank are moved onto it "
+        "(layer units; 0: 1e-7 × each polygon's extent, above a reprojection's round-off).\n"
         "<b>Width</b>: give away only where the polygon is narrower than this (layer units; 0: the whole "
         "polygon); wider parts stay polygons of their own (Remainders, kind = wide).\n"
         "<b>Tolerance</b>: with a width, the band around it as a fraction of it, as in Collapse.\n"
@@ -690,8 +701,8 @@ class PartitionAlgorithm(_Algorithm):
         "remainder, kind = unowned) or nearest (to the unit it borders along the longest stretch).\n"
         "<b>Prune</b>, <b>Minimum leg length</b>, <b>Extend</b>: the medial axis written to Skeletons, as in "
         "Skeletonise polygons.\n"
-        "<b>Grown coverage</b>: every unit with its fields, src_fid (its FID) and received (the area it "
-        "received).\n"
+        "<b>Grown coverage</b>: every unit with its fields, src_fid (its FID), received (the area it "
+        "received) and held (the area of the polygons it held before, cut out of it).\n"
         "<b>New boundaries</b>: the lines between two units that run through the polygons (left_fid, "
         "right_fid, length).\n"
         "<b>Remainders</b>: optional; the parts given to no unit (kind wide or unowned).\n"
@@ -707,6 +718,8 @@ class PartitionAlgorithm(_Algorithm):
         self.addParameter(QgsProcessingParameterNumber("WIDTH", _tr("Width (layer units; 0: the whole polygon)"), number, 0.0, minValue=0.0))
         self.addParameter(QgsProcessingParameterNumber("TOLERANCE", _tr("Tolerance (fraction of the width)"), number, 0.2, minValue=0.0, maxValue=0.99))
         self.addParameter(QgsProcessingParameterEnum("UNOWNED", _tr("Unowned area"), options=UNOWNED, defaultValue=0))
+        self.addParameter(QgsProcessingParameterEnum("OVERLAP", _tr("Units that overlap a polygon"), options=OVERLAP, defaultValue=0))
+        self.addParameter(QgsProcessingParameterNumber("SNAP", _tr("Snap (layer units; 0: 1e-7 × extent)"), number, 0.0, minValue=0.0))
         _method_parameters(self, choose=False)
         _partition_sinks(self, required=True)
         self.addParameter(
@@ -720,6 +733,7 @@ class PartitionAlgorithm(_Algorithm):
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802
         partition = {
             "unowned": UNOWNED[self.parameterAsEnum(parameters, "UNOWNED", context)],
+            "overlap": OVERLAP[self.parameterAsEnum(parameters, "OVERLAP", context)],
             "tolerance": self.parameterAsDouble(parameters, "TOLERANCE", context),
         }
         width = self.parameterAsDouble(parameters, "WIDTH", context)

@@ -100,7 +100,7 @@ pub struct ConnectSpec {
     /// Layer name or zero-based index; default the first layer.
     #[serde(default)]
     pub layer: Option<LayerRef>,
-    /// A line end within this distance of a polygon's boundary connects (CRS units; default 0: only lines that touch or cross it).
+    /// A line end within this distance of a polygon's boundary connects (CRS units; default 0: lines that touch or cross it, and line ends within the round-off of a reprojection, 1e-7 × the polygon's extent, of it).
     #[serde(default)]
     pub snap: f64,
 }

@@ -16,6 +16,7 @@
 //! |---|---|---|---|
 //! | [`SAME_POINT`] | 10⁻⁹ | × extent | one point; on ∂P (SPEC §3) |
 //! | [`ON_BOUNDARY_END`] | 10⁻⁷ | × extent | a line end on ∂P |
+//! | [`ROUND_OFF`] | 10⁻⁷ | × extent | a second input's vertex on ∂P |
 //! | [`BAR_ORIGIN`] | 10⁻⁶ | × extent | a bar's hit at its own origin |
 //! | [`TRACE_CROSSING`] | 10⁻⁶ | × extent | the straight skeleton's verification |
 //! | [`VERTEX_SNAP`] | 10⁻¹² | × extent | a chord end at a boundary vertex |
@@ -42,6 +43,13 @@ pub const SAME_POINT: f64 = 1e-9;
 /// resolution of any method (MA's grid, ≤ 1.5 × 10⁻⁸ × extent), so every
 /// method's leaves that reach ∂P count as reaching it.
 pub const ON_BOUNDARY_END: f64 = 1e-7;
+
+/// A vertex of a second input (a unit of `input.neighbours`, a line end of
+/// `input.connect`) within `ROUND_OFF × extent` of ∂P is on it whatever
+/// side of it round-off put it: the default snap, 1 cm on a 100 km river,
+/// far above what a reprojection between two CRSs moves a vertex by
+/// (0.1–0.3 mm measured between EPSG:4326 and UTM) and below anything drawn.
+pub const ROUND_OFF: f64 = 1e-7;
 
 /// A bar's hit closer than `BAR_ORIGIN × extent` to the bar's origin is the
 /// origin itself (SPEC §6.2): the boundary vertex a bar starts from.

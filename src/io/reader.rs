@@ -351,6 +351,7 @@ impl Reader {
             repaired: false,
             checked: false,
             members: Vec::new(),
+            member_wkb: Vec::new(),
         };
         // gdal hands out a wrapper around a null handle for NULL geometries.
         // SAFETY: the handle is only compared with null.

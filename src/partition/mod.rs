@@ -39,7 +39,7 @@ mod split;
 
 pub use assemble::{assemble, Growth};
 pub use layer::{BoundaryRow, CoverageRow, GivenRow, BOUNDARIES, COVERAGE, GIVEN};
-pub use owners::{Coverage, Unit, DEFAULT_SNAP};
+pub use owners::{unit_geometry, Coverage, Unit, DEFAULT_SNAP};
 pub use split::Owner;
 
 use crate::collapse::CollapseParams;

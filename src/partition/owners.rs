@@ -14,10 +14,8 @@ use rstar::{RTree, AABB};
 use rustc_hash::FxHashMap;
 
 /// The default of `input.neighbours.snap`, relative to a collapsed
-/// polygon's extent: 10⁻⁷ (1 cm on a 100 km river), well above the
-/// round-off of a reprojection (0.1–0.3 mm measured between EPSG:4326 and
-/// UTM) and well below anything drawn.
-pub const DEFAULT_SNAP: f64 = 1e-7;
+/// polygon's extent: [`ROUND_OFF`](crate::geometry::tolerance::ROUND_OFF).
+pub const DEFAULT_SNAP: f64 = crate::geometry::tolerance::ROUND_OFF;
 
 /// One unit of the neighbours' coverage.
 #[derive(Debug, Clone, PartialEq)]
@@ -28,6 +26,44 @@ pub struct Unit {
     pub geometry: MultiPolygon<f64>,
     /// Its fields, in the source's order.
     pub attributes: Vec<Value>,
+}
+
+/// A unit's geometry as a coverage takes it: NULL and EMPTY are a unit
+/// without area, polygons and multipolygons are taken as they are, and
+/// anything else — another type, a NaN or infinite coordinate — is why
+/// the unit cannot be (`fid` names it in the message).
+pub fn unit_geometry(
+    fid: Option<u64>,
+    g: Option<&geo::Geometry<f64>>,
+) -> Result<MultiPolygon<f64>, String> {
+    use geo::{CoordsIter, HasDimensions};
+    let name = || fid.map_or_else(|| "(no fid)".into(), |f| f.to_string());
+    let m = match g {
+        None => return Ok(MultiPolygon(Vec::new())),
+        Some(g) if g.is_empty() => return Ok(MultiPolygon(Vec::new())),
+        Some(geo::Geometry::Polygon(p)) => MultiPolygon(vec![p.clone()]),
+        Some(geo::Geometry::MultiPolygon(m)) => m.clone(),
+        Some(_) => {
+            return Err(format!(
+                "feature {} is not a polygon; the coverage is a layer of polygons",
+                name()
+            ))
+        }
+    };
+    if let Some(c) = m
+        .coords_iter()
+        .find(|c| !(c.x.is_finite() && c.y.is_finite()))
+    {
+        return Err(format!(
+            "feature {} has a coordinate that is not a finite number ({}, {}); fix or remove the unit",
+            name(),
+            c.x,
+            c.y
+        ));
+    }
+    Ok(MultiPolygon(
+        m.0.into_iter().filter(|p| !p.is_empty()).collect(),
+    ))
 }
 
 /// A unit's boundary segment in the index: the unit and its two ends.

@@ -47,7 +47,7 @@ impl Counts {
             });
         }
         for rej in &r.rows.rejected {
-            tracing::warn!(fid = f.fid, reason = %rej.reason, "feature rejected");
+            tracing::warn!(fid = rej.src_fid, reason = %rej.reason, "feature rejected");
         }
         match &r.status {
             Status::Rejected => self.rejected += f.source_count(),

@@ -180,27 +180,22 @@ pub(super) fn read_neighbours(
     let mut bad = None;
     reader.read::<IoError>(1024, false, |batch| {
         for f in batch {
-            let geometry = match &f.geometry {
-                None => geo::MultiPolygon(Vec::new()),
-                Some(geo::Geometry::Polygon(p)) => geo::MultiPolygon(vec![p.clone()]),
-                Some(geo::Geometry::MultiPolygon(m)) => m.clone(),
-                Some(_) => {
-                    bad.get_or_insert(f.fid);
-                    continue;
+            match crate::partition::unit_geometry(f.fid, f.geometry.as_ref()) {
+                Ok(geometry) => units.push(Unit {
+                    fid: f.fid,
+                    geometry,
+                    attributes: f.attributes,
+                }),
+                Err(why) => {
+                    bad.get_or_insert(why);
                 }
-            };
-            units.push(Unit {
-                fid: f.fid,
-                geometry,
-                attributes: f.attributes,
-            });
+            }
         }
         Ok(())
     })?;
-    if let Some(fid) = bad {
+    if let Some(why) = bad {
         return Err(error(format!(
-            "`input.neighbours`: feature {} of layer `{}` is not a polygon; the coverage is a layer of polygons (filter it with `input.neighbours.where`)",
-            fid.map_or_else(|| "(no fid)".into(), |f| f.to_string()),
+            "`input.neighbours`: {why} (layer `{}`; filter units out with `input.neighbours.where`)",
             reader.info().layer
         )));
     }

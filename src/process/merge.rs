@@ -34,8 +34,82 @@ pub fn merge_adjacent(features: Vec<Feature>, by: Option<usize>) -> Vec<Feature>
 /// dropped, every other vertex kept bit for bit), for polygons that share
 /// their edges vertex for vertex (reaches cut from one river) — what a
 /// partition needs, whose pieces must keep the source's vertices.
+///
+/// Polygons that overlap (two reaches drawn over each other by a
+/// millimetre) join a group too; such a group cannot be put together
+/// exactly and is dissolved as [`merge_adjacent`] dissolves (a warning
+/// names its members): the units are snapped onto the bank they then have.
 pub fn merge_adjacent_exactly(features: Vec<Feature>, by: Option<usize>) -> Vec<Feature> {
-    merge_with(features, by, dissolve_exactly)
+    let overlapping = overlapping_pairs(&features);
+    let mut uf = UnionFind::new(features.len());
+    for &(i, j) in &overlapping {
+        uf.union(i, j);
+    }
+    let overlapped: std::collections::HashSet<u64> = overlapping
+        .iter()
+        .flat_map(|&(i, j)| [features[i].fid, features[j].fid])
+        .flatten()
+        .collect();
+    merge_groups(features, by, uf, |group| {
+        if group
+            .iter()
+            .any(|f| f.fid.is_some_and(|x| overlapped.contains(&x)))
+        {
+            let fids: Vec<String> = group
+                .iter()
+                .map(|f| f.fid.map_or_else(|| "(no fid)".into(), |x| x.to_string()))
+                .collect();
+            tracing::warn!(
+                "features {} overlap each other: dissolved into one polygon (not exactly, as `merge_adjacent` does) before the partition",
+                fids.join(", ")
+            );
+            dissolve(group)
+        } else {
+            dissolve_exactly(group)
+        }
+    })
+}
+
+/// The pairs of polygon features whose interiors overlap (by their
+/// indices, the smaller first).
+fn overlapping_pairs(features: &[Feature]) -> Vec<(usize, usize)> {
+    use geo::{BoundingRect, Relate};
+    use rstar::primitives::{GeomWithData, Rectangle};
+    use rstar::RTreeObject;
+    let polys: Vec<Option<MultiPolygon<f64>>> = features
+        .iter()
+        .map(|f| polygons(f).map(MultiPolygon))
+        .collect();
+    let boxes: Vec<GeomWithData<Rectangle<[f64; 2]>, usize>> = polys
+        .iter()
+        .enumerate()
+        .filter_map(|(i, p)| {
+            let r = p.as_ref()?.bounding_rect()?;
+            Some(GeomWithData::new(
+                Rectangle::from_corners([r.min().x, r.min().y], [r.max().x, r.max().y]),
+                i,
+            ))
+        })
+        .collect();
+    let tree = rstar::RTree::bulk_load(boxes.clone());
+    let mut out = Vec::new();
+    for b in &boxes {
+        let i = b.data;
+        for hit in tree.locate_in_envelope_intersecting(&b.geom().envelope()) {
+            let j = hit.data;
+            if j <= i {
+                continue;
+            }
+            let (Some(a), Some(c)) = (&polys[i], &polys[j]) else {
+                continue;
+            };
+            // Interiors that meet.
+            if a.relate(c).matches("T********").unwrap_or(false) {
+                out.push((i, j));
+            }
+        }
+    }
+    out
 }
 
 fn merge_with(
@@ -43,8 +117,18 @@ fn merge_with(
     by: Option<usize>,
     dissolve: fn(Vec<Feature>) -> Feature,
 ) -> Vec<Feature> {
+    let uf = UnionFind::new(features.len());
+    merge_groups(features, by, uf, dissolve)
+}
+
+/// [`merge_with`] starting from the groups `uf` already joined.
+fn merge_groups(
+    features: Vec<Feature>,
+    by: Option<usize>,
+    mut uf: UnionFind,
+    dissolve: impl Fn(Vec<Feature>) -> Feature,
+) -> Vec<Feature> {
     let n = features.len();
-    let mut uf = UnionFind::new(n);
     // Each edge (quantised, unordered) → the first feature seen with it, per group key.
     let mut edges: HashMap<EdgeKey, usize> = HashMap::new();
     for (i, f) in features.iter().enumerate() {
@@ -154,6 +238,11 @@ pub fn dissolve(mut group: Vec<Feature>) -> Feature {
 /// geometry, the members' FIDs listed, repaired if any member was.
 fn merged_feature(mut group: Vec<Feature>, merged: Vec<Polygon<f64>>) -> Feature {
     let members: Vec<u64> = group.iter().filter_map(|f| f.fid).collect();
+    let member_wkb: Vec<Option<Vec<u8>>> = group
+        .iter()
+        .filter(|f| f.fid.is_some())
+        .map(|f| f.source_wkb.clone())
+        .collect();
     let repaired = group.iter().any(|f| f.repaired);
     let mut first = group.swap_remove(0);
     first.geometry = Some(match merged.len() {
@@ -164,6 +253,7 @@ fn merged_feature(mut group: Vec<Feature>, merged: Vec<Polygon<f64>>) -> Feature
     first.repaired = repaired;
     first.checked = false;
     first.members = members;
+    first.member_wkb = member_wkb;
     first
 }
 

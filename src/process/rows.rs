@@ -118,7 +118,7 @@ pub fn feature_rows(
 ) -> FeatureRows {
     let mut rows = Rows::default();
     if let Some(e) = &f.geometry_error {
-        rows.rejected.push(rejected(f, e.clone()));
+        rows.rejected.extend(rejected(f, e.clone()));
         return FeatureRows {
             rows,
             status: Status::Rejected,
@@ -152,7 +152,7 @@ pub fn feature_rows(
                     Some(i) if opts.explode => format!("part {i}: {reason}"),
                     _ => reason,
                 };
-                rows.rejected.push(rejected(f, reason));
+                rows.rejected.extend(rejected(f, reason));
             }
         }
     }
@@ -162,7 +162,7 @@ pub fn feature_rows(
     if rows.rejected.len() > 1 || (!rows.rejected.is_empty() && !methods.is_empty()) {
         let reasons: Vec<String> = rows.rejected.drain(..).map(|r| r.reason).collect();
         rows = Rows::default();
-        rows.rejected.push(rejected(f, reasons.join("; ")));
+        rows.rejected.extend(rejected(f, reasons.join("; ")));
         methods.clear();
     }
     let status = if !rows.rejected.is_empty() {
@@ -220,12 +220,26 @@ fn notes(c: &crate::process::CandidateSkeleton) -> Option<String> {
     (!parts.is_empty()).then(|| parts.join("; "))
 }
 
-fn rejected(f: &Feature, reason: String) -> RejectedRow {
-    RejectedRow {
-        src_fid: f.fid,
-        reason,
-        wkb: f.source_wkb.clone(),
+/// The `rejected` rows of a feature: one, or for a group of merged
+/// features one per member, each with its own FID and source geometry.
+fn rejected(f: &Feature, reason: String) -> Vec<RejectedRow> {
+    if f.members.is_empty() {
+        return vec![RejectedRow {
+            src_fid: f.fid,
+            reason,
+            wkb: f.source_wkb.clone(),
+        }];
     }
+    let all = members_text(f).unwrap_or_default();
+    f.members
+        .iter()
+        .enumerate()
+        .map(|(i, &fid)| RejectedRow {
+            src_fid: Some(fid),
+            reason: format!("{reason} (merged features {all})"),
+            wkb: f.member_wkb.get(i).cloned().flatten(),
+        })
+        .collect()
 }
 
 /// The source FIDs a feature stands for, comma-separated (its own when it
