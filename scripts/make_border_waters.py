@@ -141,7 +141,9 @@ def main():
         units_utm = [shapely.transform(u, to_utm, interleaved=False) for u in units]
         write(out, f"waters_{name}", ws, f"EPSG:{epsg}", water_id=np.arange(1, len(ws) + 1))
         write(out, f"units_{name}", units_utm, f"EPSG:{epsg}", code=codes)
-        write(out, f"units_{name}_4326", units, "EPSG:4326", code=codes)
+        # The same units as another source would give them: in longitude/latitude, rounded
+        # to 1e-8° (about a millimetre), every vertex then off the UTM one by round-off.
+        write(out, f"units_{name}_4326", shapely.set_precision(np.array(units), 1e-8), "EPSG:4326", code=codes)
         nv = sum(shapely.get_num_coordinates(w) for w in ws)
         nu = sum(shapely.get_num_coordinates(u) for u in units_utm)
         cover = shapely.area(shapely.intersection(shapely.union_all(ws), shapely.union_all(units_utm)))

@@ -279,12 +279,17 @@ fn faces(g: &Graph) -> Vec<Face> {
     // The next half-edge of a cycle: at the end of `h`, the first outgoing
     // one clockwise from the way back (the twin, when there is one, is
     // skipped: it lies exactly on the way back).
+    // None: no half-edge leaves the vertex (edges that do not close into
+    // cycles; that open chain gives no face).
     let next = |h: u32| {
         let e = g.half[h as usize];
         let list = &out[e.to as usize];
+        if list.is_empty() {
+            return None;
+        }
         let back = g.pos[e.from as usize] - g.pos[e.to as usize];
         let i = list.partition_point(|&x| angle_order(dir(x), back) == std::cmp::Ordering::Less);
-        list[(i + list.len() - 1) % list.len()]
+        Some(list[(i + list.len() - 1) % list.len()])
     };
     let mut seen = vec![false; g.half.len()];
     let mut shells: Vec<Shell> = Vec::new();
@@ -296,13 +301,20 @@ fn faces(g: &Graph) -> Vec<Face> {
         let mut cycle = Vec::new();
         let mut h = start;
         let mut outside = false;
+        let mut open = false;
         while !seen[h as usize] {
             seen[h as usize] = true;
             outside |= g.half[h as usize].outside;
             cycle.push(h);
-            h = next(h);
+            match next(h) {
+                Some(n) => h = n,
+                None => {
+                    open = true;
+                    break;
+                }
+            }
         }
-        if outside {
+        if outside || open || h != start {
             continue;
         }
         for part in simple_cycles(g, &cycle) {

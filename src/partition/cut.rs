@@ -15,7 +15,7 @@
 
 use super::owners::{with_inserted, Coverage, Inserts, Unit};
 use crate::geometry::overlay::{
-    self, overlay, snap_edges, snap_vertices, vertex_index, BankInsert, Edits,
+    self, interiors_meet, overlay, snap_edges, snap_vertices, vertex_index, BankInsert, Edits,
 };
 use crate::geometry::PreparedPolygon;
 use geo::{Area, Coord, InteriorPoint, MultiPolygon, Polygon};
@@ -46,7 +46,9 @@ pub struct Near {
 impl Near {
     /// The units near `p` in `cov`, snapped onto its bank within `snap`
     /// and cut by it (points within `tol` of an edge count as on it).
-    pub fn of(p: &PreparedPolygon, cov: &Coverage, snap: f64, tol: f64) -> Near {
+    /// Or why a unit could not be cut exactly (its pieces would not add up
+    /// to it).
+    pub fn of(p: &PreparedPolygon, cov: &Coverage, snap: f64, tol: f64) -> Result<Near, String> {
         let b = p.boundary();
         let grow = Coord { x: snap, y: snap };
         let indices = cov.units_near(b.bbox_min() - grow, b.bbox_max() + grow);
@@ -54,7 +56,7 @@ impl Near {
         let mut edits = vec![Edits::default(); indices.len()];
         let mut into_p: Vec<BankInsert> = Vec::new();
         for (e, &k) in edits.iter_mut().zip(&indices) {
-            snap_vertices(&units[k as usize].geometry, b, snap, e, &mut into_p);
+            snap_vertices(&units[k as usize].geometry, b, (snap, tol), e, &mut into_p);
         }
         let mut inserts = Inserts::default();
         for ((ring, index), c) in into_p {
@@ -62,26 +64,45 @@ impl Near {
         }
         let polygon = with_inserted(p.polygon(), &inserts, |c| c);
         let points = vertex_index(&polygon);
-        let near = indices
+        let bank = crate::geometry::Boundary::new(&polygon);
+        let probe = geo::InteriorPoint::interior_point(&polygon).map(|q| q.0);
+        let near: Result<Vec<NearUnit>, String> = indices
             .iter()
             .zip(edits)
             .map(|(&k, mut e)| {
                 let g = &units[k as usize].geometry;
-                snap_edges(g, &points, snap, &mut e);
+                snap_edges(g, &points, (snap, tol), &mut e);
                 let snapped = e.apply(g);
+                // Most units of a clean coverage only meet the polygon
+                // along its bank: nothing to cut, no overlay.
+                if !interiors_meet(&snapped, &bank, probe, tol) {
+                    return Ok(NearUnit {
+                        index: k,
+                        cut: snapped.0,
+                        edits: e,
+                        held: Vec::new(),
+                    });
+                }
                 let o = overlay(&snapped.0, &polygon, tol);
-                NearUnit {
+                let (whole, parts) = (snapped.unsigned_area(), overlay::area(&o.outside) + overlay::area(&o.inside));
+                if (whole - parts).abs() > 1e-9 * whole.max(p.polygon().unsigned_area()) {
+                    let fid = units[k as usize].fid.map_or_else(|| "(no fid)".into(), |f| f.to_string());
+                    return Err(format!(
+                        "unit {fid} of `input.neighbours` could not be cut exactly by the polygon (its pieces add up to {parts}, not {whole}); check the unit's validity, or try another `input.neighbours.snap`"
+                    ));
+                }
+                Ok(NearUnit {
                     index: k,
                     cut: o.outside,
                     edits: e,
                     held: o.inside,
-                }
+                })
             })
             .collect();
-        Near {
+        Ok(Near {
             polygon,
-            units: near,
-        }
+            units: near?,
+        })
     }
 
     /// The near units, cut, as a coverage of their own (unit `i` of it is

@@ -215,7 +215,7 @@ pub fn partition(
     ma: Option<&SkeletonGraph>,
 ) -> Result<PartPartition, String> {
     let tol = SAME_POINT * p.extent();
-    let near = cut::Near::of(p, cov, cov.snap_for(p.extent()), tol);
+    let near = cut::Near::of(p, cov, cov.snap_for(p.extent()), tol)?;
     if params.overlap == Overlap::Reject {
         if let Some((k, area, at)) = near.first_overlap(tol) {
             let fid = cov.units()[k as usize]
@@ -266,7 +266,7 @@ fn partition_cut(
     ma: Option<&SkeletonGraph>,
 ) -> Result<PartPartition, String> {
     let tol = SAME_POINT * p.extent();
-    let mut owned = owners::owned(p, cov, tol)?;
+    let mut owned = owners::owned(p, cov, tol);
     let mut cuts: Vec<Vec<Coord<f64>>> = Vec::new();
     let mut wide_parts: Vec<Polygon<f64>> = Vec::new();
     if let Some(c) = params.narrow() {

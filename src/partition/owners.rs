@@ -1,11 +1,10 @@
 //! Who owns each edge of a collapsed polygon: the coverage's units indexed
 //! by their boundary segments, a unit vertex that lies on one of the
 //! polygon's edges (a T-junction) inserted there, every edge of the polygon
-//! given to the unit whose boundary it lies on (or to none: unowned bank),
-//! and a polygon that overlaps a unit's interior refused.
+//! given to the unit whose boundary it lies on (or to none: unowned bank).
 
 use crate::feature::Value;
-use crate::geometry::segment::{closest_on_segment, inner_points_along, properly_cross};
+use crate::geometry::segment::{closest_on_segment, inner_points_along};
 use crate::geometry::vector::norm;
 use crate::geometry::{Boundary, PreparedPolygon};
 use geo::{BoundingRect, Coord, LineString, MultiPolygon, Polygon};
@@ -277,18 +276,17 @@ pub struct VertexOwners {
     pub out_of: Coord<f64>,
 }
 
-/// `p` with its owners in `cov`, or why it cannot be partitioned: it
-/// overlaps a unit's interior (more than `tol`).
-pub fn owned(p: &PreparedPolygon, cov: &Coverage, tol: f64) -> Result<Owned, String> {
+/// `p` with its owners in `cov`, whose units meet it only along its
+/// boundary (cut by it: [`super::cut`]).
+pub fn owned(p: &PreparedPolygon, cov: &Coverage, tol: f64) -> Owned {
     let polygon = with_t_junctions(p, cov, tol);
-    overlaps(p, &polygon, cov, tol)?;
     let mut owner = FxHashMap::default();
     for r in std::iter::once(polygon.exterior()).chain(polygon.interiors()) {
         for w in r.0.windows(2) {
             owner.insert((key(w[0]), key(w[1])), owner_of(cov, w[0], w[1], tol));
         }
     }
-    Ok(Owned { polygon, owner })
+    Owned { polygon, owner }
 }
 
 /// The unit whose boundary holds the edge `a`–`b` (both ends within `tol`
@@ -377,150 +375,4 @@ pub(super) fn with_inserted(
             .map(|(k, r)| ring(k + 1, r))
             .collect(),
     )
-}
-
-/// The rings of a unit.
-fn rings(u: &Unit) -> Vec<&LineString<f64>> {
-    u.geometry
-        .0
-        .iter()
-        .flat_map(|q| std::iter::once(q.exterior()).chain(q.interiors()))
-        .collect()
-}
-
-/// An error when a unit near `p` overlaps its interior: a vertex of one
-/// farther than `tol` inside the other, or edges that cross.
-fn overlaps(
-    p: &PreparedPolygon,
-    polygon: &Polygon<f64>,
-    cov: &Coverage,
-    tol: f64,
-) -> Result<(), String> {
-    let b = p.boundary();
-    let Some(bbox) = polygon.bounding_rect() else {
-        return Ok(());
-    };
-    let mut near: Vec<u32> = cov
-        .near(bbox.min(), bbox.max(), tol)
-        .map(|s| s.data)
-        .collect();
-    near.sort_unstable();
-    near.dedup();
-    let units: Vec<&Unit> = near.iter().map(|&k| &cov.units[k as usize]).collect();
-    let bounds: Vec<Boundary> = units
-        .iter()
-        .map(|u| Boundary::from_rings(rings(u)))
-        .collect();
-    let inside_p = |v: Coord<f64>| {
-        let (lo, hi) = (bbox.min(), bbox.max());
-        (lo.x..=hi.x).contains(&v.x)
-            && (lo.y..=hi.y).contains(&v.y)
-            && b.contains(v)
-            && b.distance(v) > tol
-    };
-    // A vertex the polygon and a unit share lies on both boundaries: only
-    // the others are tested for lying inside (an overlap through shared
-    // vertices alone shows as crossing edges).
-    let p_vertices: rustc_hash::FxHashSet<(u64, u64)> = std::iter::once(polygon.exterior())
-        .chain(polygon.interiors())
-        .flat_map(|r| r.0.iter().map(|&c| key(c)))
-        .collect();
-    let p_vertex_in = polygon_vertices_in(polygon, &units, &bounds, tol);
-    for (i, unit) in units.iter().enumerate() {
-        let ub = &bounds[i];
-        let vertex_in = rings(unit)
-            .into_iter()
-            .flat_map(|r| r.0.iter().copied())
-            .filter(|&v| !p_vertices.contains(&key(v)))
-            .find(|&v| inside_p(v))
-            .or(p_vertex_in[i]);
-        if let Some(at) = vertex_in.or_else(|| first_crossing(ub, b, tol)) {
-            let fid = unit
-                .fid
-                .map_or_else(|| "(no fid)".into(), |f| f.to_string());
-            return Err(format!(
-                "the polygon overlaps the interior of unit {fid} of `input.neighbours` near ({:.3}, {:.3}); the units must meet the collapsed polygons along their boundaries, not cover them: remove the overlap from the coverage (e.g. cut the polygons out of it) and run again",
-                at.x, at.y
-            ));
-        }
-    }
-    Ok(())
-}
-
-/// For each of `units` (their boundaries `bounds`), a vertex of `polygon`
-/// farther than `tol` inside it, if any: each vertex the units do not
-/// share, tested against the units whose box holds it.
-fn polygon_vertices_in(
-    polygon: &Polygon<f64>,
-    units: &[&Unit],
-    bounds: &[Boundary],
-    tol: f64,
-) -> Vec<Option<Coord<f64>>> {
-    let boxes: RTree<GeomWithData<rstar::primitives::Rectangle<[f64; 2]>, usize>> =
-        RTree::bulk_load(
-            units
-                .iter()
-                .enumerate()
-                .filter_map(|(i, u)| {
-                    let r = u.geometry.bounding_rect()?;
-                    Some(GeomWithData::new(
-                        rstar::primitives::Rectangle::from_corners(
-                            [r.min().x - tol, r.min().y - tol],
-                            [r.max().x + tol, r.max().y + tol],
-                        ),
-                        i,
-                    ))
-                })
-                .collect(),
-        );
-    let shared: rustc_hash::FxHashSet<(u64, u64)> = units
-        .iter()
-        .flat_map(|u| rings(u))
-        .flat_map(|r| r.0.iter().map(|&c| key(c)))
-        .collect();
-    let mut inside: Vec<Option<Coord<f64>>> = vec![None; units.len()];
-    for &v in std::iter::once(polygon.exterior())
-        .chain(polygon.interiors())
-        .flat_map(|r| r.0.iter())
-        .filter(|&&v| !shared.contains(&key(v)))
-    {
-        for hit in boxes.locate_all_at_point(&[v.x, v.y]) {
-            let i = hit.data;
-            let ub = &bounds[i];
-            if inside[i].is_none() && ub.contains(v) && ub.distance(v) > tol {
-                inside[i] = Some(v);
-            }
-        }
-    }
-    inside
-}
-
-/// Where an edge of `ub` first properly crosses one of `b` (farther than
-/// `tol` from their ends, and not running along it: a piece of an edge
-/// whose ends lie within `tol` of the other is on it, whichever side
-/// rounding put them).
-fn first_crossing(ub: &Boundary, b: &Boundary, tol: f64) -> Option<Coord<f64>> {
-    let along = |a: Coord<f64>, b: Coord<f64>, c: Coord<f64>, d: Coord<f64>| {
-        let on = |x: Coord<f64>, p: Coord<f64>, q: Coord<f64>| {
-            norm(closest_on_segment(p, q, x).0 - x) <= tol
-        };
-        (on(a, c, d) && on(b, c, d)) || (on(c, a, b) && on(d, a, b))
-    };
-    ub.segments().iter().find_map(|s| {
-        b.segments_near(s.a, s.b)
-            .map(|i| &b.segments()[i])
-            .find(|t| {
-                properly_cross(s.a, s.b, t.a, t.b)
-                    && far_from_ends(s.a, s.b, t.a, t.b, tol)
-                    && !along(s.a, s.b, t.a, t.b)
-            })
-            .map(|t| crate::geometry::segment::crossing_point(s.a, s.b, t.a, t.b))
-    })
-}
-
-/// Whether two crossing segments cross farther than `tol` from all four
-/// ends (a crossing at a shared vertex, within rounding, is a touch).
-fn far_from_ends(a: Coord<f64>, b: Coord<f64>, c: Coord<f64>, d: Coord<f64>, tol: f64) -> bool {
-    let x = crate::geometry::segment::crossing_point(a, b, c, d);
-    [a, b, c, d].iter().all(|&e| norm(x - e) > tol)
 }

@@ -71,9 +71,12 @@ pub fn merge_adjacent_exactly(features: Vec<Feature>, by: Option<usize>) -> Vec<
 }
 
 /// The pairs of polygon features whose interiors overlap (by their
-/// indices, the smaller first).
+/// indices, the smaller first): `geometry::overlay::interiors_meet` either
+/// way round (within `1e-9 ×` the pair's extent).
 fn overlapping_pairs(features: &[Feature]) -> Vec<(usize, usize)> {
-    use geo::{BoundingRect, Relate};
+    use crate::geometry::overlay::interiors_meet;
+    use crate::geometry::Boundary;
+    use geo::{BoundingRect, InteriorPoint};
     use rstar::primitives::{GeomWithData, Rectangle};
     use rstar::RTreeObject;
     let polys: Vec<Option<MultiPolygon<f64>>> = features
@@ -95,6 +98,8 @@ fn overlapping_pairs(features: &[Feature]) -> Vec<(usize, usize)> {
     let mut out = Vec::new();
     for b in &boxes {
         let i = b.data;
+        let (lo, hi) = (b.geom().envelope().lower(), b.geom().envelope().upper());
+        let extent = (hi[0] - lo[0]).max(hi[1] - lo[1]);
         for hit in tree.locate_in_envelope_intersecting(&b.geom().envelope()) {
             let j = hit.data;
             if j <= i {
@@ -103,8 +108,13 @@ fn overlapping_pairs(features: &[Feature]) -> Vec<(usize, usize)> {
             let (Some(a), Some(c)) = (&polys[i], &polys[j]) else {
                 continue;
             };
-            // Interiors that meet.
-            if a.relate(c).matches("T********").unwrap_or(false) {
+            let meet = |a: &MultiPolygon<f64>, c: &MultiPolygon<f64>| {
+                c.0.iter().any(|q| {
+                    let probe = q.interior_point().map(|p| p.0);
+                    interiors_meet(a, &Boundary::new(q), probe, 1e-9 * extent)
+                })
+            };
+            if meet(a, c) || meet(c, a) {
                 out.push((i, j));
             }
         }

@@ -129,6 +129,7 @@ pub fn feature_rows(
     let mut methods = Vec::new();
     let mut times: Vec<(MethodId, StageTimes)> = Vec::new();
     let mut partition_time = std::time::Duration::ZERO;
+    let mut reasons: Vec<String> = Vec::new();
     for (part, geom) in units(f.geometry.as_ref(), opts.explode) {
         let processed = fenced(geom.as_ref(), f.checked, skeletons, params);
         let label = match skeletons {
@@ -148,19 +149,18 @@ pub fn feature_rows(
             }
             Processed::Filtered => {}
             Processed::Rejected(reason) => {
-                let reason = match part {
+                reasons.push(match part {
                     Some(i) if opts.explode => format!("part {i}: {reason}"),
                     _ => reason,
-                };
-                rows.rejected.extend(rejected(f, reason));
+                });
             }
         }
     }
     // A feature is written whole or rejected whole: with `explode`, a part
     // that cannot be processed rejects the feature (one row, every part's
-    // reason), and its other parts' rows are not written.
-    if rows.rejected.len() > 1 || (!rows.rejected.is_empty() && !methods.is_empty()) {
-        let reasons: Vec<String> = rows.rejected.drain(..).map(|r| r.reason).collect();
+    // reason; a row per member of a merged group), and its other parts'
+    // rows are not written.
+    if !reasons.is_empty() {
         rows = Rows::default();
         rows.rejected.extend(rejected(f, reasons.join("; ")));
         methods.clear();
