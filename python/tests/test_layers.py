@@ -75,6 +75,47 @@ def test_partition_gives_the_command_lines_coverage_and_boundaries(tmp_path):
     assert abs(cov.area.sum() + layers["areas"].area.sum() - total) <= 1e-9 * total
 
 
+def test_units_that_cover_a_lake_give_the_command_lines_rows_and_take_the_snap(tmp_path):
+    # Real countries covering a real lake (tests/data/border-waters.gpkg): the overlap is cut as
+    # on the command line, with the same options; `neighbour_snap` is input.neighbours.snap.
+    import os
+    import subprocess
+
+    from conftest import cli_binary
+
+    border = ROOT / "tests" / "data" / "border-waters.gpkg"
+    pipeline = ROOT / "pipelines" / "partition-border-waters.yaml"
+    out = tmp_path / "p.gpkg"
+    subprocess.run(
+        [str(cli_binary()), "run", str(pipeline), "-o", str(out), "-q", "--set", "input.layer=waters_titicaca",
+         "--set", "input.neighbours.layer=units_titicaca"],
+        check=True, cwd=ROOT, env=dict(os.environ, SKELETONISE_SRC=str(border)),
+    )
+    waters = pyogrio.read_dataframe(border, layer="waters_titicaca", fid_as_index=True)
+    units = pyogrio.read_dataframe(border, layer="units_titicaca", fid_as_index=True)
+    layers = skeletonise.apply_layers(waters, pipeline, neighbours=units)
+    cov = layers["coverage"]
+    assert cov["held"].gt(0).all()
+    same_rows(cov, out, "coverage")
+    given = pyogrio.read_dataframe(out, layer="given", read_geometry=False).sort_values(["src_fid", "unit_fid"])
+    got = layers["given"].sort_values(["src_fid", "unit_fid"])
+    assert list(got.unit_fid) == list(given.unit_fid)
+    assert np.allclose(got.area, given.area, rtol=1e-12) and np.allclose(got.held, given.held, rtol=1e-12)
+    assert shapely.coverage_is_valid(cov.geometry.values)
+    # `overlap: reject` refuses the lakes the countries cover, as the command line does.
+    rejected = skeletonise.apply_layers(waters, pipeline, neighbours=units, overrides=["steps.partition.overlap=reject"])
+    assert rejected["skeletons"]["rejected"].str.contains("overlaps unit").sum() >= 1
+    # The same units from another source in longitude/latitude (reprojected by GeoPandas): the
+    # same areas to 1e-6, with the default snap and with one given.
+    lonlat = pyogrio.read_dataframe(border, layer="units_titicaca_4326", fid_as_index=True)
+    for snap in (None, 0.01):
+        other = skeletonise.apply_layers(waters, pipeline, neighbours=lonlat, neighbour_snap=snap)["coverage"]
+        assert shapely.coverage_is_valid(other.geometry.values)
+        assert np.allclose(other.area.values, cov.area.values, rtol=1e-6)
+    with pytest.raises(skeletonise.PipelineError, match="neighbour_snap"):
+        skeletonise.apply_layers(waters, pipeline, neighbours=units, neighbour_snap=-1.0)
+
+
 def test_a_partition_without_neighbours_says_what_to_give():
     rivers = pyogrio.read_dataframe(COVERAGE, layer="rivers_danube", fid_as_index=True)
     with pytest.raises(skeletonise.PipelineError, match="neighbours"):

@@ -264,10 +264,16 @@ class _Algorithm(QgsProcessingAlgorithm):
                 break
             except (bridge.core().RejectedError, bridge.core().PipelineError) as e:
                 raise QgsProcessingException(str(e)) from None
+            # Counted whether or not the skeletons are written (a partition's are optional).
+            counts["rejected"] += done["skeletons"]["counts"]["rejected"]
+            counts["written"] += done["skeletons"]["counts"]["written"]
+            if "OUTPUT" not in outputs and done["skeletons"]["counts"]["rejected"]:
+                feedback.reportError(
+                    f"{done['skeletons']['counts']['rejected']} features rejected; write the Skeletons output to see why"
+                )
             for _key, (sink, layer, keep) in outputs.items():
                 if layer == "skeletons":
-                    counts["rejected"] += bridge.write(sink, done[layer], features, start, keep, feedback)
-                    counts["written"] += done[layer]["counts"]["written"]
+                    bridge.write(sink, done[layer], features, start, keep, feedback)
                     continue
                 rows_of = done["skeletons"]["layers"][layer]
                 if rows_of["fields"] == "neighbours":

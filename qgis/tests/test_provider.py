@@ -427,6 +427,34 @@ class Partition(Case):
         grown = sum(r["_geom"].area() for r in coverage) + sum(r["_geom"].area() for r in rows(res["AREAS"]))
         self.assertAlmostEqual(grown, total, delta=1e-9 * total)
 
+    def test_units_that_cover_a_lake_are_cut_as_on_the_command_line(self):
+        # Real countries covering Lake Titicaca (tests/data/border-waters.gpkg): Overlap cut (the
+        # default) gives the command line's coverage; reject rejects the lake; Snap is taken.
+        src = os.path.join(ROOT, "tests", "data", "border-waters.gpkg")
+        pipeline = os.path.join(ROOT, "pipelines", "partition-border-waters.yaml")
+        cli("run", pipeline, "-o", self.out("cli.gpkg"), "--set", "input.layer=waters_titicaca",
+            "--set", "input.neighbours.layer=units_titicaca", "--set", f"input.source={src}",
+            "--set", f"input.neighbours.source={src}")
+        params = {
+            "INPUT": f"{src}|layername=waters_titicaca",
+            "NEIGHBOURS": f"{src}|layername=units_titicaca",
+            "COVERAGE": self.out("c.gpkg"),
+            "BOUNDARIES": self.out("b.gpkg"),
+        }
+        res = processing.run("skeletonise:partition", params)
+        coverage = rows(res["COVERAGE"])
+        self.assertSameRows(coverage, rows(self.out("cli.gpkg"), "coverage"))
+        self.assertTrue(all(r["held"] > 0 for r in coverage))
+        res = processing.run("skeletonise:partition", dict(params, OVERLAP=1, COVERAGE=self.out("c2.gpkg"),
+                                                           BOUNDARIES=self.out("b2.gpkg")))
+        self.assertGreaterEqual(res["FEATURES_REJECTED"], 1)
+        res = processing.run("skeletonise:partition", dict(params, SNAP=0.01, COVERAGE=self.out("c3.gpkg"),
+                                                           BOUNDARIES=self.out("b3.gpkg")))
+        areas = sorted(r["_geom"].area() for r in rows(res["COVERAGE"]))
+        want = sorted(r["_geom"].area() for r in coverage)
+        for a, b in zip(areas, want):
+            self.assertAlmostEqual(a, b, delta=1e-6 * b)
+
     def test_a_pipeline_file_with_a_partition_step_needs_the_neighbours(self):
         cov = os.path.join(ROOT, "tests", "data", "coverage-train.gpkg")
         with self.assertRaises(QgsProcessingException) as e:

@@ -233,6 +233,28 @@ pub fn interiors_meet(
     probe: Option<Coord<f64>>,
     tol: f64,
 ) -> bool {
+    contact(a, b, probe, tol) != Contact::Apart
+}
+
+/// How a polygon set A and a polygon B meet (see [`interiors_meet`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Contact {
+    /// Their interiors do not meet.
+    Apart,
+    /// B lies inside A, no vertex of A on ∂B (a lake inside a unit).
+    Holds,
+    /// A's boundary runs through B's interior.
+    Crosses,
+}
+
+/// How `a` and B (its boundary `b`, a point `probe` inside it) meet: the
+/// tests of [`interiors_meet`], telling a B wholly inside `a` apart.
+pub fn contact(
+    a: &MultiPolygon<f64>,
+    b: &Boundary,
+    probe: Option<Coord<f64>>,
+    tol: f64,
+) -> Contact {
     use geo::{BoundingRect, Contains};
     let (lo, hi) = (b.bbox_min(), b.bbox_max());
     let in_box = |c: Coord<f64>| {
@@ -248,14 +270,17 @@ pub fn interiors_meet(
             2 * u8::from(b.contains(c))
         }
     };
+    // Whether a's boundary touches ∂B anywhere.
+    let mut touches = false;
     for (_, _, r) in rings_of(a) {
         let mut at = r.0.first().map_or(0, |&c| place(c));
         for w in r.0.windows(2) {
             let (p, q) = (w[0], w[1]);
             let (at_p, at_q) = (at, place(q));
             at = at_q;
+            touches |= at_p == 1;
             if at_p == 2 {
-                return true;
+                return Contact::Crosses;
             }
             if p.x.max(q.x) < lo.x
                 || p.x.min(q.x) > hi.x
@@ -266,25 +291,51 @@ pub fn interiors_meet(
             }
             // An edge between two points of ∂B runs inside or outside.
             if at_p == 1 && at_q == 1 && place((p + q) * 0.5) == 2 {
-                return true;
+                return Contact::Crosses;
             }
             let crosses = b.segments_near(p, q).any(|i| {
                 let s = &b.segments()[i];
                 properly_cross(p, q, s.a, s.b)
             });
             if crosses {
-                return true;
+                return Contact::Crosses;
             }
         }
     }
     let (Some(q), Some(r)) = (probe, a.bounding_rect()) else {
-        return false;
+        return Contact::Apart;
     };
-    r.min().x <= q.x
+    let holds = r.min().x <= q.x
         && q.x <= r.max().x
         && r.min().y <= q.y
         && q.y <= r.max().y
-        && a.contains(&geo::Point(q))
+        && a.contains(&geo::Point(q));
+    match (holds, touches) {
+        (true, false) => Contact::Holds,
+        // B inside `a` with their boundaries touching: the overlay nodes
+        // them.
+        (true, true) => Contact::Crosses,
+        (false, _) => Contact::Apart,
+    }
+}
+
+/// `a` less a polygon `b` that lies inside it, its boundary apart from
+/// `a`'s ([`Contact::Holds`]): `b`'s exterior a new hole of the part of
+/// `a` that holds it, `b`'s holes (islands) new parts.
+pub fn with_hole(a: &MultiPolygon<f64>, b: &Polygon<f64>, probe: Coord<f64>) -> Vec<Polygon<f64>> {
+    use geo::Contains;
+    let mut out = a.0.clone();
+    if let Some(k) = out.iter().position(|q| q.contains(&geo::Point(probe))) {
+        let mut holes = out[k].interiors().to_vec();
+        holes.push(b.exterior().clone());
+        out[k] = Polygon::new(out[k].exterior().clone(), holes);
+    }
+    out.extend(
+        b.interiors()
+            .iter()
+            .map(|r| Polygon::new(r.clone(), Vec::new())),
+    );
+    out
 }
 
 /// The vertices of a polygon's rings as points of an R-tree.

@@ -276,6 +276,7 @@ impl OutputFile {
                 elapsed_s: c.real(f, name::run::ELAPSED_S).unwrap_or(f64::NAN),
                 threads: c.count(f, name::run::THREADS),
                 stage_seconds: t(name::run::STAGE_SECONDS),
+                area_held: c.real(f, name::run::AREA_HELD),
             }
         })?;
         Ok(runs.into_iter().last())

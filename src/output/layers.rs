@@ -103,6 +103,9 @@ pub mod name {
         pub const ELAPSED_S: &str = "elapsed_s";
         /// Step times, JSON.
         pub const STAGE_SECONDS: &str = "stage_seconds";
+        /// The area of the collapsed polygons the units held before a
+        /// partition cut it out of them (NULL: no partition).
+        pub const AREA_HELD: &str = "area_held";
     }
 }
 
@@ -446,6 +449,9 @@ pub struct RunRecord {
     /// Thread time per method and step, JSON (`{"MA": {"skeleton": s,
     /// "prune_extend": s, "score": s}, …}`).
     pub stage_seconds: String,
+    /// With `partition`: the area of the collapsed polygons the units held
+    /// before (cut out of them and given by the rule), CRS units².
+    pub area_held: Option<f64>,
 }
 
 /// The `skeletonise_runs` attribute table.
@@ -475,6 +481,9 @@ pub const RUNS: LayerDef<RunRecord> = LayerDef {
         col(name::run::THREADS, Int64, |r| int(r.threads)),
         col(name::run::ELAPSED_S, Real, |r| Cell::Real(r.elapsed_s)),
         col(name::run::STAGE_SECONDS, Text, |r| text(&r.stage_seconds)),
+        col(name::run::AREA_HELD, Real, |r| {
+            r.area_held.map_or(Cell::Null, Cell::Real)
+        }),
     ],
 };
 

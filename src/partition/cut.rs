@@ -15,7 +15,8 @@
 
 use super::owners::{with_inserted, Coverage, Inserts, Unit};
 use crate::geometry::overlay::{
-    self, interiors_meet, overlay, snap_edges, snap_vertices, vertex_index, BankInsert, Edits,
+    self, contact, overlay, snap_edges, snap_vertices, vertex_index, with_hole, BankInsert,
+    Contact, Edits,
 };
 use crate::geometry::PreparedPolygon;
 use geo::{Area, Coord, InteriorPoint, MultiPolygon, Polygon};
@@ -75,13 +76,28 @@ impl Near {
                 let snapped = e.apply(g);
                 // Most units of a clean coverage only meet the polygon
                 // along its bank: nothing to cut, no overlay.
-                if !interiors_meet(&snapped, &bank, probe, tol) {
-                    return Ok(NearUnit {
-                        index: k,
-                        cut: snapped.0,
-                        edits: e,
-                        held: Vec::new(),
-                    });
+                match contact(&snapped, &bank, probe, tol) {
+                    Contact::Apart => {
+                        return Ok(NearUnit {
+                            index: k,
+                            cut: snapped.0,
+                            edits: e,
+                            held: Vec::new(),
+                        })
+                    }
+                    // A lake inside a unit: a hole of it, no overlay of
+                    // the whole unit (a country holds thousands).
+                    Contact::Holds => {
+                        if let Some(q) = probe {
+                            return Ok(NearUnit {
+                                index: k,
+                                cut: with_hole(&snapped, &polygon, q),
+                                edits: e,
+                                held: vec![polygon.clone()],
+                            });
+                        }
+                    }
+                    Contact::Crosses => {}
                 }
                 let o = overlay(&snapped.0, &polygon, tol);
                 let (whole, parts) = (snapped.unsigned_area(), overlay::area(&o.outside) + overlay::area(&o.inside));

@@ -729,4 +729,50 @@ mod tests {
         assert_eq!(rows[0].held, 300.0);
         assert!(rows.iter().all(|c| c.geometry.0.len() == 1));
     }
+
+    #[test]
+    fn a_lake_with_an_island_inside_a_unit_goes_back_to_it_whole() {
+        // No unit boundary near the lake: it becomes a hole of the unit,
+        // the island a part of it, and the lake is given back whole.
+        let lake = Polygon::new(
+            geo::LineString::from(vec![
+                (10., 10.),
+                (30., 10.),
+                (30., 20.),
+                (10., 20.),
+                (10., 10.),
+            ]),
+            vec![geo::LineString::from(vec![
+                (15., 12.),
+                (15., 18.),
+                (20., 18.),
+                (20., 12.),
+                (15., 12.),
+            ])],
+        );
+        let p = PreparedPolygon::new(&lake).unwrap();
+        let cov = Coverage::new(vec![unit(
+            1,
+            polygon![(x: 0., y: 0.), (x: 40., y: 0.), (x: 40., y: 30.), (x: 0., y: 30.)],
+        )]);
+        let r = partition(&p, &cov, &PartitionParams::default(), None).unwrap();
+        assert_eq!(given_area(&r), vec![(0, 170.0)]);
+        assert_eq!(r.units.len(), 1);
+        assert_eq!(crate::geometry::overlay::area(&r.units[0].held), 170.0);
+        let mut grown: Vec<(Option<u64>, Growth)> = r
+            .given
+            .iter()
+            .map(|g| (g.fid, Growth::Given(g.polygon.clone())))
+            .collect();
+        grown.extend(
+            r.units[0]
+                .held
+                .iter()
+                .map(|h| (Some(1), Growth::Held(h.clone()))),
+        );
+        let rows = assemble(cov.units(), grown).unwrap();
+        assert_eq!(rows[0].geometry.unsigned_area(), 1200.0);
+        assert_eq!(rows[0].geometry.0.len(), 1);
+        assert!(rows[0].geometry.0[0].interiors().is_empty());
+    }
 }

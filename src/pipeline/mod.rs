@@ -508,6 +508,7 @@ fn grown_coverage(
             held.iter().sum::<f64>()
         );
     }
+    counts.area_held = held.iter().sum::<f64>() + 0.0;
     Ok(Rows {
         coverage,
         ..Rows::default()

@@ -27,6 +27,8 @@ pub(super) struct Counts {
     pub(super) network: Option<u64>,
     /// Units of the partitioned coverage written, when the run partitions.
     pub(super) units: Option<u64>,
+    /// With a partition: the area the units held of the collapsed polygons.
+    pub(super) area_held: f64,
     /// The `partition` step's CPU time: the polygons, and the coverage
     /// assembled at the end.
     pub(super) partition_time: std::time::Duration,
@@ -105,6 +107,7 @@ pub(super) fn finish_run(
         elapsed_s,
         threads,
         stage_seconds: stage_json(&counts.stages, counts.units.map(|_| counts.partition_time)),
+        area_held: counts.units.map(|_| counts.area_held),
     };
     let out = writer.finish(&record)?;
     Ok(RunSummary {
