@@ -7,6 +7,7 @@ of the water (the legal boundary runs inside it), come from another source
 than the shorelines, and their shores do not match the water's.
 
     scripts/make_border_waters.py [OUT.gpkg]     # default tests/data/border-waters.gpkg
+    scripts/make_border_waters.py --scale OUT.gpkg   # Finland's 194 lakes (not kept in the repository)
 
 Layers per case NAME: `waters_NAME` (the GSHHG polygons in the box of at least
 MIN km², in the case's UTM zone), `units_NAME` (the DCW units clipped to the
@@ -40,6 +41,10 @@ CASES = [
     ("parana", (-58.95, -55.8, -27.9, -27.0), "AR,PY", "r", 0.5, 32721),
     ("victoria", (31.4, 35.0, -3.2, 0.7), "UG,KE,TZ", "l", 20.0, 32736),
 ]
+
+# `--scale`: a larger case, not kept in the repository: Finland's lakes of at least 0.1 km²
+# (194 of them, 35 000 vertices), most inside one country, some on its borders.
+SCALE = [("finland", (19.0, 32.0, 59.7, 70.2), "FI,SE,NO,RU,EE", "l", 0.1, 32635)]
 
 
 def segments(text: str):
@@ -117,14 +122,18 @@ def write(path, layer, geoms, crs, **cols):
     import geopandas as gpd
 
     frame = gpd.GeoDataFrame(pd.DataFrame(cols), geometry=list(geoms), crs=crs)
-    pyogrio.write_dataframe(frame, path, layer=layer, driver="GPKG", promote_to_multi=True)
+    # GeoPackage 1.2: what GDAL 3.6 (Debian's, QGIS 3.22's) reads without a warning.
+    pyogrio.write_dataframe(frame, path, layer=layer, driver="GPKG", promote_to_multi=True,
+                            dataset_options={"VERSION": "1.2"} if not os.path.exists(path) else None)
 
 
 def main():
-    out = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "..", "tests", "data", "border-waters.gpkg")
+    args = [a for a in sys.argv[1:] if a != "--scale"]
+    cases = SCALE if "--scale" in sys.argv else CASES
+    out = args[0] if args else os.path.join(os.path.dirname(__file__), "..", "tests", "data", "border-waters.gpkg")
     if os.path.exists(out):
         os.remove(out)
-    for name, box, codes, kind, min_km2, epsg in CASES:
+    for name, box, codes, kind, min_km2, epsg in cases:
         codes = codes.split(",")
         units = [unit(c, box) for c in codes]
         # The units among themselves as one coverage: where two clipped

@@ -82,6 +82,8 @@ def sample_points(rivers, n, seed=1):
     counts = rng.multinomial(n, areas / areas.sum())
     pts = []
     for g, k in zip(geoms, counts):
+        if k == 0:
+            continue
         shapely.prepare(g)
         minx, miny, maxx, maxy = g.bounds
         got = []

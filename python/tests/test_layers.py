@@ -100,7 +100,7 @@ def test_units_that_cover_a_lake_give_the_command_lines_rows_and_take_the_snap(t
     given = pyogrio.read_dataframe(out, layer="given", read_geometry=False).sort_values(["src_fid", "unit_fid"])
     got = layers["given"].sort_values(["src_fid", "unit_fid"])
     assert list(got.unit_fid) == list(given.unit_fid)
-    assert np.allclose(got.area, given.area, rtol=1e-12) and np.allclose(got.held, given.held, rtol=1e-12)
+    assert np.allclose(got["area"], given["area"], rtol=1e-12) and np.allclose(got["held"], given["held"], rtol=1e-12)
     assert shapely.coverage_is_valid(cov.geometry.values)
     # `overlap: reject` refuses the lakes the countries cover, as the command line does.
     rejected = skeletonise.apply_layers(waters, pipeline, neighbours=units, overrides=["steps.partition.overlap=reject"])

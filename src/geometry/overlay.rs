@@ -567,7 +567,12 @@ pub fn signed_union(plus: &[Polygon<f64>], minus: &[Polygon<f64>], tol: f64) -> 
             );
             for x in index.locate_in_envelope(&env) {
                 let x = Coord { x: x[0], y: x[1] };
-                if x != p && x != q && norm(closest_on_segment(p, q, x).0 - x) <= tol {
+                // Not a point near an end (it would go in on the wrong side
+                // of it): such a point is a vertex of its own.
+                if norm(x - p) > tol
+                    && norm(x - q) > tol
+                    && norm(closest_on_segment(p, q, x).0 - x) <= tol
+                {
                     inserts.entry(i).or_default().push(x);
                 }
             }

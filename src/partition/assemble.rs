@@ -85,15 +85,37 @@ fn changed(unit: &MultiPolygon<f64>, c: &Changes) -> MultiPolygon<f64> {
     let snapped = c.edits.apply(unit);
     let mut plus = snapped.0;
     plus.extend(c.given.iter().cloned());
-    let tol = SAME_POINT * extent(&plus);
-    MultiPolygon(signed_union(&plus, &c.held, tol))
+    MultiPolygon(signed_union(&plus, &c.held, tolerance(c)))
 }
 
-/// The larger side of the box around polygons.
-fn extent(ps: &[Polygon<f64>]) -> f64 {
-    MultiPolygon(ps.to_vec())
-        .bounding_rect()
-        .map_or(0.0, |r| r.width().max(r.height()))
+/// The tolerance that puts a unit together again: `SAME_POINT` × the
+/// smallest collapsed polygon's extent that changed it (each was cut and
+/// partitioned at its own scale; a country's extent would merge vertices a
+/// millimetre apart on a small lake), but never below what the coordinates
+/// resolve.
+fn tolerance(c: &Changes) -> f64 {
+    let pieces = c.given.iter().chain(&c.held);
+    let smallest = pieces
+        .clone()
+        .filter_map(|p| p.bounding_rect())
+        .map(|r| r.width().max(r.height()))
+        .fold(f64::INFINITY, f64::min);
+    let largest = pieces
+        .filter_map(|p| p.bounding_rect())
+        .map(|r| {
+            r.min()
+                .x
+                .abs()
+                .max(r.min().y.abs())
+                .max(r.max().x.abs())
+                .max(r.max().y.abs())
+        })
+        .fold(0.0, f64::max);
+    let resolution = 64.0 * f64::EPSILON * largest;
+    match smallest.is_finite() {
+        true => (SAME_POINT * smallest).max(resolution),
+        false => resolution,
+    }
 }
 
 /// Why a changed unit cannot be written: a part that is not a valid
