@@ -368,6 +368,9 @@ def test_a_unit_equal_to_the_river_keeps_its_row_with_no_area(tmp_path):
     assert first.geometry is None or first.geometry.is_empty
     assert first.held == 1000.0 and first.received == 0.0
     assert np.allclose(shapely.get_coordinates(boundary(bnd, 2, 3))[:, 1], 5.0, atol=1e-9)
+    r = subprocess.run([str(cli_binary()), "run", str(tmp_path / "case.yaml")], cwd=ROOT, capture_output=True,
+                       text=True, check=True)
+    assert "1 units lie wholly in the collapsed polygons (FIDs 1)" in r.stderr, r.stderr
 
 
 def test_a_unit_covering_the_river_with_collinear_sides_is_cut(tmp_path):

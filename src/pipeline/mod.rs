@@ -509,6 +509,19 @@ fn grown_coverage(
         );
     }
     counts.area_held = held.iter().sum::<f64>() + 0.0;
+    let landless: Vec<String> = coverage
+        .iter()
+        .filter(|c| c.held > 0.0 && c.geometry.0.is_empty())
+        .map(|c| c.src_fid.map_or_else(|| "(no fid)".into(), |f| f.to_string()))
+        .collect();
+    if !landless.is_empty() {
+        tracing::info!(
+            units = %landless.join(","),
+            "partition: {} units lie wholly in the collapsed polygons (FIDs {}): they get nothing and are written with an empty geometry",
+            landless.len(),
+            landless.join(", ")
+        );
+    }
     Ok(Rows {
         coverage,
         ..Rows::default()
