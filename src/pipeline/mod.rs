@@ -512,7 +512,10 @@ fn grown_coverage(
     let landless: Vec<String> = coverage
         .iter()
         .filter(|c| c.held > 0.0 && c.geometry.0.is_empty())
-        .map(|c| c.src_fid.map_or_else(|| "(no fid)".into(), |f| f.to_string()))
+        .map(|c| {
+            c.src_fid
+                .map_or_else(|| "(no fid)".into(), |f| f.to_string())
+        })
         .collect();
     if !landless.is_empty() {
         tracing::info!(
