@@ -22,7 +22,7 @@
 //!    bounds A ∩ B when its middle is inside B, else A − B; an edge of B
 //!    that is none of A's bounds A ∩ B (and, reversed, A − B) when its
 //!    middle is inside A. The two sets of directed edges are walked into
-//!    polygons by [`polygons_of_edges`], an edge met both ways cancelling.
+//!    polygons by `polygons_of_edges` (in `arrangement`), an edge met both ways cancelling.
 //!
 //! No vertex of A or B moves but by the snap; every vertex added is a
 //! crossing or a vertex of the other, so A − B, A ∩ B and B share their
