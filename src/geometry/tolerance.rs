@@ -48,7 +48,8 @@ pub const ON_BOUNDARY_END: f64 = 1e-7;
 /// `input.connect`) within `ROUND_OFF × extent` of ∂P is on it whatever
 /// side of it round-off put it: the default snap, 1 cm on a 100 km river,
 /// far above what a reprojection between two CRSs moves a vertex by
-/// (0.1–0.3 mm measured between EPSG:4326 and UTM) and below anything drawn.
+/// (nanometres for a round trip through EPSG:4326; a millimetre for
+/// degrees stored to 8 decimals) and below anything drawn.
 pub const ROUND_OFF: f64 = 1e-7;
 
 /// A bar's hit closer than `BAR_ORIGIN × extent` to the bar's origin is the
