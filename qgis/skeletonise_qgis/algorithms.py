@@ -724,7 +724,7 @@ class PartitionAlgorithm(_Algorithm):
         self.addParameter(QgsProcessingParameterNumber("WIDTH", _tr("Width (layer units; 0: the whole polygon)"), number, 0.0, minValue=0.0))
         self.addParameter(QgsProcessingParameterNumber("TOLERANCE", _tr("Tolerance (fraction of the width)"), number, 0.2, minValue=0.0, maxValue=0.99))
         self.addParameter(QgsProcessingParameterEnum("UNOWNED", _tr("Unowned area"), options=UNOWNED, defaultValue=0))
-        self.addParameter(QgsProcessingParameterEnum("OVERLAP", _tr("Units that overlap a polygon"), options=OVERLAP, defaultValue=0))
+        self.addParameter(QgsProcessingParameterEnum("OVERLAP", _tr("Overlap (units that overlap a polygon)"), options=OVERLAP, defaultValue=0))
         self.addParameter(QgsProcessingParameterNumber("SNAP", _tr("Snap (layer units; 0: 1e-7 × extent)"), number, 0.0, minValue=0.0))
         _method_parameters(self, choose=False)
         _partition_sinks(self, required=True)
