@@ -324,7 +324,12 @@ fn unreadable_sources_missing_layers_and_bad_filters() {
         (
             "zero threads",
             vec!["run", "pipelines/demo.yaml", "--threads", "0", "-o", o],
-            fails(1, "between 1 and"),
+            fails(2, "between 1 and"),
+        ),
+        (
+            "too many threads",
+            vec!["run", "pipelines/demo.yaml", "--threads", "257", "-o", o],
+            fails(2, "between 1 and 256"),
         ),
     ] {
         check(name, &argv, &out, want);

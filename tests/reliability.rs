@@ -228,7 +228,8 @@ fn too_many_threads_is_a_clear_error_at_once() {
         "/tmp/never.gpkg",
     ]);
     let (code, err) = code_and_err(&o);
-    assert_eq!(code, 1, "{err}");
+    // A usage error, as `--threads abc` is.
+    assert_eq!(code, 2, "{err}");
     assert!(err.contains("between 1 and 256"), "{err}");
     assert!(t.elapsed().as_secs() < 20);
 }
