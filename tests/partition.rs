@@ -315,3 +315,27 @@ fn a_unit_with_a_nan_coordinate_is_named_and_nothing_panics() {
     assert!(!err.contains("panicked"), "{err}");
     assert!(!out.exists());
 }
+
+#[test]
+fn a_negative_snap_is_refused_with_its_key_before_anything_runs() {
+    let dir = tmp();
+    let (p, out) = danube(
+        dir.path(),
+        true,
+        "  - skeleton: { methods: [MA] }\n  - partition: {}\n",
+    );
+    for cmd in ["validate", "run"] {
+        let (code, err) = code_and_err(&skeletonise(&[
+            cmd,
+            p.to_str().unwrap(),
+            "--set",
+            "input.neighbours.snap=-1",
+        ]));
+        assert_eq!(code, 78, "{cmd}: {err}");
+        assert!(
+            err.contains("input.neighbours.snap") && err.contains("snap must be ≥ 0"),
+            "{err}"
+        );
+    }
+    assert!(!out.exists());
+}

@@ -30,8 +30,31 @@ pub use boundary::{Boundary, RayHit};
 pub use segment::BoundarySegment;
 pub use vector::{norm, within_hypot};
 
-use geo::{Coord, Polygon};
+use geo::{Coord, Polygon, Rect};
+use rstar::primitives::{GeomWithData, Rectangle};
 use thiserror::Error;
+
+/// A box in a [`box_index`], with the place of its item.
+pub type IndexedBox = GeomWithData<Rectangle<[f64; 2]>, usize>;
+
+/// An R-tree of the boxes of items by their place in `rects` (an item
+/// without a box, NULL or empty, is left out): the polygons of a layer,
+/// the units of a coverage.
+pub fn box_index(rects: impl IntoIterator<Item = Option<Rect<f64>>>) -> rstar::RTree<IndexedBox> {
+    rstar::RTree::bulk_load(
+        rects
+            .into_iter()
+            .enumerate()
+            .filter_map(|(i, r)| {
+                let r = r?;
+                Some(GeomWithData::new(
+                    Rectangle::from_corners([r.min().x, r.min().y], [r.max().x, r.max().y]),
+                    i,
+                ))
+            })
+            .collect(),
+    )
+}
 
 /// Why a polygon cannot be prepared for skeletonisation.
 #[derive(Debug, Error, Clone, PartialEq)]

@@ -68,16 +68,13 @@ pub fn unit_geometry(
 /// A unit's boundary segment in the index: the unit and its two ends.
 type Indexed = GeomWithData<Line<[f64; 2]>, u32>;
 
-/// A unit's bounding box in the index, with the unit.
-type UnitBox = GeomWithData<rstar::primitives::Rectangle<[f64; 2]>, u32>;
-
 /// The neighbours' coverage, indexed by the units' boundary segments and
 /// boxes.
 #[derive(Debug)]
 pub struct Coverage {
     units: Vec<Unit>,
     segments: RTree<Indexed>,
-    boxes: RTree<UnitBox>,
+    boxes: RTree<crate::geometry::IndexedBox>,
     snap: Option<f64>,
 }
 
@@ -105,24 +102,11 @@ impl Coverage {
                 }
             }
         }
-        let boxes = units
-            .iter()
-            .enumerate()
-            .filter_map(|(k, u)| {
-                let r = u.geometry.bounding_rect()?;
-                Some(GeomWithData::new(
-                    rstar::primitives::Rectangle::from_corners(
-                        [r.min().x, r.min().y],
-                        [r.max().x, r.max().y],
-                    ),
-                    k as u32,
-                ))
-            })
-            .collect();
+        let boxes = crate::geometry::box_index(units.iter().map(|u| u.geometry.bounding_rect()));
         Self {
             units,
             segments: RTree::bulk_load(segs),
-            boxes: RTree::bulk_load(boxes),
+            boxes,
             snap: None,
         }
     }
@@ -146,7 +130,7 @@ impl Coverage {
         let mut near: Vec<u32> = self
             .boxes
             .locate_in_envelope_intersecting(&env)
-            .map(|b| b.data)
+            .map(|b| b.data as u32)
             .collect();
         near.sort_unstable();
         near

@@ -77,24 +77,17 @@ fn overlapping_pairs(features: &[Feature]) -> Vec<(usize, usize)> {
     use crate::geometry::overlay::interiors_meet;
     use crate::geometry::Boundary;
     use geo::{BoundingRect, InteriorPoint};
-    use rstar::primitives::{GeomWithData, Rectangle};
     use rstar::RTreeObject;
     let polys: Vec<Option<MultiPolygon<f64>>> = features
         .iter()
         .map(|f| polygons(f).map(MultiPolygon))
         .collect();
-    let boxes: Vec<GeomWithData<Rectangle<[f64; 2]>, usize>> = polys
-        .iter()
-        .enumerate()
-        .filter_map(|(i, p)| {
-            let r = p.as_ref()?.bounding_rect()?;
-            Some(GeomWithData::new(
-                Rectangle::from_corners([r.min().x, r.min().y], [r.max().x, r.max().y]),
-                i,
-            ))
-        })
-        .collect();
-    let tree = rstar::RTree::bulk_load(boxes.clone());
+    let tree = crate::geometry::box_index(
+        polys
+            .iter()
+            .map(|p| p.as_ref().and_then(|p| p.bounding_rect())),
+    );
+    let boxes: Vec<&crate::geometry::IndexedBox> = tree.iter().collect();
     let mut out = Vec::new();
     for b in &boxes {
         let i = b.data;

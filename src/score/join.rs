@@ -9,7 +9,7 @@
 use crate::geometry::PreparedPolygon;
 use crate::process::polygon_parts;
 use geo::{BoundingRect, Geometry, LineString};
-use rstar::{primitives::GeomWithData, primitives::Rectangle, RTree, AABB};
+use rstar::AABB;
 use std::collections::HashMap;
 
 /// Skeleton rows that were joined to no polygon, by why.
@@ -125,18 +125,11 @@ pub fn by_location(
                 .unwrap_or_default()
         })
         .collect();
-    let boxes: Vec<GeomWithData<Rectangle<[f64; 2]>, usize>> = polygons
-        .iter()
-        .enumerate()
-        .filter_map(|(i, g)| {
-            let r = g.as_ref()?.bounding_rect()?;
-            Some(GeomWithData::new(
-                Rectangle::from_corners([r.min().x, r.min().y], [r.max().x, r.max().y]),
-                i,
-            ))
-        })
-        .collect();
-    let tree = RTree::bulk_load(boxes);
+    let tree = crate::geometry::box_index(
+        polygons
+            .iter()
+            .map(|g| g.as_ref().and_then(|g| g.bounding_rect())),
+    );
     for ls in skeletons {
         if ls.is_empty() {
             unjoined.not_lines += 1;
