@@ -11,6 +11,13 @@
   line should end in the south tip, not at the middle of the east shore.
 * `crescent`: a crescent lake (the difference of two discs), horns north and
   south; its line should reach both horns.
+* `lobe_lake`: a compact lake, a disc of radius 2 km drawn with 96 shallow
+  bank vertices, with one rounded lobe 700 m wide running 1.6 km out to the
+  north-east. Its line should end in the lobe, along the lobe's axis, not
+  at a vertex of the broad shore.
+* `corner_island`: a near-square island 2 km across whose north-east
+  corner is drawn out into a sharp corner (about 30°). Its line should end
+  in that corner.
 
 usage: make_rough_cases.py OUT.gpkg
 needs: shapely, geopandas, pyogrio, numpy (PyPI)
@@ -63,7 +70,27 @@ def crescent():
     return shapely.affinity.translate(shapely.difference(outer, inner), X0 + 20_000, Y0 + 20_000)
 
 
-cases = {"slot_spike_river": slot_spike_river(), "tip_lake": tip_lake(), "crescent": crescent()}
+def lobe_lake():
+    disc = shapely.Point(0, 0).buffer(2000, quad_segs=24)
+    # The lobe: a 700 m wide band along the north-east diagonal, ending in
+    # a half disc 3.6 km from the centre.
+    axis = shapely.LineString([(0, 0), (3600 / 2**0.5 - 350 / 2**0.5, 3600 / 2**0.5 - 350 / 2**0.5)])
+    lobe = axis.buffer(350, quad_segs=8)
+    return shapely.affinity.translate(shapely.union(disc, lobe), X0 + 30_000, Y0 + 20_000)
+
+
+def corner_island():
+    square = shapely.Polygon([(0, 0), (2000, 0), (2000, 1500), (2700, 2700), (1500, 2000), (0, 2000)])
+    return shapely.affinity.translate(square, X0 + 40_000, Y0 + 20_000)
+
+
+cases = {
+    "slot_spike_river": slot_spike_river(),
+    "tip_lake": tip_lake(),
+    "crescent": crescent(),
+    "lobe_lake": lobe_lake(),
+    "corner_island": corner_island(),
+}
 for name, g in cases.items():
     assert g.is_valid and g.geom_type == "Polygon", name
 gpd.GeoDataFrame({"name": list(cases)}, geometry=list(cases.values()), crs="EPSG:32633").to_file(

@@ -311,7 +311,10 @@ fn a_lake_whose_relaxed_line_is_cut_keeps_the_smoothed_one() {
     // towards the axis one bend is too sharp, and the gentle run of the
     // relaxed line is too short for a line; the line as smoothed is gentle
     // enough, and is kept. Smoothed, not relaxed towards the axis, it is
-    // less centred than the training lines: Z 0.020 (the 0.01 is
-    // for those), held here to 0.025.
-    assert_eq!(check_layer(BENDS, "bent_lake", 0.025), (1, 0));
+    // less centred than the training lines: Z 0.026 (the 0.01 is
+    // for those; 0.020 before the axis's south end followed the medial
+    // axis into the round bay's west corner instead of a straight chord to
+    // its south shore, which changed where the smoothed line bends), held
+    // here to 0.03.
+    assert_eq!(check_layer(BENDS, "bent_lake", 0.03), (1, 0));
 }

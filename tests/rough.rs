@@ -168,6 +168,104 @@ fn a_crescent_keeps_both_horns() {
     }
 }
 
+/// The direction of the line `lines` over its last `len` at the end nearest
+/// `p`, pointing out of the line, and that end.
+fn end_course(lines: &MultiLineString<f64>, p: Coord<f64>, len: f64) -> (Coord<f64>, Coord<f64>) {
+    let d = |a: Coord<f64>, b: Coord<f64>| (a.x - b.x).hypot(a.y - b.y);
+    let line = lines
+        .0
+        .iter()
+        .map(|l| {
+            let mut c = l.0.clone();
+            if d(c[0], p) > d(*c.last().unwrap(), p) {
+                c.reverse();
+            }
+            c
+        })
+        .min_by(|a, b| d(a[0], p).total_cmp(&d(b[0], p)))
+        .expect("a line");
+    let end = line[0];
+    let mut walked = 0.0;
+    let mut back = end;
+    for w in line.windows(2) {
+        let step = d(w[0], w[1]);
+        if walked + step >= len {
+            let t = (len - walked) / step;
+            back = Coord {
+                x: w[0].x + (w[1].x - w[0].x) * t,
+                y: w[0].y + (w[1].y - w[0].y) * t,
+            };
+            break;
+        }
+        walked += step;
+        back = w[1];
+    }
+    let n = d(end, back);
+    (
+        Coord {
+            x: (end.x - back.x) / n,
+            y: (end.y - back.y) / n,
+        },
+        end,
+    )
+}
+
+/// A compact lake with one real lobe and 96 shallow bank vertices on its
+/// broad shore: one end of its line lies in the lobe's end, reached along
+/// the lobe's axis; no end is a hook.
+#[test]
+fn a_compact_lake_with_one_lobe_ends_in_the_lobe_along_its_axis() {
+    let dir = tmp();
+    let lines = &run_cases(dir.path(), &[])[3];
+    // make_rough_cases.py: the disc's centre at (530 000, 6 020 000), the
+    // lobe along the north-east diagonal, its end 3.6 km from the centre.
+    let s = 3600.0 / 2f64.sqrt();
+    let lobe_end = Coord {
+        x: 530_000.0 + s,
+        y: 6_020_000.0 + s,
+    };
+    let ends = leaves(lines);
+    assert_eq!(ends.len(), 2, "{ends:?}");
+    let d = |a: Coord<f64>, b: Coord<f64>| (a.x - b.x).hypot(a.y - b.y);
+    assert!(
+        ends.iter().any(|&e| d(e, lobe_end) < 60.0),
+        "no end in the lobe's end: {ends:?}"
+    );
+    // Over the lobe's last 700 m (its width) the line runs along its axis.
+    let (course, _) = end_course(lines, lobe_end, 700.0);
+    let axis = 0.5f64.sqrt();
+    let cos = course.x * axis + course.y * axis;
+    assert!(
+        cos > 30f64.to_radians().cos(),
+        "the end leaves the lobe's axis: {course:?}"
+    );
+    let g = SkeletonGraph::from_lines(lines);
+    let turns = end_turns(&g, &cases()[3]);
+    assert!(turns.iter().all(|&t| t <= HOOK_DEG), "hooks: {turns:?}");
+}
+
+/// A near-square island with one sharp corner (about 30°): its line ends
+/// in that corner.
+#[test]
+fn a_near_square_island_ends_in_its_sharp_corner() {
+    let dir = tmp();
+    let lines = &run_cases(dir.path(), &[])[4];
+    let corner = Coord {
+        x: 540_000.0 + 2700.0,
+        y: 6_020_000.0 + 2700.0,
+    };
+    let ends = leaves(lines);
+    assert_eq!(ends.len(), 2, "{ends:?}");
+    assert!(
+        ends.iter()
+            .any(|e| (e.x - corner.x).hypot(e.y - corner.y) < 1.0),
+        "no end in the sharp corner: {ends:?}"
+    );
+    let g = SkeletonGraph::from_lines(lines);
+    let turns = end_turns(&g, &cases()[4]);
+    assert!(turns.iter().all(|&t| t <= HOOK_DEG), "hooks: {turns:?}");
+}
+
 /// A five-lobed polygon of radius `radius` with up to `rough` of random
 /// radial roughness at each of `n` vertices (scripts/make_rough_polygon.py's
 /// shape, with a small seeded generator of its own).

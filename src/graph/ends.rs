@@ -5,56 +5,60 @@
 //! from such a leaf is not medial: bars that hit it score a large z, and on
 //! a bend it turns sideways onto the bank (a *hook*). The method's own
 //! skeleton already continues to ∂P — the legs pruning removed behind the
-//! leaf — so the centred extension keeps the right one of them:
+//! leaf — so the centred extension follows the right one of them, *along
+//! the axis*, into the polygon's tip.
 //!
-//! * From a leaf ℓ that pruning made, descend into the removed subtree,
-//!   coming in along the direction d the kept line had over its last two
-//!   local radii. At each node v (radius r_v) with removed children c
-//!   (each with its departure direction u_c over the first r_v and its
-//!   *protrusion* p_c = depth_c − r_v beyond the disc at v, depth capped at
-//!   3 r_v), the children with p_c ≥ p_max / 2 are the substantial ones:
-//!   - if the substantial child most aligned with d is within 30° of it, the
-//!     line continues along that child (a tapering tip: the medial axis runs
-//!     on into the tip vertex, and the whiskers beside it protrude little);
-//!   - else if substantial children lie on both sides of d and the two most
-//!     aligned do not both protrude [`HORN_PROTRUSION`] radii or more (horns:
-//!     the line follows the more aligned one, below), the removed legs
-//!     fork around the line (the corners of a rectangle's or a river reach's
-//!     cut end, at ±45° for right-angled corners): the line ends with a
-//!     straight segment from v to where v's inscribed disc touches ∂P
-//!     between the two most aligned of them (the nearest boundary point in
-//!     the sector between their directions) — the end side's midpoint at a
-//!     rectangle's end, the foot on the far side of a square block;
-//!   - else the line follows the most aligned substantial child (the end
-//!     bends to one side; the medial line bends with it).
+//! **Tips.** A leaf ℓ of the removed subtree (on ∂P for MA, StSk and CDT;
+//! inside P for VD and DVD) is a tip of depth
 //!
-//!   The end zone is the last two local radii of the line: the descent
-//!   starts where the line, walked back from its leaf, first lies two
-//!   radii from it (never past a kept junction), and within the zone d
-//!   stays the line's course, so that small turns at successive junctions
-//!   cannot add up to a hook. An end that still turns by more than
-//!   [`HOOK_DEG`] over its last local width (on a compact island the
-//!   medial axis reaches ∂P only in corners) ends earlier instead: at the
-//!   last node of the descent from which a straight segment to where its
-//!   disc touches ∂P ahead (the nearest boundary point within 45° of the
-//!   course) makes no hook — a segment square to the end side, so bars that
-//!   hit it still find the same distance to either side.
-//!   The descent stops on ∂P, or at a leaf inside P (VD and DVD legs stop
-//!   short of ∂P), from which a straight ray continues the last direction.
-//! * A leaf that already lies on ∂P (a kept leg, or a `trunk` end) is
-//!   checked once at the last junction u before it, when the leg is short
-//!   (at most 2 r_u): the same rule decides between the kept leg and the
-//!   removed ones at u, so a trunk that ran into one corner of a cut end
-//!   ends at the cut's midpoint instead.
+//! ```text
+//!   τ(ℓ) = max over nodes x on the path from x* to ℓ of  |ℓ − x| + r_ℓ − r_x
+//! ```
 //!
-//! * At a cut end ([`crate::graph::cut`]) the line always ends on the cut,
-//!   where the disc at its junction touches it.
+//! where x* is the node of largest radius on the path from the line's end
+//! zone to ℓ and r the radius of the inscribed disc at a node (0 on ∂P): how
+//! far ℓ's disc reaches beyond the largest disc on its way and beyond every
+//! disc after it. A *real* tip reaches at least [`REAL_TIP`] = ½ of r(x*)
+//! beyond it: the discs shrink towards it over a stretch long against
+//! their width — a lobe, a horn, a narrowing bay, a river's end, a corner
+//! sharper than about 80° (a corner of angle α protrudes
+//! r(1/sin(α/2) − 1): 0.41 r at 90°, 1 r at 60°). A leaf at a shallow bank
+//! vertex lies on the disc it leaves (τ ≈ 0), and a rectangle's corner
+//! reaches 0.41 r: neither is a real tip.
 //!
-//! The 30° threshold sits between a continuing leg (0° on a straight tip)
-//! and the ±45° legs of a square cut end; the half-protrusion threshold
-//! keeps whiskers (protrusion ≈ 0) from steering the end.
+//! **The end.** From a leaf ℓ that pruning made, the line's last two local
+//! radii (its end zone) are taken back and the end is decided from the
+//! zone's start s, coming in along the direction d the kept line had there:
+//!
+//! * the line follows the medial path from s to the deepest real tip ahead
+//!   of it (τ largest among the leaves in the half-plane ahead of s), all
+//!   the way to ∂P: the line ends in the tip along the axis, never with a
+//!   straight chord across a wide part;
+//! * when no tip ahead is real (a round, flat or blunt end), the line
+//!   follows the path to the deepest leaf ahead, but ends at the first node
+//!   v where removed legs lie on both sides of the course and v's disc
+//!   touches ∂P straight ahead between them (within [`FORK_AHEAD_DEG`] of
+//!   the course, at most [`FORK_TOUCH`] radii away): with a straight
+//!   segment to that contact — the end side's midpoint of a rectangle or
+//!   a river reach's square end, the apex of a round end. Where the disc
+//!   touches ∂P to one side only (a blunt, lopsided end) the line follows
+//!   the medial path into the deepest corner instead;
+//! * with nothing ahead, a straight ray along d (or the nearest boundary
+//!   point) ends the line.
+//!
+//! Within the end zone the course stays the line's, so small turns at
+//! successive junctions cannot add up to a hook. A descent that reaches a
+//! leaf inside P (VD and DVD legs stop short of ∂P) continues its last
+//! direction with a straight ray. A leaf that already lies on ∂P (a kept
+//! leg, a main axis end, a `trunk` end) is decided anew from its end zone
+//! the same way, so a line that ran into one corner of a square end ends
+//! at the end side's midpoint instead.
+//!
+//! At a cut end ([`crate::graph::cut`]) the line always ends on the cut,
+//! where the disc at its junction touches it.
+//!
 //! Every ray is checked against ∂P (no crossing, inside P); a ray that fails
-//! falls back to following the skeleton, then to the nearest point of ∂P.
+//! falls back to the nearest point of ∂P.
 
 use super::cut::{cut_ends, CutEnd};
 use super::line::{end_turn, point_at, HOOK_DEG};
@@ -64,32 +68,43 @@ use crate::geometry::vector::{cross, dot, hypot};
 use crate::geometry::{Boundary, PreparedPolygon};
 use geo::Coord;
 
+/// A tip is real when it reaches this fraction of the largest disc's
+/// radius beyond that disc (see the module documentation).
+pub const REAL_TIP: f64 = 0.5;
+
+/// Largest angle between a blunt end's course and its straight last segment.
+const FORK_AHEAD_DEG: f64 = 45.0;
+
+/// A blunt end's straight segment is at most this many radii of its node
+/// long (the node's disc touches ∂P there).
+const FORK_TOUCH: f64 = 3.0;
+
+/// Largest mean local distortion of a straight end ([`Extender::balance`]).
+const CHORD_BALANCE: f64 = 0.05;
+
 /// Largest angle between the line's course and a removed leg that the line
-/// follows.
+/// follows before looking for a fork.
 const FOLLOW_ANGLE_DEG: f64 = 30.0;
 
-/// Depth of a removed subtree is explored up to this many radii of the node
-/// it hangs from (enough to tell a whisker from a continuing leg).
-const DEPTH_CAP: f64 = 3.0;
+/// Removed legs whose deepest tip reaches at least this fraction of the
+/// deepest one's τ are the substantial ones (whiskers to shallow bank
+/// vertices, τ ≈ 0, never steer the end).
+const SUBSTANTIAL: f64 = 0.5;
 
-/// Legs protruding at least this many radii beyond the disc at their node
-/// on both sides of the line are horns, not the corners of an end side: the
-/// line follows the more aligned one into its tip instead of ending between
-/// them. The corner legs of a square end protrude √2 − 1 = 0.41 radii, of
-/// a 70° corner 1/sin 35° − 1 = 0.74; the two horns of a notched end or two
-/// lobes of a star more.
-const HORN_PROTRUSION: f64 = 0.75;
-
-/// Largest angle between the line's course and its last segment at a fork
-/// (beyond it the end would turn onto the bank: a hook).
-const FORK_ANGLE_DEG: f64 = 45.0;
+/// Length of the kept line behind an end zone that its end is judged
+/// with, in radii of the zone's start.
+const BACK: f64 = 6.0;
 
 /// Length of a line's end zone, in radii.
 const ZONE: f64 = 2.0;
 
-/// A fork's ray must meet ∂P within this many radii of the fork node (its
-/// inscribed disc touches ∂P at one radius).
-const FORK_REACH: f64 = 3.0;
+/// The walk to a tip looks this many radii of the largest disc on its way
+/// beyond that disc; a node there counts as a leaf (its disc's reach is in
+/// its τ).
+const TIP_REACH: f64 = 4.0;
+
+/// Most nodes the walk to the tips visits from one end.
+const TIP_NODES: usize = 5_000;
 
 /// The centred extension of a pruned skeleton.
 ///
@@ -118,10 +133,10 @@ pub fn centred(m: &SkeletonGraph, keep: Vec<bool>, polygon: &PreparedPolygon) ->
         else {
             continue;
         };
-        let d = e.arrival(behind, start);
-        let rec = e.descend(start, d, &mut st);
-        if e.hooks(start, &rec, &st, polygon) {
-            e.unhook(start, d, rec, &mut st, polygon);
+        let back = e.line_back(start, behind, &st);
+        let rec = e.descend(start, back, &mut st);
+        if e.hooks(start, &rec, polygon) {
+            e.unhook(start, rec, &mut st, polygon);
         }
     }
     assemble(m, &st.keep, &st.segments)
@@ -213,11 +228,32 @@ pub fn assemble(
     g.merged()
 }
 
-/// What a descent added: the edges it followed (from its start) and its
-/// end segment's point on ∂P.
+/// A leaf of a removed subtree, as a line end.
+#[derive(Debug, Clone, Copy)]
+struct Tip {
+    /// Its depth τ: how far its disc reaches beyond the largest disc on the
+    /// way to it (and beyond every disc after that one).
+    tau: f64,
+    /// Radius of the largest disc on the way.
+    widest: f64,
+    /// The removed edge at the walk's start that leads to it.
+    first: EdgeId,
+}
+
+impl Tip {
+    /// A real tip: it reaches [`REAL_TIP`] of the largest disc's radius
+    /// beyond that disc.
+    fn is_real(&self) -> bool {
+        self.tau >= REAL_TIP * self.widest
+    }
+}
+
+/// What a descent added: the edges it followed (from its start), its end
+/// segment's point on ∂P, and the kept line behind its start.
 struct Descent {
     edges: Vec<EdgeId>,
     segment: Option<Coord<f64>>,
+    back: Vec<Coord<f64>>,
 }
 
 /// What to do at a node of the descent.
@@ -225,11 +261,10 @@ struct Descent {
 enum Decision {
     /// Continue along this edge.
     Follow(EdgeId),
-    /// End with a straight segment to ∂P between the departure directions
-    /// of two legs: clockwise-most `right`, counter-clockwise-most `left`.
-    Fork { right: Coord<f64>, left: Coord<f64> },
-    /// End with a straight segment to this point of ∂P (on a cut).
+    /// End with a straight segment to this point of ∂P (a fork or a cut).
     End(Coord<f64>),
+    /// Nothing to follow: end here.
+    Stop,
 }
 
 struct Extender<'a> {
@@ -241,30 +276,19 @@ struct Extender<'a> {
     len: Vec<f64>,
     tol: f64,
     max_t: f64,
-    /// `m` has no cycle: the subtree beyond an edge is the same for every
-    /// walk that reaches it, so its depth can be remembered.
-    forest: bool,
-    /// Depths of subtrees found during the current descent.
-    heights: std::cell::RefCell<Heights>,
 }
 
-/// Remembered subtree depths, by directed edge (`2·edge + 0` from its
-/// `a` end, `+ 1` from `b`), valid while `stamp` equals `generation`.
-struct Heights {
-    generation: u32,
-    stamp: Vec<u32>,
-    value: Vec<f64>,
-}
+/// A removed leg at a node: its edge, its departure direction and the
+/// deepest tip beyond it.
+type Leg = (EdgeId, Coord<f64>, Tip);
 
-impl Heights {
-    fn get(&self, k: usize) -> Option<f64> {
-        (self.stamp[k] == self.generation).then(|| self.value[k])
-    }
-
-    fn set(&mut self, k: usize, v: f64) {
-        self.stamp[k] = self.generation;
-        self.value[k] = v;
-    }
+/// The leg of `legs` most aligned with `d` (on its left for `side` > 0, its
+/// right for `side` < 0, either for 0); ties by edge index.
+fn most_aligned<'a>(legs: &[&'a Leg], d: Coord<f64>, side: f64) -> Option<&'a Leg> {
+    legs.iter()
+        .filter(|l| side == 0.0 || cross(d, l.1) * side > 0.0)
+        .max_by(|a, b| dot(a.1, d).total_cmp(&dot(b.1, d)).then(b.0.cmp(&a.0)))
+        .copied()
 }
 
 fn unit(v: Coord<f64>) -> Option<Coord<f64>> {
@@ -290,13 +314,6 @@ impl<'a> Extender<'a> {
                 .collect(),
             tol,
             max_t: 2.0 * hypot(span) + 1.0,
-            forest: m.edges().iter().all(|e| e.a != e.b)
-                && m.edges().len() + m.components() == m.nodes().len(),
-            heights: std::cell::RefCell::new(Heights {
-                generation: 1,
-                stamp: vec![0; 2 * m.edges().len()],
-                value: vec![0.0; 2 * m.edges().len()],
-            }),
         }
     }
 
@@ -312,14 +329,41 @@ impl<'a> Extender<'a> {
         self.radius(n) <= self.tol
     }
 
-    /// Unit direction in which edge `e` arrives at node `at`, measured over
-    /// its last two local radii (the whole edge when `at` lies on ∂P).
-    fn arrival(&self, e: EdgeId, at: NodeId) -> Coord<f64> {
-        let c = self.m.oriented_coords(e, at);
-        let r = self.radius(at);
-        let l = self.len[e.index()];
-        let s = if r > self.tol { (2.0 * r).min(l) } else { l };
-        unit(c[0] - point_at(&c, s)).unwrap_or(Coord { x: 1.0, y: 0.0 })
+    /// The kept line behind `start`, from `start` back along `behind` and
+    /// on through the kept line for at most [`BACK`] radii of `start` (the
+    /// course is measured over its first two radii, a hook over its first
+    /// local widths).
+    fn line_back(&self, start: NodeId, behind: EdgeId, st: &State) -> Vec<Coord<f64>> {
+        let reach = BACK * self.radius(start);
+        let mut line = self.m.oriented_coords(behind, start);
+        let (mut at, mut via) = (self.m.opposite(behind, start), behind);
+        let mut walked = self.len[behind.index()];
+        for _ in 0..self.m.edges().len() {
+            if walked >= reach || st.kdeg[at.index()] != 2 {
+                break;
+            }
+            let Some(e) = self.next_kept(at, Some(via), st) else {
+                break;
+            };
+            line.extend_from_slice(&self.m.oriented_coords(e, at)[1..]);
+            walked += self.len[e.index()];
+            at = self.m.opposite(e, at);
+            via = e;
+        }
+        line
+    }
+
+    /// Unit direction in which the line `back` (from its first point
+    /// backwards) arrives at its first point, measured over the last two
+    /// local radii `r` (the whole line when `r` is 0 or the line shorter).
+    fn course(back: &[Coord<f64>], r: f64) -> Coord<f64> {
+        let total = super::polyline_length(back);
+        let s = if r > 0.0 {
+            (ZONE * r).min(total)
+        } else {
+            total
+        };
+        unit(back[0] - point_at(back, s)).unwrap_or(Coord { x: 1.0, y: 0.0 })
     }
 
     /// Unit direction in which edge `e` leaves node `from`, over the first
@@ -346,135 +390,116 @@ impl<'a> Extender<'a> {
             .collect()
     }
 
-    /// Depth of the subtree entered by edge `e` from `v`: the longest path
-    /// through untaken edges plus the reach (radius) of its last node,
-    /// explored up to `cap`.
-    fn depth(&self, v: NodeId, e: EdgeId, taken: &[bool], cap: f64) -> f64 {
-        if self.forest {
-            return self.height(v, e, taken).min(cap);
-        }
-        let mut best = 0.0f64;
-        let mut stack = vec![(self.m.opposite(e, v), e, self.len[e.index()])];
-        let mut seen = std::collections::HashSet::new();
-        seen.insert(v);
-        while let Some((n, via, d)) = stack.pop() {
-            if d >= cap {
-                return cap;
-            }
-            if !seen.insert(n) {
-                continue;
-            }
+    /// The tips of the removed subtree beyond `start`: every leaf (a node
+    /// with no further removed edge, or one [`TIP_REACH`] radii beyond the
+    /// largest disc on its way, or where [`TIP_NODES`] nodes have been
+    /// visited) with its depth τ and the removed edge at `start` it lies
+    /// beyond.
+    fn tips(&self, start: NodeId, st: &State) -> Vec<Tip> {
+        let mut tips = Vec::new();
+        // The walk's current path: node, arc length from `start`, index of
+        // the largest disc on the path up to it.
+        let mut path: Vec<(NodeId, f64, usize)> = Vec::new();
+        let mut stack: Vec<(NodeId, usize, f64)> = vec![(start, 0, 0.0)];
+        let mut first: std::collections::HashMap<NodeId, EdgeId> = std::collections::HashMap::new();
+        let mut seen = std::collections::HashSet::from([start]);
+        let mut budget = TIP_NODES;
+        while let Some((n, depth, s)) = stack.pop() {
+            path.truncate(depth);
+            let widest = match path.last() {
+                Some(&(_, _, k)) if self.radius(path[k].0) >= self.radius(n) => k,
+                _ => depth,
+            };
+            path.push((n, s, widest));
+            let (x, sx, _) = path[widest];
+            let rx = self.radius(x);
+            let beyond = s - sx > TIP_REACH * rx.max(self.tol);
+            budget = budget.saturating_sub(1);
             let mut leaf = true;
-            for &f in &self.adj[n.index()] {
-                if f != via && !taken[f.index()] {
-                    let o = self.m.opposite(f, n);
-                    if !seen.contains(&o) {
+            if !beyond && budget > 0 {
+                for &e in &self.adj[n.index()] {
+                    let ed = self.m.edge(e);
+                    let o = self.m.opposite(e, n);
+                    if st.taken[e.index()] || ed.a == ed.b || st.kdeg[o.index()] != 0 {
+                        continue;
+                    }
+                    if seen.insert(o) {
+                        first.insert(o, if n == start { e } else { first[&n] });
+                        stack.push((o, depth + 1, s + self.len[e.index()]));
                         leaf = false;
-                        stack.push((o, f, d + self.len[f.index()]));
                     }
                 }
             }
-            let reach = if leaf { self.radius(n) } else { 0.0 };
-            best = best.max(d + reach);
-        }
-        best.min(cap)
-    }
-
-    /// [`Self::depth`] without the cap, in a forest: the longest path from
-    /// `v` through `e` and untaken edges beyond it, plus the radius of its
-    /// last node. Every subtree is measured once per descent (the edges a
-    /// descent takes lie behind it, so the subtrees ahead stay the same);
-    /// the walk with a cap would measure the same subtree again at every
-    /// step, quadratic on a long descent.
-    fn height(&self, v: NodeId, e: EdgeId, taken: &[bool]) -> f64 {
-        let key = |from: NodeId, e: EdgeId| 2 * e.index() + usize::from(self.m.edge(e).a != from);
-        let mut h = self.heights.borrow_mut();
-        let mut stack = vec![(v, e, false)];
-        while let Some((from, e, ready)) = stack.pop() {
-            let k = key(from, e);
-            if h.get(k).is_some() {
-                continue;
-            }
-            let b = self.m.opposite(e, from);
-            let ahead = self.adj[b.index()]
-                .iter()
-                .copied()
-                .filter(|&f| f != e && !taken[f.index()]);
-            if ready {
-                let deepest = ahead
-                    .map(|f| h.get(key(b, f)).expect("measured before"))
-                    .reduce(f64::max);
-                h.set(
-                    k,
-                    self.len[e.index()] + deepest.unwrap_or_else(|| self.radius(b)),
-                );
-            } else {
-                stack.push((from, e, true));
-                stack.extend(
-                    ahead
-                        .filter(|&f| h.get(key(b, f)).is_none())
-                        .map(|f| (b, f, false)),
-                );
-            }
-        }
-        h.get(key(v, e)).expect("measured")
-    }
-
-    /// The centred-end rule at node `v` (see the module documentation).
-    fn decide(
-        &self,
-        v: NodeId,
-        d: Coord<f64>,
-        children: &[EdgeId],
-        taken: &[bool],
-    ) -> Option<Decision> {
-        if let Some(cut) = self.cuts.get(&v) {
-            if cut.legs.iter().all(|l| children.contains(l)) {
-                return Some(Decision::End(cut.contact));
-            }
-        }
-        let rv = self.radius(v);
-        let cap = DEPTH_CAP * rv.max(self.tol);
-        let cands: Vec<(EdgeId, Coord<f64>, f64)> = children
-            .iter()
-            .filter_map(|&c| {
-                let u = self.departure(c, v)?;
-                Some((c, u, self.depth(v, c, taken, cap) - rv))
-            })
-            .collect();
-        let p_max = cands.iter().map(|c| c.2).fold(f64::NEG_INFINITY, f64::max);
-        let substantial: Vec<&(EdgeId, Coord<f64>, f64)> = cands
-            .iter()
-            .filter(|c| p_max <= 0.0 || c.2 >= 0.5 * p_max)
-            .collect();
-        // Most aligned first; ties by edge index (deterministic).
-        let aligned = |side: f64| {
-            substantial
-                .iter()
-                .filter(move |c| side == 0.0 || cross(d, c.1) * side > 0.0)
-                .max_by(|a, b| dot(a.1, d).total_cmp(&dot(b.1, d)).then(b.0.cmp(&a.0)))
-                .copied()
-        };
-        let best = aligned(0.0)?;
-        if dot(best.1, d) >= FOLLOW_ANGLE_DEG.to_radians().cos() {
-            return Some(Decision::Follow(best.0));
-        }
-        if let (Some(l), Some(r)) = (aligned(1.0), aligned(-1.0)) {
-            if l.2.min(r.2) < HORN_PROTRUSION * rv {
-                return Some(Decision::Fork {
-                    right: r.1,
-                    left: l.1,
+            if leaf && n != start {
+                let (p, r) = (self.pos(n), self.radius(n));
+                let tau = path[widest..]
+                    .iter()
+                    .map(|&(y, _, _)| hypot(p - self.pos(y)) + r - self.radius(y))
+                    .fold(0.0f64, f64::max);
+                tips.push(Tip {
+                    tau,
+                    widest: rx,
+                    first: first[&n],
                 });
             }
         }
-        Some(Decision::Follow(best.0))
+        tips
     }
 
-    /// Where the end at a fork at `v` meets ∂P: the point where the disc at
-    /// `v` touches ∂P between the two legs (the nearest boundary point in the
-    /// sector between their directions), if it lies within
-    /// [`FORK_REACH`] radii.
-    fn fork_contact(
+    /// The centred-end rule at node `v` for a line coming in along `d`
+    /// (see the module documentation).
+    fn decide(&self, v: NodeId, d: Coord<f64>, st: &State) -> Decision {
+        if let Some(q) = self.cut_at(v, st) {
+            return Decision::End(q);
+        }
+        let tips = self.tips(v, st);
+        // The deepest tip beyond each removed edge at v.
+        let mut legs: Vec<Leg> = Vec::new();
+        for t in tips {
+            match legs.iter_mut().find(|l| l.0 == t.first) {
+                Some(l) if l.2.tau >= t.tau => {}
+                Some(l) => l.2 = t,
+                None => {
+                    if let Some(u) = self.departure(t.first, v) {
+                        legs.push((t.first, u, t));
+                    }
+                }
+            }
+        }
+        let deepest = legs.iter().map(|l| l.2.tau).fold(0.0f64, f64::max);
+        let substantial: Vec<&Leg> = legs
+            .iter()
+            .filter(|l| l.2.tau >= SUBSTANTIAL * deepest)
+            .collect();
+        // Most aligned first; ties by edge index (deterministic).
+        let aligned = |side: f64| most_aligned(&substantial, d, side);
+        let Some(best) = aligned(0.0) else {
+            return Decision::Stop;
+        };
+        // Substantial legs on both sides of the course, not both real tips:
+        // the corners of an end side (a rectangle's, a river reach's), and
+        // the line ends on the end side between them.
+        let sides = match (aligned(1.0), aligned(-1.0)) {
+            (Some(l), Some(r)) if !(l.2.is_real() && r.2.is_real()) => Some((l, r)),
+            _ => None,
+        };
+        if dot(best.1, d) >= FOLLOW_ANGLE_DEG.to_radians().cos() {
+            return Decision::Follow(best.0);
+        }
+        if let Some((l, r)) = sides {
+            if let Some(q) = self.fork(v, d, r.1, l.1) {
+                return Decision::End(q);
+            }
+        }
+        Decision::Follow(best.0)
+    }
+
+    /// Where an end forks at `v` (course `d`) between removed legs leaving
+    /// along `right` and `left`: the point where v's disc touches ∂P
+    /// straight ahead between them (within [`FORK_AHEAD_DEG`] of the
+    /// course, no farther than [`FORK_TOUCH`] radii) — the end side's
+    /// midpoint of a rectangle, the apex of a round end.
+    fn fork(
         &self,
         v: NodeId,
         d: Coord<f64>,
@@ -483,8 +508,38 @@ impl<'a> Extender<'a> {
     ) -> Option<Coord<f64>> {
         let p = self.pos(v);
         let (q, dist) = self.boundary.nearest_in_sector(p, right, left)?;
-        let ahead = unit(q - p).is_some_and(|u| dot(u, d) >= FORK_ANGLE_DEG.to_radians().cos());
-        (dist > 0.0 && dist <= FORK_REACH * self.radius(v) && ahead).then_some(q)
+        let ahead = unit(q - p).is_some_and(|u| dot(u, d) >= FORK_AHEAD_DEG.to_radians().cos());
+        (dist > 0.0
+            && dist <= FORK_TOUCH * self.radius(v)
+            && ahead
+            && self.balance(p, q) <= CHORD_BALANCE)
+            .then_some(q)
+    }
+
+    /// How far a straight end from `p` to `q` (on ∂P) lies off the middle:
+    /// the mean over points along it of the paper's local distortion
+    /// |d_L − d_R| / (d_L + d_R), with d_L and d_R the distances to ∂P on
+    /// either side of the segment (0 on the medial axis, 1 on the bank).
+    fn balance(&self, p: Coord<f64>, q: Coord<f64>) -> f64 {
+        let Some(t) = unit(q - p) else {
+            return 0.0;
+        };
+        let back = t * -1.0;
+        let samples = 8;
+        let mut sum = 0.0;
+        for k in 1..=samples {
+            let x = p + (q - p) * (k as f64 / (samples + 1) as f64);
+            let side = |from: Coord<f64>, to: Coord<f64>| {
+                self.boundary
+                    .nearest_in_sector(x, from, to)
+                    .map_or(0.0, |(_, dist)| dist)
+            };
+            let (l, r) = (side(t, back), side(back, t));
+            if l + r > 0.0 {
+                sum += (l - r).abs() / (l + r);
+            }
+        }
+        sum / samples as f64
     }
 
     /// The point where the ray from `p` along `dir` meets ∂P, if the segment
@@ -510,96 +565,123 @@ impl<'a> Extender<'a> {
             .or_else(|| self.boundary.nearest(p).map(|(q, _, _)| q))
     }
 
-    /// Descends from the leaf `start` (course `d`) into the removed subtree,
-    /// keeping the followed edges; records the end segment if the descent
-    /// stops inside P.
-    fn descend(&self, start: NodeId, mut d: Coord<f64>, st: &mut State) -> Descent {
-        self.heights.borrow_mut().generation += 1;
+    /// The cut end at `v`, when the descent reaches its junction with all
+    /// its legs still removed.
+    fn cut_at(&self, v: NodeId, st: &State) -> Option<Coord<f64>> {
+        let cut = self.cuts.get(&v)?;
+        let children = self.children(v, st);
+        cut.legs
+            .iter()
+            .all(|l| children.contains(l))
+            .then_some(cut.contact)
+    }
+
+    /// Descends from `start` (course `d`) into the removed subtree by
+    /// [`Self::decide`], keeping the followed edges; records the end
+    /// segment when the line ends at a fork, a cut or inside P.
+    fn descend(&self, start: NodeId, back: Vec<Coord<f64>>, st: &mut State) -> Descent {
         let mut rec = Descent {
             edges: Vec::new(),
             segment: None,
+            back: back.clone(),
         };
-        let mut v = start;
         // Within the end zone (two radii of the start) the course stays the
         // line's: following it leg by leg would let the end drift sideways.
         let zone = ZONE * self.radius(start);
-        let mut walked = 0.0;
+        let r0 = if self.on_boundary(start) {
+            0.0
+        } else {
+            self.radius(start)
+        };
+        let mut d = Self::course(&back, r0);
+        // The line walked so far, from its end backwards.
+        let mut trail: Vec<Coord<f64>> = back;
+        trail.reverse();
+        let (mut v, mut walked) = (start, 0.0);
         for _ in 0..=self.m.edges().len() {
-            let children = self.children(v, st);
-            if children.is_empty() {
-                if !self.on_boundary(v) {
-                    if let Some(q) = self.straight_end(v, d) {
-                        st.segments.push((v, q));
-                        rec.segment = Some(q);
-                    }
-                }
-                return rec;
-            }
-            let next = match self.decide(v, d, &children, &st.taken) {
-                Some(Decision::Fork { right, left }) => {
-                    if let Some(q) = self.fork_contact(v, d, right, left) {
-                        st.segments.push((v, q));
-                        rec.segment = Some(q);
-                        return rec;
-                    }
-                    // The fork's ray fails: follow the most aligned leg.
-                    self.most_aligned(v, d, &children)
-                }
-                Some(Decision::End(q)) => {
+            match self.decide(v, d, st) {
+                Decision::End(q) => {
                     st.segments.push((v, q));
                     rec.segment = Some(q);
                     return rec;
                 }
-                Some(Decision::Follow(c)) => Some(c),
-                None => None,
-            };
-            let Some(c) = next else {
-                if let Some(q) = self.straight_end(v, d) {
-                    st.segments.push((v, q));
-                    rec.segment = Some(q);
+                Decision::Stop => break,
+                Decision::Follow(e) => {
+                    st.set(self.m, e, true);
+                    rec.edges.push(e);
+                    let o = self.m.opposite(e, v);
+                    walked += self.len[e.index()];
+                    trail.extend_from_slice(&self.m.oriented_coords(e, v)[1..]);
+                    if walked > zone {
+                        let back: Vec<Coord<f64>> = trail.iter().rev().copied().collect();
+                        let r = if self.on_boundary(o) {
+                            0.0
+                        } else {
+                            self.radius(o)
+                        };
+                        d = Self::course(&back, r);
+                    }
+                    v = o;
                 }
-                return rec;
-            };
-            st.set(self.m, c, true);
-            rec.edges.push(c);
-            let o = self.m.opposite(c, v);
-            walked += self.len[c.index()];
-            if walked > zone {
-                d = self.arrival(c, o);
             }
-            v = o;
+        }
+        if !self.on_boundary(v) {
+            if let Some(q) = self.straight_end(v, d) {
+                st.segments.push((v, q));
+                rec.segment = Some(q);
+            }
         }
         rec
     }
 
-    fn hooks(&self, start: NodeId, rec: &Descent, st: &State, polygon: &PreparedPolygon) -> bool {
-        end_turn(&self.end_line(start, rec, st), polygon).is_some_and(|t| t > HOOK_DEG)
+    /// True when the end `rec` made from `start` is a hook.
+    fn hooks(&self, start: NodeId, rec: &Descent, polygon: &PreparedPolygon) -> bool {
+        end_turn(&self.end_line(start, rec), polygon).is_some_and(|t| t > HOOK_DEG)
     }
 
-    /// Replaces a hooked end: walking back from its end along the descent,
-    /// the first node from which a straight segment to where its disc
-    /// touches ∂P ahead (within [`FORK_ANGLE_DEG`] of the course) makes no
-    /// hook ends the line there. When none does, the hooked end stays.
-    fn unhook(
-        &self,
-        start: NodeId,
-        d: Coord<f64>,
-        rec: Descent,
-        st: &mut State,
-        polygon: &PreparedPolygon,
-    ) {
+    /// The end's line, from its end point back through the descent from
+    /// `start` and the kept line behind `start`.
+    fn end_line(&self, start: NodeId, rec: &Descent) -> Vec<Coord<f64>> {
+        let mut fwd = vec![self.pos(start)];
+        let mut at = start;
+        for &e in &rec.edges {
+            let c = self.m.oriented_coords(e, at);
+            fwd.extend_from_slice(&c[1..]);
+            at = self.m.opposite(e, at);
+        }
+        fwd.extend(rec.segment);
+        fwd.reverse();
+        fwd.extend_from_slice(&rec.back[1..]);
+        fwd
+    }
+
+    /// Replaces a hooked end by a straight one along the axis: walking back
+    /// from its end along the descent, the first node from which a straight
+    /// segment to where its disc touches ∂P ahead (within
+    /// [`FORK_AHEAD_DEG`] of the course there, at most [`FORK_TOUCH`] radii
+    /// away) is balanced ([`Self::balance`]) and makes no hook ends the
+    /// line there. When none does, the hooked end stays: it follows the
+    /// medial axis into its corner.
+    fn unhook(&self, start: NodeId, rec: Descent, st: &mut State, polygon: &PreparedPolygon) {
         let mut nodes = vec![start];
         for &e in &rec.edges {
             nodes.push(self.m.opposite(e, *nodes.last().expect("non-empty")));
         }
-        self.undo(&rec, st);
+        let mut trail: Vec<Coord<f64>> = rec.back.iter().rev().copied().collect();
+        let mut trails = vec![trail.clone()];
+        for (k, &e) in rec.edges.iter().enumerate() {
+            trail.extend_from_slice(&self.m.oriented_coords(e, nodes[k])[1..]);
+            trails.push(trail.clone());
+        }
         for k in (0..nodes.len()).rev() {
             let v = nodes[k];
-            let course = if k == 0 {
-                d
+            let back: Vec<Coord<f64>> = trails[k].iter().rev().copied().collect();
+            let r = if self.on_boundary(v) {
+                0.0
             } else {
-                self.arrival(rec.edges[k - 1], v)
+                self.radius(v)
             };
+            let course = Self::course(&back, r);
             let p = self.pos(v);
             let cone = |deg: f64| {
                 let (s, c) = deg.to_radians().sin_cos();
@@ -610,75 +692,32 @@ impl<'a> Extender<'a> {
             };
             let Some((q, dist)) =
                 self.boundary
-                    .nearest_in_sector(p, cone(-FORK_ANGLE_DEG), cone(FORK_ANGLE_DEG))
+                    .nearest_in_sector(p, cone(-FORK_AHEAD_DEG), cone(FORK_AHEAD_DEG))
             else {
                 continue;
             };
-            if dist <= 0.0 || dist > FORK_REACH * self.radius(v).max(self.tol) {
+            if dist <= 0.0
+                || dist > FORK_TOUCH * self.radius(v).max(self.tol)
+                || self.balance(p, q) > CHORD_BALANCE
+            {
                 continue;
             }
             let trial = Descent {
                 edges: rec.edges[..k].to_vec(),
                 segment: Some(q),
+                back: rec.back.clone(),
             };
-            if !self.hooks(start, &trial, st, polygon) {
-                for &e in &trial.edges {
-                    st.set(self.m, e, true);
+            if !self.hooks(start, &trial, polygon) {
+                for &e in &rec.edges[k..] {
+                    st.release(self.m, e);
+                }
+                if rec.segment.is_some() {
+                    st.segments.pop();
                 }
                 st.segments.push((v, q));
                 return;
             }
         }
-        // Nothing better: the end as the descent made it.
-        for &e in &rec.edges {
-            st.set(self.m, e, true);
-        }
-        if let Some(q) = rec.segment {
-            let last = *nodes.last().expect("non-empty");
-            st.segments.push((last, q));
-        }
-    }
-
-    /// Takes back what `rec` added.
-    fn undo(&self, rec: &Descent, st: &mut State) {
-        for &e in &rec.edges {
-            st.release(self.m, e);
-        }
-        if rec.segment.is_some() {
-            st.segments.pop();
-        }
-    }
-
-    /// The end's line from its end point back through the descent from
-    /// `start` and the kept line behind `start` (six radii of `start` at
-    /// most).
-    fn end_line(&self, start: NodeId, rec: &Descent, st: &State) -> Vec<Coord<f64>> {
-        let mut fwd = vec![self.pos(start)];
-        let mut at = start;
-        for &e in &rec.edges {
-            let c = self.m.oriented_coords(e, at);
-            fwd.extend_from_slice(&c[1..]);
-            at = self.m.opposite(e, at);
-        }
-        fwd.extend(rec.segment);
-        fwd.reverse();
-        // Behind the start, along the kept line.
-        let limit = 6.0 * self.radius(start);
-        let (mut at, mut via, mut walked) = (start, rec.edges.first().copied(), 0.0);
-        for _ in 0..self.m.edges().len() {
-            let Some(e) = self.next_kept(at, via, st) else {
-                break;
-            };
-            let c = self.m.oriented_coords(e, at);
-            fwd.extend_from_slice(&c[1..]);
-            walked += self.len[e.index()];
-            at = self.m.opposite(e, at);
-            via = Some(e);
-            if walked > limit || st.kdeg[at.index()] != 2 {
-                break;
-            }
-        }
-        fwd
     }
 
     /// The kept edge at `at` other than `via`, walking along a kept line.
@@ -692,25 +731,27 @@ impl<'a> Extender<'a> {
     /// The start of `leaf`'s end zone: walking back along the kept line,
     /// the first node whose distance from the leaf along the line reaches
     /// [`ZONE`] times its radius (one local width), never past a kept
-    /// junction; and the kept edges from there to the leaf. The end is
-    /// decided anew from there, so a line that bends into a corner over
-    /// its last width is straightened.
+    /// junction nor past the middle of a line between two leaves (whose
+    /// other end has its own zone); and the kept edges from there to the
+    /// leaf. The end is decided anew from there, so a line that bends into
+    /// a corner over its last width is straightened.
     fn end_zone(&self, leaf: NodeId, st: &State) -> (NodeId, Vec<EdgeId>) {
+        let chain = self.chain(leaf, st);
+        let limit = match chain.last() {
+            Some(&(_, o)) if st.kdeg[o.index()] == 1 => {
+                0.5 * chain.iter().map(|(e, _)| self.len[e.index()]).sum::<f64>()
+            }
+            _ => f64::INFINITY,
+        };
         let mut tail = Vec::new();
-        let (mut at, mut via) = (leaf, None);
-        let mut s = 0.0;
-        for _ in 0..self.m.edges().len() {
-            let Some(e) = self.next_kept(at, via, st) else {
-                break;
-            };
-            let o = self.m.opposite(e, at);
-            if st.kdeg[o.index()] != 2 {
+        let (mut at, mut s) = (leaf, 0.0);
+        for &(e, o) in &chain {
+            if st.kdeg[o.index()] != 2 || s + self.len[e.index()] > limit {
                 break;
             }
             s += self.len[e.index()];
             tail.push(e);
             at = o;
-            via = Some(e);
             if s >= ZONE * self.radius(o) {
                 break;
             }
@@ -718,80 +759,24 @@ impl<'a> Extender<'a> {
         (at, tail)
     }
 
-    fn most_aligned(&self, v: NodeId, d: Coord<f64>, children: &[EdgeId]) -> Option<EdgeId> {
-        children
-            .iter()
-            .filter_map(|&c| Some((c, dot(self.departure(c, v)?, d))))
-            .max_by(|a, b| a.1.total_cmp(&b.1).then(b.0.cmp(&a.0)))
-            .map(|(c, _)| c)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A random tree of `n` nodes in the unit square's interior (each node
-    /// joined to a random earlier one), with random radii.
-    fn random_tree(n: usize, seed: u64) -> SkeletonGraph {
-        let mut s = seed;
-        let mut next = || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        };
-        let mut g = SkeletonGraph::new();
-        let mut ids = Vec::new();
-        for i in 0..n {
-            let p = Coord {
-                x: 0.1 + 0.8 * next(),
-                y: 0.1 + 0.8 * next(),
+    /// The kept line from `leaf` to the next node that is no inner node of
+    /// it (a junction or the other leaf): its edges, each with the node it
+    /// leads to.
+    fn chain(&self, leaf: NodeId, st: &State) -> Vec<(EdgeId, NodeId)> {
+        let mut out = Vec::new();
+        let (mut at, mut via) = (leaf, None);
+        for _ in 0..self.m.edges().len() {
+            let Some(e) = self.next_kept(at, via, st) else {
+                break;
             };
-            let id = g.add_node(p, 0.1 * next(), None);
-            if i > 0 {
-                let j = (next() * i as f64) as usize;
-                g.add_edge(ids[j], id, Vec::new());
+            let o = self.m.opposite(e, at);
+            out.push((e, o));
+            if st.kdeg[o.index()] != 2 || o == leaf {
+                break;
             }
-            ids.push(id);
+            at = o;
+            via = Some(e);
         }
-        g
-    }
-
-    #[test]
-    fn remembered_subtree_depths_equal_the_walk() {
-        let ring = vec![(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0), (0.0, 0.0)];
-        let square = geo::Polygon::new(geo::LineString::from(ring), vec![]);
-        let polygon = PreparedPolygon::new(&square).unwrap();
-        for seed in 1..20u64 {
-            let g = random_tree(200, seed * 7919);
-            let mut e = Extender::new(&g, &polygon);
-            assert!(e.forest);
-            // Some edges taken, as kept edges and earlier steps would be.
-            let taken: Vec<bool> = (0..g.edges().len()).map(|i| i % 11 == 3).collect();
-            let mut remembered = Vec::new();
-            for (i, ed) in g.edges().iter().enumerate() {
-                for from in [ed.a, ed.b] {
-                    remembered.push(e.depth(from, EdgeId::from_index(i), &taken, f64::INFINITY));
-                }
-            }
-            e.forest = false;
-            let mut k = 0;
-            for (i, ed) in g.edges().iter().enumerate() {
-                for from in [ed.a, ed.b] {
-                    let walked = e.depth(from, EdgeId::from_index(i), &taken, f64::INFINITY);
-                    let r = remembered[k];
-                    assert!(
-                        (walked - r).abs() <= 1e-12 * walked.max(1.0),
-                        "{walked} {r}"
-                    );
-                    k += 1;
-                }
-            }
-        }
-        // A cycle: not a forest, so every depth is walked.
-        let mut g = random_tree(10, 3);
-        g.add_edge(NodeId::from_index(0), NodeId::from_index(9), Vec::new());
-        assert!(!Extender::new(&g, &polygon).forest);
+        out
     }
 }

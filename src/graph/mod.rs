@@ -15,7 +15,7 @@ pub(crate) mod ends;
 pub mod extend;
 mod handle;
 mod invariants;
-pub(crate) mod line;
+pub mod line;
 pub mod planar;
 pub mod prune;
 pub(crate) mod structure;

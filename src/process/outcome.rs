@@ -225,51 +225,6 @@ fn length_outside(lines: &MultiLineString<f64>, parts: &[PreparedPolygon]) -> (f
     (outside, total)
 }
 
-/// The candidates' scores for selection, without those whose lines end in
-/// more hooks than the reference's ([`crate::score::defects`]): with a
-/// shared structure every method is conformed to the reference's ends, and
-/// where a method's conformed end turns sideways into a corner the
-/// reference does not turn into, its lower distortion (often from the
-/// extra hits of that stub) never outweighs a defect the eye sees first.
-/// The reference is the first method of the reference order that has
-/// lines. Such a candidate is still written in `candidates`, with its
-/// scores, unchosen.
-fn without_added_hooks(
-    mut scores: Vec<Option<Scores>>,
-    candidates: &[Candidate],
-    params: &ProcessParams,
-) -> Vec<Option<Scores>> {
-    let shared = params
-        .prune
-        .is_some_and(|p| p.structure == crate::graph::prune::Structure::Shared);
-    if !shared || params.select.is_none() || params.score.is_none() {
-        return scores;
-    }
-    let hooks = |k: usize| {
-        scores[k]
-            .as_ref()
-            .and(candidates[k].result.as_ref().ok())
-            .map(|s| s.hooks)
-    };
-    let Some(limit) = params
-        .skeleton
-        .reference_order()
-        .into_iter()
-        .find_map(|m| hooks(candidates.iter().position(|c| c.method == m)?))
-    else {
-        return scores;
-    };
-    let over: Vec<bool> = (0..scores.len())
-        .map(|k| hooks(k).is_some_and(|h| h > limit))
-        .collect();
-    for (s, over) in scores.iter_mut().zip(over) {
-        if over {
-            *s = None;
-        }
-    }
-    scores
-}
-
 /// The outcome for a feature's candidates: the chosen one by `select` (or
 /// the first with a skeleton), or the rejection when none has one.
 fn choose(candidates: Vec<Candidate>, parts: usize, params: &ProcessParams) -> Processed {
@@ -280,7 +235,6 @@ fn choose(candidates: Vec<Candidate>, parts: usize, params: &ProcessParams) -> P
             _ => None,
         })
         .collect();
-    let scores = without_added_hooks(scores, &candidates, params);
     let chosen = match (&params.select, params.score.is_some()) {
         (Some(sel), true) => select(&scores, sel),
         _ => None,

@@ -24,7 +24,6 @@
 
 use super::{LegMeasure, PruneParams};
 use crate::geometry::tolerance::ON_BOUNDARY_END;
-use crate::geometry::vector::dot;
 use crate::geometry::Boundary;
 use crate::graph::cut::cut_ends;
 use crate::graph::line::point_at;
@@ -379,6 +378,8 @@ pub fn mask(m: &SkeletonGraph, params: &PruneParams, boundary: &Boundary) -> Vec
         }
     }
     let mut keep = w.keep;
+    let mut collapsed: Vec<NodeId> = collapsed;
+    collapsed.extend(short_lines(m, &keep, tol));
     if !collapsed.is_empty() {
         // Everything in these components was insignificant: which two legs
         // were left over is an accident of the removal order, so the
@@ -393,44 +394,85 @@ pub fn mask(m: &SkeletonGraph, params: &PruneParams, boundary: &Boundary) -> Vec
     keep
 }
 
-/// Most leaves for which the farthest pair is searched among all leaves; a
-/// component with more searches its leaves' convex hull (and falls back to
-/// its longest path when even the hull has more).
-const MAX_AXIS_LEAVES: usize = 2000;
-
-/// Keeps, in component `c` of `m`, only its main axis: the path between
-/// the two leaves farthest apart (straight-line distance, the polygon's
-/// length), so a compact island gets a line through its middle from end to
-/// end rather than a curve between two corners on one side.
-fn main_axis(m: &SkeletonGraph, labels: &[usize], c: usize, keep: &mut [bool]) {
-    let deg = m.degrees();
-    let leaves: Vec<NodeId> = (0..m.nodes().len())
-        .filter(|&n| labels[n] == c && deg[n] == 1)
-        .map(NodeId::from_index)
-        .collect();
-    let in_c: Vec<bool> = m.edges().iter().map(|e| labels[e.a.index()] == c).collect();
-    // The farthest pair lies on the leaves' convex hull: with many leaves
-    // (the thickets of a rough rim) only the hull's are paired.
-    let candidates = if leaves.len() > MAX_AXIS_LEAVES {
-        hull_leaves(m, &leaves)
-    } else {
-        leaves
-    };
-    let pair = if candidates.len() > MAX_AXIS_LEAVES {
-        None
-    } else {
-        let mut best: Option<(f64, NodeId, NodeId)> = None;
-        for (i, &a) in candidates.iter().enumerate() {
-            for &b in &candidates[i + 1..] {
-                let d = m.node(a).pos - m.node(b).pos;
-                let d2 = dot(d, d);
-                if best.is_none_or(|(bd, _, _)| d2 > bd) {
-                    best = Some((d2, a, b));
-                }
+/// A node of every kept line that is shorter than the diameter of the
+/// largest disc on it and ends inside P at both ends: such a line lies
+/// within about one disc — a compact shape whose legs were all
+/// insignificant although two of them were left — and its course says
+/// nothing about where the shape's tips are; it gets the main axis instead.
+fn short_lines(m: &SkeletonGraph, keep: &[bool], tol: f64) -> Vec<NodeId> {
+    let n = m.nodes().len();
+    let mut uf = crate::graph::UnionFind::new(n);
+    let mut deg = vec![0usize; n];
+    for (i, e) in m.edges().iter().enumerate() {
+        if keep[i] {
+            uf.union(e.a.index(), e.b.index());
+            deg[e.a.index()] += 1;
+            deg[e.b.index()] += 1;
+        }
+    }
+    // Per component root: length, widest radius, leaves, branching.
+    let mut length = std::collections::HashMap::<usize, f64>::new();
+    for (i, e) in m.edges().iter().enumerate() {
+        if keep[i] {
+            *length.entry(uf.find(e.a.index())).or_default() +=
+                m.edge_length(EdgeId::from_index(i));
+        }
+    }
+    let mut widest = std::collections::HashMap::<usize, f64>::new();
+    let mut leaves = std::collections::HashMap::<usize, Vec<usize>>::new();
+    let mut branching = std::collections::HashSet::<usize>::new();
+    for (k, node) in m.nodes().iter().enumerate() {
+        if deg[k] == 0 {
+            continue;
+        }
+        let root = uf.find(k);
+        let w = widest.entry(root).or_default();
+        *w = w.max(node.radius);
+        match deg[k] {
+            1 => leaves.entry(root).or_default().push(k),
+            2 => {}
+            _ => {
+                branching.insert(root);
             }
         }
-        best.map(|(_, a, b)| (a, b))
-    };
+    }
+    let mut out: Vec<NodeId> = leaves
+        .iter()
+        .filter(|(root, ls)| {
+            ls.len() == 2
+                && !branching.contains(root)
+                && ls.iter().all(|&k| m.nodes()[k].radius > tol)
+                && length[root] < 2.0 * widest[root]
+        })
+        .map(|(_, ls)| NodeId::from_index(ls[0]))
+        .collect();
+    out.sort();
+    out
+}
+
+/// Most leaves paired in [`deepest_pair`]; a component with more pairs
+/// those on its leaves' convex hull and its deepest tips.
+const MAX_AXIS_LEAVES: usize = 2000;
+
+/// Ancestors (besides the centre) against whose discs a leaf's depth is
+/// measured in [`main_axis`]: the nearest ones on its path to the centre.
+const AXIS_TIP_ANCESTORS: usize = 64;
+
+/// Keeps, in component `c` of `m`, only its main axis: the path between
+/// its two deepest tips, so a compact island gets a line through its
+/// middle from tip to tip rather than a curve between two corners on one
+/// side or a line to a shallow bank vertex.
+///
+/// From the node of largest radius (the centre z, its disc the largest
+/// inscribed one), every leaf ℓ has the depth
+/// `τ(ℓ) = max over x on the path z..ℓ of |ℓ − x| + r_ℓ − r_x` (how far ℓ
+/// reaches beyond the largest disc and every disc after it; the tip depth
+/// of `crate::graph::ends`). The axis joins the deepest leaf to the
+/// deepest leaf of another branch at z, so that it runs through the
+/// largest disc; ties go to the leaf farther from z, then to node order.
+fn main_axis(m: &SkeletonGraph, labels: &[usize], c: usize, keep: &mut [bool]) {
+    let in_c: Vec<bool> = m.edges().iter().map(|e| labels[e.a.index()] == c).collect();
+    let pair = deepest_pair(m, labels, c);
     let path = pair.and_then(|(a, b)| super::trunk::shortest_path(m, &in_c, a, b));
     match path {
         Some(path) => {
@@ -452,6 +494,82 @@ fn main_axis(m: &SkeletonGraph, labels: &[usize], c: usize, keep: &mut [bool]) {
             }
         }
     }
+}
+
+/// The two deepest tips of component `c` in different branches at its
+/// centre (see [`main_axis`]).
+fn deepest_pair(m: &SkeletonGraph, labels: &[usize], c: usize) -> Option<(NodeId, NodeId)> {
+    let centre = (0..m.nodes().len())
+        .filter(|&n| labels[n] == c)
+        .map(NodeId::from_index)
+        .max_by(|a, b| {
+            m.node(*a)
+                .radius
+                .total_cmp(&m.node(*b).radius)
+                .then(b.cmp(a))
+        })?;
+    let adj = m.adjacency();
+    let z = m.node(centre);
+    // Depth-first from the centre with the path kept: (node, depth, branch).
+    let mut path: Vec<NodeId> = Vec::new();
+    let mut seen = vec![false; m.nodes().len()];
+    seen[centre.index()] = true;
+    let mut stack = vec![(centre, 0usize, None::<EdgeId>)];
+    // (τ, distance from the centre, leaf, branch)
+    let mut tips: Vec<(f64, f64, NodeId, EdgeId)> = Vec::new();
+    while let Some((n, depth, branch)) = stack.pop() {
+        path.truncate(depth);
+        path.push(n);
+        let mut leaf = true;
+        for &e in &adj[n.index()] {
+            let o = m.opposite(e, n);
+            if !seen[o.index()] {
+                seen[o.index()] = true;
+                leaf = false;
+                stack.push((o, depth + 1, Some(branch.unwrap_or(e))));
+            }
+        }
+        if let (true, Some(branch)) = (leaf, branch) {
+            let l = m.node(n);
+            let reach = |x: NodeId| {
+                let x = m.node(x);
+                crate::geometry::vector::hypot(l.pos - x.pos) + l.radius - x.radius
+            };
+            let from = path.len().saturating_sub(AXIS_TIP_ANCESTORS);
+            let tau = path[from..]
+                .iter()
+                .map(|&x| reach(x))
+                .fold(reach(centre), f64::max)
+                .max(0.0);
+            let dist = crate::geometry::vector::hypot(l.pos - z.pos);
+            tips.push((tau, dist, n, branch));
+        }
+    }
+    // The pair with the largest |a − b| + τ(a) + τ(b): as far apart as the
+    // shape is long, with real tips preferred to shallow bank vertices.
+    // With many leaves (the thickets of a rough rim) only those on the
+    // leaves' convex hull and the deepest ones are paired.
+    if tips.len() > MAX_AXIS_LEAVES {
+        let hull: std::collections::HashSet<NodeId> =
+            hull_leaves(m, &tips.iter().map(|t| t.2).collect::<Vec<_>>())
+                .into_iter()
+                .collect();
+        tips.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.2.cmp(&b.2)));
+        let deepest: Vec<NodeId> = tips.iter().take(MAX_AXIS_LEAVES / 4).map(|t| t.2).collect();
+        tips.retain(|t| hull.contains(&t.2) || deepest.contains(&t.2));
+        tips.truncate(MAX_AXIS_LEAVES);
+    }
+    let pos = |n: NodeId| m.node(n).pos;
+    let mut best: Option<(f64, NodeId, NodeId)> = None;
+    for (i, a) in tips.iter().enumerate() {
+        for b in &tips[i + 1..] {
+            let score = crate::geometry::vector::hypot(pos(a.2) - pos(b.2)) + a.0 + b.0;
+            if best.is_none_or(|(s, _, _)| score > s) {
+                best = Some((score, a.2, b.2));
+            }
+        }
+    }
+    best.map(|(_, a, b)| (a, b))
 }
 
 /// The leaves among `leaves` at the corners of their convex hull, in

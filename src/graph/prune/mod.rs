@@ -443,13 +443,16 @@ mod tests {
 
     #[test]
     fn star_of_whiskers_keeps_its_main_axis() {
-        // Every leg is insignificant: the line between the two leaves
-        // farthest apart stays, (1.5, 0)–(−1.2, 0), not the two longest legs.
+        // Every leg is insignificant: the main axis joins the pair with the
+        // largest distance plus tip depths (τ = 0.5, 0.2, 0.8 beyond the
+        // unit disc): (1.5, 0)–(0, 1.8), 2.34 + 1.3, rather than the pair
+        // farthest apart, (1.5, 0)–(−1.2, 0), 2.7 + 0.7, whose end at
+        // (−1.2, 0) barely leaves the disc.
         let g = star(1.0, &[(1.5, 0.), (-1.2, 0.), (0., 1.8)]);
         let p = prune(&g, &PruneParams::default(), &far());
         assert_eq!(p.edges().len(), 1);
         assert!(
-            (p.total_length() - 2.7).abs() < 1e-12,
+            (p.total_length() - 3.3).abs() < 1e-12,
             "{}",
             p.total_length()
         );
