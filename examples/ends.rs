@@ -84,15 +84,12 @@ fn ends_of(
     p: &PreparedPolygon,
     axis: &RTree<Seg>,
 ) -> (usize, usize, usize, f64) {
-    let g = SkeletonGraph::from_lines(lines).filter_edges(|_, _| true);
-    let g = {
-        let sub = g.filter_edges(|e, _| {
-            let c = g.edge_coords(e);
-            p.boundary()
-                .contains_with_tolerance(c[c.len() / 2], 1e-6 * p.extent())
-        });
-        sub
-    };
+    let all = SkeletonGraph::from_lines(lines);
+    let g = all.filter_edges(|e, _| {
+        let c = all.edge_coords(e);
+        p.boundary()
+            .contains_with_tolerance(c[c.len() / 2], 1e-6 * p.extent())
+    });
     let adj = g.adjacency();
     let (mut ends, mut hooks, mut off, mut worst) = (0, 0, 0, 0.0f64);
     for n in 0..g.nodes().len() {
