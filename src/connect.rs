@@ -98,8 +98,19 @@ impl Network {
                 continue;
             }
             let mut found: Vec<Coord<f64>> = Vec::new();
-            let add = |found: &mut Vec<Coord<f64>>, c: Coord<f64>, tol: f64| {
-                if found.iter().all(|f| crate::geometry::norm(*f - c) > tol) {
+            // Points found so far by their cell of side eps: a point within
+            // eps of another lies in one of the 3 × 3 cells around it.
+            let mut cells: std::collections::HashMap<(i64, i64), Vec<usize>> = Default::default();
+            let cell = |c: Coord<f64>| ((c.x / eps).floor() as i64, (c.y / eps).floor() as i64);
+            let mut add = |found: &mut Vec<Coord<f64>>, c: Coord<f64>, tol: f64| {
+                let (i, j) = cell(c);
+                let near = (i - 1..=i + 1)
+                    .flat_map(|x| (j - 1..=j + 1).map(move |y| (x, y)))
+                    .filter_map(|k| cells.get(&k))
+                    .flatten()
+                    .any(|&f| crate::geometry::norm(found[f] - c) <= tol);
+                if !near {
+                    cells.entry((i, j)).or_default().push(found.len());
                     found.push(c);
                 }
             };
@@ -143,7 +154,11 @@ fn intersection(p: Coord<f64>, q: Coord<f64>, a: Coord<f64>, b: Coord<f64>) -> O
 /// point of the skeleton that sees it within 60° of the boundary's inward
 /// normal there (the edge split at that point).
 /// A point the skeleton already reaches (within `1e-9 × extent`) gets a
-/// zero-length leg, so that every connection point is listed.
+/// zero-length leg, so that every connection point is listed. Points are
+/// served in order, and a leg made for an earlier point is a line a later
+/// one can join. The skeleton's segments are searched through a packed
+/// tree and the legs through one rebuilt as they accumulate, so that a
+/// polygon with thousands of connection points costs O(k log n).
 pub fn add_legs(
     g: &SkeletonGraph,
     p: &PreparedPolygon,
@@ -153,12 +168,13 @@ pub fn add_legs(
         return (g.clone(), Vec::new());
     }
     let tol = 1e-9 * p.extent();
-    let mut polylines: Vec<Vec<Coord<f64>>> = (0..g.edges().len())
+    let polylines: Vec<Vec<Coord<f64>>> = (0..g.edges().len())
         .map(|e| g.edge_coords(crate::graph::EdgeId::from_index(e)))
         .collect();
+    let mut lines = Reachable::new(polylines, p.extent());
     let mut legs = Vec::new();
     for &(fid, c) in points {
-        let Some((k, i, s)) = nearest_visible(&polylines, p, c) else {
+        let Some((at, s)) = nearest_visible(&lines, p, c) else {
             continue;
         };
         if crate::geometry::norm(s - c) <= tol {
@@ -169,25 +185,138 @@ pub fn add_legs(
             });
             continue;
         }
-        // Split polyline k at s (after vertex i).
-        let line = std::mem::take(&mut polylines[k]);
-        let mut first: Vec<Coord<f64>> = line[..=i].to_vec();
-        let mut second: Vec<Coord<f64>> = vec![s];
-        second.extend_from_slice(&line[i + 1..]);
-        first.push(s);
-        polylines[k] = first;
-        polylines.push(second);
-        polylines.push(vec![s, c]);
+        lines.split(at, s);
+        lines.add_leg(s, c);
         legs.push(ConnectionLeg {
             line_fid: fid,
             leg: LineString(vec![s, c]),
         });
     }
     let mut b = GraphBuilder::new();
-    for l in &polylines {
-        b.polyline(l);
+    for l in lines.pieces() {
+        b.polyline(&l);
     }
     (b.finish(p.boundary()), legs)
+}
+
+/// A segment of [`Reachable`]: (line, segment index in it).
+type SegmentAt = (usize, usize);
+
+/// The skeleton's polylines and the legs added to them, with the points
+/// they are split at, searchable by distance.
+struct Reachable {
+    /// The skeleton's polylines, then one two-point line per leg.
+    lines: Vec<Vec<Coord<f64>>>,
+    /// The split points of each line: (segment, parameter, point).
+    splits: Vec<Vec<(usize, f64, Coord<f64>)>>,
+    /// Every segment of the skeleton's polylines, and a tree of them.
+    segments: Vec<SegmentAt>,
+    tree: crate::geometry::packed::PackedTree,
+    /// The legs in `legs_tree` (the first `indexed` legs) and those after.
+    legs_tree: crate::geometry::packed::PackedTree,
+    indexed: usize,
+    skeleton_lines: usize,
+    extent: f64,
+}
+
+/// Legs not in the legs' tree that make it be rebuilt.
+const LEGS_UNINDEXED: usize = 256;
+
+impl Reachable {
+    fn new(lines: Vec<Vec<Coord<f64>>>, extent: f64) -> Self {
+        let mut segments = Vec::new();
+        let mut ends = Vec::new();
+        for (k, l) in lines.iter().enumerate() {
+            for (i, w) in l.windows(2).enumerate() {
+                segments.push((k, i));
+                ends.push([[w[0].x, w[0].y], [w[1].x, w[1].y]]);
+            }
+        }
+        Self {
+            splits: vec![Vec::new(); lines.len()],
+            skeleton_lines: lines.len(),
+            lines,
+            tree: crate::geometry::packed::PackedTree::of_segments(&ends),
+            segments,
+            legs_tree: Default::default(),
+            indexed: 0,
+            extent,
+        }
+    }
+
+    fn segment(&self, (k, i): SegmentAt) -> (Coord<f64>, Coord<f64>) {
+        (self.lines[k][i], self.lines[k][i + 1])
+    }
+
+    /// Every segment with a point within `r` of `c` (by its box), in the
+    /// order of the lines (skeleton first, then the legs).
+    fn near(&self, c: Coord<f64>, r: f64) -> Vec<SegmentAt> {
+        use std::ops::ControlFlow;
+        let r2 = r * r;
+        let within = |b: &crate::geometry::packed::Bbox| {
+            crate::geometry::packed::box_distance_2(b, c.x, c.y) <= r2
+        };
+        let mut out: Vec<SegmentAt> = Vec::new();
+        self.tree.visit(within, |id| {
+            out.push(self.segments[id as usize]);
+            ControlFlow::<()>::Continue(())
+        });
+        let first_leg = self.skeleton_lines;
+        self.legs_tree.visit(within, |id| {
+            out.push((first_leg + id as usize, 0));
+            ControlFlow::<()>::Continue(())
+        });
+        for k in first_leg + self.indexed..self.lines.len() {
+            let (a, z) = self.segment((k, 0));
+            let b = [a.x.min(z.x), a.y.min(z.y), a.x.max(z.x), a.y.max(z.y)];
+            if within(&b) {
+                out.push((k, 0));
+            }
+        }
+        out.sort_unstable();
+        out
+    }
+
+    /// Splits segment `at` at `s`, a point of it.
+    fn split(&mut self, (k, i): SegmentAt, s: Coord<f64>) {
+        let (a, z) = self.segment((k, i));
+        let (_, t) = crate::geometry::segment::closest_on_segment(a, z, s);
+        self.splits[k].push((i, t, s));
+    }
+
+    /// A leg from `s` to `c`, a line later points can join.
+    fn add_leg(&mut self, s: Coord<f64>, c: Coord<f64>) {
+        self.lines.push(vec![s, c]);
+        self.splits.push(Vec::new());
+        let legs = self.lines.len() - self.skeleton_lines;
+        if legs - self.indexed > LEGS_UNINDEXED {
+            let ends: Vec<[[f64; 2]; 2]> = self.lines[self.skeleton_lines..]
+                .iter()
+                .map(|l| [[l[0].x, l[0].y], [l[1].x, l[1].y]])
+                .collect();
+            self.legs_tree = crate::geometry::packed::PackedTree::of_segments(&ends);
+            self.indexed = legs;
+        }
+    }
+
+    /// Every line cut at its split points.
+    fn pieces(mut self) -> Vec<Vec<Coord<f64>>> {
+        let mut out = Vec::new();
+        for (line, mut splits) in self.lines.drain(..).zip(self.splits.drain(..)) {
+            splits.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+            let mut piece = vec![line[0]];
+            let mut next = splits.iter().peekable();
+            for i in 0..line.len() - 1 {
+                while let Some(&(_, _, s)) = next.next_if(|x| x.0 == i) {
+                    piece.push(s);
+                    out.push(std::mem::replace(&mut piece, vec![s]));
+                }
+                piece.push(line[i + 1]);
+            }
+            out.push(piece);
+        }
+        out
+    }
 }
 
 /// `prune: {mode: network}`: the through-lines of `raw` (a method's raw
@@ -197,50 +326,75 @@ pub fn add_legs(
 /// between them along the skeleton (`graph::prune::network`). The
 /// result's leaves are the connection points (with one point: it and the
 /// farthest tip); a point no straight leg inside P reaches keeps the leaf
-/// nearest to it instead. Nothing is extended.
+/// nearest to it instead. Nothing is extended. `None` when `expired()`
+/// said the feature's time is up before the paths were found.
 pub fn through_lines(
     raw: &SkeletonGraph,
     p: &PreparedPolygon,
     points: &[Coord<f64>],
-) -> SkeletonGraph {
+    expired: &dyn Fn() -> bool,
+) -> Option<SkeletonGraph> {
     let listed: Vec<(Option<u64>, Coord<f64>)> = points.iter().map(|&c| (None, c)).collect();
     let (with_legs, _) = add_legs(raw, p, &listed);
+    if expired() {
+        return None;
+    }
     let m = with_legs.merged();
     let tol = 1e-9 * p.extent();
     let deg = m.degrees();
-    // The node at each point; where no straight leg inside P reached it (a
-    // conformed method's end cut short), the leaf nearest to it.
-    let nearest = |c: Coord<f64>, leaves_only: bool| {
+    // The node at each point (nodes sorted by x, looked up within tol);
+    // where no straight leg inside P reached it (a conformed method's end
+    // cut short), the leaf nearest to it.
+    let mut by_x: Vec<(f64, usize)> = m
+        .nodes()
+        .iter()
+        .enumerate()
+        .map(|(i, n)| (n.pos.x, i))
+        .collect();
+    by_x.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let at = |c: Coord<f64>| {
+        let from = by_x.partition_point(|&(x, _)| x < c.x - tol);
+        by_x[from..]
+            .iter()
+            .take_while(|&&(x, _)| x <= c.x + tol)
+            .map(|&(_, i)| (crate::geometry::norm(m.nodes()[i].pos - c), i))
+            .filter(|&(d, _)| d <= tol)
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+            .map(|(_, i)| i)
+    };
+    let nearest_leaf = |c: Coord<f64>| {
         m.nodes()
             .iter()
             .enumerate()
-            .filter(|&(i, _)| !leaves_only || deg[i] == 1)
+            .filter(|&(i, _)| deg[i] == 1)
             .map(|(i, n)| (crate::geometry::norm(n.pos - c), i))
             .min_by(|a, b| a.0.total_cmp(&b.0))
+            .map(|(_, i)| i)
     };
     let mut terminals: Vec<crate::graph::NodeId> = points
         .iter()
-        .filter_map(|&c| match nearest(c, false) {
-            Some((d, i)) if d <= tol => Some(i),
-            _ => nearest(c, true).map(|(_, i)| i),
-        })
+        .filter_map(|&c| at(c).or_else(|| nearest_leaf(c)))
         .map(crate::graph::NodeId::from_index)
         .collect();
     terminals.sort();
     terminals.dedup();
-    let keep = crate::graph::prune::network::mask(&m, &terminals);
-    m.filter_edges(|e, _| keep[e.index()]).merged()
+    let keep = crate::graph::prune::network::mask(&m, &terminals, expired)?;
+    Some(m.filter_edges(|e, _| keep[e.index()]).merged())
 }
 
-/// The point of the skeleton's polylines nearest to `c` from which the
+/// The point of the skeleton's lines nearest to `c` from which the
 /// straight segment to `c` stays inside P and meets ∂P within 60° of its
-/// inward normal at `c` (so that a leg never runs along the shore):
-/// (polyline, segment index, point).
+/// inward normal at `c` (so that a leg never runs along the shore), among
+/// the 64 nearest in that cone: (segment, point). The lines are searched
+/// within a radius doubled until it holds the answer, 64 candidates, or
+/// the whole polygon; candidates at one distance are taken in the lines'
+/// order.
 fn nearest_visible(
-    polylines: &[Vec<Coord<f64>>],
+    lines: &Reachable,
     p: &PreparedPolygon,
     c: Coord<f64>,
-) -> Option<(usize, usize, Coord<f64>)> {
+) -> Option<(SegmentAt, Coord<f64>)> {
+    const CANDIDATES: usize = 64;
     let b = p.boundary();
     let (_, seg, _) = b.nearest(c)?;
     let s = &b.segments()[seg];
@@ -264,36 +418,52 @@ fn nearest_visible(
         y: n.x * sin + n.y * cos,
     };
     let cross = |u: Coord<f64>, v: Coord<f64>| u.x * v.y - u.y * v.x;
-    let mut candidates: Vec<(f64, usize, usize, Coord<f64>)> = Vec::new();
-    for (k, l) in polylines.iter().enumerate() {
-        for i in 0..l.len().saturating_sub(1) {
-            // The part of the segment inside the cone: both half-planes.
-            let (a, z) = (l[i], l[i + 1]);
-            let (mut t0, mut t1) = (0.0_f64, 1.0_f64);
-            for (edge, sign) in [(right, 1.0), (left, -1.0)] {
-                let (fa, fz) = (sign * cross(edge, a - c), sign * cross(edge, z - c));
-                if fa < 0.0 && fz < 0.0 {
-                    t1 = -1.0;
-                } else if fa < 0.0 {
-                    t0 = t0.max(fa / (fa - fz));
-                } else if fz < 0.0 {
-                    t1 = t1.min(fa / (fa - fz));
-                }
+    // The point of a segment inside the cone nearest to c.
+    let in_cone = |a: Coord<f64>, z: Coord<f64>| {
+        // The part of the segment inside the cone: both half-planes.
+        let (mut t0, mut t1) = (0.0_f64, 1.0_f64);
+        for (edge, sign) in [(right, 1.0), (left, -1.0)] {
+            let (fa, fz) = (sign * cross(edge, a - c), sign * cross(edge, z - c));
+            if fa < 0.0 && fz < 0.0 {
+                t1 = -1.0;
+            } else if fa < 0.0 {
+                t0 = t0.max(fa / (fa - fz));
+            } else if fz < 0.0 {
+                t1 = t1.min(fa / (fa - fz));
             }
-            if t0 > t1 {
-                continue;
-            }
-            let (pa, pz) = (a + (z - a) * t0, a + (z - a) * t1);
-            let (q, _) = crate::geometry::segment::closest_on_segment(pa, pz, c);
-            candidates.push((crate::geometry::norm(q - c), k, i, q));
         }
+        if t0 > t1 {
+            return None;
+        }
+        let (pa, pz) = (a + (z - a) * t0, a + (z - a) * t1);
+        let (q, _) = crate::geometry::segment::closest_on_segment(pa, pz, c);
+        Some((crate::geometry::norm(q - c), q))
+    };
+    let mut r = lines.extent / 1024.0;
+    loop {
+        let whole = r > 2.0 * lines.extent;
+        let mut candidates: Vec<(f64, SegmentAt, Coord<f64>)> = lines
+            .near(c, if whole { f64::INFINITY } else { r })
+            .into_iter()
+            .filter_map(|at| {
+                let (a, z) = lines.segment(at);
+                in_cone(a, z).map(|(d, q)| (d, at, q))
+            })
+            .filter(|&(d, _, _)| whole || d <= r)
+            .collect();
+        candidates.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let found = candidates
+            .iter()
+            .take(CANDIDATES)
+            .find(|&&(_, _, q)| b.reaches(q, c));
+        if let Some(&(_, at, q)) = found {
+            return Some((at, q));
+        }
+        if whole || candidates.len() >= CANDIDATES {
+            return None;
+        }
+        r *= 2.0;
     }
-    candidates.sort_by(|a, b| a.0.total_cmp(&b.0));
-    candidates
-        .into_iter()
-        .take(64)
-        .find(|&(_, _, _, q)| b.reaches(q, c))
-        .map(|(_, k, i, q)| (k, i, q))
 }
 
 /// One row of the `connections` layer: a leg added to a skeleton for a
@@ -379,15 +549,28 @@ pub fn skeleton_rows(
     legs: &[ConnectionLeg],
     src_fid: Option<u64>,
 ) -> Vec<NetworkRow> {
+    // Each leg by its two ends (the first leg listed for a pair).
+    let key = |a: Coord<f64>, b: Coord<f64>| {
+        let (a, b) = (
+            (a.x.to_bits(), a.y.to_bits()),
+            (b.x.to_bits(), b.y.to_bits()),
+        );
+        (a.min(b), a.max(b))
+    };
+    let mut by_ends: std::collections::HashMap<_, &ConnectionLeg> = Default::default();
+    for l in legs {
+        let (a, b) = (l.leg.0[0], l.leg.0[l.leg.0.len() - 1]);
+        if a != b {
+            by_ends.entry(key(a, b)).or_insert(l);
+        }
+    }
     (0..g.edges().len())
         .map(|e| {
             let coords = g.edge_coords(crate::graph::EdgeId::from_index(e));
-            let leg = legs.iter().find(|l| {
-                let (a, b) = (l.leg.0[0], l.leg.0[l.leg.0.len() - 1]);
-                a != b
-                    && coords.len() == 2
-                    && ((coords[0], coords[1]) == (a, b) || (coords[0], coords[1]) == (b, a))
-            });
+            let leg = match coords[..] {
+                [a, b] => by_ends.get(&key(a, b)).copied(),
+                _ => None,
+            };
             NetworkRow {
                 kind: leg.map_or(NetworkKind::Skeleton, |_| NetworkKind::Connection),
                 src_fid,
@@ -446,17 +629,44 @@ impl NetworkLine {
     fn cuts(&self, points: &[Coord<f64>]) -> (Vec<Cut>, Vec<LineString<f64>>) {
         let line = &self.line.0;
         let (mut cuts, mut snapped) = (Vec::new(), Vec::new());
-        for &c in points {
-            let nearest = line
+        let tol = self.tolerance();
+        // The line's segments in a tree when many points are looked up.
+        let tree = (points.len() > 8 && line.len() > 64).then(|| {
+            let ends: Vec<[[f64; 2]; 2]> = line
                 .windows(2)
-                .enumerate()
-                .map(|(i, w)| {
-                    let (q, t) = crate::geometry::segment::closest_on_segment(w[0], w[1], c);
-                    (crate::geometry::norm(q - c), i, t)
-                })
-                .min_by(|a, b| a.0.total_cmp(&b.0));
+                .map(|w| [[w[0].x, w[0].y], [w[1].x, w[1].y]])
+                .collect();
+            crate::geometry::packed::PackedTree::of_segments(&ends)
+        });
+        let at = |i: usize, c: Coord<f64>| {
+            let (q, t) = crate::geometry::segment::closest_on_segment(line[i], line[i + 1], c);
+            (crate::geometry::norm(q - c), i, t)
+        };
+        // The segment nearest to c within tol (ties: the first).
+        let first =
+            |a: (f64, usize, f64), b: (f64, usize, f64)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1));
+        for &c in points {
+            let nearest = match &tree {
+                Some(tree) => {
+                    let mut best: Option<(f64, usize, f64)> = None;
+                    tree.visit(
+                        |b| crate::geometry::packed::box_distance_2(b, c.x, c.y) <= tol * tol,
+                        |i| {
+                            let x = at(i as usize, c);
+                            if best.is_none_or(|b| first(x, b).is_lt()) {
+                                best = Some(x);
+                            }
+                            std::ops::ControlFlow::<()>::Continue(())
+                        },
+                    );
+                    best
+                }
+                None => (0..line.len() - 1)
+                    .map(|i| at(i, c))
+                    .min_by(|&a, &b| first(a, b)),
+            };
             match nearest {
-                Some((d, i, t)) if d <= self.tolerance() => cuts.push((i, t, c)),
+                Some((d, i, t)) if d <= tol => cuts.push((i, t, c)),
                 _ => {
                     let (first, last) = (line[0], line[line.len() - 1]);
                     let far = crate::geometry::norm(first - c) > crate::geometry::norm(last - c);

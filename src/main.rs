@@ -442,8 +442,10 @@ fn log_summary(s: &pipeline::RunSummary) {
             c.lines_used,
             c.lines
         );
-        if c.connections == 0 {
-            tracing::warn!("connect: no line of the network touches, crosses or comes within `snap` of a polygon; check that the network is the right layer and covers the polygons");
+        if c.connections == 0 && s.written == 0 {
+            tracing::warn!("connect: no connection made, as no polygon was written (the `rejected` layer says why)");
+        } else if c.connections == 0 {
+            tracing::warn!("connect: no line of the network touches, crosses or comes within `snap` of a written polygon; check that the network is the right layer and covers the polygons");
         }
     }
     for (m, t) in &s.stages {

@@ -403,3 +403,86 @@ fn network_mode_without_lines_is_an_error_naming_input_connect() {
     );
     assert!(!out.exists(), "nothing written");
 }
+
+/// A lake (a wavy strip 100 km × 2 km, 2 002 vertices) and one zig-zag line
+/// crossing it `crossings` times, as WKT.
+fn zig_zag_lake(crossings: usize) -> (String, String) {
+    let (l, w, m) = (100_000.0, 2_000.0, 1000);
+    let top = (0..=m).map(|i| {
+        let i = i as f64;
+        (l * i / m as f64, w / 2.0 + 150.0 * (i / 37.0).sin())
+    });
+    let bottom = (0..=m).rev().map(|i| {
+        let i = i as f64;
+        (l * i / m as f64, -w / 2.0 + 150.0 * (i / 23.0).cos())
+    });
+    let mut ring: Vec<(f64, f64)> = top.chain(bottom).collect();
+    ring.push(ring[0]);
+    let k = crossings / 2;
+    let line: Vec<(f64, f64)> = (0..=k)
+        .map(|i| {
+            let x = 500.0 + (l - 1000.0) * i as f64 / k as f64;
+            (x, if i % 2 == 0 { 2.0 * w } else { -2.0 * w })
+        })
+        .collect();
+    let text = |pts: &[(f64, f64)]| {
+        pts.iter()
+            .map(|(x, y)| format!("{x} {y}"))
+            .collect::<Vec<_>>()
+            .join(",")
+    };
+    (
+        format!("POLYGON(({}))", text(&ring)),
+        format!("LINESTRING({})", text(&line)),
+    )
+}
+
+/// Network pruning keeps the feature's time budget: a lake crossed 20 000
+/// times by one line (which took minutes, past any `timeout_s`, when every
+/// connection point ran a search of the whole skeleton) is rejected for its
+/// budget soon after it runs out, the reason naming `skeleton.timeout_s`,
+/// and the summary does not claim that no line meets a polygon. With the
+/// budget it needs, the same lake gets one through-line per crossing pair.
+#[test]
+fn a_lake_crossed_twenty_thousand_times_keeps_its_time_budget() {
+    let dir = tmp();
+    let src = dir.path().join("zz.gpkg");
+    let (lake, line) = zig_zag_lake(20_000);
+    make_layer(&src, "lake", 32633, &[Some(&lake)]);
+    make_layer(&src, "lines", 32633, &[Some(&line)]);
+    let run = |timeout: &str, out: &Path| {
+        let text = format!(
+            "input:\n  source: {src}\n  layer: lake\n  connect:\n    source: {src}\n    layer: lines\n\
+             steps:\n  - skeleton:\n      methods: [MA]\n      timeout_s: {timeout}\n\
+             \x20 - prune: {{ mode: network }}\n  - score: {{}}\n  - select: {{ by: distortion }}\n\
+             output:\n  path: {out}\non_error: reject\n",
+            src = src.display(),
+            out = out.display()
+        );
+        let p = pipeline(dir.path(), "p.yaml", &text);
+        let started = std::time::Instant::now();
+        let o = skeletonise(&["run", p.to_str().unwrap()]);
+        (o, started.elapsed().as_secs_f64())
+    };
+    let out = dir.path().join("short.gpkg");
+    let (o, seconds) = run("0.05", &out);
+    let (_, err) = code_and_err(&o);
+    let ds = open(&out);
+    assert_eq!(count(&ds, "skeletons"), 0, "{err}");
+    let reasons: Vec<String> = strings(&ds, "rejected", "reason")
+        .into_iter()
+        .flatten()
+        .collect();
+    assert!(
+        reasons.len() == 1 && reasons[0].contains("skeleton.timeout_s"),
+        "{reasons:?}"
+    );
+    assert!(seconds < 60.0, "the run took {seconds} s");
+    assert!(!err.contains("no line of the network touches"), "{err}");
+    let out = dir.path().join("long.gpkg");
+    let (o, _) = run("600", &out);
+    assert!(o.status.success(), "{}", code_and_err(&o).1);
+    let ds = open(&out);
+    let connections = count(&ds, "connections");
+    assert_eq!(connections, 20_000);
+}

@@ -337,17 +337,18 @@ impl<'a> PartWork<'a> {
     }
 
     /// A raw skeleton pruned and extended on its own (with `mode: network`,
-    /// its through-lines between the connection points).
-    fn finish(&self, raw: &SkeletonGraph) -> SkeletonGraph {
+    /// its through-lines between the connection points; `None` when
+    /// `expired()` stopped their search).
+    fn finish(&self, raw: &SkeletonGraph, expired: &dyn Fn() -> bool) -> Option<SkeletonGraph> {
         if let Some(points) = &self.network {
-            return crate::connect::through_lines(raw, self.p, points);
+            return crate::connect::through_lines(raw, self.p, points, expired);
         }
-        prune_and_extend(
+        Some(prune_and_extend(
             raw,
             self.p,
             self.prune.as_ref(),
             self.params.extend.as_ref(),
-        )
+        ))
     }
 
     /// Another method's raw skeleton conformed to the reference's structure
@@ -359,11 +360,12 @@ impl<'a> PartWork<'a> {
         &self,
         raw: &SkeletonGraph,
         s: &crate::graph::structure::Structure,
-    ) -> SkeletonGraph {
+        expired: &dyn Fn() -> bool,
+    ) -> Option<SkeletonGraph> {
         let g = crate::graph::structure::conform(raw, s, self.p);
         match &self.network {
-            Some(points) => crate::connect::through_lines(&g, self.p, points),
-            None => g,
+            Some(points) => crate::connect::through_lines(&g, self.p, points, expired),
+            None => Some(g),
         }
     }
 
@@ -379,7 +381,7 @@ impl<'a> PartWork<'a> {
         ctx: &MethodContext,
     ) -> Result<Option<Reference>, String> {
         let m = self.params.skeleton.methods[k];
-        let g = self.staged(m, ctx, || self.finish(raw))?;
+        let g = self.staged(m, ctx, |x| self.finish(raw, x))?;
         Ok((!g.is_empty()).then(|| {
             (
                 k,
@@ -392,22 +394,24 @@ impl<'a> PartWork<'a> {
     /// `finish` (pruning and extending, method `m`) under the method's
     /// budget: declined when its working memory would pass
     /// `skeleton.max_memory_mb`, dropped when it ended past the deadline
-    /// (it is judged when it returns, as a method that cannot be
-    /// interrupted is).
+    /// (judged when it returns; a search whose cost can grow faster than
+    /// the polygon — network pruning's — asks the deadline as it goes, via
+    /// the `expired` it is given, and stops).
     fn staged(
         &self,
         m: crate::methods::MethodId,
         ctx: &MethodContext,
-        finish: impl FnOnce() -> SkeletonGraph,
+        finish: impl FnOnce(&dyn Fn() -> bool) -> Option<SkeletonGraph>,
     ) -> Result<SkeletonGraph, String> {
         const STAGE: &str = "pruning and extending";
         let bytes = PRUNE_BYTES_PER_VERTEX * self.p.vertex_count() as f64;
         ctx.check_stage(m, STAGE)
             .and_then(|()| ctx.afford_stage(m, STAGE, bytes))
             .map_err(|e| e.to_string())?;
-        let g = finish();
+        let expired = || ctx.check_stage(m, STAGE).is_err();
+        let g = finish(&expired);
         ctx.check_stage(m, STAGE).map_err(|e| e.to_string())?;
-        Ok(g)
+        g.ok_or_else(|| "pruning stopped without a deadline".to_string())
     }
 
     /// Every method's raw skeleton. The first of the reference order is
@@ -496,7 +500,7 @@ impl<'a> PartWork<'a> {
                     .map_err(|e| e.to_string())
             })
             .ok()?;
-            let g = self.staged(m, &ctx, || self.finish(&raw)).ok()?;
+            let g = self.staged(m, &ctx, |x| self.finish(&raw, x)).ok()?;
             (!g.is_empty()).then(|| {
                 (
                     HIDDEN,
@@ -550,8 +554,8 @@ impl<'a> PartWork<'a> {
                 let g = raw.graph.as_ref().map_err(Clone::clone)?;
                 let finished = guarded(methods[k], || match reference {
                     Some((r, _, g)) if *r == k => Ok(g.clone()),
-                    Some((_, s, _)) => self.staged(methods[k], &raw.ctx, || self.conform(g, s)),
-                    None => self.staged(methods[k], &raw.ctx, || self.finish(g)),
+                    Some((_, s, _)) => self.staged(methods[k], &raw.ctx, |x| self.conform(g, s, x)),
+                    None => self.staged(methods[k], &raw.ctx, |x| self.finish(g, x)),
                 })?;
                 let kept = keep_ma && methods[k] == crate::methods::MethodId::MA;
                 Ok(PartSkeleton {

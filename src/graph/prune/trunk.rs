@@ -74,7 +74,7 @@ impl Sweep {
 
 /// Total order on distances (never NaN: lengths are finite sums).
 #[derive(Debug, Clone, Copy, PartialEq)]
-struct OrdF(f64);
+pub(super) struct OrdF(pub(super) f64);
 impl Eq for OrdF {}
 impl PartialOrd for OrdF {
     fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
