@@ -7,7 +7,9 @@
 //! another line.
 
 mod common;
-use common::{code_and_err, make_layer, open, pipeline, skeletonise, tmp, TRAIN};
+use common::{
+    code_and_err, count, make_layer, open, pipeline, root, skeletonise, strings, tmp, wkts, TRAIN,
+};
 use gdal::vector::LayerAccess;
 use geo::{Area, Coord, Geometry, LineString, MultiPolygon, Polygon};
 use skeletonise::geometry::PreparedPolygon;
@@ -1203,11 +1205,11 @@ fn a_connection_leg_in_a_kept_lake_is_kept_and_cuts_no_notch() {
 }
 
 #[test]
-fn collapse_with_another_method_than_ma_is_refused_with_the_reason() {
+fn collapse_without_ma_is_refused_with_the_reason() {
     let dir = tmp();
     let src = wkt_layer(dir.path(), &[TOUCHING]);
     let out = dir.path().join("o.gpkg");
-    for methods in ["[MA, CDT]", "[StSk]", "[DVD]"] {
+    for methods in ["[CDT]", "[StSk, VD]", "[DVD]"] {
         let text = format!(
             "input: {{ source: {src}, layer: shapes }}\nsteps:\n  - skeleton: {{ methods: {methods} }}\n  - collapse: {{ width: 300 }}\noutput: {{ path: {} }}\n",
             out.display()
@@ -1217,11 +1219,51 @@ fn collapse_with_another_method_than_ma_is_refused_with_the_reason() {
             let (code, err) = code_and_err(&skeletonise(&[cmd, p.to_str().unwrap()]));
             assert_eq!(code, 78, "{cmd} {methods}: {err}");
             assert!(
-                err.contains("`steps[0].skeleton.methods`") && err.contains("list MA alone"),
+                err.contains("`steps[0].skeleton.methods`") && err.contains("add MA to the list"),
                 "{err}"
             );
             assert!(!out.exists());
         }
+    }
+}
+
+/// `collapse` with the skeleton step's default methods runs MA alone (the
+/// collapse draws the medial axis; the others would only be scored and
+/// dropped), and with MA among other listed methods the skeleton layer is
+/// MA's collapsed lines (the others are scored as candidates): the same
+/// layers as with MA alone.
+#[test]
+fn collapse_with_the_default_methods_runs_ma() {
+    let dir = tmp();
+    let run = |skeleton: &str, name: &str| {
+        let out = dir.path().join(format!("{name}.gpkg"));
+        let text = format!(
+            "input: {{ source: {}, layer: river_lena }}\nsteps:\n  - skeleton: {skeleton}\n  - prune: {{}}\n  - extend: {{}}\n  - collapse: {{ width: 1500 }}\n  - score: {{}}\n  - select: {{}}\noutput: {{ path: {} }}\n",
+            root(TRAIN),
+            out.display()
+        );
+        let p = pipeline(dir.path(), &format!("{name}.yaml"), &text);
+        let o = skeletonise(&["run", p.to_str().unwrap(), "-q"]);
+        assert!(o.status.success(), "{name}: {}", code_and_err(&o).1);
+        out
+    };
+    let ma = run("{ methods: [MA] }", "ma");
+    let default = run("{}", "default");
+    let bare = run("", "bare");
+    let both = run("{ methods: [CDT, MA] }", "both");
+    let collapsed = |out: &Path| {
+        let ds = open(out);
+        (count(&ds, "areas"), wkts(&ds, "skeletons"))
+    };
+    let (ma_areas, ma_lines) = collapsed(&ma);
+    assert!(ma_areas > 0);
+    for (name, out) in [("default", &default), ("bare", &bare), ("both", &both)] {
+        assert_eq!(collapsed(out), (ma_areas, ma_lines.clone()), "{name}");
+        let methods = strings(&open(out), "skeletons", "method");
+        assert!(
+            methods.iter().all(|m| m.as_deref() == Some("MA")),
+            "{methods:?}"
+        );
     }
 }
 

@@ -38,6 +38,7 @@ pub(super) fn parse<T: serde::de::DeserializeOwned + HasSteps>(
     let mut typed = Typed::new();
     substitute_env(&mut value, "", &mut typed).map_err(|(k, m)| r.at_value(&k, m))?;
     unknown_skeleton_keys(&value).map_err(|(k, m)| r.at_key(&k, m))?;
+    collapse_runs_ma(&mut value);
     let extras = take_registered(&mut value, registry).map_err(|(k, m)| r.at_key(&k, m))?;
     let mut file: T = r.deserialize(value, typed)?;
     for (i, extra) in extras {
@@ -311,6 +312,36 @@ fn unknown_skeleton_keys(root: &Value) -> Result<(), (String, String)> {
         }
     }
     Ok(())
+}
+
+/// With a `collapse` step, a skeleton step that lists no `methods` runs MA
+/// alone: collapse cuts by the medial axis's discs and draws its lines, so
+/// the other methods would only be scored and dropped. An explicit list is
+/// kept (and must hold MA, `validate::collapse_on_ma`).
+fn collapse_runs_ma(root: &mut Value) {
+    let Some(steps) = root.get_mut("steps").and_then(Value::as_sequence_mut) else {
+        return;
+    };
+    if !steps.iter().any(|s| s.get("collapse").is_some()) {
+        return;
+    }
+    for step in steps.iter_mut() {
+        let Some(m) = step.as_mapping_mut() else {
+            continue;
+        };
+        let Some(body) = m.get_mut("skeleton") else {
+            continue;
+        };
+        if body.is_null() {
+            *body = Value::Mapping(Default::default());
+        }
+        if let Value::Mapping(opts) = body {
+            let key = Value::String("methods".into());
+            if !opts.contains_key(&key) {
+                opts.insert(key, Value::Sequence(vec![Value::String("MA".into())]));
+            }
+        }
+    }
 }
 
 /// A key path without list indices: `steps[2].prune.ratio` → `steps.prune.ratio`.

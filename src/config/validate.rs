@@ -112,9 +112,11 @@ pub(super) fn validate_steps(steps: &[Step]) -> Result<(), (String, String)> {
 }
 
 /// `collapse` cuts the polygon by the medial axis's inscribed discs and
-/// draws the lines on the medial axis: the skeleton step must list MA
-/// alone. Another method's lines are not centred on those discs, so its
-/// collapsed lines would cross the kept areas.
+/// draws the lines on the medial axis: MA must be among the skeleton
+/// step's methods (a step that lists none runs MA alone with `collapse`,
+/// see `config::parse`). Another method's lines are not centred on those
+/// discs, so collapsed lines are always MA's, whichever `select` chooses
+/// for the skeleton layer.
 fn collapse_on_ma(steps: &[Step]) -> Result<(), (String, String)> {
     let collapses = steps.iter().any(|s| matches!(s, Step::Collapse(_)));
     let skeleton = steps.iter().enumerate().find_map(|(i, s)| match s {
@@ -122,9 +124,9 @@ fn collapse_on_ma(steps: &[Step]) -> Result<(), (String, String)> {
         _ => None,
     });
     match skeleton {
-        Some((i, p)) if collapses && p.methods != [crate::methods::MethodId::MA] => Err((
+        Some((i, p)) if collapses && !p.methods.contains(&crate::methods::MethodId::MA) => Err((
             format!("steps[{i}].skeleton.methods"),
-            "`collapse` cuts the polygon where the medial axis's inscribed discs meet the collapse width and draws the medial axis: list MA alone (`skeleton: { methods: [MA] }`); other methods' lines are not centred on those discs, so their collapsed lines would cross the kept areas".into(),
+            "`collapse` cuts the polygon where the medial axis's inscribed discs meet the collapse width and draws the medial axis: add MA to the list (or leave `methods` out: with `collapse` it is MA alone); other methods' lines are not centred on those discs, so their collapsed lines would cross the kept areas".into(),
         )),
         _ => Ok(()),
     }

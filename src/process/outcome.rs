@@ -35,20 +35,45 @@ pub fn process_checked(
         connect_chosen(o, &prepared, net);
     }
     if let (Some(c), Processed::Done(o)) = (&params.collapse, &mut processed) {
-        let legs: Vec<(geo::Coord<f64>, geo::Coord<f64>)> = o
-            .connections
-            .iter()
-            .filter_map(|l| Some((*l.leg.0.first()?, *l.leg.0.last()?)))
-            .collect();
-        let (_, chosen) = o.chosen();
-        o.collapse = Some(
-            chosen
-                .graphs
-                .iter()
-                .zip(&prepared)
-                .map(|(g, p)| collapse(g, p, c, &legs))
-                .collect(),
-        );
+        // The medial axis's lines: with `collapse` the skeleton layer is
+        // MA's, whichever `select` preferred among the other listed methods
+        // (their scores stay in the candidates); the chosen skeleton's
+        // connection legs are added to MA's when it was another.
+        let ma = match o.candidates.iter().position(|c| c.method == MethodId::MA) {
+            Some(k) => match &o.candidates[k].result {
+                Ok(_) => Ok(k),
+                Err(e) => Err(format!(
+                    "`collapse` draws the medial axis, and MA failed on this polygon: {e}"
+                )),
+            },
+            None => Err("`collapse` draws the medial axis: add MA to `skeleton.methods`".into()),
+        };
+        match ma {
+            Ok(k) => {
+                if o.chosen != k {
+                    o.chosen = k;
+                    if let Some(net) = &params.connect {
+                        o.connections.clear();
+                        connect_chosen(o, &prepared, net);
+                    }
+                }
+                let legs: Vec<(geo::Coord<f64>, geo::Coord<f64>)> = o
+                    .connections
+                    .iter()
+                    .filter_map(|l| Some((*l.leg.0.first()?, *l.leg.0.last()?)))
+                    .collect();
+                let (_, chosen) = o.chosen();
+                o.collapse = Some(
+                    chosen
+                        .graphs
+                        .iter()
+                        .zip(&prepared)
+                        .map(|(g, p)| collapse(g, p, c, &legs))
+                        .collect(),
+                )
+            }
+            Err(reason) => return Processed::Rejected(reason),
+        }
     }
     if let (true, Processed::Done(o)) = (params.keep_measures, &mut processed) {
         measure(o, &prepared);
