@@ -117,7 +117,7 @@ def install_hint():
         # Into the profile's python folder (on QGIS's path): no system change, and no clash with a
         # Python that refuses pip outside a virtual environment (PEP 668).
         shell = "in Terminal run" if sys.platform == "darwin" else "run"
-        how = f"{shell} `{python_command()} -m pip install --no-deps --target {quote(profile_python())} {spec}`"
+        how = f"{shell} `{python_command()} -m pip install --upgrade --no-deps --target {quote(profile_python())} {spec}`"
     return (
         f"install the skeletonise Python package{' ' + version if version else ''} into QGIS's Python ({why}): "
         f"{how}, then restart QGIS (--no-deps keeps QGIS's own numpy; pip needs a wheel for this platform "
