@@ -131,7 +131,11 @@ def quote(path):
 
 
 def profile_python():
-    """The QGIS profile's python folder (QGIS puts it on its Python's path)."""
+    """The QGIS profile's python folder (QGIS puts it on its Python's path): the one this plugin
+    is installed in (``<profile>/python/plugins/skeletonise_qgis``), else the running profile's."""
+    plugins = os.path.dirname(HERE)
+    if os.path.basename(plugins) == "plugins" and os.path.basename(os.path.dirname(plugins)) == "python":
+        return os.path.dirname(plugins)
     try:
         from qgis.core import QgsApplication
 
