@@ -1,6 +1,7 @@
 """The QGIS plugin in a real, headless QGIS: every algorithm of the `skeletonise`
 provider through `processing.run` (PyQGIS) and through `qgis_process`, compared
-row for row with the command line's output on the training layers.
+row for row with the command line's output on the training layers; the packed
+ZIP (the wheel bundled) installed alone into a fresh profile (PackedPlugin).
 
 Run by scripts/test-qgis.sh (QGIS's own Python, the wheel and the plugin on its
 paths, a throw-away profile); the command line binary is $SKELETONISE_BIN, else
