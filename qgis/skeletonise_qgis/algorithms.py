@@ -99,7 +99,7 @@ class _Algorithm(QgsProcessingAlgorithm):
 
     def canExecute(self):  # noqa: N802
         if bridge.version() is None:
-            return False, f"The skeletonise Python package is missing: {bridge.INSTALL_HINT}."
+            return False, f"The skeletonise Python package is missing. {bridge.install_hint()}"
         return True, ""
 
     # --- shared steps -------------------------------------------------------

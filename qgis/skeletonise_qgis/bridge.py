@@ -10,6 +10,7 @@ pandas: QGIS's own numpy is all the wheel needs.
 
 import json
 import math
+import os
 import threading
 
 import numpy as np
@@ -27,11 +28,7 @@ from qgis.core import (
 )
 from qgis.PyQt.QtCore import QVariant
 
-INSTALL_HINT = (
-    "install the skeletonise wheel into QGIS's Python, e.g. `python3 -m pip install --no-deps "
-    "skeletonise` (OSGeo4W shell on Windows), or run QGIS through scripts/qgis-process.sh of a "
-    "skeletonise checkout"
-)
+from . import bundle
 
 # The work of one call into Rust: enough for the threads to share (a batch of
 # small lakes), small enough that progress moves and a cancel between batches
@@ -43,22 +40,39 @@ _TYPES = {"int32": QVariant.Int, "int64": QVariant.LongLong, "real": QVariant.Do
 
 
 def core():
-    """The wheel's Rust module, or a Processing error saying how to install it."""
+    """The wheel's Rust module (the plugin's bundled copy where it runs, else an installed one),
+    or a Processing error saying what to install."""
+    bundle.activate()
     try:
         from skeletonise import _core
     except ImportError as e:
         raise QgsProcessingException(
-            f"the skeletonise Python package is not installed in QGIS's Python ({e}): {INSTALL_HINT}"
+            f"The skeletonise Python package could not be imported ({e}). {install_hint()}"
         ) from None
     return _core
 
 
+def install_hint():
+    """What to install on this platform, with the exact command (bundle.install_hint)."""
+    hint = bundle.install_hint()
+    return hint[:1].upper() + hint[1:] + "."
+
+
 def version():
-    """The wheel's version, or None when it is not installed."""
+    """The wheel's version, or None when it is not there."""
     try:
         return core().__version__
     except QgsProcessingException:
         return None
+
+
+def bundled():
+    """Whether the `skeletonise` in use is the plugin's bundled copy."""
+    if version() is None:
+        return False
+    import skeletonise
+
+    return os.path.abspath(skeletonise.__file__).startswith(bundle.FOLDER + os.sep)
 
 
 def check_crs(crs, name):

@@ -18,7 +18,10 @@ class SkeletoniseProvider(QgsProcessingProvider):
     def longName(self):  # noqa: N802
         from . import bridge
 
-        return f"Skeletonise {bridge.version() or '(the skeletonise wheel is not installed)'}"
+        version = bridge.version()
+        if version is None:
+            return "Skeletonise (the skeletonise Python package is missing: see an algorithm's message)"
+        return f"Skeletonise {version}{' (bundled)' if bridge.bundled() else ''}"
 
     def icon(self):
         return QIcon(os.path.join(os.path.dirname(__file__), "icon.svg"))

@@ -1,6 +1,7 @@
 """The QGIS plugin in a real, headless QGIS: every algorithm of the `skeletonise`
 provider through `processing.run` (PyQGIS) and through `qgis_process`, compared
-row for row with the command line's output on the training layers.
+row for row with the command line's output on the training layers; the packed
+ZIP (the wheel bundled) installed alone into a fresh profile (PackedPlugin).
 
 Run by scripts/test-qgis.sh (QGIS's own Python, the wheel and the plugin on its
 paths, a throw-away profile); the command line binary is $SKELETONISE_BIN, else
@@ -119,6 +120,174 @@ class Case(unittest.TestCase):
                 self.assertTrue(all(math.dist(p, q) <= 1e-6 for p, q in zip(va, vb)))
 
 
+def qgis_process_program():
+    # Debian's /usr/bin/qgis_process wrapper passes --noversioncheck, which qgis_process does not know.
+    return "qgis_process.bin" if shutil.which("qgis_process.bin") else "qgis_process"
+
+
+def fresh_environment(home):
+    """A user's environment with a new, empty HOME (so a new default QGIS profile) and nothing
+    of the test run's: no PYTHONPATH (the wheel the other tests use), no QGIS_PLUGINPATH."""
+    env = {k: os.environ[k] for k in ("PATH", "LANG", "LC_ALL", "TMPDIR") if k in os.environ}
+    env.update(HOME=home, QT_QPA_PLATFORM="offscreen", XDG_RUNTIME_DIR=home)
+    return env
+
+
+def gpkg_lines(path):
+    """The features of a GeoPackage's one feature table with a line geometry, read with sqlite3."""
+    import sqlite3
+
+    with sqlite3.connect(path) as db:
+        (table, kind), = db.execute("SELECT table_name, geometry_type_name FROM gpkg_geometry_columns").fetchall()
+        count, = db.execute(f'SELECT count(*) FROM "{table}" WHERE geom IS NOT NULL').fetchone()
+    return kind, count
+
+
+class PackedPlugin(Case):
+    """scripts/package-qgis-plugin.sh's ZIP alone, installed as Plugins ▸ Manage and Install
+    Plugins ▸ Install from ZIP installs it: nothing else done."""
+
+    @classmethod
+    def setUpClass(cls):
+        p = subprocess.run([os.path.join(ROOT, "scripts", "package-qgis-plugin.sh")], capture_output=True, text=True,
+                           cwd=ROOT)
+        assert p.returncode == 0, p.stderr
+        cls.zip, cls.wheel = [os.path.join(ROOT, line) for line in p.stdout.strip().splitlines()[-2:]]
+
+    def install(self, home):
+        """The ZIP into a fresh default profile with QGIS's own installer code (pyplugin_installer's
+        unzip, what Install from ZIP runs), and the plugin enabled in the profile's settings as the
+        plugin manager leaves it. Returns the profile's folder."""
+        import importlib.util
+
+        spec = importlib.util.spec_from_file_location("unzip", "/usr/share/qgis/python/pyplugin_installer/unzip.py")
+        installer = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(installer)
+        profile = os.path.join(home, ".local", "share", "QGIS", "QGIS3", "profiles", "default")
+        installer.unzip(self.zip, os.path.join(profile, "python", "plugins"))
+        os.makedirs(os.path.join(profile, "QGIS"))
+        with open(os.path.join(profile, "QGIS", "QGIS3.ini"), "w") as f:
+            f.write("[PythonPlugins]\nskeletonise_qgis=true\n")
+        return profile
+
+    def test_the_zip_carries_the_wheel_and_what_the_plugin_repository_checks(self):
+        import configparser
+        import zipfile
+
+        with zipfile.ZipFile(self.zip) as z, zipfile.ZipFile(self.wheel) as w:
+            names = z.namelist()
+            self.assertEqual(names[0], "skeletonise_qgis/")
+            self.assertEqual({n.split("/")[0] for n in names}, {"skeletonise_qgis"})
+            for n in w.namelist():
+                self.assertEqual(z.read(f"skeletonise_qgis/_bundled/linux_x86_64/{n}"), w.read(n), n)
+            self.assertFalse([n for n in names if ".pyc" in n or "__pycache__" in n.split("/") or ".." in n])
+            self.assertIn("skeletonise_qgis/LICENSE", names)
+            meta = configparser.ConfigParser(interpolation=None)
+            meta.optionxform = str
+            meta.read_string(z.read("skeletonise_qgis/metadata.txt").decode("utf-8"))
+            general = meta["general"]
+            for key in ("name", "qgisMinimumVersion", "description", "about", "version", "author", "email",
+                        "homepage", "repository", "tracker", "tags", "category", "icon", "experimental",
+                        "hasProcessingProvider", "changelog"):
+                self.assertTrue(general.get(key, "").strip(), key)
+            self.assertEqual(general["hasProcessingProvider"], "yes")
+            self.assertIn(f"skeletonise_qgis/{general['icon']}", names)
+            self.assertIn(general["version"], os.path.basename(self.wheel))
+            self.assertIn(f"skeletonise=={general['version']}", general["about"])
+        # The plugin repository takes at most 25 MB.
+        self.assertLess(os.path.getsize(self.zip), 25_000_000)
+
+    def test_install_from_zip_alone_runs_in_a_fresh_profile(self):
+        home = os.path.join(self.dir, "home")
+        os.makedirs(home)
+        profile = self.install(home)
+        env = fresh_environment(home)
+        # No skeletonise in QGIS's Python of this environment but the plugin's.
+        probe = subprocess.run(["/usr/bin/python3", "-c", "import skeletonise"], capture_output=True, text=True,
+                               env=env, cwd=home)
+        self.assertNotEqual(probe.returncode, 0)
+        self.assertIn("No module named 'skeletonise'", probe.stderr)
+        out = self.out("lakes.gpkg")
+        run = subprocess.run(
+            [qgis_process_program(), "--json", "run", "skeletonise:skeletonise",
+             f"--INPUT={TRAIN}|layername=lakes_scotland", f"--OUTPUT={out}"],
+            capture_output=True, text=True, env=env, cwd=home,
+        )
+        self.assertEqual(run.returncode, 0, run.stdout + run.stderr)
+        result = json.loads(run.stdout[run.stdout.index("{"):])
+        self.assertEqual(result["provider_details"]["long_name"], "Skeletonise 0.1.0 (bundled)")
+        self.assertEqual(result["results"]["FEATURES_READ"], 18)
+        self.assertEqual(result["results"]["FEATURES_REJECTED"], 0)
+        self.assertEqual(gpkg_lines(out), ("MULTILINESTRING", 18))
+        self.assertTrue(os.path.isfile(os.path.join(profile, "python", "plugins", "skeletonise_qgis", "_bundled",
+                                                    "linux_x86_64", "skeletonise", "_core.abi3.so")))
+
+    def test_the_bundled_copy_wins_over_an_installed_one(self):
+        # An installed copy in the profile's python folder (the old way), made unloadable: the
+        # bundled one is taken first and the run does not touch it.
+        home = os.path.join(self.dir, "home")
+        os.makedirs(home)
+        profile = self.install(home)
+        installed = os.path.join(profile, "python", "skeletonise")
+        os.makedirs(installed)
+        with open(os.path.join(installed, "__init__.py"), "w") as f:
+            f.write("raise ImportError('the installed copy was imported')\n")
+        run = subprocess.run(
+            [qgis_process_program(), "--json", "run", "skeletonise:skeletonise",
+             f"--INPUT={TRAIN}|layername=islands_hebrides", f"--OUTPUT={self.out('islands.gpkg')}"],
+            capture_output=True, text=True, env=fresh_environment(home), cwd=home,
+        )
+        self.assertEqual(run.returncode, 0, run.stdout + run.stderr)
+        result = json.loads(run.stdout[run.stdout.index("{"):])
+        self.assertEqual(result["provider_details"]["long_name"], "Skeletonise 0.1.0 (bundled)")
+        self.assertEqual(result["results"]["FEATURES_READ"], 1192)
+        kind, count = gpkg_lines(self.out("islands.gpkg"))
+        self.assertEqual(kind, "MULTILINESTRING")
+        self.assertGreater(count, 1000)
+
+    def test_where_no_build_is_bundled_the_algorithms_name_the_exact_install_command(self):
+        home = os.path.join(self.dir, "home")
+        os.makedirs(home)
+        profile = self.install(home)
+        plugins = os.path.join(profile, "python", "plugins")
+        env = fresh_environment(home)
+        script = os.path.join(ROOT, "qgis", "tests", "unsupported_platform.py")
+        want = {
+            ("win32", "AMD64"): ("this is Windows, not Linux",
+                                 "in the OSGeo4W Shell (Start menu ▸ QGIS) run "
+                                 "`python -m pip install --no-deps skeletonise==0.1.0`, then restart QGIS"),
+            ("darwin", "arm64"): ("this is macOS, not Linux",
+                                  "in Terminal run `{python} -m pip install --upgrade --no-deps --target "
+                                  "{profile} skeletonise==0.1.0`, then restart QGIS"),
+            ("linux", "aarch64"): ("this Linux runs on aarch64, not x86-64",
+                                   "run `{python} -m pip install --upgrade --no-deps --target {profile} "
+                                   "skeletonise==0.1.0`, then restart QGIS"),
+        }
+        python = f"{sys.exec_prefix}/bin/python{sys.version_info[0]}.{sys.version_info[1]}"
+        for (system, machine), (reason, command) in want.items():
+            with self.subTest(system=system, machine=machine):
+                p = subprocess.run(
+                    ["/usr/bin/python3", script, plugins, system, machine, f"{TRAIN}|layername=lakes_scotland",
+                     self.out("x.gpkg")],
+                    capture_output=True, text=True, env=env, cwd=home,
+                )
+                self.assertEqual(p.returncode, 0, p.stdout + p.stderr)
+                self.assertNotIn("Traceback", p.stdout + p.stderr)
+                got = json.loads(p.stdout[p.stdout.index("{"):])
+                self.assertFalse(got["on_path"])
+                self.assertFalse(got["imported"])
+                self.assertFalse(got["can_execute"])
+                exact = command.format(python=python, profile=got["profile_python"])
+                self.assertEqual(got["profile_python"], os.path.join(profile, "python"))
+                for text in (got["why"], got["error"]):
+                    self.assertIn("Install the skeletonise Python package 0.1.0 into QGIS's Python (the plugin "
+                                  f"bundles it for x86-64 Linux only, and {reason})", text)
+                    self.assertIn(exact, text)
+                    self.assertNotIn("Traceback", text)
+                self.assertIn("package is missing", got["long_name"])
+                self.assertFalse(os.path.exists(self.out("x.gpkg")))
+
+
 class Feedback(QgsProcessingFeedback):
     """Collects the errors reported."""
 
@@ -206,34 +375,10 @@ class Skeletonise(Case):
         )
         self.assertNotEqual(run.returncode, 0)
         self.assertIn("skeletonise Python package", run.stdout + run.stderr)
-        self.assertIn("pip install --no-deps", run.stdout + run.stderr)
+        self.assertIn("pip install --upgrade --no-deps --target", run.stdout + run.stderr)
+        self.assertIn("skeletonise==0.1.0", run.stdout + run.stderr)
+        self.assertNotIn("Traceback", run.stdout + run.stderr)
         self.assertFalse(os.path.exists(self.out("x.gpkg")))
-
-    def test_the_packed_plugin_and_wheel_install_as_the_readme_says(self):
-        # scripts/package-qgis-plugin.sh's ZIP unpacked into a fresh profile's python/plugins (what
-        # "Install from ZIP" does), the wheel into its python folder; then qgis_process runs it.
-        p = subprocess.run([os.path.join(ROOT, "scripts", "package-qgis-plugin.sh")], capture_output=True, text=True, cwd=ROOT)
-        self.assertEqual(p.returncode, 0, p.stderr)
-        zip_path, wheel = [os.path.join(ROOT, line) for line in p.stdout.strip().splitlines()[-2:]]
-        profile = os.path.join(self.dir, "profile")
-        python = os.path.join(profile, "profiles", "default", "python")
-        os.makedirs(os.path.join(python, "plugins"))
-        import zipfile
-
-        zipfile.ZipFile(zip_path).extractall(os.path.join(python, "plugins"))
-        zipfile.ZipFile(wheel).extractall(python)
-        env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "QGIS_PLUGINPATH")}
-        env.update(QGIS_CUSTOM_CONFIG_PATH=profile, QT_QPA_PLATFORM="offscreen")
-        qp = "qgis_process.bin" if shutil.which("qgis_process.bin") else "qgis_process"
-        subprocess.run([qp, "plugins", "enable", "skeletonise_qgis"], capture_output=True, env=env, check=True)
-        run = subprocess.run(
-            [qp, "--json", "run", "skeletonise:skeletonise", f"--INPUT={TRAIN}|layername=lakes_scotland",
-             f"--OUTPUT={self.out('z.gpkg')}"],
-            capture_output=True, text=True, env=env,
-        )
-        self.assertEqual(run.returncode, 0, run.stdout + run.stderr)
-        self.assertEqual(json.loads(run.stdout[run.stdout.index("{"):])["results"]["FEATURES_READ"], 18)
-        self.assertEqual(len(rows(self.out("z.gpkg"))), 18)
 
     def test_an_output_onto_an_input_file_is_refused_and_the_input_kept(self):
         import hashlib
