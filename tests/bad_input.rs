@@ -1524,3 +1524,229 @@ fn a_crs_unit_name_is_escaped_once_in_the_report() {
     );
     assert!(!page.contains("&amp;#39;"), "escaped twice");
 }
+
+/// The error line of a refused command: its last `ERROR` line, without the
+/// timestamp.
+fn error_line(err: &str) -> String {
+    err.lines()
+        .filter_map(|l| l.split_once(" ERROR ").map(|(_, m)| m.to_string()))
+        .next_back()
+        .unwrap_or_default()
+}
+
+/// `validate` refuses whatever `run` refuses before it processes a feature,
+/// with the same exit code and message: every refusal below is first
+/// checked to be one of `run`'s (nothing written), then `validate`'s.
+#[test]
+fn validate_refuses_everything_run_refuses_with_the_same_code_and_message() {
+    let dir = tmp();
+    let d = dir.path();
+    let src = d.join("in.gpkg");
+    make_layer(&src, "lakes", 32633, &[Some(SQUARE)]);
+    make_layer(&src, "lines", 32633, &[Some("LINESTRING(-10 50,110 50)")]);
+    make_layer(&src, "empty", 32633, &[]);
+    make_layer(
+        &src,
+        "units",
+        32633,
+        &[
+            Some("POLYGON((-50 -50,50 -50,50 150,-50 150,-50 -50))"),
+            Some("POLYGON((50 -50,150 -50,150 150,50 150,50 -50))"),
+        ],
+    );
+    std::fs::create_dir(d.join("a-directory.gpkg")).unwrap();
+    let s = src.display().to_string();
+    let out = d.join("out.gpkg");
+    let partition = format!(
+        "  neighbours:\n    source: {s}\n    layer: units\nsteps:\n  - skeleton: {{ methods: [MA] }}\n  - partition: {{}}\n"
+    );
+    let network = "steps:\n  - skeleton: { methods: [MA] }\n  - prune: { mode: network }\n";
+    let connect =
+        |layer: &str| format!("  connect:\n    source: {s}\n    layer: {layer}\n{network}");
+    let cases: Vec<(&str, String, Vec<&str>)> = vec![
+        (
+            "neighbours where selecting no unit",
+            partition.replace("layer: units\n", "layer: units\n    where: id > 99\n"),
+            vec![],
+        ),
+        (
+            "an empty neighbours layer",
+            partition.replace("layer: units", "layer: empty"),
+            vec![],
+        ),
+        (
+            "a neighbours layer of lines",
+            partition.replace("layer: units", "layer: lines"),
+            vec![],
+        ),
+        (
+            "a missing neighbours layer",
+            partition.replace("layer: units", "layer: nowhere"),
+            vec![],
+        ),
+        ("a connect layer of polygons", connect("lakes"), vec![]),
+        ("an empty connect layer", connect("empty"), vec![]),
+        ("a missing connect layer", connect("nowhere"), vec![]),
+        ("network pruning without lines", network.to_string(), vec![]),
+        (
+            "collapse without MA",
+            "steps:\n  - skeleton: { methods: [CDT] }\n  - collapse: { width: 10 }\n".into(),
+            vec![],
+        ),
+        (
+            "the output layer named as a step's layer",
+            "steps:\n  - skeleton: { methods: [MA] }\n  - label: {}\n".into(),
+            vec!["--set", "output.layer=labels"],
+        ),
+        (
+            "an output path ending in a separator",
+            "steps:\n  - skeleton: { methods: [MA] }\n".into(),
+            vec!["-o", "dir.gpkg/"],
+        ),
+        (
+            "an output path that is a directory",
+            "steps:\n  - skeleton: { methods: [MA] }\n".into(),
+            vec!["-o", "a-directory.gpkg"],
+        ),
+        (
+            "a missing input layer",
+            "steps:\n  - skeleton: { methods: [MA] }\n".into(),
+            vec!["-l", "nowhere"],
+        ),
+        (
+            "an input filter that fails",
+            "steps:\n  - skeleton: { methods: [MA] }\n".into(),
+            vec!["--set", "input.where=nosuchfield > 1"],
+        ),
+    ];
+    for (name, body, extra) in cases {
+        let (input, steps) = match body.split_once("steps:\n") {
+            Some((i, s)) => (i.to_string(), s.to_string()),
+            None => (String::new(), body.clone()),
+        };
+        let text = format!(
+            "input:\n  source: {s}\n  layer: lakes\n{input}steps:\n{steps}output:\n  path: {}\n",
+            out.display()
+        );
+        let p = pipeline(d, "p.yaml", &text);
+        let p = p.to_str().unwrap();
+        let mut run = vec!["run", p];
+        run.extend(&extra);
+        let mut validate = vec!["validate", p];
+        validate.extend(&extra);
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_skeletonise"))
+            .args(&run)
+            .current_dir(d)
+            .output()
+            .unwrap();
+        let (run_code, run_err) = code_and_err(&o);
+        assert_ne!(run_code, 0, "{name}: run succeeded: {run_err}");
+        assert!(
+            !out.exists() && !d.join("dir.gpkg").exists(),
+            "{name}: run wrote"
+        );
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_skeletonise"))
+            .args(&validate)
+            .current_dir(d)
+            .output()
+            .unwrap();
+        let (code, err) = code_and_err(&o);
+        assert_eq!(code, run_code, "{name}: validate {err}\nrun {run_err}");
+        assert_eq!(error_line(&err), error_line(&run_err), "{name}");
+        assert!(!error_line(&err).is_empty(), "{name}: {err}");
+    }
+}
+
+/// Adds text columns `names` (filled with the column's own name) to `layer`.
+fn add_columns(path: &Path, layer: &str, names: &[&str]) {
+    let ds = gdal::Dataset::open_ex(
+        path,
+        gdal::DatasetOptions {
+            open_flags: gdal::GdalOpenFlags::GDAL_OF_UPDATE | gdal::GdalOpenFlags::GDAL_OF_VECTOR,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    for n in names {
+        for sql in [
+            format!("ALTER TABLE {layer} ADD COLUMN {n} TEXT"),
+            format!("UPDATE {layer} SET {n} = '{n}'"),
+        ] {
+            ds.execute_sql(sql, None, gdal::vector::sql::Dialect::SQLITE)
+                .unwrap();
+        }
+    }
+}
+
+/// Source fields named as the tool's columns are written with a `src_`
+/// prefix repeated until the name is free — a previous run's output (with
+/// `src_fid`, and a source field `src_fid` renamed `src_src_fid`) runs
+/// again — and a unit field named as a coverage column (`received`) is
+/// renamed in the coverage: the run writes every feature instead of failing
+/// on a duplicate column after the work.
+#[test]
+fn fields_named_as_the_tools_columns_are_renamed_until_free() {
+    let dir = tmp();
+    let d = dir.path();
+    let src = d.join("in.gpkg");
+    make_layer(&src, "lakes", 32633, &[Some(SQUARE)]);
+    add_columns(
+        &src,
+        "lakes",
+        &["src_fid", "src_src_fid", "kind", "src_kind", "method"],
+    );
+    make_layer(
+        &src,
+        "units",
+        32633,
+        &[
+            Some("POLYGON((-50 -50,50 -50,50 150,-50 150,-50 -50))"),
+            Some("POLYGON((50 -50,150 -50,150 150,50 150,50 -50))"),
+        ],
+    );
+    add_columns(&src, "units", &["received", "src_received", "held"]);
+    let out = d.join("out.gpkg");
+    let text = format!(
+        "input:\n  source: {s}\n  layer: lakes\n  neighbours:\n    source: {s}\n    layer: units\n\
+         steps:\n  - skeleton: {{ methods: [MA] }}\n  - partition: {{}}\noutput:\n  path: {o}\n",
+        s = src.display(),
+        o = out.display()
+    );
+    let p = pipeline(d, "p.yaml", &text);
+    let o = skeletonise(&["run", p.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", code_and_err(&o).1);
+    let ds = open(&out);
+    let column = |name: &str| strings(&ds, "skeletons", name);
+    let value = |v: &str| vec![Some(v.to_string())];
+    assert_eq!(column("src_src_src_fid"), value("src_fid"));
+    assert_eq!(column("src_src_fid"), value("src_src_fid"));
+    assert_eq!(column("src_src_kind"), value("kind"));
+    assert_eq!(column("src_kind"), value("src_kind"));
+    assert_eq!(column("src_method"), value("method"));
+    let coverage: Vec<String> = ds
+        .layers()
+        .filter_map(|l| {
+            use gdal::vector::LayerAccess;
+            (l.name() == "coverage")
+                .then(|| l.defn().fields().map(|f| f.name()).collect::<Vec<_>>())
+        })
+        .flatten()
+        .collect();
+    for name in ["src_received", "src_src_received", "received"] {
+        assert!(
+            coverage.contains(&name.to_string()),
+            "{name} not in {coverage:?}"
+        );
+    }
+    // Run again on the output: its columns are the source's fields now.
+    let again = d.join("again.gpkg");
+    let text = format!(
+        "input:\n  source: {}\n  layer: coverage\nsteps:\n  - skeleton: {{ methods: [MA] }}\noutput:\n  path: {}\n",
+        out.display(),
+        again.display()
+    );
+    let p = pipeline(d, "again.yaml", &text);
+    let o = skeletonise(&["run", p.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", code_and_err(&o).1);
+    assert_eq!(count(&open(&again), "skeletons"), 2);
+}

@@ -17,7 +17,9 @@ pub(super) fn validate(f: &PipelineFile) -> Result<(), (String, String)> {
             "give the output GeoPackage path".into(),
         ));
     }
-    skeleton_layer_name(&f.output.layer).map_err(|m| ("output.layer".to_string(), m))?;
+    let plan = super::plan_of(&f.output, Some(&f.input), &f.steps);
+    skeleton_layer_name(&f.output.layer, &plan).map_err(|m| ("output.layer".to_string(), m))?;
+    output_path(&f.output.path).map_err(|m| ("output.path".to_string(), m))?;
     if let Some(r) = &f.output.report {
         r.features
             .validate()
@@ -32,15 +34,34 @@ pub(super) fn validate(f: &PipelineFile) -> Result<(), (String, String)> {
     Ok(())
 }
 
+/// The output path names a file: not a directory (a path ending in `/`,
+/// or one that is a directory now), which GDAL would refuse only when the
+/// finished output is moved into place.
+fn output_path(path: &str) -> Result<(), String> {
+    if path.ends_with('/') || path.ends_with(std::path::MAIN_SEPARATOR) {
+        return Err(format!(
+            "`{path}` ends in a path separator: give the GeoPackage's file name, e.g. `{}`",
+            std::path::Path::new(path.trim_end_matches(['/', std::path::MAIN_SEPARATOR])).display()
+        ));
+    }
+    if std::path::Path::new(path).is_dir() {
+        return Err(format!(
+            "`{path}` is a directory: give the GeoPackage's file name, e.g. `{}`",
+            std::path::Path::new(path).join("out.gpkg").display()
+        ));
+    }
+    Ok(())
+}
+
 /// Checks the name of the skeleton layer: not empty, none of the tool's
-/// other layers (SQLite compares table names without case) and none of the
-/// names GeoPackage and SQLite keep for themselves.
-fn skeleton_layer_name(name: &str) -> Result<(), String> {
+/// other layers — built-in or a registered step's, e.g. `labels` with a
+/// `label` step (SQLite compares table names without case) — and none of
+/// the names GeoPackage and SQLite keep for themselves.
+fn skeleton_layer_name(name: &str, plan: &crate::output::Plan) -> Result<(), String> {
     let lower = name.to_ascii_lowercase();
     if name.trim().is_empty() {
         return Err("give the skeleton layer a name, e.g. `skeletons`".into());
     }
-    let plan = crate::output::Plan::new(name, [], &[]);
     if let Some(taken) = plan
         .tool_layer_names()
         .into_iter()

@@ -27,10 +27,7 @@ use order::in_order;
 use progress::Progress;
 use rayon::prelude::*;
 use record::{finish_run, Counts};
-use source::{
-    connect_error, merge_field, no_lines, read_batches, read_neighbours, read_network, reader_gone,
-    Merge,
-};
+use source::{merge_field, read_batches, read_neighbours, read_network, reader_gone, Merge};
 use std::collections::HashMap;
 use std::sync::mpsc;
 use std::time::Instant;
@@ -124,8 +121,9 @@ pub enum RunError {
 }
 
 /// Checks everything `run` checks before processing: the input opens, the
-/// layer exists, the CRS is projected (or reprojected), the filter is valid
-/// and the output can be written. Returns what the source holds.
+/// layer exists, the CRS is projected (or reprojected), the filter is valid,
+/// the line network and the coverage (read whole, as `run` reads them) hold
+/// what their steps need, and the output can be written. Returns what the source holds.
 pub fn validate(p: &Pipeline) -> Result<crate::io::SourceInfo, RunError> {
     let input = &p.file.input;
     let mut reader = Reader::open(input)?;
@@ -133,18 +131,13 @@ pub fn validate(p: &Pipeline) -> Result<crate::io::SourceInfo, RunError> {
     if let Some(reason) = merge_field(input, reader.info()).err() {
         return Err(RunError::Io(reason));
     }
+    // The second inputs are read whole, as `run` reads them before any
+    // feature: whatever `run` would refuse in them, `validate` refuses.
     if let Some(c) = &input.connect {
-        let mut lines = Reader::open(&c.input(reader.info().srs_wkt.as_deref()))
-            .map_err(|e| connect_error(c, e))?;
-        lines.probe()?;
-        if lines.info().selected == Some(0) {
-            return Err(no_lines(c, lines.info(), 0));
-        }
+        read_network(c, reader.info())?;
     }
     if let Some(n) = &input.neighbours {
-        let mut units = Reader::open(&n.input(reader.info().srs_wkt.as_deref()))
-            .map_err(|e| connect_error_of("neighbours", &n.source, e))?;
-        units.probe()?;
+        read_neighbours(n, reader.info())?;
     }
     let job = Job::of(p);
     check_output(&p.file.output, &job.protected())?;
@@ -248,14 +241,6 @@ pub fn run(p: &Pipeline, opts: &RunOptions) -> Result<RunSummary, RunError> {
         })?);
     }
     Ok(summary)
-}
-
-/// An error opening the source of `input.<what>`, said to be about it.
-fn connect_error_of(what: &str, source: &str, e: IoError) -> RunError {
-    RunError::Io(IoError::Read {
-        source_name: source.to_string(),
-        reason: format!("`input.{what}`: {e}"),
-    })
 }
 
 /// Checks the path of the report a job writes after its run (if any):

@@ -92,7 +92,7 @@ pub(super) fn read_network(
 }
 
 /// An error opening `input.connect`, said to be about it.
-pub(super) fn connect_error(c: &crate::config::ConnectSpec, e: IoError) -> RunError {
+fn connect_error(c: &crate::config::ConnectSpec, e: IoError) -> RunError {
     RunError::Io(IoError::Read {
         source_name: c.source.clone(),
         reason: format!("`input.connect`: {e}"),
@@ -100,11 +100,7 @@ pub(super) fn connect_error(c: &crate::config::ConnectSpec, e: IoError) -> RunEr
 }
 
 /// The error of a connect layer without lines.
-pub(super) fn no_lines(
-    c: &crate::config::ConnectSpec,
-    info: &SourceInfo,
-    features: usize,
-) -> RunError {
+fn no_lines(c: &crate::config::ConnectSpec, info: &SourceInfo, features: usize) -> RunError {
     RunError::Io(IoError::Read {
         source_name: c.source.clone(),
         reason: format!(
