@@ -200,9 +200,9 @@ impl Writer {
             path,
             spec: spec.clone(),
             plan: plan.clone(),
-            source_fields: source_fields(source, plan),
+            source_fields: source_fields(source, &plan.reserved_names()),
             neighbour_fields: neighbours
-                .map(|n| source_fields(n, plan))
+                .map(|n| source_fields(n, &plan.reserved_neighbour_names()))
                 .unwrap_or_default(),
             in_transaction: None,
         };
@@ -403,22 +403,31 @@ impl Writer {
 }
 
 /// The source's fields as the output names them: those whose names clash
-/// with [`Plan::reserved_names`] get a `src_` prefix — in every layer alike.
-fn source_fields(source: &SourceInfo, plan: &Plan) -> Vec<(String, FieldInfo)> {
-    let reserved = plan.reserved_names();
+/// with `reserved` (the tool's columns of the layers that carry them, see
+/// [`Plan::reserved_names`]) get a `src_` prefix — in every layer alike —
+/// repeated until the name is free (`src_fid` beside a source field
+/// `src_src_fid`, as in a previous run's output, becomes `src_src_src_fid`).
+/// SQLite compares column names without case.
+fn source_fields(source: &SourceInfo, reserved: &[&str]) -> Vec<(String, FieldInfo)> {
+    let mut taken: Vec<String> = reserved
+        .iter()
+        .map(|n| n.to_ascii_lowercase())
+        .chain(source.fields.iter().map(|f| f.name.to_ascii_lowercase()))
+        .collect();
     source
         .fields
         .iter()
         .map(|f| {
             let clash = reserved.iter().any(|n| n.eq_ignore_ascii_case(&f.name));
-            (
-                if clash {
-                    format!("src_{}", f.name)
-                } else {
-                    f.name.clone()
-                },
-                f.clone(),
-            )
+            let mut name = f.name.clone();
+            if clash {
+                name = format!("src_{name}");
+                while taken.contains(&name.to_ascii_lowercase()) {
+                    name = format!("src_{name}");
+                }
+                taken.push(name.to_ascii_lowercase());
+            }
+            (name, f.clone())
         })
         .collect()
 }

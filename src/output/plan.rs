@@ -62,13 +62,26 @@ impl Plan {
     pub fn reserved_names(&self) -> Vec<&'static str> {
         super::SKELETONS
             .column_names()
-            .chain(
-                self.layers()
-                    .into_iter()
-                    .filter(|l| l.fields() == Some(crate::layer::Fields::Input))
-                    .flat_map(|l| l.columns().into_iter().map(|c| c.name)),
-            )
+            .chain(self.columns_carrying(crate::layer::Fields::Input))
             .collect()
+    }
+
+    /// The names for which a field of `input.neighbours` is renamed: the
+    /// columns of the layers that carry the units' fields (the grown
+    /// coverage's `received`, `src_fid`, …).
+    pub fn reserved_neighbour_names(&self) -> Vec<&'static str> {
+        self.columns_carrying(crate::layer::Fields::Neighbours)
+            .collect()
+    }
+
+    fn columns_carrying(
+        &self,
+        fields: crate::layer::Fields,
+    ) -> impl Iterator<Item = &'static str> + '_ {
+        self.layers()
+            .into_iter()
+            .filter(move |l| l.fields() == Some(fields))
+            .flat_map(|l| l.columns().into_iter().map(|c| c.name))
     }
 
     /// The name `layer` is written under (the skeleton layer's is
