@@ -39,7 +39,8 @@ pub(super) fn parse<T: serde::de::DeserializeOwned + HasSteps>(
     substitute_env(&mut value, "", &mut typed).map_err(|(k, m)| r.at_value(&k, m))?;
     unknown_skeleton_keys(&value).map_err(|(k, m)| r.at_key(&k, m))?;
     collapse_runs_ma(&mut value);
-    let extras = take_registered(&mut value, registry).map_err(|(k, m)| r.at_key(&k, m))?;
+    let extras =
+        take_registered(&mut value, registry, &mut typed).map_err(|(k, m)| r.at_key(&k, m))?;
     let mut file: T = r.deserialize(value, typed)?;
     for (i, extra) in extras {
         let steps = file.steps_mut();
@@ -172,10 +173,13 @@ impl HasSteps for StepsFile {
 
 /// Takes the registered steps out of `steps` (serde knows only the
 /// built-in ones) and builds each from its options: `(index, step)`, in
-/// order.
+/// order. A substituted `${…}` that makes a number or a boolean is put in
+/// as such where the step does not take the string (as for the built-in
+/// steps); a YAML `.nan` or `.inf` is refused at its key.
 fn take_registered(
     root: &mut Value,
     registry: &StepRegistry,
+    typed: &mut Typed,
 ) -> Result<Vec<(usize, Extra)>, (String, String)> {
     let Some(steps) = root.get_mut("steps").and_then(Value::as_sequence_mut) else {
         return Ok(Vec::new());
@@ -197,26 +201,42 @@ fn take_registered(
             continue;
         };
         let body = steps.remove(i);
-        let options = body.get(entry.name).cloned().unwrap_or(Value::Null);
-        let options = match options {
-            Value::Null => serde_json::Value::Object(Default::default()),
-            v => serde_json::to_value(&v)
-                .map_err(|e| (format!("steps[{index}].{}", entry.name), e.to_string()))?,
-        };
+        let mut yaml = body.get(entry.name).cloned().unwrap_or(Value::Null);
         let at = format!("steps[{index}].{}", entry.name);
-        let step = (entry.build)(&options).map_err(|(k, m)| {
-            // serde's "unknown field `x`" names the key to point at.
-            let k = match unknown_field(&m) {
-                Some(f) if k.is_empty() => f,
-                _ => k,
+        let (options, step) = loop {
+            if let Some(k) = not_finite(&yaml, "") {
+                return Err((
+                    locate::join(&at, &k),
+                    "not a finite number: give a number such as 0.5".into(),
+                ));
+            }
+            let options = match &yaml {
+                Value::Null => serde_json::Value::Object(Default::default()),
+                v => serde_json::to_value(v).map_err(|e| (at.clone(), e.to_string()))?,
             };
-            let key = if k.is_empty() {
-                at.clone()
-            } else {
-                locate::join(&at, &k)
-            };
-            (key, hint(&m))
-        })?;
+            match (entry.build)(&options) {
+                Ok(step) => break (options, step),
+                Err((k, m)) => {
+                    if let Some(t) = typed.remove(&locate::join(&at, &k)) {
+                        if let Some(slot) = value_at(&mut yaml, &k).filter(|_| !k.is_empty()) {
+                            *slot = t;
+                            continue;
+                        }
+                    }
+                    // serde's "unknown field `x`" names the key to point at.
+                    let k = match unknown_field(&m) {
+                        Some(f) if k.is_empty() => f,
+                        _ => k,
+                    };
+                    let key = if k.is_empty() {
+                        at.clone()
+                    } else {
+                        locate::join(&at, &k)
+                    };
+                    return Err((key, hint(&m)));
+                }
+            }
+        };
         out.push((
             index,
             Extra {
@@ -228,6 +248,25 @@ fn take_registered(
         index += 1;
     }
     Ok(out)
+}
+
+/// The key path (below `path`) of the first number in `v` that is NaN or
+/// infinite (JSON has none: they would be read as null).
+fn not_finite(v: &Value, path: &str) -> Option<String> {
+    match v {
+        Value::Number(n) => n
+            .as_f64()
+            .filter(|x| !x.is_finite())
+            .map(|_| path.to_string()),
+        Value::Mapping(m) => m.iter().find_map(|(k, val)| {
+            not_finite(val, &locate::join(path, k.as_str().unwrap_or_default()))
+        }),
+        Value::Sequence(s) => s
+            .iter()
+            .enumerate()
+            .find_map(|(i, val)| not_finite(val, &format!("{path}[{i}]"))),
+        _ => None,
+    }
 }
 
 /// Deepest nesting of flow collections (`[`, `{`) a pipeline file may have

@@ -289,11 +289,7 @@ pub const ENTRY: StepEntry = StepEntry {
     ],
     layers: LABELS,
     build: |v| {
-        let p: LabelParams = if v.is_null() {
-            LabelParams::default()
-        } else {
-            serde_json::from_value(v.clone()).map_err(|e| (String::new(), e.to_string()))?
-        };
+        let p: LabelParams = crate::process::step::step_options(v)?;
         p.validate()?;
         Ok(Arc::new(p))
     },

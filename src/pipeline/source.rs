@@ -95,8 +95,26 @@ pub(super) fn read_network(
 fn connect_error(c: &crate::config::ConnectSpec, e: IoError) -> RunError {
     RunError::Io(IoError::Read {
         source_name: c.source.clone(),
-        reason: format!("`input.connect`: {e}"),
+        reason: second_input_error("connect", e),
     })
+}
+
+/// Why a second input (`input.<what>`) could not be opened, with the keys
+/// of that input to fix (its `layer`, its `where`), not the polygons'.
+fn second_input_error(what: &str, e: IoError) -> String {
+    match e {
+        IoError::NoLayer {
+            source_name,
+            layer,
+            available,
+        } => format!(
+            "`input.{what}`: layer {layer} not found in `{source_name}`; available layers: {available}; choose one with `input.{what}.layer`"
+        ),
+        IoError::BadWhere { filter, reason } => format!(
+            "`input.{what}`: invalid `input.{what}.where` filter `{filter}`: {reason}; use OGR SQL syntax, e.g. \"area_m2 > 1e6\""
+        ),
+        e => format!("`input.{what}`: {e}"),
+    }
 }
 
 /// The error of a connect layer without lines.
@@ -171,7 +189,7 @@ pub(super) fn read_neighbours(
         })
     };
     let mut reader = Reader::open(&n.input(polygons.srs_wkt.as_deref()))
-        .map_err(|e| error(format!("`input.neighbours`: {e}")))?;
+        .map_err(|e| error(second_input_error("neighbours", e)))?;
     let mut units = Vec::new();
     let mut bad = None;
     reader.read::<IoError>(1024, false, |batch| {

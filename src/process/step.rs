@@ -142,6 +142,22 @@ pub struct StepEntry {
     pub build: fn(&serde_json::Value) -> Result<Arc<dyn FeatureStep>, OptionError>,
 }
 
+/// A registered step's options as `T`, from the YAML mapping under its key
+/// (as JSON; null: `T::default()`): a wrong value is reported at its key
+/// (`parts`, not the step), with serde's reason.
+pub fn step_options<T: serde::de::DeserializeOwned + Default>(
+    v: &serde_json::Value,
+) -> Result<T, OptionError> {
+    if v.is_null() {
+        return Ok(T::default());
+    }
+    serde_path_to_error::deserialize(v.clone()).map_err(|e| {
+        let key = e.path().to_string();
+        let key = if key == "." { String::new() } else { key };
+        (key, e.into_inner().to_string())
+    })
+}
+
 /// The registered steps: the `label` step, and what a caller adds (the
 /// other built-in steps are the variants of `config::Step`).
 #[derive(Debug, Clone, Default)]
