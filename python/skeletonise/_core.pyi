@@ -38,6 +38,10 @@ class Pipeline:
     @staticmethod
     def from_options(text: str, origin: str) -> Pipeline:
         """Validates a steps document made from keyword options (JSON text); raises PipelineError."""
+    def check_inputs(self, *, connect: bool) -> None:
+        """Raises PipelineError, with the command line's message, for what the command line refuses
+        of the inputs: ``prune: {mode: network}`` without the lines of ``input.connect``
+        (``connect``: they are given). ``run`` makes the same check."""
     @property
     def make_valid(self) -> bool:
         """Whether the ``prepare`` step repairs invalid polygons."""
