@@ -194,6 +194,11 @@ class _Algorithm(QgsProcessingAlgorithm):
         source, skip = self._input(parameters, context)
         crs = source.sourceCrs()
         connect = self._connect(parameters, context, crs)
+        try:
+            # What the command line refuses of the inputs (prune mode network without lines), before any work.
+            pipeline.check_inputs(connect=connect is not None)
+        except bridge.core().PipelineError as e:
+            raise QgsProcessingException(str(e)) from None
         collapse, partition = pipeline.collapse, pipeline.partition
         extra = {}
         if connect is not None:
@@ -655,8 +660,14 @@ class LabelAlgorithm(_Algorithm):
             if feedback.isCanceled():
                 break
             try:
+                # Repaired geometries keep their polygons (a spike's line left out), and are
+                # prepared with make_valid on, as the command line's label step has them.
                 row, part, kind, length, width, elong, wkb, rejected = core.labels(
-                    features.wkbs[start:end], json.dumps(options), None
+                    features.wkbs[start:end],
+                    json.dumps(options),
+                    None,
+                    repaired=features.repaired[start:end],
+                    make_valid=True,
                 )
             except core.PipelineError as e:
                 raise QgsProcessingException(str(e)) from None

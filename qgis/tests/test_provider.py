@@ -289,14 +289,46 @@ class PackedPlugin(Case):
 
 
 class Feedback(QgsProcessingFeedback):
-    """Collects the errors reported."""
+    """Collects the errors reported and the lines of the log."""
 
     def __init__(self):
         super().__init__()
         self.errors = []
+        self.infos = []
 
     def reportError(self, error, fatalError=False):  # noqa: N802
         self.errors.append(error)
+
+    def pushInfo(self, info):  # noqa: N802
+        self.infos.append(info)
+
+
+def cli_refusal(*args):
+    """The message of a command line that refuses its pipeline file (exit status 78)."""
+    p = cli(*args, check=False)
+    assert p.returncode == 78, p.stderr
+    return p.stderr.strip().splitlines()[-1].split(" ERROR ", 1)[1]
+
+
+def polygons_gpkg(path, layer, wkts, epsg=32630):
+    """A GeoPackage layer of polygons (a `name` field) from ``(name, WKT)`` pairs, written with
+    QGIS's own writer."""
+    from qgis.core import QgsCoordinateTransformContext, QgsVectorFileWriter
+
+    mem = QgsVectorLayer(f"Polygon?crs=EPSG:{epsg}&field=name:string", layer, "memory")
+    features = []
+    for name, wkt in wkts:
+        f = QgsFeature(mem.fields())
+        f["name"] = name
+        f.setGeometry(QgsGeometry.fromWkt(wkt))
+        features.append(f)
+    mem.dataProvider().addFeatures(features)
+    options = QgsVectorFileWriter.SaveVectorOptions()
+    options.driverName = "GPKG"
+    options.layerName = layer
+    err = QgsVectorFileWriter.writeAsVectorFormatV3(mem, path, QgsCoordinateTransformContext(), options)
+    assert err[0] == QgsVectorFileWriter.NoError, err
+    return path
 
 
 class Skeletonise(Case):
@@ -719,6 +751,53 @@ class Pipeline(Case):
         self.assertIn(message.splitlines()[0].split(": ", 1)[-1][:40], p.stderr)
 
 
+    def lakes_pipeline(self, prune):
+        """A pipeline file on the training lakes with the prune step ``prune``, no input.connect."""
+        path = self.out("p.yaml")
+        with open(path, "w") as f:
+            f.write(f"input:\n  source: {TRAIN}\n  layer: lakes_scotland\nsteps:\n  - skeleton: {{ methods: [MA] }}\n"
+                    f"  - prune: {prune}\n  - extend: {{}}\n  - score: {{}}\n  - select: {{}}\n"
+                    f"output:\n  path: {self.out('o.gpkg')}\n")
+        return path
+
+    def test_network_pruning_without_lines_is_refused_with_the_command_lines_message(self):
+        # The command line refuses `prune: {mode: network}` without input.connect (exit 78); the
+        # algorithm refuses it without Connecting lines, with the same message, before any work,
+        # rather than prune every lake with the fallback.
+        path = self.lakes_pipeline("{ mode: network }")
+        want = cli_refusal("validate", path)
+        self.assertIn("`steps[1].prune.mode`", want)
+        self.assertIn("input.connect", want)
+        with self.assertRaises(QgsProcessingException) as e:
+            processing.run("skeletonise:pipeline", {"INPUT": f"{TRAIN}|layername=lakes_scotland", "PIPELINE": path,
+                                                    "OUTPUT": self.out("q.gpkg")})
+        self.assertEqual(str(e.exception), want)
+        self.assertFalse(os.path.exists(self.out("q.gpkg")))
+        # Set by an override: the override is named.
+        plain = self.lakes_pipeline("{}")
+        want = cli_refusal("validate", plain, "--set", "steps.prune.mode=network")
+        with self.assertRaises(QgsProcessingException) as e:
+            processing.run("skeletonise:pipeline", {"INPUT": f"{TRAIN}|layername=lakes_scotland", "PIPELINE": plain,
+                                                    "OVERRIDES": "steps.prune.mode=network", "OUTPUT": self.out("q.gpkg")})
+        self.assertEqual(str(e.exception), want)
+        # With the lines it runs.
+        network = os.path.join(ROOT, "tests", "data", "network-train.gpkg")
+        res = processing.run("skeletonise:pipeline", {"INPUT": f"{TRAIN}|layername=lakes_scotland", "PIPELINE": path,
+                                                      "CONNECT": f"{network}|layername=lines_lakes_scotland", "SNAP": 1,
+                                                      "OUTPUT": self.out("q.gpkg")})
+        self.assertEqual(res["FEATURES_READ"], 18)
+
+    def test_a_prune_fallback_outside_network_mode_is_refused_with_the_command_lines_message(self):
+        path = self.lakes_pipeline("{ mode: significance, fallback: trunk }")
+        want = cli_refusal("validate", path)
+        self.assertIn("`steps[1].prune.fallback`", want)
+        self.assertIn("only with `mode: network`", want)
+        with self.assertRaises(QgsProcessingException) as e:
+            processing.run("skeletonise:pipeline", {"INPUT": f"{TRAIN}|layername=lakes_scotland", "PIPELINE": path,
+                                                    "OUTPUT": self.out("q.gpkg")})
+        self.assertEqual(str(e.exception), want)
+
+
 class Labels(Case):
     def test_labels_give_the_command_lines_rows_with_minzoom(self):
         cli("run", os.path.join(ROOT, "pipelines", "lake-labels.yaml"), "-o", self.out("cli.gpkg"))
@@ -736,6 +815,38 @@ class Labels(Case):
         self.assertIn("src_kind", want[0])
         self.assertSameRows(got, want, key=("src_fid", "polygon_part"))
         self.assertTrue(all(r["minzoom"] is not None for r in got))
+
+
+    def test_a_polygon_with_a_spike_is_labelled_as_on_the_command_line(self):
+        # QGIS's makeValid (GEOS MakeValid, as the command line's) makes a polygon and a line of a
+        # polygon with a zero-width spike: its polygon is labelled, a point for the square and a
+        # line for the strip, row for row the command line's labels layer.
+        src = polygons_gpkg(self.out("spiked.gpkg"), "spiked", [
+            ("square", "POLYGON((0 0,10 0,10 5,20 5,10 5,10 10,0 10,0 0))"),
+            ("strip", "POLYGON((0 20,100 20,100 25,120 25,100 25,100 30,0 30,0 20))"),
+        ])
+        layer = QgsVectorLayer(f"{src}|layername=spiked", "s", "ogr")
+        for f in layer.getFeatures():
+            self.assertFalse(f.geometry().isGeosValid())
+            self.assertEqual(f.geometry().makeValid().wkbType(), 7)  # GeometryCollection
+        pipeline = self.out("labels.yaml")
+        with open(pipeline, "w") as f:
+            f.write(f"input: {{ source: {src}, layer: spiked }}\nsteps:\n  - prepare: {{ make_valid: true }}\n"
+                    "  - skeleton: { methods: [MA] }\n  - label: {}\n  - prune: { mode: trunk }\n  - extend: {}\n"
+                    f"  - score: {{}}\n  - select: {{}}\noutput: {{ path: {self.out('cli.gpkg')} }}\n")
+        cli("run", pipeline)
+        want = rows(self.out("cli.gpkg"), "labels")
+        self.assertEqual([r["kind"] for r in want], ["point", "line"])
+        feedback = Feedback()
+        res = processing.run("skeletonise:label", {"INPUT": f"{src}|layername=spiked", "OUTPUT": self.out("q.gpkg"),
+                                                   "POINTS": self.out("p.gpkg")}, feedback=feedback)
+        self.assertEqual(feedback.errors, [])
+        self.assertEqual(res["FEATURES_REJECTED"], 0)
+        got = rows(res["OUTPUT"]) + rows(res["POINTS"])
+        self.assertEqual([r["rejected"] for r in got], [None, None])
+        for r in got:
+            del r["rejected"]
+        self.assertSameRows(got, want, key=("src_fid", "polygon_part"))
 
 
 class QgisProcess(Case):
