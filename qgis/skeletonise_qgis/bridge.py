@@ -87,6 +87,17 @@ def check_crs(crs, name):
         )
 
 
+def layer_name(layer, source):
+    """The name the command line gives a layer: a file's layer name (``layername=`` of the
+    source), else the QGIS layer's name, else the source's."""
+    if layer is not None:
+        from qgis.core import QgsProviderRegistry
+
+        parts = QgsProviderRegistry.instance().decodeUri(layer.providerType(), layer.source())
+        return parts.get("layerName") or layer.name()
+    return source.sourceName()
+
+
 class Features:
     """The features of a source as the wheel takes them: FIDs, attributes, WKB."""
 

@@ -658,6 +658,72 @@ class Partition(Case):
         self.assertSameRows(rows(res["COVERAGE"]), rows(self.out("cli.gpkg"), "coverage"))
 
 
+    def test_the_log_counts_the_features_the_command_line_counts(self):
+        # The summary line gives the command line's run record (read, written, rejected), with the
+        # Skeletons output or without it (it is optional here), and with rejected lakes.
+        cov = os.path.join(ROOT, "tests", "data", "coverage-train.gpkg")
+        src = os.path.join(ROOT, "tests", "data", "border-waters.gpkg")
+        cli("run", os.path.join(ROOT, "pipelines", "partition-rivers.yaml"), "-o", self.out("danube.gpkg"))
+        titicaca = ["--set", "input.layer=waters_titicaca", "--set", "input.neighbours.layer=units_titicaca",
+                    "--set", f"input.source={src}", "--set", f"input.neighbours.source={src}"]
+        pipeline = os.path.join(ROOT, "pipelines", "partition-border-waters.yaml")
+        cli("run", pipeline, "-o", self.out("titicaca.gpkg"), *titicaca)
+        cli("run", pipeline, "-o", self.out("reject.gpkg"), *titicaca, "--set", "steps.partition.overlap=reject")
+        lakes = {"INPUT": f"{src}|layername=waters_titicaca", "NEIGHBOURS": f"{src}|layername=units_titicaca"}
+        cases = [
+            ("danube", {"INPUT": f"{cov}|layername=rivers_danube", "NEIGHBOURS": f"{cov}|layername=units_danube"}),
+            ("titicaca", lakes),
+            ("reject", dict(lakes, OVERLAP=1)),
+        ]
+        for name, params in cases:
+            run = rows(self.out(f"{name}.gpkg"), "skeletonise_runs")[0]
+            want = (f"{run['features_read']} features read, {run['features_written']} written, "
+                    f"{run['features_rejected']} rejected")
+            if name != "reject":
+                self.assertGreater(run["features_written"], 0)
+            else:
+                self.assertGreater(run["features_rejected"], 0)
+            for skeletons in (False, True):
+                with self.subTest(case=name, skeletons=skeletons):
+                    sinks = {"COVERAGE": self.out(f"{name}-{skeletons}-c.gpkg"),
+                             "BOUNDARIES": self.out(f"{name}-{skeletons}-b.gpkg")}
+                    if skeletons:
+                        sinks["OUTPUT"] = self.out(f"{name}-s.gpkg")
+                    feedback = Feedback()
+                    res = processing.run("skeletonise:partition", dict(params, **sinks), feedback=feedback)
+                    self.assertIn(want, feedback.infos)
+                    self.assertEqual(res["FEATURES_READ"], run["features_read"])
+                    self.assertEqual(res["FEATURES_REJECTED"], run["features_rejected"])
+
+    def test_an_empty_neighbours_layer_is_refused_before_any_work(self):
+        # The command line refuses an empty `input.neighbours`; so do Partition into neighbours and
+        # Run a pipeline file, with its words, and nothing is written.
+        cov = os.path.join(ROOT, "tests", "data", "coverage-train.gpkg")
+        empty = polygons_gpkg(self.out("empty.gpkg"), "units", [])
+        self.assertEqual(QgsVectorLayer(f"{empty}|layername=units", "u", "ogr").featureCount(), 0)
+        p = cli("run", os.path.join(ROOT, "pipelines", "partition-rivers.yaml"), "-o", self.out("cli.gpkg"),
+                "--set", f"input.neighbours.source={empty}", "--set", "input.neighbours.layer=units", check=False)
+        self.assertNotEqual(p.returncode, 0)
+        self.assertIn("`input.neighbours`: layer `units` has no units", p.stderr)
+        self.assertIn("give the coverage whose units take the area", p.stderr)
+        memory = QgsVectorLayer("Polygon?crs=EPSG:32633", "units", "memory")
+        for alg, extra in (
+            ("skeletonise:partition", {}),
+            ("skeletonise:pipeline", {"PIPELINE": os.path.join(ROOT, "pipelines", "partition-rivers.yaml")}),
+        ):
+            for units in (f"{empty}|layername=units", memory):
+                with self.subTest(algorithm=alg, units=units):
+                    params = dict(extra, INPUT=f"{cov}|layername=rivers_danube", NEIGHBOURS=units,
+                                  COVERAGE=self.out("c.gpkg"), OUTPUT=self.out("s.gpkg"))
+                    with self.assertRaises(QgsProcessingException) as e:
+                        processing.run(alg, params)
+                    message = str(e.exception)
+                    self.assertIn("`input.neighbours`: layer `units` has no units", message)
+                    self.assertIn("give the coverage whose units take the area", message)
+                    self.assertFalse(os.path.exists(self.out("c.gpkg")))
+                    self.assertFalse(os.path.exists(self.out("s.gpkg")))
+
+
 class Score(Case):
     def test_score_by_location_and_by_key_gives_the_command_lines_rows(self):
         cli("run", "-i", TRAIN, "-l", "lakes_scotland", "-o", self.out("run.gpkg"),
@@ -697,6 +763,31 @@ class Score(Case):
                 {"INPUT": f"{TRAIN}|layername=lakes_scotland", "SKELETONS": far, "OUTPUT": self.out("s.gpkg")},
             )
         self.assertIn("no skeleton line could be joined to a polygon (1 lines inside no polygon)", str(e.exception))
+
+    def test_a_missing_key_field_is_named_with_the_layers_fields(self):
+        # As `skeletonise score`: the layer, the field and the fields it has (a Processing error, no
+        # Python KeyError), before any work.
+        cli("run", "-i", TRAIN, "-l", "lakes_scotland", "-o", self.out("run.gpkg"),
+            "--set", "steps.skeleton.methods=[CDT]")
+        base = ["score", "--polygons", TRAIN, "--polygons-layer", "lakes_scotland", "--skeletons",
+                self.out("run.gpkg"), "--skeletons-layer", "skeletons", "-o", self.out("cli.gpkg")]
+        params = {"INPUT": f"{TRAIN}|layername=lakes_scotland", "SKELETONS": f"{self.out('run.gpkg')}|layername=skeletons",
+                  "OUTPUT": self.out("q.gpkg")}
+        for what, args, keys in (
+            ("skeleton", ["--skeleton-key", "nope"], {"SKELETON_KEY": "nope"}),
+            ("polygon", ["--skeleton-key", "src_fid", "--polygon-key", "nope"],
+             {"SKELETON_KEY": "src_fid", "POLYGON_KEY": "nope"}),
+        ):
+            with self.subTest(key=what):
+                p = cli(*base, *args, check=False)
+                self.assertNotEqual(p.returncode, 0)
+                want = p.stderr.strip().splitlines()[-1].split(" ERROR ", 1)[1]
+                self.assertTrue(want.startswith(f"{what} layer `"), want)
+                self.assertIn("has no field `nope`; fields: kind, area_m2", want)
+                with self.assertRaises(QgsProcessingException) as e:
+                    processing.run("skeletonise:score", dict(params, **keys))
+                self.assertEqual(str(e.exception), want)
+                self.assertFalse(os.path.exists(self.out("q.gpkg")))
 
 
 class Help(unittest.TestCase):
