@@ -354,6 +354,76 @@ fn broken_pipeline_files_exit_78_with_the_place() {
     }
 }
 
+/// `prune.fallback` is what `mode: network` gives a polygon no line meets:
+/// in any other mode it does nothing, and `validate` and `run` refuse it
+/// (exit 78, naming the key) rather than accept it silently; with
+/// `mode: network` it is taken. `mode: network` without `input.connect` is
+/// refused with the message the Python package and QGIS give too.
+#[test]
+fn a_prune_fallback_outside_network_mode_is_an_invalid_pipeline() {
+    let d = tmp();
+    let out = d.path().join("o.gpkg");
+    let train = root(TRAIN);
+    for (mode, fallback) in [
+        ("significance", "trunk"),
+        ("trunk", "drop"),
+        ("length", "trunk"),
+    ] {
+        let text = basic_pipeline(
+            &train,
+            "lakes_scotland",
+            &out,
+            &format!("  - prune: {{ mode: {mode}, fallback: {fallback} }}\n"),
+        );
+        let p = pipeline(d.path(), "p.yaml", &text);
+        for command in ["validate", "run"] {
+            let (code, err) = code_and_err(&skeletonise(&[command, p.to_str().unwrap()]));
+            assert_eq!(code, 78, "{command} {mode}/{fallback}: {err}");
+            assert!(
+                err.contains("`steps[1].prune.fallback`")
+                    && err.contains(skeletonise::graph::prune::FALLBACK_OUTSIDE_NETWORK),
+                "{command} {mode}/{fallback}: {err}"
+            );
+        }
+        assert!(!out.exists(), "{mode}/{fallback}: nothing written");
+    }
+    // Without `fallback`, and with it under `mode: network` (and its lines), the file is valid.
+    let plain = basic_pipeline(
+        &train,
+        "lakes_scotland",
+        &out,
+        "  - prune: { mode: trunk }\n",
+    );
+    let p = pipeline(d.path(), "plain.yaml", &plain);
+    let (code, err) = code_and_err(&skeletonise(&["validate", p.to_str().unwrap()]));
+    assert_eq!(code, 0, "{err}");
+    let network = plain.replace(
+        "  layer: lakes_scotland\n",
+        &format!(
+            "  layer: lakes_scotland\n  connect: {{ source: {}, layer: lines_lakes_scotland }}\n",
+            root("tests/data/network-train.gpkg")
+        ),
+    );
+    for fallback in ["significance", "trunk", "drop"] {
+        let text = network.replace(
+            "mode: trunk }",
+            &format!("mode: network, fallback: {fallback} }}"),
+        );
+        let p = pipeline(d.path(), "network.yaml", &text);
+        let (code, err) = code_and_err(&skeletonise(&["validate", p.to_str().unwrap()]));
+        assert_eq!(code, 0, "network/{fallback}: {err}");
+    }
+    let without_lines = plain.replace("mode: trunk }", "mode: network }");
+    let p = pipeline(d.path(), "lines.yaml", &without_lines);
+    let (code, err) = code_and_err(&skeletonise(&["validate", p.to_str().unwrap()]));
+    assert_eq!(code, 78, "{err}");
+    assert!(
+        err.contains("`steps[1].prune.mode`")
+            && err.contains(skeletonise::graph::prune::NETWORK_NEEDS_CONNECT),
+        "{err}"
+    );
+}
+
 #[test]
 fn outputs_that_must_not_be_written() {
     let d = tmp();

@@ -840,7 +840,9 @@ def labels(
         ``min_pixels`` sets ``minzoom``.
     make_valid
         Repair invalid polygons with GEOS MakeValid first (as the command
-        line's ``prepare`` step does by default).
+        line's ``prepare`` step does by default); of a repaired geometry the
+        polygons are labelled, as on the command line (a spike that MakeValid
+        turns into a line is left out, not a reason to reject the feature).
     threads
         Worker threads (``None``: one per core).
 
@@ -859,7 +861,7 @@ def labels(
 
     arr, index, crs = _geometry_array(geometries)
     _check_call(crs, threads)
-    arr, _, _ = _prepare(arr, make_valid)
+    arr, repaired, _ = _prepare(arr, make_valid)
     options = {
         "smooth": smooth,
         "margin": margin,
@@ -867,8 +869,14 @@ def labels(
         "parts": parts,
         "min_pixels": min_pixels,
     }
+    # A repaired geometry keeps MakeValid's polygons (a spike's line left out), as the command line's
+    # reader keeps them.
     row, part, kind, length, width, elong, wkb, rejected = _core.labels(
-        _encode(arr, "wkb"), json.dumps(options, default=_json_default), threads
+        _encode(arr, "wkb"),
+        json.dumps(options, default=_json_default),
+        threads,
+        repaired=repaired.tolist(),
+        make_valid=make_valid,
     )
     row = np.asarray(row, dtype=np.intp)
     idx = (index if index is not None else pd.RangeIndex(len(arr)))[row]

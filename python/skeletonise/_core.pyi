@@ -38,6 +38,10 @@ class Pipeline:
     @staticmethod
     def from_options(text: str, origin: str) -> Pipeline:
         """Validates a steps document made from keyword options (JSON text); raises PipelineError."""
+    def check_inputs(self, *, connect: bool) -> None:
+        """Raises PipelineError, with the command line's message, for what the command line refuses
+        of the inputs: ``prune: {mode: network}`` without the lines of ``input.connect``
+        (``connect``: they are given). ``run`` makes the same check."""
     @property
     def make_valid(self) -> bool:
         """Whether the ``prepare`` step repairs invalid polygons."""
@@ -134,7 +138,12 @@ def schema() -> str:
     """The JSON Schema of the pipeline file, as JSON text."""
 
 def labels(
-    wkbs: list[bytes | None], options: str, threads: int | None = None
+    wkbs: list[bytes | None],
+    options: str,
+    threads: int | None = None,
+    *,
+    repaired: Optional[Sequence[bool]] = None,
+    make_valid: bool = False,
 ) -> tuple[
     list[int],
     list[int | None],
@@ -148,4 +157,6 @@ def labels(
     """The ``label`` step on every feature (WKB in, ``options`` the step's keys as JSON):
     the columns ``(row, polygon_part, kind, length, max_width, elongation, wkb, rejected)``,
     one row per labelled part, one row with the reason for a feature that cannot be
-    prepared. Raises PipelineError for a wrong option."""
+    prepared. ``repaired``: which geometries MakeValid repaired (of those only the
+    polygons are labelled, as the command line keeps them); ``make_valid``: the
+    ``prepare`` step's option. Raises PipelineError for a wrong option."""

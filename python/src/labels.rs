@@ -2,14 +2,19 @@
 //! where a polygon part is elongated enough for a curved name, else the
 //! centre of its largest inscribed disc — WKB in, one row per labelled part
 //! out, on rayon's threads with the GIL released.
+//!
+//! The features are read as `Pipeline.run` reads them ([`crate::run::features`]:
+//! a repaired geometry keeps MakeValid's polygons, as the command line's
+//! reader keeps them) and prepared as the command line's per-feature path
+//! prepares them (`prepare_checked`).
 
-use crate::wkb;
+use crate::run::{features, Input};
 use geo::{Coord, Geometry};
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
 use rayon::prelude::*;
 use skeletonise::label::{Label, LabelParams, Labelled};
-use skeletonise::process::{prepare, NotPrepared, PrepareParams};
+use skeletonise::process::{prepare_checked, NotPrepared, PrepareParams};
 
 /// One output row: the input row, the part, the label (or why the feature
 /// has none).
@@ -17,19 +22,25 @@ type Row = (usize, Option<usize>, Result<Option<Labelled>, String>);
 
 /// The labels of the features `wkbs` (`None`: NULL) with the `label`
 /// step's options (`options`: JSON with its keys); `threads` worker
-/// threads (`None`: rayon's global pool). Returns the columns
-/// `(row, polygon_part, kind, length, max_width, elongation, wkb,
-/// rejected)`: one row per labelled part; a feature that cannot be
-/// prepared (NULL, not a polygon, invalid) one row with its reason in
-/// `rejected`.
+/// threads (`None`: rayon's global pool). `repaired`: which geometries
+/// MakeValid repaired (of a repaired one only the polygons are labelled,
+/// as the command line keeps them: a spike MakeValid turns into a line
+/// does not reject the feature); `make_valid`: the `prepare` step's
+/// `make_valid` (it words the reason of a polygon that stays invalid).
+/// Returns the columns `(row, polygon_part, kind, length, max_width,
+/// elongation, wkb, rejected)`: one row per labelled part; a feature that
+/// cannot be prepared (NULL, not a polygon, invalid) one row with its
+/// reason in `rejected`.
 #[pyfunction]
-#[pyo3(signature = (wkbs, options, threads = None))]
+#[pyo3(signature = (wkbs, options, threads = None, *, repaired = None, make_valid = false))]
 #[allow(clippy::type_complexity)]
 pub fn labels<'py>(
     py: Python<'py>,
     wkbs: Vec<Option<Vec<u8>>>,
     options: &str,
     threads: Option<usize>,
+    repaired: Option<Vec<bool>>,
+    make_valid: bool,
 ) -> PyResult<(
     Vec<usize>,
     Vec<Option<usize>>,
@@ -45,30 +56,40 @@ pub fn labels<'py>(
     params
         .validate()
         .map_err(|(k, m)| crate::PipelineError::new_err(format!("`{k}`: {m}")))?;
+    if let Some(r) = repaired.as_ref().filter(|r| r.len() != wkbs.len()) {
+        return Err(pyo3::exceptions::PyValueError::new_err(format!(
+            "repaired has {} entries for {} geometries",
+            r.len(),
+            wkbs.len()
+        )));
+    }
     let prep = PrepareParams {
-        make_valid: false,
+        make_valid,
         min_area: 0.0,
         max_vertices: 0,
     };
-    let one = |i: usize, w: &Option<Vec<u8>>| -> Vec<Row> {
-        let geom = match w.as_deref().map(wkb::read).transpose() {
-            Ok(g) => g,
-            Err(e) => return vec![(i, None, Err(e))],
-        };
-        match prepare(geom.as_ref(), &prep) {
-            Ok(parts) => params
-                .labels(&parts)
-                .into_iter()
-                .map(|(k, l)| (i, Some(k), Ok(l)))
-                .collect(),
-            Err(NotPrepared::Rejected(r)) => vec![(i, None, Err(r))],
-            Err(NotPrepared::Filtered) => vec![(i, None, Err("no polygon part".into()))],
-        }
-    };
+    let input = Input::Wkb(wkbs.iter().map(Option::as_deref).collect());
     let work = || -> Vec<Row> {
-        wkbs.par_iter()
+        let feats = features(&input, None, repaired.as_deref(), input.len() > 1);
+        feats
+            .par_iter()
             .enumerate()
-            .flat_map_iter(|(i, w)| one(i, w))
+            .flat_map_iter(|(i, f)| -> Vec<Row> {
+                if let Some(e) = &f.geometry_error {
+                    return vec![(i, None, Err(e.clone()))];
+                }
+                match prepare_checked(f.geometry.as_ref(), &prep, f.checked) {
+                    Ok(parts) => params
+                        .labels(&parts)
+                        .into_iter()
+                        .map(|(k, l)| (i, Some(k), Ok(l)))
+                        .collect(),
+                    Err(NotPrepared::Rejected(r)) => vec![(i, None, Err(r))],
+                    Err(NotPrepared::Filtered) => {
+                        vec![(i, None, Err("no polygon part".into()))]
+                    }
+                }
+            })
             .collect()
     };
     let rows: Vec<Row> = match threads {

@@ -74,6 +74,12 @@ impl Cancel {
 #[pyclass(frozen, module = "skeletonise._core")]
 pub struct Pipeline {
     steps: Steps,
+    /// The `--set` style overrides the file was loaded with: a refusal of a
+    /// key one of them set names it, as the command line names it.
+    overrides: Vec<String>,
+    /// Made from keyword options (`from_options`): a refusal names the
+    /// keyword (`prune.mode`), not the steps document's key path.
+    keyword: bool,
 }
 
 /// Rewrites a key path of the steps document made from keyword options to
@@ -102,8 +108,71 @@ impl Pipeline {
     /// The steps (every step runs here; what a GeoDataFrame cannot hold
     /// is refused by the Python functions).
     fn supported(steps: config::Steps) -> PyResult<Self> {
-        Ok(Self { steps })
+        Ok(Self {
+            steps,
+            overrides: Vec::new(),
+            keyword: false,
+        })
     }
+
+    /// What the command line refuses of a file whose `input` lacks the
+    /// lines (`connect`: they are given): `prune: {mode: network}` without
+    /// `input.connect`, with the command line's message. Without this a
+    /// run would prune every polygon with the fallback instead.
+    fn refuse_without_lines(&self, connect: bool) -> PyResult<()> {
+        let network = self.steps.file.steps.iter().position(
+            |s| matches!(s, config::Step::Prune(p) if p.mode == skeletonise::graph::prune::PruneMode::Network),
+        );
+        match (network, connect) {
+            (Some(i), false) => Err(pipeline_error(self.error_at(
+                &format!("steps[{i}].prune.mode"),
+                skeletonise::graph::prune::NETWORK_NEEDS_CONNECT,
+            ))),
+            _ => Ok(()),
+        }
+    }
+
+    /// The error of key `key` (a key path of the steps document) as the
+    /// command line's validation words it: the file's `line:column` of the
+    /// key, or the override that set it; the keyword for keyword options.
+    fn error_at(&self, key: &str, message: &str) -> ConfigError {
+        let mut e = ConfigError {
+            origin: self.steps.origin.clone(),
+            position: None,
+            key: key.to_string(),
+            message: message.to_string(),
+        };
+        if self.keyword {
+            e.key = keyword_key(key);
+            return e;
+        }
+        let plain = strip_indices(key);
+        let overridden = self.overrides.iter().find(|o| {
+            let k = o.split_once('=').map_or(o.as_str(), |(k, _)| k);
+            plain == k || plain.starts_with(&format!("{k}.")) || k.starts_with(&format!("{plain}."))
+        });
+        match overridden {
+            Some(o) => e.origin = format!("--set {o}"),
+            None => e.position = config::locate::Locations::index(&self.steps.text).key(key),
+        }
+        e
+    }
+}
+
+/// A key path without its sequence indices: `steps[2].prune.mode` →
+/// `steps.prune.mode` (the form of an override's key).
+fn strip_indices(key: &str) -> String {
+    let mut out = String::with_capacity(key.len());
+    let mut depth = 0;
+    for c in key.chars() {
+        match c {
+            '[' => depth += 1,
+            ']' => depth -= 1,
+            _ if depth == 0 => out.push(c),
+            _ => {}
+        }
+    }
+    out
 }
 
 #[pymethods]
@@ -113,9 +182,11 @@ impl Pipeline {
     #[staticmethod]
     #[pyo3(signature = (path, overrides = Vec::new()))]
     fn load(path: std::path::PathBuf, overrides: Vec<String>) -> PyResult<Self> {
-        config::load_steps(&path, &overrides)
+        let mut p = config::load_steps(&path, &overrides)
             .map_err(pipeline_error)
-            .and_then(Self::supported)
+            .and_then(Self::supported)?;
+        p.overrides = overrides;
+        Ok(p)
     }
 
     /// Validates a steps document made from keyword options (JSON text);
@@ -131,6 +202,16 @@ impl Pipeline {
                 })
             })
             .and_then(Self::supported)
+            .map(|p| Self { keyword: true, ..p })
+    }
+
+    /// Refuses, before any work, what the command line refuses of the
+    /// pipeline's inputs: `prune: {mode: network}` without the lines of
+    /// `input.connect` (`connect`: they are given), with its message.
+    /// `run` makes the same check.
+    #[pyo3(signature = (*, connect))]
+    fn check_inputs(&self, connect: bool) -> PyResult<()> {
+        self.refuse_without_lines(connect)
     }
 
     /// Whether the pipeline has a `collapse` step (its kept areas come back
@@ -214,6 +295,7 @@ impl Pipeline {
         neighbour_snap: Option<f64>,
         with_candidates: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
+        self.refuse_without_lines(connect.is_some())?;
         let mut params = self.steps.process_params();
         let partition = params.partition.is_some();
         match (partition, neighbours) {
@@ -545,6 +627,15 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
 #[cfg(test)]
 mod tests {
     use super::keyword_key;
+
+    #[test]
+    fn indices_are_left_out_of_a_key_as_an_override_writes_it() {
+        assert_eq!(
+            super::strip_indices("steps[2].prune.mode"),
+            "steps.prune.mode"
+        );
+        assert_eq!(super::strip_indices("steps"), "steps");
+    }
 
     #[test]
     fn keys_of_keyword_options_name_the_keyword() {

@@ -64,7 +64,7 @@ enum Stop {
 }
 
 /// The geometries as handed over.
-enum Input<'a> {
+pub(crate) enum Input<'a> {
     /// WKB per feature (`None` for NULL).
     Wkb(Vec<Option<&'a [u8]>>),
     /// `shapely.to_ragged_array` of polygons (3) or multipolygons (6).
@@ -77,7 +77,7 @@ enum Input<'a> {
 }
 
 impl Input<'_> {
-    fn len(&self) -> usize {
+    pub(crate) fn len(&self) -> usize {
         match self {
             Input::Wkb(v) => v.len(),
             Input::Ragged { offsets, .. } => {
@@ -174,8 +174,9 @@ enum Encoded {
 }
 
 /// The features of the input (parsed, repaired parts kept as the command
-/// line keeps them).
-fn features(
+/// line keeps them: MakeValid's polygons, not the lines and points a
+/// collapsed spike becomes). `Pipeline.run` and `labels` both read them so.
+pub(crate) fn features(
     input: &Input<'_>,
     fids: Option<&[i64]>,
     repaired: Option<&[bool]>,

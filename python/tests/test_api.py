@@ -416,3 +416,49 @@ def test_labels_keep_the_source_columns_row_by_row_under_their_own_names():
     # Each label lies in its own part.
     for (_, row), part in zip(got.iterrows(), parts[:5]):
         assert part.contains(row.geometry)
+
+
+def test_labels_of_a_polygon_with_a_spike_are_the_command_lines(tmp_path):
+    """MakeValid turns a polygon with a zero-width spike into a polygon and a line (a
+    GeometryCollection): the command line's `label` step labels its polygon, and so does
+    ``skeletonise.labels`` (a point for the square, a line for the long strip), row for row;
+    without make_valid the feature is rejected with the reason."""
+    import subprocess
+
+    import pyogrio
+
+    from conftest import cli_binary
+
+    spiked = gpd.GeoDataFrame(
+        {"name": ["square", "strip"]},
+        geometry=shapely.from_wkt([
+            "POLYGON((0 0,10 0,10 5,20 5,10 5,10 10,0 10,0 0))",
+            "POLYGON((0 20,100 20,100 25,120 25,100 25,100 30,0 30,0 20))",
+        ]),
+        crs="EPSG:32630",
+    )
+    assert not shapely.is_valid(spiked.geometry.values).any()
+    assert (shapely.get_type_id(shapely.make_valid(spiked.geometry.values)) == 7).all()
+    src = tmp_path / "spiked.gpkg"
+    pyogrio.write_dataframe(spiked, src, layer="spiked")
+    pipeline = tmp_path / "labels.yaml"
+    out = tmp_path / "out.gpkg"
+    pipeline.write_text(
+        f"input: {{ source: {src}, layer: spiked }}\nsteps:\n  - prepare: {{ make_valid: true }}\n"
+        "  - skeleton: { methods: [MA] }\n  - label: {}\n  - prune: { mode: trunk }\n  - extend: {}\n"
+        f"  - score: {{}}\n  - select: {{}}\noutput: {{ path: {out} }}\n"
+    )
+    subprocess.run([str(cli_binary()), "run", str(pipeline), "-q"], cwd=ROOT, check=True)
+    cli = gpd.read_file(out, layer="labels")
+    assert list(cli.kind) == ["point", "line"]
+    got = skeletonise.labels(spiked)
+    assert got.rejected.isna().all(), list(got.rejected)
+    assert list(got.kind) == list(cli.kind)
+    assert list(got.polygon_part) == list(cli.polygon_part)
+    assert list(got.minzoom) == list(cli.minzoom)
+    assert shapely.equals_exact(np.asarray(cli.geometry.values), np.asarray(got.geometry.values), 1e-9).all()
+    for fid, row in got.iterrows():
+        assert shapely.make_valid(spiked.geometry[fid]).contains(row.geometry)
+    # Without make_valid the spike is the prepare step's reason, as on the command line.
+    plain = skeletonise.labels(spiked, make_valid=False)
+    assert plain.rejected.str.contains("make_valid").all(), list(plain.rejected)

@@ -133,3 +133,75 @@ def test_bad_second_inputs_are_clear_errors():
         skeletonise.apply_layers(rivers, ROOT / "pipelines" / "partition-rivers.yaml", neighbours=units.iloc[:0])
     with pytest.raises(skeletonise.PipelineError, match="no lines"):
         skeletonise.apply_layers(rivers, ROOT / "pipelines" / "collapse-rivers.yaml", connect=rivers.centroid)
+
+
+def cli_refusal(*args: str) -> str:
+    """The message of a command line that refuses its pipeline file (exit status 78)."""
+    import subprocess
+
+    from conftest import cli_binary
+
+    p = subprocess.run([str(cli_binary()), *args], cwd=ROOT, capture_output=True, text=True)
+    assert p.returncode == 78, p.stderr
+    return p.stderr.strip().splitlines()[-1].split(" ERROR ", 1)[1]
+
+
+def lakes_pipeline(tmp_path, prune: str) -> str:
+    """A pipeline file on the training lakes with the prune step ``prune`` (no ``input.connect``)."""
+    path = tmp_path / "p.yaml"
+    path.write_text(
+        f"input:\n  source: {TRAIN}\n  layer: lakes_scotland\nsteps:\n  - skeleton: {{ methods: [MA] }}\n"
+        f"  - prune: {prune}\n  - extend: {{}}\n  - score: {{}}\n  - select: {{}}\n"
+        f"output:\n  path: {tmp_path / 'o.gpkg'}\n"
+    )
+    return str(path)
+
+
+def test_network_pruning_without_lines_is_refused_with_the_command_lines_message(tmp_path):
+    """`prune: {mode: network}` without the lines of `input.connect`: the command line refuses
+    the file (exit 78); apply_layers, apply and the keyword API refuse the run with its
+    message (PipelineError), rather than prune every lake with the fallback."""
+    lakes = pyogrio.read_dataframe(TRAIN, layer="lakes_scotland", fid_as_index=True)
+    path = lakes_pipeline(tmp_path, "{ mode: network }")
+    want = cli_refusal("validate", path)
+    assert "`steps[1].prune.mode`" in want and "input.connect" in want
+    with pytest.raises(skeletonise.PipelineError) as e:
+        skeletonise.apply_layers(lakes, path)
+    assert str(e.value) == want
+    with pytest.raises(skeletonise.PipelineError) as e:
+        skeletonise.apply(lakes, path)
+    assert str(e.value) == want
+    # An empty frame is refused all the same: the file is wrong, not the data.
+    with pytest.raises(skeletonise.PipelineError) as e:
+        skeletonise.apply_layers(lakes.iloc[:0], path)
+    assert str(e.value) == want
+    # Set by an override: the override is named, as on the command line.
+    plain = lakes_pipeline(tmp_path, "{}")
+    want = cli_refusal("validate", plain, "--set", "steps.prune.mode=network")
+    assert want.startswith("--set steps.prune.mode=network: ")
+    with pytest.raises(skeletonise.PipelineError) as e:
+        skeletonise.apply_layers(lakes, plain, overrides=["steps.prune.mode=network"])
+    assert str(e.value) == want
+    # The keyword API names its keyword.
+    with pytest.raises(skeletonise.PipelineError, match=r"`prune\.mode`: `mode: network` keeps .*input\.connect"):
+        skeletonise.skeletonise(lakes.geometry, methods=["MA"], prune={"mode": "network"})
+    # With the lines it runs.
+    network = pyogrio.read_dataframe(ROOT / "tests" / "data" / "network-train.gpkg", layer="lines_lakes_scotland")
+    out = skeletonise.apply_layers(lakes, path, connect=network, snap=1.0)
+    assert out["skeletons"]["method"].notna().sum() > 0
+
+
+def test_a_prune_fallback_outside_network_mode_is_refused_as_on_the_command_line(tmp_path):
+    """`prune.fallback` only means something with `mode: network`: elsewhere the command line's
+    validation refuses it, and so do load_pipeline and the keyword API, with its message."""
+    path = lakes_pipeline(tmp_path, "{ mode: significance, fallback: trunk }")
+    want = cli_refusal("validate", path)
+    assert "`steps[1].prune.fallback`" in want and "only with `mode: network`" in want
+    with pytest.raises(skeletonise.PipelineError) as e:
+        skeletonise.load_pipeline(path)
+    assert str(e.value) == want
+    lakes = pyogrio.read_dataframe(TRAIN, layer="lakes_scotland", fid_as_index=True)
+    with pytest.raises(skeletonise.PipelineError, match=r"`prune\.fallback`: .*only with `mode: network`"):
+        skeletonise.skeletonise(lakes.geometry, prune={"mode": "trunk", "fallback": "drop"})
+    # With `mode: network` it is taken.
+    skeletonise.load_pipeline(lakes_pipeline(tmp_path, "{ mode: network, fallback: trunk }"))

@@ -172,6 +172,13 @@ class _Algorithm(QgsProcessingAlgorithm):
         units = self.parameterAsSource(parameters, "NEIGHBOURS", context)
         if units is None:
             raise QgsProcessingException(self.invalidSourceError(parameters, "NEIGHBOURS"))
+        if units.featureCount() == 0:
+            # The command line's refusal of an empty `input.neighbours`, before any work.
+            name = bridge.layer_name(self.parameterAsVectorLayer(parameters, "NEIGHBOURS", context), units)
+            raise QgsProcessingException(
+                f"`input.neighbours`: layer `{name}` has no units; give the coverage whose units take the area "
+                "(Neighbours)"
+            )
         request = QgsFeatureRequest().setDestinationCrs(crs, context.transformContext())
         wkbs, fids, attributes = [], [], {}
         for f in units.getFeatures(request):
@@ -194,6 +201,11 @@ class _Algorithm(QgsProcessingAlgorithm):
         source, skip = self._input(parameters, context)
         crs = source.sourceCrs()
         connect = self._connect(parameters, context, crs)
+        try:
+            # What the command line refuses of the inputs (prune mode network without lines), before any work.
+            pipeline.check_inputs(connect=connect is not None)
+        except bridge.core().PipelineError as e:
+            raise QgsProcessingException(str(e)) from None
         collapse, partition = pipeline.collapse, pipeline.partition
         extra = {}
         if connect is not None:
@@ -655,8 +667,14 @@ class LabelAlgorithm(_Algorithm):
             if feedback.isCanceled():
                 break
             try:
+                # Repaired geometries keep their polygons (a spike's line left out), and are
+                # prepared with make_valid on, as the command line's label step has them.
                 row, part, kind, length, width, elong, wkb, rejected = core.labels(
-                    features.wkbs[start:end], json.dumps(options), None
+                    features.wkbs[start:end],
+                    json.dumps(options),
+                    None,
+                    repaired=features.repaired[start:end],
+                    make_valid=True,
                 )
             except core.PipelineError as e:
                 raise QgsProcessingException(str(e)) from None
@@ -809,6 +827,11 @@ class ScoreAlgorithm(_Algorithm):
                 "a polygon key field needs a skeleton key field (the skeleton field that holds it); "
                 "leave both empty to join by location"
             )
+        # A key field the layer lacks is refused before any work, as `skeletonise score` refuses it.
+        if skeleton_key:
+            self._key_field(parameters, context, "SKELETONS", lines, skeleton_key, "skeleton")
+        if polygon_key:
+            self._key_field(parameters, context, "INPUT", source, polygon_key, "polygon")
         features = bridge.read(source, False, feedback)
         request = QgsFeatureRequest().setDestinationCrs(crs, context.transformContext())
         line_wkbs, line_keys = [], []
@@ -850,6 +873,22 @@ class ScoreAlgorithm(_Algorithm):
             raise QgsProcessingException(self.invalidSinkError(parameters, "OUTPUT"))
         rejected = bridge.write(sink, done, features, 0, carried if carries else [], feedback)
         return {"OUTPUT": dest, "FEATURES_READ": len(features), "FEATURES_REJECTED": rejected}
+
+    def _key_field(self, parameters, context, name, source, key, what):
+        """Refuses a key field that the layer of parameter ``name`` does not have, naming the layer and
+        its fields (without a GeoPackage's FID column), as `skeletonise score` does."""
+        fields = source.fields()
+        if fields.lookupField(key) >= 0:
+            return
+        layer = self.parameterAsVectorLayer(parameters, name, context)
+        skip = set()
+        if layer is not None:
+            skip = {fields.at(i).name() for i in layer.dataProvider().pkAttributeIndexes()}
+        names = [n for n in fields.names() if n not in skip]
+        raise QgsProcessingException(
+            f"{what} layer `{bridge.layer_name(layer, source)}`: has no field `{key}`; "
+            f"fields: {', '.join(names) or '(none)'}"
+        )
 
 
 ALGORITHMS = [

@@ -18,11 +18,13 @@ from qgis.core import (
     QgsCoordinateReferenceSystem,
     QgsCoordinateTransform,
     QgsFeature,
+    QgsFeatureRequest,
     QgsFeatureSink,
     QgsField,
     QgsFields,
     QgsGeometry,
     QgsProcessingException,
+    QgsProcessingFeatureSource,
     QgsProject,
     QgsWkbTypes,
 )
@@ -85,6 +87,17 @@ def check_crs(crs, name):
         )
 
 
+def layer_name(layer, source):
+    """The name the command line gives a layer: a file's layer name (``layername=`` of the
+    source), else the QGIS layer's name, else the source's."""
+    if layer is not None:
+        from qgis.core import QgsProviderRegistry
+
+        parts = QgsProviderRegistry.instance().decodeUri(layer.providerType(), layer.source())
+        return parts.get("layerName") or layer.name()
+    return source.sourceName()
+
+
 class Features:
     """The features of a source as the wheel takes them: FIDs, attributes, WKB."""
 
@@ -105,10 +118,15 @@ def read(source, make_valid, feedback, share=10.0):
     the command line's reader uses, also comes from; on a repaired polygon the
     two may differ in detail) when the
     pipeline's ``prepare.make_valid`` is on; curves segmentised; Z and M
-    dropped by the reader in Rust. Progress runs to ``share`` percent."""
+    dropped by the reader in Rust. Progress runs to ``share`` percent.
+    With ``make_valid`` on, QGIS's own invalid-geometry check (the
+    Processing setting, which stops the algorithm at an invalid polygon or
+    skips it by default) is left out: the polygon is repaired here, as the
+    command line repairs it."""
     out = Features()
     total = source.featureCount() or 1
-    for i, f in enumerate(source.getFeatures()):
+    flags = QgsProcessingFeatureSource.FlagSkipGeometryValidityChecks if make_valid else QgsProcessingFeatureSource.Flags()
+    for i, f in enumerate(source.getFeatures(QgsFeatureRequest(), flags)):
         if feedback.isCanceled():
             break
         out.fids.append(int(f.id()))

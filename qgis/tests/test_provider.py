@@ -289,14 +289,46 @@ class PackedPlugin(Case):
 
 
 class Feedback(QgsProcessingFeedback):
-    """Collects the errors reported."""
+    """Collects the errors reported and the lines of the log."""
 
     def __init__(self):
         super().__init__()
         self.errors = []
+        self.infos = []
 
     def reportError(self, error, fatalError=False):  # noqa: N802
         self.errors.append(error)
+
+    def pushInfo(self, info):  # noqa: N802
+        self.infos.append(info)
+
+
+def cli_refusal(*args):
+    """The message of a command line that refuses its pipeline file (exit status 78)."""
+    p = cli(*args, check=False)
+    assert p.returncode == 78, p.stderr
+    return p.stderr.strip().splitlines()[-1].split(" ERROR ", 1)[1]
+
+
+def polygons_gpkg(path, layer, wkts, epsg=32630):
+    """A GeoPackage layer of polygons (a `name` field) from ``(name, WKT)`` pairs, written with
+    QGIS's own writer."""
+    from qgis.core import QgsCoordinateTransformContext, QgsVectorFileWriter
+
+    mem = QgsVectorLayer(f"Polygon?crs=EPSG:{epsg}&field=name:string", layer, "memory")
+    features = []
+    for name, wkt in wkts:
+        f = QgsFeature(mem.fields())
+        f["name"] = name
+        f.setGeometry(QgsGeometry.fromWkt(wkt))
+        features.append(f)
+    mem.dataProvider().addFeatures(features)
+    options = QgsVectorFileWriter.SaveVectorOptions()
+    options.driverName = "GPKG"
+    options.layerName = layer
+    err = QgsVectorFileWriter.writeAsVectorFormatV3(mem, path, QgsCoordinateTransformContext(), options)
+    assert err[0] == QgsVectorFileWriter.NoError, err
+    return path
 
 
 class Skeletonise(Case):
@@ -626,6 +658,72 @@ class Partition(Case):
         self.assertSameRows(rows(res["COVERAGE"]), rows(self.out("cli.gpkg"), "coverage"))
 
 
+    def test_the_log_counts_the_features_the_command_line_counts(self):
+        # The summary line gives the command line's run record (read, written, rejected), with the
+        # Skeletons output or without it (it is optional here), and with rejected lakes.
+        cov = os.path.join(ROOT, "tests", "data", "coverage-train.gpkg")
+        src = os.path.join(ROOT, "tests", "data", "border-waters.gpkg")
+        cli("run", os.path.join(ROOT, "pipelines", "partition-rivers.yaml"), "-o", self.out("danube.gpkg"))
+        titicaca = ["--set", "input.layer=waters_titicaca", "--set", "input.neighbours.layer=units_titicaca",
+                    "--set", f"input.source={src}", "--set", f"input.neighbours.source={src}"]
+        pipeline = os.path.join(ROOT, "pipelines", "partition-border-waters.yaml")
+        cli("run", pipeline, "-o", self.out("titicaca.gpkg"), *titicaca)
+        cli("run", pipeline, "-o", self.out("reject.gpkg"), *titicaca, "--set", "steps.partition.overlap=reject")
+        lakes = {"INPUT": f"{src}|layername=waters_titicaca", "NEIGHBOURS": f"{src}|layername=units_titicaca"}
+        cases = [
+            ("danube", {"INPUT": f"{cov}|layername=rivers_danube", "NEIGHBOURS": f"{cov}|layername=units_danube"}),
+            ("titicaca", lakes),
+            ("reject", dict(lakes, OVERLAP=1)),
+        ]
+        for name, params in cases:
+            run = rows(self.out(f"{name}.gpkg"), "skeletonise_runs")[0]
+            want = (f"{run['features_read']} features read, {run['features_written']} written, "
+                    f"{run['features_rejected']} rejected")
+            if name != "reject":
+                self.assertGreater(run["features_written"], 0)
+            else:
+                self.assertGreater(run["features_rejected"], 0)
+            for skeletons in (False, True):
+                with self.subTest(case=name, skeletons=skeletons):
+                    sinks = {"COVERAGE": self.out(f"{name}-{skeletons}-c.gpkg"),
+                             "BOUNDARIES": self.out(f"{name}-{skeletons}-b.gpkg")}
+                    if skeletons:
+                        sinks["OUTPUT"] = self.out(f"{name}-s.gpkg")
+                    feedback = Feedback()
+                    res = processing.run("skeletonise:partition", dict(params, **sinks), feedback=feedback)
+                    self.assertIn(want, feedback.infos)
+                    self.assertEqual(res["FEATURES_READ"], run["features_read"])
+                    self.assertEqual(res["FEATURES_REJECTED"], run["features_rejected"])
+
+    def test_an_empty_neighbours_layer_is_refused_before_any_work(self):
+        # The command line refuses an empty `input.neighbours`; so do Partition into neighbours and
+        # Run a pipeline file, with its words, and nothing is written.
+        cov = os.path.join(ROOT, "tests", "data", "coverage-train.gpkg")
+        empty = polygons_gpkg(self.out("empty.gpkg"), "units", [])
+        self.assertEqual(QgsVectorLayer(f"{empty}|layername=units", "u", "ogr").featureCount(), 0)
+        p = cli("run", os.path.join(ROOT, "pipelines", "partition-rivers.yaml"), "-o", self.out("cli.gpkg"),
+                "--set", f"input.neighbours.source={empty}", "--set", "input.neighbours.layer=units", check=False)
+        self.assertNotEqual(p.returncode, 0)
+        self.assertIn("`input.neighbours`: layer `units` has no units", p.stderr)
+        self.assertIn("give the coverage whose units take the area", p.stderr)
+        memory = QgsVectorLayer("Polygon?crs=EPSG:32633", "units", "memory")
+        for alg, extra in (
+            ("skeletonise:partition", {}),
+            ("skeletonise:pipeline", {"PIPELINE": os.path.join(ROOT, "pipelines", "partition-rivers.yaml")}),
+        ):
+            for units in (f"{empty}|layername=units", memory):
+                with self.subTest(algorithm=alg, units=units):
+                    params = dict(extra, INPUT=f"{cov}|layername=rivers_danube", NEIGHBOURS=units,
+                                  COVERAGE=self.out("c.gpkg"), OUTPUT=self.out("s.gpkg"))
+                    with self.assertRaises(QgsProcessingException) as e:
+                        processing.run(alg, params)
+                    message = str(e.exception)
+                    self.assertIn("`input.neighbours`: layer `units` has no units", message)
+                    self.assertIn("give the coverage whose units take the area", message)
+                    self.assertFalse(os.path.exists(self.out("c.gpkg")))
+                    self.assertFalse(os.path.exists(self.out("s.gpkg")))
+
+
 class Score(Case):
     def test_score_by_location_and_by_key_gives_the_command_lines_rows(self):
         cli("run", "-i", TRAIN, "-l", "lakes_scotland", "-o", self.out("run.gpkg"),
@@ -665,6 +763,31 @@ class Score(Case):
                 {"INPUT": f"{TRAIN}|layername=lakes_scotland", "SKELETONS": far, "OUTPUT": self.out("s.gpkg")},
             )
         self.assertIn("no skeleton line could be joined to a polygon (1 lines inside no polygon)", str(e.exception))
+
+    def test_a_missing_key_field_is_named_with_the_layers_fields(self):
+        # As `skeletonise score`: the layer, the field and the fields it has (a Processing error, no
+        # Python KeyError), before any work.
+        cli("run", "-i", TRAIN, "-l", "lakes_scotland", "-o", self.out("run.gpkg"),
+            "--set", "steps.skeleton.methods=[CDT]")
+        base = ["score", "--polygons", TRAIN, "--polygons-layer", "lakes_scotland", "--skeletons",
+                self.out("run.gpkg"), "--skeletons-layer", "skeletons", "-o", self.out("cli.gpkg")]
+        params = {"INPUT": f"{TRAIN}|layername=lakes_scotland", "SKELETONS": f"{self.out('run.gpkg')}|layername=skeletons",
+                  "OUTPUT": self.out("q.gpkg")}
+        for what, args, keys in (
+            ("skeleton", ["--skeleton-key", "nope"], {"SKELETON_KEY": "nope"}),
+            ("polygon", ["--skeleton-key", "src_fid", "--polygon-key", "nope"],
+             {"SKELETON_KEY": "src_fid", "POLYGON_KEY": "nope"}),
+        ):
+            with self.subTest(key=what):
+                p = cli(*base, *args, check=False)
+                self.assertNotEqual(p.returncode, 0)
+                want = p.stderr.strip().splitlines()[-1].split(" ERROR ", 1)[1]
+                self.assertTrue(want.startswith(f"{what} layer `"), want)
+                self.assertIn("has no field `nope`; fields: kind, area_m2", want)
+                with self.assertRaises(QgsProcessingException) as e:
+                    processing.run("skeletonise:score", dict(params, **keys))
+                self.assertEqual(str(e.exception), want)
+                self.assertFalse(os.path.exists(self.out("q.gpkg")))
 
 
 class Help(unittest.TestCase):
@@ -719,6 +842,53 @@ class Pipeline(Case):
         self.assertIn(message.splitlines()[0].split(": ", 1)[-1][:40], p.stderr)
 
 
+    def lakes_pipeline(self, prune):
+        """A pipeline file on the training lakes with the prune step ``prune``, no input.connect."""
+        path = self.out("p.yaml")
+        with open(path, "w") as f:
+            f.write(f"input:\n  source: {TRAIN}\n  layer: lakes_scotland\nsteps:\n  - skeleton: {{ methods: [MA] }}\n"
+                    f"  - prune: {prune}\n  - extend: {{}}\n  - score: {{}}\n  - select: {{}}\n"
+                    f"output:\n  path: {self.out('o.gpkg')}\n")
+        return path
+
+    def test_network_pruning_without_lines_is_refused_with_the_command_lines_message(self):
+        # The command line refuses `prune: {mode: network}` without input.connect (exit 78); the
+        # algorithm refuses it without Connecting lines, with the same message, before any work,
+        # rather than prune every lake with the fallback.
+        path = self.lakes_pipeline("{ mode: network }")
+        want = cli_refusal("validate", path)
+        self.assertIn("`steps[1].prune.mode`", want)
+        self.assertIn("input.connect", want)
+        with self.assertRaises(QgsProcessingException) as e:
+            processing.run("skeletonise:pipeline", {"INPUT": f"{TRAIN}|layername=lakes_scotland", "PIPELINE": path,
+                                                    "OUTPUT": self.out("q.gpkg")})
+        self.assertEqual(str(e.exception), want)
+        self.assertFalse(os.path.exists(self.out("q.gpkg")))
+        # Set by an override: the override is named.
+        plain = self.lakes_pipeline("{}")
+        want = cli_refusal("validate", plain, "--set", "steps.prune.mode=network")
+        with self.assertRaises(QgsProcessingException) as e:
+            processing.run("skeletonise:pipeline", {"INPUT": f"{TRAIN}|layername=lakes_scotland", "PIPELINE": plain,
+                                                    "OVERRIDES": "steps.prune.mode=network", "OUTPUT": self.out("q.gpkg")})
+        self.assertEqual(str(e.exception), want)
+        # With the lines it runs.
+        network = os.path.join(ROOT, "tests", "data", "network-train.gpkg")
+        res = processing.run("skeletonise:pipeline", {"INPUT": f"{TRAIN}|layername=lakes_scotland", "PIPELINE": path,
+                                                      "CONNECT": f"{network}|layername=lines_lakes_scotland", "SNAP": 1,
+                                                      "OUTPUT": self.out("q.gpkg")})
+        self.assertEqual(res["FEATURES_READ"], 18)
+
+    def test_a_prune_fallback_outside_network_mode_is_refused_with_the_command_lines_message(self):
+        path = self.lakes_pipeline("{ mode: significance, fallback: trunk }")
+        want = cli_refusal("validate", path)
+        self.assertIn("`steps[1].prune.fallback`", want)
+        self.assertIn("only with `mode: network`", want)
+        with self.assertRaises(QgsProcessingException) as e:
+            processing.run("skeletonise:pipeline", {"INPUT": f"{TRAIN}|layername=lakes_scotland", "PIPELINE": path,
+                                                    "OUTPUT": self.out("q.gpkg")})
+        self.assertEqual(str(e.exception), want)
+
+
 class Labels(Case):
     def test_labels_give_the_command_lines_rows_with_minzoom(self):
         cli("run", os.path.join(ROOT, "pipelines", "lake-labels.yaml"), "-o", self.out("cli.gpkg"))
@@ -736,6 +906,38 @@ class Labels(Case):
         self.assertIn("src_kind", want[0])
         self.assertSameRows(got, want, key=("src_fid", "polygon_part"))
         self.assertTrue(all(r["minzoom"] is not None for r in got))
+
+
+    def test_a_polygon_with_a_spike_is_labelled_as_on_the_command_line(self):
+        # QGIS's makeValid (GEOS MakeValid, as the command line's) makes a polygon and a line of a
+        # polygon with a zero-width spike: its polygon is labelled, a point for the square and a
+        # line for the strip, row for row the command line's labels layer.
+        src = polygons_gpkg(self.out("spiked.gpkg"), "spiked", [
+            ("square", "POLYGON((0 0,10 0,10 5,20 5,10 5,10 10,0 10,0 0))"),
+            ("strip", "POLYGON((0 20,100 20,100 25,120 25,100 25,100 30,0 30,0 20))"),
+        ])
+        layer = QgsVectorLayer(f"{src}|layername=spiked", "s", "ogr")
+        for f in layer.getFeatures():
+            self.assertFalse(f.geometry().isGeosValid())
+            self.assertEqual(f.geometry().makeValid().wkbType(), 7)  # GeometryCollection
+        pipeline = self.out("labels.yaml")
+        with open(pipeline, "w") as f:
+            f.write(f"input: {{ source: {src}, layer: spiked }}\nsteps:\n  - prepare: {{ make_valid: true }}\n"
+                    "  - skeleton: { methods: [MA] }\n  - label: {}\n  - prune: { mode: trunk }\n  - extend: {}\n"
+                    f"  - score: {{}}\n  - select: {{}}\noutput: {{ path: {self.out('cli.gpkg')} }}\n")
+        cli("run", pipeline)
+        want = rows(self.out("cli.gpkg"), "labels")
+        self.assertEqual([r["kind"] for r in want], ["point", "line"])
+        feedback = Feedback()
+        res = processing.run("skeletonise:label", {"INPUT": f"{src}|layername=spiked", "OUTPUT": self.out("q.gpkg"),
+                                                   "POINTS": self.out("p.gpkg")}, feedback=feedback)
+        self.assertEqual(feedback.errors, [])
+        self.assertEqual(res["FEATURES_REJECTED"], 0)
+        got = rows(res["OUTPUT"]) + rows(res["POINTS"])
+        self.assertEqual([r["rejected"] for r in got], [None, None])
+        for r in got:
+            del r["rejected"]
+        self.assertSameRows(got, want, key=("src_fid", "polygon_part"))
 
 
 class QgisProcess(Case):

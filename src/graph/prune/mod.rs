@@ -90,6 +90,16 @@ use crate::geometry::Boundary;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
+/// Why `prune: {mode: network}` cannot run without the lines of
+/// `input.connect` (the message of the key `prune.mode`): the command line
+/// refuses such a pipeline file, the Python package and QGIS a run without
+/// the lines.
+pub const NETWORK_NEEDS_CONNECT: &str = "`mode: network` keeps the lines between the points where a line network meets each polygon: add `input.connect: { source: …, layer: … }`, or use another mode";
+
+/// Why `fallback` is refused in any mode but `network` (the message of the
+/// key `prune.fallback`).
+pub const FALLBACK_OUTSIDE_NETWORK: &str = "`fallback` applies only with `mode: network` (what a polygon that no line of `input.connect` meets gets instead); remove it, or use `mode: network`";
+
 /// How legs are pruned.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "lowercase")]
@@ -242,6 +252,9 @@ impl PruneParams {
                 "min_length".into(),
                 "min_length must be ≥ 0 (CRS units)".into(),
             ));
+        }
+        if self.mode != PruneMode::Network && self.fallback != Fallback::default() {
+            return Err(("fallback".into(), FALLBACK_OUTSIDE_NETWORK.into()));
         }
         Ok(())
     }
@@ -439,6 +452,42 @@ mod tests {
         }
         .validate()
         .is_err());
+    }
+
+    /// `fallback` says what `network` pruning gives a polygon no line meets:
+    /// in any other mode a fallback other than the default is refused.
+    #[test]
+    fn a_fallback_outside_network_mode_is_refused() {
+        for mode in [
+            PruneMode::Significance,
+            PruneMode::Length,
+            PruneMode::Trunk,
+            PruneMode::None,
+        ] {
+            for fallback in [Fallback::Trunk, Fallback::Drop] {
+                let p = PruneParams {
+                    mode,
+                    fallback,
+                    ..Default::default()
+                };
+                let (key, message) = p.validate().unwrap_err();
+                assert_eq!(key, "fallback", "{mode:?} {fallback:?}");
+                assert!(message.contains("only with `mode: network`"), "{message}");
+            }
+            let plain = PruneParams {
+                mode,
+                ..Default::default()
+            };
+            assert!(plain.validate().is_ok(), "{mode:?}");
+        }
+        for fallback in [Fallback::Significance, Fallback::Trunk, Fallback::Drop] {
+            let p = PruneParams {
+                mode: PruneMode::Network,
+                fallback,
+                ..Default::default()
+            };
+            assert!(p.validate().is_ok(), "{fallback:?}");
+        }
     }
 
     #[test]
