@@ -262,7 +262,7 @@ fn network_needs_connect(f: &PipelineFile) -> Result<(), (String, String)> {
     match (network, &f.input.connect) {
         (Some(i), None) => Err((
             format!("steps[{i}].prune.mode"),
-            "`mode: network` keeps the lines between the points where a line network meets each polygon: add `input.connect: { source: …, layer: … }`, or use another mode".into(),
+            crate::graph::prune::NETWORK_NEEDS_CONNECT.into(),
         )),
         _ => Ok(()),
     }
