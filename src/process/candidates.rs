@@ -117,10 +117,11 @@ fn every_part_has_a_skeleton(
                     "{m} gives no skeleton of this polygon part (too thin or too small for the \
                      method): it has {} CRS units² of the feature's {}; skip parts that small \
                      with `prepare: {{ min_area: {} }}`, or list another method in \
-                     `skeleton.methods` (e.g. MA)",
+                     `skeleton.methods` (e.g. {})",
                     sig(part, 4),
                     sig(whole, 4),
-                    sig(part * 1.01, 4)
+                    sig(part * 1.01, 4),
+                    if m == crate::methods::MethodId::MA { "CDT" } else { "MA" }
                 ),
             ))
         }
