@@ -1633,6 +1633,7 @@ fn validate_refuses_everything_run_refuses_with_the_same_code_and_message() {
     let network = "steps:\n  - skeleton: { methods: [MA] }\n  - prune: { mode: network }\n";
     let connect =
         |layer: &str| format!("  connect:\n    source: {s}\n    layer: {layer}\n{network}");
+    let ma_alone = "steps:\n  - skeleton: { methods: [MA] }\n";
     let cases: Vec<(&str, String, Vec<&str>)> = vec![
         (
             "neighbours where selecting no unit",
@@ -1670,22 +1671,22 @@ fn validate_refuses_everything_run_refuses_with_the_same_code_and_message() {
         ),
         (
             "an output path ending in a separator",
-            "steps:\n  - skeleton: { methods: [MA] }\n".into(),
+            ma_alone.into(),
             vec!["-o", "dir.gpkg/"],
         ),
         (
             "an output path that is a directory",
-            "steps:\n  - skeleton: { methods: [MA] }\n".into(),
+            ma_alone.into(),
             vec!["-o", "a-directory.gpkg"],
         ),
         (
             "a missing input layer",
-            "steps:\n  - skeleton: { methods: [MA] }\n".into(),
+            ma_alone.into(),
             vec!["-l", "nowhere"],
         ),
         (
             "an input filter that fails",
-            "steps:\n  - skeleton: { methods: [MA] }\n".into(),
+            ma_alone.into(),
             vec!["--set", "input.where=nosuchfield > 1"],
         ),
     ];

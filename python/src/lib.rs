@@ -159,21 +159,7 @@ impl Pipeline {
     }
 }
 
-/// A key path without its sequence indices: `steps[2].prune.mode` →
-/// `steps.prune.mode` (the form of an override's key).
-fn strip_indices(key: &str) -> String {
-    let mut out = String::with_capacity(key.len());
-    let mut depth = 0;
-    for c in key.chars() {
-        match c {
-            '[' => depth += 1,
-            ']' => depth -= 1,
-            _ if depth == 0 => out.push(c),
-            _ => {}
-        }
-    }
-    out
-}
+use skeletonise::config::locate::strip_indices;
 
 #[pymethods]
 impl Pipeline {

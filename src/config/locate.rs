@@ -96,6 +96,22 @@ impl Locations {
     }
 }
 
+/// A key path without list indices: `steps[2].prune.ratio` → `steps.prune.ratio`
+/// (the form of an override's key).
+pub fn strip_indices(key: &str) -> String {
+    let mut out = String::with_capacity(key.len());
+    let mut depth = 0;
+    for c in key.chars() {
+        match c {
+            '[' => depth += 1,
+            ']' => depth -= 1,
+            _ if depth == 0 => out.push(c),
+            _ => {}
+        }
+    }
+    out
+}
+
 /// `path.key`, or `key` at the root.
 pub fn join(path: &str, key: &str) -> String {
     if path.is_empty() {

@@ -88,7 +88,7 @@ impl Reading<'_> {
     /// The error at `position` in key `key`: the override's when a `--set`
     /// gave the key, else the file's.
     fn error(&self, position: Option<(usize, usize)>, key: &str, message: String) -> ConfigError {
-        let plain = strip_indices(key);
+        let plain = locate::strip_indices(key);
         let overridden = self.overrides.iter().find(|o| {
             let k = o.split_once('=').map_or(o.as_str(), |(k, _)| k);
             plain == k || plain.starts_with(&format!("{k}.")) || k.starts_with(&format!("{plain}."))
@@ -381,21 +381,6 @@ fn collapse_runs_ma(root: &mut Value) {
             }
         }
     }
-}
-
-/// A key path without list indices: `steps[2].prune.ratio` → `steps.prune.ratio`.
-fn strip_indices(key: &str) -> String {
-    let mut out = String::with_capacity(key.len());
-    let mut depth = 0;
-    for c in key.chars() {
-        match c {
-            '[' => depth += 1,
-            ']' => depth -= 1,
-            _ if depth == 0 => out.push(c),
-            _ => {}
-        }
-    }
-    out
 }
 
 fn path_string(p: &serde_path_to_error::Path) -> String {

@@ -121,7 +121,11 @@ fn every_part_has_a_skeleton(
                     sig(part, 4),
                     sig(whole, 4),
                     sig(part * 1.01, 4),
-                    if m == crate::methods::MethodId::MA { "CDT" } else { "MA" }
+                    if m == crate::methods::MethodId::MA {
+                        "CDT"
+                    } else {
+                        "MA"
+                    }
                 ),
             ))
         }

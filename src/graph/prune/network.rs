@@ -30,10 +30,8 @@
 //! 10 000). The walk can be stopped: `expired` is asked between and during
 //! the Dijkstras (a feature's time budget).
 
-use super::trunk::{OrdF, Sweep};
+use super::trunk::Sweep;
 use crate::graph::{EdgeId, NodeId, SkeletonGraph};
-use std::cmp::Reverse;
-use std::collections::BinaryHeap;
 
 /// The kept edges of `m` (a merged graph): every shortest path between two
 /// of `terminals`, or with one terminal the path to its farthest leaf.
@@ -278,25 +276,21 @@ fn between(
     Some(())
 }
 
-/// Dijkstra inside one block, with buffers reused across blocks.
+/// Searches inside one block, with buffers reused across blocks.
 struct BlockSearch {
-    dist: Vec<f64>,
-    pred: Vec<Option<EdgeId>>,
-    touched: Vec<NodeId>,
-    /// The sweep that last walked each edge back (walks of one sweep stop
-    /// where another of the same sweep went before: its tree).
+    sweep: Sweep,
+    /// The search that last walked each edge back (walks of one search
+    /// stop where another of the same search went before: its tree).
     walked: Vec<u32>,
-    sweep: u32,
+    searches: u32,
 }
 
 impl BlockSearch {
     fn new(nodes: usize, edges: usize) -> Self {
         Self {
-            dist: vec![f64::INFINITY; nodes],
-            pred: vec![None; nodes],
-            touched: Vec::new(),
+            sweep: Sweep::new(nodes),
             walked: vec![u32::MAX; edges],
-            sweep: 0,
+            searches: 0,
         }
     }
 
@@ -315,68 +309,22 @@ impl BlockSearch {
         expired: &dyn Fn() -> bool,
     ) -> Option<()> {
         for (i, &s) in portals[..portals.len() - 1].iter().enumerate() {
-            self.run(m, adj, len, block, b, s, expired)?;
-            self.sweep += 1;
+            let inside = |e: EdgeId| block[e.index()] == b;
+            self.sweep
+                .search(m, adj, len, s, inside, expired, |_, _| {})?;
+            self.searches += 1;
             for &t in &portals[i + 1..] {
                 let mut v = t;
                 while v != s {
-                    let Some(e) = self.pred[v.index()] else {
+                    let Some(e) = self.sweep.pred[v.index()] else {
                         break;
                     };
-                    if self.walked[e.index()] == self.sweep {
+                    if self.walked[e.index()] == self.searches {
                         break;
                     }
-                    self.walked[e.index()] = self.sweep;
+                    self.walked[e.index()] = self.searches;
                     keep[e.index()] = true;
                     v = m.opposite(e, v);
-                }
-            }
-        }
-        Some(())
-    }
-
-    #[allow(clippy::too_many_arguments)]
-    fn run(
-        &mut self,
-        m: &SkeletonGraph,
-        adj: &crate::graph::Adjacency,
-        len: &[f64],
-        block: &[u32],
-        b: u32,
-        s: NodeId,
-        expired: &dyn Fn() -> bool,
-    ) -> Option<()> {
-        for &t in &self.touched {
-            self.dist[t.index()] = f64::INFINITY;
-            self.pred[t.index()] = None;
-        }
-        self.touched.clear();
-        let mut heap = BinaryHeap::new();
-        self.dist[s.index()] = 0.0;
-        self.touched.push(s);
-        heap.push(Reverse((OrdF(0.0), s)));
-        let mut pops = 0u32;
-        while let Some(Reverse((OrdF(d), u))) = heap.pop() {
-            pops = pops.wrapping_add(1);
-            if pops.is_multiple_of(4096) && expired() {
-                return None;
-            }
-            if d > self.dist[u.index()] {
-                continue;
-            }
-            for &e in &adj[u.index()] {
-                if block[e.index()] != b {
-                    continue;
-                }
-                let o = m.opposite(e, u);
-                let nd = d + len[e.index()];
-                if nd < self.dist[o.index()] {
-                    if self.dist[o.index()].is_infinite() {
-                        self.touched.push(o);
-                    }
-                    self.dist[o.index()] = nd;
-                    self.pred[o.index()] = Some(e);
-                    heap.push(Reverse((OrdF(nd), o)));
                 }
             }
         }

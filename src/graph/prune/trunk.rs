@@ -38,6 +38,37 @@ impl Sweep {
         deg: &[usize],
         s: NodeId,
     ) -> (NodeId, f64) {
+        let mut best = (s, 0.0);
+        self.search(
+            g,
+            adj,
+            len,
+            s,
+            |_| true,
+            &|| false,
+            |n, d| {
+                if deg[n.index()] == 1 && (d > best.1 || (d == best.1 && n < best.0 && d > 0.0)) {
+                    best = (n, d);
+                }
+            },
+        );
+        best
+    }
+
+    /// Dijkstra from `s` over the edges `usable` accepts, telling `settled`
+    /// each node with its distance as it is settled; `None` when `expired()`
+    /// (asked every 4 096 nodes taken from the queue) said to stop.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn search(
+        &mut self,
+        g: &SkeletonGraph,
+        adj: &Adjacency,
+        len: &[f64],
+        s: NodeId,
+        usable: impl Fn(EdgeId) -> bool,
+        expired: &dyn Fn() -> bool,
+        mut settled: impl FnMut(NodeId, f64),
+    ) -> Option<()> {
         for &t in &self.touched {
             self.dist[t.index()] = f64::INFINITY;
             self.pred[t.index()] = None;
@@ -47,15 +78,20 @@ impl Sweep {
         self.dist[s.index()] = 0.0;
         self.touched.push(s);
         heap.push(Reverse((OrdF(0.0), s)));
-        let mut best = (s, 0.0);
+        let mut pops = 0u32;
         while let Some(Reverse((OrdF(d), n))) = heap.pop() {
+            pops = pops.wrapping_add(1);
+            if pops.is_multiple_of(4096) && expired() {
+                return None;
+            }
             if d > self.dist[n.index()] {
                 continue;
             }
-            if deg[n.index()] == 1 && (d > best.1 || (d == best.1 && n < best.0 && d > 0.0)) {
-                best = (n, d);
-            }
+            settled(n, d);
             for &e in &adj[n.index()] {
+                if !usable(e) {
+                    continue;
+                }
                 let o = g.opposite(e, n);
                 let nd = d + len[e.index()];
                 if nd < self.dist[o.index()] {
@@ -68,13 +104,13 @@ impl Sweep {
                 }
             }
         }
-        best
+        Some(())
     }
 }
 
 /// Total order on distances (never NaN: lengths are finite sums).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) struct OrdF(pub(super) f64);
+struct OrdF(f64);
 impl Eq for OrdF {}
 impl PartialOrd for OrdF {
     fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
