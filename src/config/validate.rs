@@ -19,7 +19,6 @@ pub(super) fn validate(f: &PipelineFile) -> Result<(), (String, String)> {
     }
     let plan = super::plan_of(&f.output, Some(&f.input), &f.steps);
     skeleton_layer_name(&f.output.layer, &plan).map_err(|m| ("output.layer".to_string(), m))?;
-    output_path(&f.output.path).map_err(|m| ("output.path".to_string(), m))?;
     if let Some(r) = &f.output.report {
         r.features
             .validate()
@@ -30,25 +29,6 @@ pub(super) fn validate(f: &PipelineFile) -> Result<(), (String, String)> {
                 "the report would overwrite the GeoPackage; give a path ending in .html".into(),
             ));
         }
-    }
-    Ok(())
-}
-
-/// The output path names a file: not a directory (a path ending in `/`,
-/// or one that is a directory now), which GDAL would refuse only when the
-/// finished output is moved into place.
-fn output_path(path: &str) -> Result<(), String> {
-    if path.ends_with('/') || path.ends_with(std::path::MAIN_SEPARATOR) {
-        return Err(format!(
-            "`{path}` ends in a path separator: give the GeoPackage's file name, e.g. `{}`",
-            std::path::Path::new(path.trim_end_matches(['/', std::path::MAIN_SEPARATOR])).display()
-        ));
-    }
-    if std::path::Path::new(path).is_dir() {
-        return Err(format!(
-            "`{path}` is a directory: give the GeoPackage's file name, e.g. `{}`",
-            std::path::Path::new(path).join("out.gpkg").display()
-        ));
     }
     Ok(())
 }

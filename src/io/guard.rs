@@ -102,6 +102,19 @@ impl Target<'_> {
         if !right_kind {
             return Err(self.error(self.kind.hint().into()));
         }
+        // `dir.gpkg/` names a directory to the system, though its
+        // extension reads as a file's.
+        if path
+            .as_os_str()
+            .to_string_lossy()
+            .ends_with(['/', std::path::MAIN_SEPARATOR])
+        {
+            return Err(self.error(format!(
+                "it ends in a path separator, which makes it a directory; give a file name such as `{}`",
+                Path::new(path.to_string_lossy().trim_end_matches(['/', std::path::MAIN_SEPARATOR]))
+                    .display()
+            )));
+        }
         not_special(path).map_err(|r| self.error(r))?;
         self.not_protected(path)?;
         if std::fs::symlink_metadata(path).is_ok() && !self.overwrite {
