@@ -779,6 +779,10 @@ fn a_run_that_fails_on_a_full_disk_leaves_no_temporary_file() {
             );
             if code != 0 {
                 assert_eq!(code, 1, "{kb} KB: {err}");
+                assert!(
+                    err.contains("the disk is probably full"),
+                    "{kb} KB: the message says what to do: {err}"
+                );
                 assert_eq!(
                     std::fs::read(&out).ok(),
                     before,

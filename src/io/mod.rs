@@ -168,7 +168,30 @@ impl IoError {
         };
         IoError::Gdal {
             context: context.into(),
-            reason,
+            reason: with_full_disk_hint(reason),
         }
+    }
+}
+
+/// `reason` with what to do when it is SQLite's or the system's word for a
+/// full disk (or a file size limit reached), which says only "disk I/O
+/// error", "database or disk is full", "cannot rollback" or, when SQLite
+/// rolled the transaction back itself after the failed write, "cannot
+/// commit - no transaction is active".
+pub(crate) fn with_full_disk_hint(reason: String) -> String {
+    const FULL: [&str; 6] = [
+        "disk I/O error",
+        "database or disk is full",
+        "No space left",
+        "File too large",
+        "cannot rollback",
+        "no transaction is active",
+    ];
+    if FULL.iter().any(|f| reason.contains(f)) {
+        format!(
+            "{reason}; the disk is probably full (or a file size limit was reached): free space there or write the output to another disk; nothing of this run was kept and an earlier output is unchanged"
+        )
+    } else {
+        reason
     }
 }

@@ -380,7 +380,9 @@ impl Writer {
         // Closing flushes the file before it is renamed into place.
         close_dataset(ds).map_err(|reason| IoError::Output {
             path: self.spec.path.clone(),
-            reason: format!("closing the finished file failed: {reason}"),
+            reason: super::with_full_disk_hint(format!(
+                "closing the finished file failed: {reason}"
+            )),
         })?;
         if self.path.exists() && !self.spec.overwrite {
             return Err(IoError::OutputExists {
