@@ -528,6 +528,8 @@ mod tests {
                 b.segment(pos[v], pos[w]);
             }
             let g = b.finish_raw();
+            // A tree that never grew from its first vertex has no node.
+            proptest::prop_assume!(g.nodes().len() >= 2);
             let mut ts: Vec<NodeId> = (0..terminals)
                 .map(|_| NodeId::from_index(next(g.nodes().len())))
                 .collect();
