@@ -158,14 +158,16 @@ fn intersection(p: Coord<f64>, q: Coord<f64>, a: Coord<f64>, b: Coord<f64>) -> O
 /// served in order, and a leg made for an earlier point is a line a later
 /// one can join. The skeleton's segments are searched through a packed
 /// tree and the legs through one rebuilt as they accumulate, so that a
-/// polygon with thousands of connection points costs O(k log n).
+/// polygon with thousands of connection points costs O(k log n). `None`
+/// when `expired()` (asked every 256 points) said the time is up.
 pub fn add_legs(
     g: &SkeletonGraph,
     p: &PreparedPolygon,
     points: &[(Option<u64>, Coord<f64>)],
-) -> (SkeletonGraph, Vec<ConnectionLeg>) {
+    expired: &dyn Fn() -> bool,
+) -> Option<(SkeletonGraph, Vec<ConnectionLeg>)> {
     if points.is_empty() || g.is_empty() {
-        return (g.clone(), Vec::new());
+        return Some((g.clone(), Vec::new()));
     }
     let tol = 1e-9 * p.extent();
     let polylines: Vec<Vec<Coord<f64>>> = (0..g.edges().len())
@@ -173,7 +175,10 @@ pub fn add_legs(
         .collect();
     let mut lines = Reachable::new(polylines, p.extent());
     let mut legs = Vec::new();
-    for &(fid, c) in points {
+    for (k, &(fid, c)) in points.iter().enumerate() {
+        if k % 256 == 255 && expired() {
+            return None;
+        }
         let Some((at, s)) = nearest_visible(&lines, p, c) else {
             continue;
         };
@@ -196,7 +201,7 @@ pub fn add_legs(
     for l in lines.pieces() {
         b.polyline(&l);
     }
-    (b.finish(p.boundary()), legs)
+    Some((b.finish(p.boundary()), legs))
 }
 
 /// A segment of [`Reachable`]: (line, segment index in it).
@@ -335,7 +340,7 @@ pub fn through_lines(
     expired: &dyn Fn() -> bool,
 ) -> Option<SkeletonGraph> {
     let listed: Vec<(Option<u64>, Coord<f64>)> = points.iter().map(|&c| (None, c)).collect();
-    let (with_legs, _) = add_legs(raw, p, &listed);
+    let (with_legs, _) = add_legs(raw, p, &listed, expired)?;
     if expired() {
         return None;
     }
@@ -794,7 +799,7 @@ mod tests {
         );
         let mut b = GraphBuilder::new();
         b.segment(Coord { x: 5., y: 5. }, Coord { x: 95., y: 5. });
-        let (g, legs) = add_legs(&b.finish(p.boundary()), &p, &pts);
+        let (g, legs) = add_legs(&b.finish(p.boundary()), &p, &pts, &|| false).unwrap();
         assert_eq!(legs.len(), 2);
         assert_eq!(legs[1].leg, LineString::from(vec![(50., 5.), (50., 10.)]));
         assert_eq!(

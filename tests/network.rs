@@ -404,39 +404,6 @@ fn network_mode_without_lines_is_an_error_naming_input_connect() {
     assert!(!out.exists(), "nothing written");
 }
 
-/// A lake (a wavy strip 100 km × 2 km, 2 002 vertices) and one zig-zag line
-/// crossing it `crossings` times, as WKT.
-fn zig_zag_lake(crossings: usize) -> (String, String) {
-    let (l, w, m) = (100_000.0, 2_000.0, 1000);
-    let top = (0..=m).map(|i| {
-        let i = i as f64;
-        (l * i / m as f64, w / 2.0 + 150.0 * (i / 37.0).sin())
-    });
-    let bottom = (0..=m).rev().map(|i| {
-        let i = i as f64;
-        (l * i / m as f64, -w / 2.0 + 150.0 * (i / 23.0).cos())
-    });
-    let mut ring: Vec<(f64, f64)> = top.chain(bottom).collect();
-    ring.push(ring[0]);
-    let k = crossings / 2;
-    let line: Vec<(f64, f64)> = (0..=k)
-        .map(|i| {
-            let x = 500.0 + (l - 1000.0) * i as f64 / k as f64;
-            (x, if i % 2 == 0 { 2.0 * w } else { -2.0 * w })
-        })
-        .collect();
-    let text = |pts: &[(f64, f64)]| {
-        pts.iter()
-            .map(|(x, y)| format!("{x} {y}"))
-            .collect::<Vec<_>>()
-            .join(",")
-    };
-    (
-        format!("POLYGON(({}))", text(&ring)),
-        format!("LINESTRING({})", text(&line)),
-    )
-}
-
 /// Network pruning keeps the feature's time budget: a lake crossed 20 000
 /// times by one line (which took minutes, past any `timeout_s`, when every
 /// connection point ran a search of the whole skeleton) is rejected for its
@@ -447,7 +414,7 @@ fn zig_zag_lake(crossings: usize) -> (String, String) {
 fn a_lake_crossed_twenty_thousand_times_keeps_its_time_budget() {
     let dir = tmp();
     let src = dir.path().join("zz.gpkg");
-    let (lake, line) = zig_zag_lake(20_000);
+    let (lake, line) = shapes::zig_zag_lake(20_000);
     make_layer(&src, "lake", 32633, &[Some(&lake)]);
     make_layer(&src, "lines", 32633, &[Some(&line)]);
     let run = |timeout: &str, out: &Path| {

@@ -583,3 +583,111 @@ fn a_run_longer_than_one_commit_writes_and_indexes_every_row() {
         );
     }
 }
+
+/// One feature's run for a budget test: the pipeline `text` (its `{out}`
+/// replaced) → the rejection reasons, the skeleton rows and the seconds.
+fn budget_run(dir: &Path, name: &str, text: &str) -> (Vec<String>, u64, f64) {
+    let out = dir.join(format!("{name}.gpkg"));
+    let p = pipeline(
+        dir,
+        &format!("{name}.yaml"),
+        &text.replace("{out}", &out.display().to_string()),
+    );
+    let started = std::time::Instant::now();
+    let o = skeletonise(&["run", p.to_str().unwrap()]);
+    let seconds = started.elapsed().as_secs_f64();
+    assert!(o.status.success(), "{name}: {}", out_err(&o));
+    let ds = open(&out);
+    let reasons = strings(&ds, "rejected", "reason")
+        .into_iter()
+        .flatten()
+        .collect();
+    (reasons, count(&ds, "skeletons"), seconds)
+}
+
+/// Every step after `select` keeps `skeleton.timeout_s` (a clock of its
+/// own, as long as a method's): on a polygon each method handles well
+/// within the budget, a step with far more work — connection legs to
+/// 80 000 crossings, `collapse` of a 20 km snake at 4 m (two million
+/// samples), `partition` between 20 000 units, `label` of a 50 000-vertex
+/// rough lake with its own medial axis — rejects the feature soon after the
+/// budget runs out, naming the step, and the same pipeline without the step
+/// writes it within the same budget.
+#[test]
+fn every_step_after_select_keeps_the_time_budget() {
+    let dir = tmp();
+    let src = dir.path().join("work.gpkg");
+    let (lake, line) = shapes::zig_zag_lake(80_000);
+    make_layer(&src, "lake", 32633, &[Some(&lake)]);
+    make_layer(&src, "lines", 32633, &[Some(&line)]);
+    make_layer(&src, "snake", 32633, &[Some(&shapes::snake(200, 20_000.0))]);
+    make_layer(&src, "rough", 32633, &[Some(&shapes::rough_lobes(50_000))]);
+    let (river, units) = shapes::river_between_strips(10_000);
+    make_layer(&src, "river", 32633, &[Some(&river)]);
+    let units: Vec<Option<&str>> = units.iter().map(|u| Some(u.as_str())).collect();
+    make_layer(&src, "units", 32633, &units);
+    let src = src.display().to_string();
+    let side =
+        |kind: &str, layer: &str| format!("  {kind}:\n    source: {src}\n    layer: {layer}\n");
+    // (step, input, side input, methods, timeout, the step's YAML)
+    let cases = [
+        (
+            "input.connect",
+            "lake",
+            side("connect", "lines"),
+            "MA",
+            "0.3",
+            "",
+        ),
+        (
+            "collapse",
+            "snake",
+            String::new(),
+            "MA",
+            "0.5",
+            "  - collapse: { width: 4 }\n",
+        ),
+        (
+            "partition",
+            "river",
+            side("neighbours", "units"),
+            "MA",
+            "0.1",
+            "  - partition: {}\n",
+        ),
+        (
+            "label",
+            "rough",
+            String::new(),
+            "CDT",
+            "0.5",
+            "  - label: {}\n",
+        ),
+    ];
+    for (step, layer, second, methods, timeout, yaml) in cases {
+        let text = |with: bool| {
+            let (second, yaml) = if with {
+                (second.as_str(), yaml)
+            } else {
+                ("", "")
+            };
+            format!(
+                "input:\n  source: {src}\n  layer: {layer}\n{second}steps:\n  - skeleton:\n      methods: [{methods}]\n      timeout_s: {timeout}\n{yaml}output:\n  path: {{out}}\non_error: reject\n"
+            )
+        };
+        let (reasons, written, seconds) = budget_run(dir.path(), &format!("{layer}-with"), &text(true));
+        assert_eq!(written, 0, "{step}: {reasons:?}");
+        assert!(
+            reasons.len() == 1
+                && reasons[0].contains(&format!("`{step}` ran past `skeleton.timeout_s`")),
+            "{step}: {reasons:?}"
+        );
+        assert!(seconds < 60.0, "{step}: the run took {seconds} s");
+        let (reasons, written, _) = budget_run(dir.path(), &format!("{layer}-without"), &text(false));
+        assert_eq!(
+            (written, reasons.len()),
+            (1, 0),
+            "{step} left out: {reasons:?}"
+        );
+    }
+}

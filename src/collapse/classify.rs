@@ -4,7 +4,7 @@
 
 use super::CollapseParams;
 use crate::geometry::vector::norm;
-use crate::geometry::PreparedPolygon;
+use crate::geometry::{CoordKey, PreparedPolygon};
 use crate::graph::{EdgeId, NodeId, SkeletonGraph, UnionFind};
 use geo::Coord;
 use std::cmp::Reverse;
@@ -77,25 +77,17 @@ impl Sampling {
     /// Samples edge `id` of `g` at most `step` apart (its own vertices
     /// kept); when it is one of the connection `legs`, its samples follow
     /// the end where it leaves the skeleton.
-    fn edge(
-        &mut self,
-        g: &SkeletonGraph,
-        id: EdgeId,
-        step: f64,
-        legs: &[(Coord<f64>, Coord<f64>)],
-    ) {
+    fn edge(&mut self, g: &SkeletonGraph, id: EdgeId, step: f64, legs: &Legs) {
         let edge = g.edge(id);
         let coords = g.edge_coords(id);
         let (first, last) = (coords[0], coords[coords.len() - 1]);
-        let attachment = legs.iter().find_map(|&(s, c)| {
-            if (first, last) == (s, c) {
-                Some(sample(edge.a))
-            } else if (first, last) == (c, s) {
-                Some(sample(edge.b))
-            } else {
-                None
-            }
-        });
+        let attachment = if legs.contains(&(first.into(), last.into())) {
+            Some(sample(edge.a))
+        } else if legs.contains(&(last.into(), first.into())) {
+            Some(sample(edge.b))
+        } else {
+            None
+        };
         let before = self.pos.len();
         let mut prev = sample(edge.a);
         for k in 1..coords.len() {
@@ -127,6 +119,10 @@ impl Sampling {
     }
 }
 
+/// The connection legs by their ends (where each leaves the skeleton, its
+/// point on the boundary), looked up in constant time per edge.
+type Legs = rustc_hash::FxHashSet<(CoordKey, CoordKey)>;
+
 impl Samples {
     /// Samples every edge of `g` at most `width / 4` apart; `legs` are the
     /// connection legs added to `g` (from the skeleton to the boundary).
@@ -141,8 +137,9 @@ impl Samples {
             .max(total / MAX_SAMPLES)
             .max(MIN_STEP * p.extent());
         let mut s = Sampling::of_nodes(g);
+        let legs: Legs = legs.iter().map(|&(a, c)| (a.into(), c.into())).collect();
         for e in 0..g.edges().len() {
-            s.edge(g, EdgeId::from_index(e), step, legs);
+            s.edge(g, EdgeId::from_index(e), step, &legs);
         }
         let Sampling {
             pos,

@@ -186,24 +186,42 @@ pub fn collapse(
     params: &CollapseParams,
     legs: &[(Coord<f64>, Coord<f64>)],
 ) -> PartCollapse {
+    // Without a deadline nothing stops it.
+    collapse_within(g, p, params, legs, &|| false).unwrap_or_default()
+}
+
+/// [`collapse`] that asks `expired()` between its stages (sampling the
+/// lines, classifying, merging, splitting the polygon) and stops with
+/// `None` once the time is up.
+pub fn collapse_within(
+    g: &SkeletonGraph,
+    p: &PreparedPolygon,
+    params: &CollapseParams,
+    legs: &[(Coord<f64>, Coord<f64>)],
+    expired: &dyn Fn() -> bool,
+) -> Option<PartCollapse> {
     if g.is_empty() {
-        return PartCollapse {
+        return Some(PartCollapse {
             areas: vec![Area {
                 polygon: p.polygon().clone(),
                 cuts: 0,
             }],
             ..PartCollapse::default()
-        };
+        });
     }
+    let go = || (!expired()).then_some(());
     let mut s = classify::Samples::of(g, p, params.width, legs);
+    go()?;
     s.classify(params);
     s.follow_legs();
+    go()?;
     match params.mode {
         CollapseMode::Partial => s.merge_short(params.min_length()),
         CollapseMode::Whole => s.whole(),
     }
     s.follow_legs();
-    split::split(&s, p, params.min_area)
+    go()?;
+    Some(split::split(&s, p, params.min_area))
 }
 
 /// The point at parameter `t` of segment `a`–`b`.

@@ -17,6 +17,7 @@
 pub(crate) mod arrangement;
 pub mod boundary;
 pub mod densify;
+pub mod key;
 pub(crate) mod lanes;
 pub mod overlay;
 pub(crate) mod packed;
@@ -27,6 +28,7 @@ pub(crate) mod validity;
 pub mod vector;
 
 pub use boundary::{Boundary, RayHit};
+pub use key::CoordKey;
 pub use segment::BoundarySegment;
 pub use vector::{norm, within_hypot};
 

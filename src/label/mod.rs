@@ -142,12 +142,18 @@ impl LabelParams {
     /// The label of one polygon part (`None` when it has no medial axis: a
     /// polygon thinner than the axis's grid).
     pub fn label(&self, p: &PreparedPolygon) -> Option<Labelled> {
-        self.label_on(p, None)
+        self.label_on(p, None, &MethodContext::default())
     }
 
     /// The label of one polygon part from its medial axis's raw skeleton
-    /// `raw` (MA with its default options), made here when not given.
-    pub fn label_on(&self, p: &PreparedPolygon, raw: Option<&SkeletonGraph>) -> Option<Labelled> {
+    /// `raw` (MA with its default options), made here within `ctx`'s budget
+    /// when not given.
+    pub fn label_on(
+        &self,
+        p: &PreparedPolygon,
+        raw: Option<&SkeletonGraph>,
+        ctx: &MethodContext,
+    ) -> Option<Labelled> {
         let made;
         let raw = match raw {
             Some(raw) => raw,
@@ -157,7 +163,7 @@ impl LabelParams {
                     ..Default::default()
                 };
                 made = crate::methods::build(MethodId::MA, &params)
-                    .skeletonise(p, &MethodContext::default())
+                    .skeletonise(p, ctx)
                     .ok()?;
                 &made
             }
@@ -201,16 +207,19 @@ impl LabelParams {
     /// largest by area), each with the part's index: `None` for a part with
     /// no medial axis (thinner than the axis's grid).
     pub fn labels(&self, parts: &[PreparedPolygon]) -> Vec<(usize, Option<Labelled>)> {
-        self.labels_on(parts, None)
+        self.labels_on(parts, None, &MethodContext::default())
     }
 
     /// [`Self::labels`] from the parts' medial axes' raw skeletons
     /// (`medial_axis[i]` of part i, MA with its default options), made here
-    /// when not given.
+    /// when not given, within `ctx`'s budget: once its deadline has passed
+    /// no further part is labelled (the caller, which owns the clock,
+    /// rejects the feature).
     pub fn labels_on(
         &self,
         parts: &[PreparedPolygon],
         medial_axis: Option<&[Arc<SkeletonGraph>]>,
+        ctx: &MethodContext,
     ) -> Vec<(usize, Option<Labelled>)> {
         use geo::Area;
         let raw = |i: usize| medial_axis.and_then(|m| m.get(i)).map(|g| &**g);
@@ -225,7 +234,8 @@ impl LabelParams {
         }
         parts
             .into_iter()
-            .map(|(i, p)| (i, self.label_on(p, raw(i))))
+            .take_while(|_| !ctx.expired())
+            .map(|(i, p)| (i, self.label_on(p, raw(i), ctx)))
             .collect()
     }
 
@@ -244,7 +254,7 @@ impl LabelParams {
 
 impl FeatureStep for LabelParams {
     fn rows(&self, input: &StepInput<'_>) -> Vec<(&'static str, StepRow)> {
-        self.labels_on(input.parts, input.medial_axis)
+        self.labels_on(input.parts, input.medial_axis, input.budget)
             .into_iter()
             .map(|(i, l)| {
                 let (geometry, kind) = match l.as_ref().map(|l| &l.label) {

@@ -62,6 +62,11 @@ impl MethodContext {
         }
     }
 
+    /// True once the deadline has passed (never without one).
+    pub fn expired(&self) -> bool {
+        self.deadline.is_some_and(|d| Instant::now() > d)
+    }
+
     /// Time left before the deadline (`None`: no deadline).
     pub fn remaining(&self) -> Option<Duration> {
         self.deadline

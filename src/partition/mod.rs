@@ -205,14 +205,30 @@ enum Side {
     Wide,
 }
 
+/// What [`partition`] says when `expired()` stopped it (the caller, which
+/// owns the clock, gives the reason).
+pub const STOPPED: &str = "partition stopped: its time is up";
+
+/// Fails with [`STOPPED`] once `expired()`.
+fn stop_if(expired: &dyn Fn() -> bool) -> Result<(), String> {
+    match expired() {
+        true => Err(STOPPED.into()),
+        false => Ok(()),
+    }
+}
+
 /// Partitions polygon part `p` between the units of `cov` (see the module
 /// documentation), or says why it cannot be. With `width`, `ma` is the
-/// part's medial axis (its discs say what is narrow).
+/// part's medial axis (its discs say what is narrow). `expired()` is asked
+/// between the stages (the units near the part, the narrow parts, the
+/// cells, the faces); once it says the time is up the partition stops with
+/// [`STOPPED`].
 pub fn partition(
     p: &PreparedPolygon,
     cov: &Coverage,
     params: &PartitionParams,
     ma: Option<&SkeletonGraph>,
+    expired: &dyn Fn() -> bool,
 ) -> Result<PartPartition, String> {
     let tol = SAME_POINT * p.extent();
     let near = cut::Near::of(p, cov, cov.snap_for(p.extent()), tol)?;
@@ -230,11 +246,19 @@ pub fn partition(
         }
     }
     let local = near.coverage(cov);
+    stop_if(expired)?;
     let snapped = match near.polygon == *p.polygon() {
         true => None,
         false => Some(PreparedPolygon::new(&near.polygon).map_err(|e| e.to_string())?),
     };
-    let mut out = partition_cut(snapped.as_ref().unwrap_or(p), p, &local, params, ma)?;
+    let mut out = partition_cut(
+        snapped.as_ref().unwrap_or(p),
+        p,
+        &local,
+        params,
+        ma,
+        expired,
+    )?;
     let global = |o: Owner| o.map(|i| near.units[i as usize].index);
     for g in &mut out.given {
         g.unit = near.units[g.unit as usize].index;
@@ -264,6 +288,7 @@ fn partition_cut(
     cov: &Coverage,
     params: &PartitionParams,
     ma: Option<&SkeletonGraph>,
+    expired: &dyn Fn() -> bool,
 ) -> Result<PartPartition, String> {
     let tol = SAME_POINT * p.extent();
     let mut owned = owners::owned(p, cov, tol);
@@ -295,8 +320,10 @@ fn partition_cut(
             cuts.push(line);
         }
     }
+    stop_if(expired)?;
     let prepared = PreparedPolygon::new(&owned.polygon).map_err(|e| e.to_string())?;
     let edges = cell_edges(&prepared, ArcTolerance::default()).map_err(|e| e.to_string())?;
+    stop_if(expired)?;
     let (pieces, vertices) = split::pieces(&owned, edges);
     let mut lines: Vec<Vec<Coord<f64>>> = pieces.into_iter().map(|q| q.line).collect();
     narrow::node(&mut cuts, &mut lines, tol);
@@ -305,7 +332,9 @@ fn partition_cut(
         .chain(cuts.iter().cloned())
         .map(LineString)
         .collect();
+    stop_if(expired)?;
     let faces = split::faces(&prepared, &owned, &vertices, &chords)?;
+    stop_if(expired)?;
     let mut sides: Vec<Side> = faces
         .iter()
         .map(|f| match narrow::is_wide(&f.face.polygon, &wide_parts) {
@@ -590,7 +619,7 @@ mod tests {
     #[test]
     fn a_canal_between_two_units_is_split_on_its_centre_line() {
         let (p, cov) = canal();
-        let r = partition(&p, &cov, &PartitionParams::default(), None).unwrap();
+        let r = partition(&p, &cov, &PartitionParams::default(), None, &|| false).unwrap();
         let areas = given_area(&r);
         assert_eq!(areas.len(), 4, "{areas:?}");
         for (unit, area) in areas {
@@ -630,7 +659,7 @@ mod tests {
             ),
         ]);
         let p = PreparedPolygon::new(&c).unwrap();
-        let r = partition(&p, &cov, &PartitionParams::default(), None).unwrap();
+        let r = partition(&p, &cov, &PartitionParams::default(), None, &|| false).unwrap();
         let normal = r
             .boundaries
             .iter()
@@ -661,7 +690,7 @@ mod tests {
             overlap: Overlap::Reject,
             ..PartitionParams::default()
         };
-        let e = partition(&p, &cov, &reject, None).unwrap_err();
+        let e = partition(&p, &cov, &reject, None, &|| false).unwrap_err();
         assert!(e.contains("overlaps unit 9"), "{e}");
         assert!(e.contains("80 CRS units²"), "{e}");
     }
@@ -692,7 +721,7 @@ mod tests {
     fn units_that_cover_the_canal_are_cut_and_share_it_down_the_middle() {
         let (p, _) = canal();
         let cov = covering_units();
-        let r = partition(&p, &cov, &PartitionParams::default(), None).unwrap();
+        let r = partition(&p, &cov, &PartitionParams::default(), None, &|| false).unwrap();
         let areas = given_area(&r);
         assert_eq!(areas.len(), 4, "{areas:?}");
         for (unit, area) in areas {
@@ -755,7 +784,7 @@ mod tests {
             1,
             polygon![(x: 0., y: 0.), (x: 40., y: 0.), (x: 40., y: 30.), (x: 0., y: 30.)],
         )]);
-        let r = partition(&p, &cov, &PartitionParams::default(), None).unwrap();
+        let r = partition(&p, &cov, &PartitionParams::default(), None, &|| false).unwrap();
         assert_eq!(given_area(&r), vec![(0, 170.0)]);
         assert_eq!(r.units.len(), 1);
         assert_eq!(crate::geometry::overlay::area(&r.units[0].held), 170.0);

@@ -5,10 +5,10 @@
 use super::prepare::prepare_checked;
 use super::types::{Candidate, FeatureOutcome, ProcessParams, Processed, StageTimes};
 use super::{candidates, step};
-use crate::collapse::collapse;
+use crate::collapse::collapse_within;
 use crate::connect;
 use crate::geometry::PreparedPolygon;
-use crate::methods::MethodId;
+use crate::methods::{MethodContext, MethodId};
 use crate::score::select::select;
 use crate::score::Scores;
 use geo::{Geometry, MultiLineString};
@@ -31,99 +31,168 @@ pub fn process_checked(
     };
     let candidates = candidates::computed(&prepared, params);
     let mut processed = choose(candidates, prepared.len(), params);
-    if let (Some(net), Processed::Done(o)) = (&params.connect, &mut processed) {
-        connect_chosen(o, &prepared, net);
-    }
-    if let (Some(c), Processed::Done(o)) = (&params.collapse, &mut processed) {
-        // The medial axis's lines: with `collapse` the skeleton layer is
-        // MA's, whichever `select` preferred among the other listed methods
-        // (their scores stay in the candidates); the chosen skeleton's
-        // connection legs are added to MA's when it was another.
-        let ma = match o.candidates.iter().position(|c| c.method == MethodId::MA) {
-            Some(k) => match &o.candidates[k].result {
-                Ok(_) => Ok(k),
-                Err(e) => Err(format!(
-                    "`collapse` draws the medial axis, and MA failed on this polygon: {e}"
-                )),
-            },
-            None => Err("`collapse` draws the medial axis: add MA to `skeleton.methods`".into()),
-        };
-        match ma {
-            Ok(k) => {
-                if o.chosen != k {
-                    o.chosen = k;
-                    if let Some(net) = &params.connect {
-                        o.connections.clear();
-                        connect_chosen(o, &prepared, net);
-                    }
-                }
-                let legs: Vec<(geo::Coord<f64>, geo::Coord<f64>)> = o
-                    .connections
-                    .iter()
-                    .filter_map(|l| Some((*l.leg.0.first()?, *l.leg.0.last()?)))
-                    .collect();
-                let (_, chosen) = o.chosen();
-                o.collapse = Some(
-                    chosen
-                        .graphs
-                        .iter()
-                        .zip(&prepared)
-                        .map(|(g, p)| collapse(g, p, c, &legs))
-                        .collect(),
-                )
-            }
-            Err(reason) => return Processed::Rejected(reason),
-        }
-    }
-    if let (true, Processed::Done(o)) = (params.keep_measures, &mut processed) {
-        measure(o, &prepared);
-    }
-    if let (Some(pp), Some(cov), Processed::Done(o)) =
-        (&params.partition, &params.neighbours, &mut processed)
-    {
-        let clock = crate::clock::CpuClock::start();
-        // With `width`, the medial axis's discs say what is narrow.
-        let ma = o
-            .candidates
-            .iter()
-            .find(|c| c.method == crate::methods::MethodId::MA)
-            .and_then(|c| c.result.as_ref().ok());
-        let parts: Result<Vec<_>, String> = prepared
-            .iter()
-            .enumerate()
-            .map(|(i, p)| {
-                let g = ma.and_then(|m| m.graphs.get(i));
-                crate::partition::partition(p, cov, pp, g)
-                    .map_err(|e| super::part_reason(i, prepared.len(), &e))
-            })
-            .collect();
-        match parts {
-            Ok(parts) => {
-                o.partition = Some(parts);
-                o.partition_time = super::StepTime(clock.elapsed());
-            }
-            Err(reason) => return Processed::Rejected(reason),
-        }
-    }
     if let Processed::Done(o) = &mut processed {
-        for e in &params.extra {
-            let medial_axis = o
-                .candidates
-                .iter()
-                .find(|c| c.method == MethodId::MA)
-                .and_then(|c| c.result.as_ref().ok())
-                .map(|c| c.raw.as_slice())
-                .filter(|raw| raw.len() == prepared.len());
-            let rows = e.step.rows(&step::StepInput {
-                parts: &prepared,
-                outcome: o,
-                lonlat: params.lonlat.as_ref(),
-                medial_axis,
-            });
-            o.extra.extend(rows);
+        if let Err(reason) = after_select(o, &prepared, params) {
+            return Processed::Rejected(reason);
         }
     }
     processed
+}
+
+/// The clock of the steps after `select` on one feature: `skeleton.timeout_s`
+/// once more for each polygon part (as each method has it for each part),
+/// started when selection is done (a method's own budget covers its work
+/// up to its scores). Each step checks it between polygon parts and in its
+/// long loops; the feature is rejected naming the step that ran past it.
+struct StepClock(MethodContext);
+
+impl StepClock {
+    /// The clock of the steps after `select` on a feature of `parts` polygon
+    /// parts, started now.
+    fn start(params: &ProcessParams, parts: usize) -> Self {
+        let mut budget = params.skeleton.budget();
+        budget.time = budget.time.map(|t| {
+            let s = t.as_secs_f64() * parts.max(1) as f64;
+            std::time::Duration::from_secs_f64(s.min(crate::methods::MAX_TIMEOUT_S))
+        });
+        Self(MethodContext::start(budget))
+    }
+
+    /// Fails with [`Self::reason`] once the deadline has passed.
+    fn check(&self, step: &str) -> Result<(), String> {
+        match self.0.expired() {
+            true => Err(self.reason(step)),
+            false => Ok(()),
+        }
+    }
+
+    /// Why the feature is rejected when `step` ran past the deadline.
+    fn reason(&self, step: &str) -> String {
+        format!(
+            "`{step}` ran past `skeleton.timeout_s` ({} s for this polygon: the steps after `select` have the budget once more for each polygon part, on a clock of their own); raise the budget, or leave `{step}` out for such polygons",
+            self.0.budget().time.unwrap_or_default().as_secs_f64()
+        )
+    }
+}
+
+/// The steps after `select` on one feature, in their order: the connection
+/// legs, `collapse`, the local widths (`keep_measures`), `partition` and the
+/// registered steps, within one [`StepClock`].
+fn after_select(
+    o: &mut FeatureOutcome,
+    prepared: &[PreparedPolygon],
+    params: &ProcessParams,
+) -> Result<(), String> {
+    let clock = StepClock::start(params, prepared.len());
+    if let Some(net) = &params.connect {
+        connect_chosen(o, prepared, net, &clock)?;
+    }
+    if let Some(c) = &params.collapse {
+        collapse_chosen(o, prepared, c, params, &clock)?;
+    }
+    if params.keep_measures {
+        measure(o, prepared);
+        clock.check("output.measures")?;
+    }
+    if let (Some(pp), Some(cov)) = (&params.partition, &params.neighbours) {
+        partition_chosen(o, prepared, pp, cov, &clock)?;
+    }
+    for e in &params.extra {
+        let medial_axis = o
+            .candidates
+            .iter()
+            .find(|c| c.method == MethodId::MA)
+            .and_then(|c| c.result.as_ref().ok())
+            .map(|c| c.raw.as_slice())
+            .filter(|raw| raw.len() == prepared.len());
+        let rows = e.step.rows(&step::StepInput {
+            parts: prepared,
+            outcome: o,
+            lonlat: params.lonlat.as_ref(),
+            medial_axis,
+            budget: &clock.0,
+        });
+        clock.check(e.entry.name)?;
+        o.extra.extend(rows);
+    }
+    Ok(())
+}
+
+/// `collapse` on the medial axis's lines: with `collapse` the skeleton
+/// layer is MA's, whichever `select` preferred among the other listed
+/// methods (their scores stay in the candidates); the chosen skeleton's
+/// connection legs are added to MA's when it was another.
+fn collapse_chosen(
+    o: &mut FeatureOutcome,
+    prepared: &[PreparedPolygon],
+    c: &crate::collapse::CollapseParams,
+    params: &ProcessParams,
+    clock: &StepClock,
+) -> Result<(), String> {
+    let k = match o.candidates.iter().position(|c| c.method == MethodId::MA) {
+        Some(k) => match &o.candidates[k].result {
+            Ok(_) => k,
+            Err(e) => {
+                return Err(format!(
+                    "`collapse` draws the medial axis, and MA failed on this polygon: {e}"
+                ))
+            }
+        },
+        None => {
+            return Err("`collapse` draws the medial axis: add MA to `skeleton.methods`".into())
+        }
+    };
+    if o.chosen != k {
+        o.chosen = k;
+        if let Some(net) = &params.connect {
+            o.connections.clear();
+            connect_chosen(o, prepared, net, clock)?;
+        }
+    }
+    let legs: Vec<(geo::Coord<f64>, geo::Coord<f64>)> = o
+        .connections
+        .iter()
+        .filter_map(|l| Some((*l.leg.0.first()?, *l.leg.0.last()?)))
+        .collect();
+    let (_, chosen) = o.chosen();
+    let mut parts = Vec::with_capacity(prepared.len());
+    let expired = || clock.0.expired();
+    for (g, p) in chosen.graphs.iter().zip(prepared) {
+        let part = collapse_within(g, p, c, &legs, &expired);
+        clock.check("collapse")?;
+        // `None` only when the deadline passed (checked just above).
+        parts.push(part.ok_or_else(|| clock.reason("collapse"))?);
+    }
+    o.collapse = Some(parts);
+    Ok(())
+}
+
+/// `partition` of every polygon part between the units of `cov`; with
+/// `width`, the medial axis's discs say what is narrow.
+fn partition_chosen(
+    o: &mut FeatureOutcome,
+    prepared: &[PreparedPolygon],
+    pp: &crate::partition::PartitionParams,
+    cov: &crate::partition::Coverage,
+    clock: &StepClock,
+) -> Result<(), String> {
+    let started = crate::clock::CpuClock::start();
+    let ma = o
+        .candidates
+        .iter()
+        .find(|c| c.method == MethodId::MA)
+        .and_then(|c| c.result.as_ref().ok());
+    let mut parts = Vec::with_capacity(prepared.len());
+    for (i, p) in prepared.iter().enumerate() {
+        let g = ma.and_then(|m| m.graphs.get(i));
+        let expired = || clock.0.expired();
+        let part = crate::partition::partition(p, cov, pp, g, &expired);
+        clock.check("partition")?;
+        parts.push(part.map_err(|e| super::part_reason(i, prepared.len(), &e))?);
+    }
+    o.partition = Some(parts);
+    o.partition_time = super::StepTime(started.elapsed());
+    Ok(())
 }
 
 /// The local width 2r (r: distance to the nearest polygon part's boundary)
@@ -154,15 +223,24 @@ fn measure(o: &mut FeatureOutcome, prepared: &[PreparedPolygon]) {
 
 /// The chosen skeleton with a leg to every connection point of the
 /// network (its scores stay those of the skeleton without them).
-fn connect_chosen(o: &mut FeatureOutcome, prepared: &[PreparedPolygon], net: &connect::Network) {
+fn connect_chosen(
+    o: &mut FeatureOutcome,
+    prepared: &[PreparedPolygon],
+    net: &connect::Network,
+    clock: &StepClock,
+) -> Result<(), String> {
     let chosen = o.chosen;
     let Ok(c) = &mut o.candidates[chosen].result else {
-        return;
+        return Ok(());
     };
     let mut lines = Vec::new();
     let (mut legs, mut components) = (0, 0);
+    let expired = || clock.0.expired();
     for (g, p) in c.graphs.iter_mut().zip(prepared) {
-        let (with_legs, added) = connect::add_legs(g, p, &net.points(p));
+        let added = connect::add_legs(g, p, &net.points(p), &expired);
+        clock.check("input.connect")?;
+        // `None` only when the deadline passed (checked just above).
+        let (with_legs, added) = added.ok_or_else(|| clock.reason("input.connect"))?;
         *g = with_legs;
         o.connections.extend(added);
         legs += g.leg_count();
@@ -172,6 +250,7 @@ fn connect_chosen(o: &mut FeatureOutcome, prepared: &[PreparedPolygon], net: &co
     c.geometry = MultiLineString(lines);
     c.legs = legs;
     c.components = components;
+    Ok(())
 }
 
 /// Scores skeleton lines made by another tool (`label`) for one feature's

@@ -43,6 +43,7 @@
 use super::FeatureOutcome;
 use crate::geometry::PreparedPolygon;
 use crate::layer::{StepLayer, StepRow};
+use crate::methods::MethodContext;
 use std::sync::Arc;
 
 /// What a registered step sees of one feature (or one polygon part with
@@ -62,6 +63,11 @@ pub struct StepInput<'a> {
     /// [uses it](FeatureStep::uses_medial_axis) and MA succeeded; `None`
     /// otherwise (the step makes its own).
     pub medial_axis: Option<&'a [std::sync::Arc<crate::graph::SkeletonGraph>]>,
+    /// The clock of the steps after `select` on this feature
+    /// (`skeleton.timeout_s` once more): a step with long work asks
+    /// [`MethodContext::expired`] and stops; rows that come after the
+    /// deadline are dropped and the feature rejected naming the step.
+    pub budget: &'a MethodContext,
 }
 
 /// A map from the run's coordinates to longitude and latitude in degrees

@@ -5,6 +5,8 @@
 #[cfg(feature = "gdal")]
 pub mod browser;
 
+pub mod shapes;
+
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
