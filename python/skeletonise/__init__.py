@@ -488,10 +488,8 @@ def _run(
     if attributes is not None and len(attributes.columns) and _core.columns(layer, False)[1]:
         frame = pd.DataFrame(tool, index=out_index)
         # Source fields first, renamed where they clash with the tool's (as the writer does).
-        clash = _clash(pipeline)
-        source = attributes.iloc[rows]
+        source = _renamed(attributes.iloc[rows], _reserved(pipeline))
         source.index = out_index
-        source = source.rename(columns=lambda c: f"src_{c}" if str(c).lower() in clash else c)
         frame = pd.concat([source, frame], axis=1)
         frame = gpd.GeoDataFrame(
             frame,
@@ -709,10 +707,19 @@ def _run_frame(gdf, p: "_core.Pipeline", *, candidates: bool, threads: int | Non
 __all__.append("load_pipeline")
 
 
-def _clash(pipeline: "_core.Pipeline") -> set:
-    """The (lower-case) names for which a source column is renamed ``src_<name>``, in every
-    frame alike, as the command line's writer renames them."""
-    return {n.lower() for n in _core.reserved(pipeline.collapse, pipeline.partition)} | {"rejected"}
+def _reserved(pipeline: "_core.Pipeline", neighbours: bool = False) -> list:
+    """The tool's column names beside which a source column (of ``input``, or with ``neighbours``
+    of ``neighbours``) is renamed, as the command line's writer renames them; a frame of ``input``
+    has a ``rejected`` column too."""
+    names = list(_core.reserved(pipeline.collapse, pipeline.partition, neighbours))
+    return names if neighbours else names + ["rejected"]
+
+
+def _renamed(frame: Any, reserved: Sequence[str]) -> Any:
+    """``frame`` with its columns named as the command line's writer names source fields beside
+    the tool's columns ``reserved``: ``src_`` repeated until the name is free (``_core.source_names``)."""
+    names = _core.source_names([str(c) for c in frame.columns], list(reserved))
+    return frame.set_axis([c if str(c) == n else n for c, n in zip(frame.columns, names)], axis=1)
 
 
 def _side_input(gdf, crs: Any, what: str) -> tuple[list, np.ndarray]:
@@ -727,7 +734,7 @@ def _side_input(gdf, crs: Any, what: str) -> tuple[list, np.ndarray]:
     return _encode(arr, "wkb"), _fids(series.index, len(arr))
 
 
-def _layer_frame(layer: dict, crs: Any, sources: Mapping[str, Any], clash: set) -> Any:
+def _layer_frame(layer: dict, crs: Any, sources: Mapping[str, Any], reserved: Mapping[str, list]) -> Any:
     """A GeoDataFrame of one of the result's ``layers``: the fields of the frame it carries
     (``input`` or ``neighbours``, joined by ``src_fid``), then its own columns, then its geometry."""
     import geopandas as gpd
@@ -740,7 +747,7 @@ def _layer_frame(layer: dict, crs: Any, sources: Mapping[str, Any], clash: set) 
         at = by_fid.reindex(frame["src_fid"].astype("Int64").to_numpy(na_value=-1)).to_numpy()
         own = carried.iloc[np.where(np.isnan(at), 0, at).astype(np.int64)].reset_index(drop=True)
         own.loc[np.isnan(at)] = None
-        own = own.rename(columns=lambda c: f"src_{c}" if str(c).lower() in clash else c)
+        own = _renamed(own, reserved[layer["fields"]])
         frame = pd.concat([own, frame], axis=1)
     geometry = [None if g is None else shapely.from_wkb(g) for g in layer["geometry"][1]]
     return gpd.GeoDataFrame(frame, geometry=gpd.GeoSeries(geometry, crs=crs), crs=crs)
@@ -796,8 +803,9 @@ def apply_layers(
     if neighbours is not None and hasattr(neighbours, "geometry"):
         sources["neighbours"] = neighbours.drop(columns=[neighbours.geometry.name])
     out = {"skeletons": frame}
+    reserved = {"input": _reserved(p), "neighbours": _reserved(p, neighbours=True)}
     for name, layer in done.get("layers", {}).items():
-        out[name] = _layer_frame(layer, gdf.crs, sources, _clash(p))
+        out[name] = _layer_frame(layer, gdf.crs, sources, reserved)
     return out
 
 
@@ -904,15 +912,9 @@ def _source_columns(frame: Any, row: np.ndarray) -> dict[str, Any]:
     name = frame.geometry.name
     # pandas' own accessor of a column's array (no Series made: half the time of `items()`).
     column = getattr(frame, "_get_column_array", None) or (lambda i: frame.iloc[:, i].array)
-    taken = {}
-    for i, c in enumerate(frame.columns):
-        if c == name:
-            continue
-        out = c
-        while out in _LABEL_COLUMNS or out in taken:
-            out = f"src_{out}"
-        taken[out] = column(i).take(row)
-    return taken
+    own = [(i, c) for i, c in enumerate(frame.columns) if c != name]
+    names = _core.source_names([str(c) for _, c in own], list(_LABEL_COLUMNS))
+    return {(c if str(c) == n else n): column(i).take(row) for (i, c), n in zip(own, names)}
 
 
 def _nullable(values: list[Any], dtype: Any) -> Any:

@@ -559,16 +559,29 @@ fn columns(
 
 /// The names for which a source field is written as `src_<name>` (in every
 /// layer alike, as the command line's writer renames them), with or without
-/// a `collapse` or `partition` step.
+/// a `collapse` or `partition` step; with `neighbours`, those of a field of
+/// the units (`input.neighbours`).
 #[pyfunction]
-#[pyo3(signature = (collapse = false, partition = false))]
-fn reserved(collapse: bool, partition: bool) -> Vec<&'static str> {
-    Plan::new(
+#[pyo3(signature = (collapse = false, partition = false, neighbours = false))]
+fn reserved(collapse: bool, partition: bool, neighbours: bool) -> Vec<&'static str> {
+    let plan = Plan::new(
         skeletonise::output::SKELETONS.name,
         run::step_holds(collapse, partition),
         &[],
-    )
-    .reserved_names()
+    );
+    match neighbours {
+        true => plan.reserved_neighbour_names(),
+        false => plan.reserved_names(),
+    }
+}
+
+/// The names source fields `names` are written under beside the tool's
+/// columns `reserved`: `src_` repeated until free, as the command line's
+/// writer names them (`skeletonise::output::source_names`).
+#[pyfunction]
+fn source_names(names: Vec<String>, reserved: Vec<String>) -> Vec<String> {
+    let reserved: Vec<&str> = reserved.iter().map(String::as_str).collect();
+    skeletonise::output::source_names(&names, &reserved)
 }
 
 pub(crate) fn type_name(t: ColumnType) -> &'static str {
@@ -604,6 +617,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(columns, m)?)?;
     m.add_function(wrap_pyfunction!(score, m)?)?;
     m.add_function(wrap_pyfunction!(reserved, m)?)?;
+    m.add_function(wrap_pyfunction!(source_names, m)?)?;
     m.add_function(wrap_pyfunction!(describe, m)?)?;
     m.add_function(wrap_pyfunction!(schema, m)?)?;
     m.add_function(wrap_pyfunction!(labels::labels, m)?)?;

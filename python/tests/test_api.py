@@ -398,15 +398,16 @@ def test_labels_keep_the_source_columns_row_by_row_under_their_own_names():
         index=pd.Index([10, 20, 30], name="id"),
     )
     got = skeletonise.labels(frame)
+    # `kind` becomes `src_src_kind`: `src_kind` is another source column's (the command line's rule).
     assert list(got.columns) == [
-        "name", "src_kind", "src_src_kind", "src_geometry", "rank",
+        "name", "src_src_kind", "src_kind", "src_geometry", "rank",
         "polygon_part", "kind", "length", "max_width", "elongation", "minzoom", "rejected", "geometry",
     ]
     assert got.geometry.name == "geometry" and got.crs == islands.crs
     assert list(got.index) == [10, 20, 20, 20, 30] and got.index.name == "id"
     assert list(got.polygon_part) == [0, 0, 1, 2, 0]
-    assert list(got.src_kind) == ["a", "b", "b", "b", "c"]
-    assert list(got.src_src_kind) == [1.5, 2.5, 2.5, 2.5, 3.5]
+    assert list(got.src_src_kind) == ["a", "b", "b", "b", "c"]
+    assert list(got.src_kind) == [1.5, 2.5, 2.5, 2.5, 3.5]
     assert list(got.src_geometry) == ["x", "y", "y", "y", "z"]
     assert got["name"].isna().tolist() == [False, False, False, False, True]
     assert str(got["rank"].dtype) == "Int64" and got["rank"].isna().tolist() == [False, True, True, True, False]

@@ -205,3 +205,39 @@ def test_a_prune_fallback_outside_network_mode_is_refused_as_on_the_command_line
         skeletonise.skeletonise(lakes.geometry, prune={"mode": "trunk", "fallback": "drop"})
     # With `mode: network` it is taken.
     skeletonise.load_pipeline(lakes_pipeline(tmp_path, "{ mode: network, fallback: trunk }"))
+
+
+def test_columns_named_as_the_tools_are_renamed_as_on_the_command_line(tmp_path):
+    # A previous run's output as input (`src_fid` beside `src_src_fid`, `kind` beside `src_kind`)
+    # and units with `received`/`src_received`: `src_` is repeated until the name is free, in every
+    # layer as the command line's writer names the fields (each was renamed once before, and
+    # `kind`'s new name clashed with the existing `src_kind`).
+    import os
+    import subprocess
+
+    from conftest import cli_binary
+
+    rivers = pyogrio.read_dataframe(COVERAGE, layer="rivers_danube", fid_as_index=True)
+    units = pyogrio.read_dataframe(COVERAGE, layer="units_danube", fid_as_index=True)
+    for c in ("src_fid", "src_src_fid", "kind", "src_kind", "method"):
+        rivers[c] = c
+    for c in ("received", "src_received", "held"):
+        units[c] = c
+    src = tmp_path / "in.gpkg"
+    pyogrio.write_dataframe(rivers, src, layer="rivers_danube")
+    pyogrio.write_dataframe(units, src, layer="units_danube")
+    out = tmp_path / "p.gpkg"
+    subprocess.run(
+        [str(cli_binary()), "run", str(ROOT / "pipelines" / "partition-rivers.yaml"), "-o", str(out), "-q"],
+        check=True, cwd=ROOT, env=dict(os.environ, SKELETONISE_SRC=str(src)),
+    )
+    layers = skeletonise.apply_layers(rivers, ROOT / "pipelines" / "partition-rivers.yaml", neighbours=units)
+    for name in ("skeletons", "areas", "coverage"):
+        want = pyogrio.read_dataframe(out, layer=name)
+        got = layers[name].drop(columns=["rejected"], errors="ignore")
+        assert list(got.columns) == list(want.columns), name
+        same_rows(got, out, name)
+    skel = layers["skeletons"]
+    assert list(skel["src_src_src_fid"]) == ["src_fid"] and list(skel["src_src_kind"]) == ["kind"]
+    assert list(skel["src_kind"]) == ["src_kind"] and list(skel["src_method"]) == ["method"]
+    assert {"src_src_received", "src_received"} <= set(layers["coverage"].columns)

@@ -168,15 +168,16 @@ def source_fields(fields, skip):
 
 
 def output_fields(fields, carried, tool_columns, rejected=True, reserved=()):
-    """The sink's fields: the carried source fields (``src_<name>`` where a
-    name is one of the tool's or of ``reserved``, as the command line's
-    writer renames them), the tool's columns, then ``rejected``."""
+    """The sink's fields: the carried source fields (``src_<name>``, the
+    prefix repeated until the name is free, where a name is one of the
+    tool's or of ``reserved``, as the command line's writer renames them),
+    the tool's columns, then ``rejected``."""
     out = QgsFields()
-    clash = {name.lower() for name, _ in tool_columns} | {n.lower() for n in reserved} | {"rejected"}
-    for i in carried:
+    taken = [name for name, _ in tool_columns] + list(reserved) + ["rejected"]
+    names = core().source_names([fields.at(i).name() for i in carried], taken)
+    for i, name in zip(carried, names):
         f = QgsField(fields.at(i))
-        if f.name().lower() in clash:
-            f.setName(f"src_{f.name()}")
+        f.setName(name)
         out.append(f)
     for name, kind in tool_columns:
         out.append(QgsField(name, _TYPES[kind]))

@@ -349,6 +349,37 @@ class Skeletonise(Case):
                 self.assertSameRows(got, want)
                 self.assertIn("method", want[0])
 
+    def test_fields_named_as_the_tools_are_renamed_as_on_the_command_line(self):
+        # A previous run's output as input: `src_` repeated until the name is free, as the command
+        # line's writer names the fields (`src_fid` beside `src_src_fid` became `src_src_fid` twice
+        # before).
+        from qgis.core import QgsCoordinateTransformContext, QgsVectorFileWriter
+
+        names = ["src_fid", "src_src_fid", "kind", "src_kind", "method"]
+        spec = "&".join(f"field={n}:string" for n in names)
+        mem = QgsVectorLayer(f"Polygon?crs=EPSG:32630&{spec}", "lakes", "memory")
+        f = QgsFeature(mem.fields())
+        for n in names:
+            f[n] = n
+        f.setGeometry(QgsGeometry.fromWkt("POLYGON((0 0,1000 0,1000 100,0 100,0 0))"))
+        mem.dataProvider().addFeatures([f])
+        path = self.out("previous.gpkg")
+        options = QgsVectorFileWriter.SaveVectorOptions()
+        options.driverName, options.layerName = "GPKG", "lakes"
+        err = QgsVectorFileWriter.writeAsVectorFormatV3(mem, path, QgsCoordinateTransformContext(), options)
+        self.assertEqual(err[0], QgsVectorFileWriter.NoError, err)
+        cli("run", "-i", path, "-l", "lakes", "-o", self.out("cli.gpkg"))
+        res = processing.run("skeletonise:skeletonise", {"INPUT": f"{path}|layername=lakes", "OUTPUT": self.out("q.gpkg")})
+        want = rows(self.out("cli.gpkg"), "skeletons")
+        got = rows(res["OUTPUT"])
+        self.assertEqual([k for k in got[0] if k != "rejected"], list(want[0]))
+        self.assertEqual(
+            [got[0][k] for k in ("src_src_src_fid", "src_src_fid", "kind", "src_kind", "src_method")],
+            ["src_fid", "src_src_fid", "kind", "src_kind", "method"],
+        )
+        del got[0]["rejected"]
+        self.assertSameRows(got, want, key=("src_src_src_fid",))
+
     def test_options_and_candidates_give_the_command_lines_rows(self):
         cli(
             "run", "-i", TRAIN, "-l", "lakes_scotland", "-o", self.out("cli.gpkg"),

@@ -411,26 +411,10 @@ impl Writer {
 /// `src_src_fid`, as in a previous run's output, becomes `src_src_src_fid`).
 /// SQLite compares column names without case.
 fn source_fields(source: &SourceInfo, reserved: &[&str]) -> Vec<(String, FieldInfo)> {
-    let mut taken: Vec<String> = reserved
-        .iter()
-        .map(|n| n.to_ascii_lowercase())
-        .chain(source.fields.iter().map(|f| f.name.to_ascii_lowercase()))
-        .collect();
-    source
-        .fields
-        .iter()
-        .map(|f| {
-            let clash = reserved.iter().any(|n| n.eq_ignore_ascii_case(&f.name));
-            let mut name = f.name.clone();
-            if clash {
-                name = format!("src_{name}");
-                while taken.contains(&name.to_ascii_lowercase()) {
-                    name = format!("src_{name}");
-                }
-                taken.push(name.to_ascii_lowercase());
-            }
-            (name, f.clone())
-        })
+    let names: Vec<&str> = source.fields.iter().map(|f| f.name.as_str()).collect();
+    crate::output::source_names(&names, reserved)
+        .into_iter()
+        .zip(source.fields.iter().cloned())
         .collect()
 }
 

@@ -19,7 +19,7 @@ pub use layers::{
     name, BarRow, CandidateRow, RejectedRow, RunRecord, Scored, SkeletonRow, WidthRow, BARS,
     CANDIDATES, REJECTED, RUNS, SKELETONS, WIDTHS,
 };
-pub use plan::Plan;
+pub use plan::{source_names, Plan};
 pub use rows::{
     Builtin, ColumnInfo, ExtraRow, Layer, Rows, BUILTIN, CANDIDATE_LAYER, SKELETON_LAYER,
 };

@@ -122,3 +122,53 @@ impl Plan {
             .collect()
     }
 }
+
+/// The names a source's fields are written under beside the tool's columns
+/// `reserved` (see [`Plan::reserved_names`]): a field named as one of them
+/// gets a `src_` prefix, repeated until the name is neither reserved, nor
+/// another field's, nor given already (`src_fid` beside a source field
+/// `src_src_fid`, as in a previous run's output, becomes `src_src_src_fid`);
+/// the others keep their names. Names compare without case, as SQLite's
+/// columns do. The command line's writer, the Python package and QGIS all
+/// name the fields by this rule.
+pub fn source_names<S: AsRef<str>>(names: &[S], reserved: &[&str]) -> Vec<String> {
+    let mut taken: Vec<String> = reserved
+        .iter()
+        .map(|n| n.to_ascii_lowercase())
+        .chain(names.iter().map(|n| n.as_ref().to_ascii_lowercase()))
+        .collect();
+    names
+        .iter()
+        .map(|n| {
+            let mut name = n.as_ref().to_string();
+            if reserved.iter().any(|r| r.eq_ignore_ascii_case(&name)) {
+                name = format!("src_{name}");
+                while taken.contains(&name.to_ascii_lowercase()) {
+                    name = format!("src_{name}");
+                }
+                taken.push(name.to_ascii_lowercase());
+            }
+            name
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::source_names;
+
+    #[test]
+    fn fields_named_as_a_column_are_prefixed_until_free() {
+        let names = ["kind", "SRC_KIND", "name", "src_fid", "src_src_fid"];
+        assert_eq!(
+            source_names(&names, &["src_fid", "kind"]),
+            [
+                "src_src_kind",
+                "SRC_KIND",
+                "name",
+                "src_src_src_fid",
+                "src_src_fid"
+            ]
+        );
+    }
+}
