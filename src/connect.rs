@@ -10,18 +10,9 @@
 use crate::geometry::PreparedPolygon;
 use crate::graph::{GraphBuilder, SkeletonGraph};
 use crate::layer::{col, fid, text, Attributes, ColumnType, GeometryKind, LayerDef, Shape, When};
-use geo::{BoundingRect, Coord, Geometry, LineString, Rect};
+use geo::{BoundingRect, Coord, LineString, Rect};
 
-/// The lines of a geometry, appended to `out` (other kinds are skipped).
-pub fn lines_of(g: &Geometry<f64>, out: &mut Vec<LineString<f64>>) {
-    match g {
-        Geometry::LineString(l) => out.push(l.clone()),
-        Geometry::MultiLineString(m) => out.extend(m.0.iter().cloned()),
-        Geometry::Line(l) => out.push(LineString(vec![l.start, l.end])),
-        Geometry::GeometryCollection(c) => c.iter().for_each(|g| lines_of(g, out)),
-        _ => {}
-    }
-}
+pub use crate::geometry::parts::lines_of;
 
 /// One line of the network.
 #[derive(Debug, Clone, PartialEq)]

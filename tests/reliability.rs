@@ -675,7 +675,8 @@ fn every_step_after_select_keeps_the_time_budget() {
                 "input:\n  source: {src}\n  layer: {layer}\n{second}steps:\n  - skeleton:\n      methods: [{methods}]\n      timeout_s: {timeout}\n{yaml}output:\n  path: {{out}}\non_error: reject\n"
             )
         };
-        let (reasons, written, seconds) = budget_run(dir.path(), &format!("{layer}-with"), &text(true));
+        let (reasons, written, seconds) =
+            budget_run(dir.path(), &format!("{layer}-with"), &text(true));
         assert_eq!(written, 0, "{step}: {reasons:?}");
         assert!(
             reasons.len() == 1
@@ -683,7 +684,8 @@ fn every_step_after_select_keeps_the_time_budget() {
             "{step}: {reasons:?}"
         );
         assert!(seconds < 60.0, "{step}: the run took {seconds} s");
-        let (reasons, written, _) = budget_run(dir.path(), &format!("{layer}-without"), &text(false));
+        let (reasons, written, _) =
+            budget_run(dir.path(), &format!("{layer}-without"), &text(false));
         assert_eq!(
             (written, reasons.len()),
             (1, 0),

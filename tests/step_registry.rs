@@ -12,7 +12,7 @@ use skeletonise::output::{
     columns::{columns, Item, Values},
     Cell, ColumnType, GeometryKind, Rows, StepLayer, StepRow,
 };
-use skeletonise::process::step::{FeatureStep, StepEntry, StepInput, StepRegistry};
+use skeletonise::process::step::{FeatureStep, StepEntry, StepInput};
 
 /// The module of the toy step: everything it is, in one place.
 mod toy {
@@ -80,7 +80,7 @@ fn pipeline_text(out: &std::path::Path, toy: &str) -> String {
 
 #[test]
 fn a_registered_step_writes_its_own_layer_through_the_run_and_the_python_table() {
-    let registry = StepRegistry::builtin().with(toy::ENTRY);
+    let registry = skeletonise::config::builtin_steps().with(toy::ENTRY);
     let d = tmp();
     let out = d.path().join("toy.gpkg");
     let text = pipeline_text(&out, "  - toy: { scale: 2 }\n");
@@ -165,7 +165,7 @@ fn a_registered_step_writes_its_own_layer_through_the_run_and_the_python_table()
 
 #[test]
 fn a_registered_steps_options_and_place_are_checked_like_the_others() {
-    let registry = StepRegistry::builtin().with(toy::ENTRY);
+    let registry = skeletonise::config::builtin_steps().with(toy::ENTRY);
     let d = tmp();
     let out = d.path().join("toy.gpkg");
     let load = |toy: &str| {

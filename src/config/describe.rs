@@ -13,7 +13,7 @@ pub fn json_schema() -> serde_json::Value {
 /// options — their values and defaults taken from the same JSON Schema that
 /// `skeletonise schema` prints (so from the types and their serde defaults).
 pub fn describe(registry: &crate::methods::Registry) -> String {
-    describe_with(registry, &crate::process::step::StepRegistry::builtin())
+    describe_with(registry, &super::builtin_steps())
 }
 
 /// [`describe`] with the registered steps of `steps` too.

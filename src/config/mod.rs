@@ -296,7 +296,7 @@ pub fn load_steps_str(
         text,
         origin,
         overrides,
-        &StepRegistry::builtin(),
+        &builtin_steps(),
         |f: &StepsFile| validate_steps(&f.steps),
     )?;
     Ok(Steps {
@@ -359,7 +359,13 @@ fn read_text(path: &std::path::Path, origin: &str) -> Result<String, ConfigError
 
 /// [`load`] from text; `origin` names it in errors.
 pub fn load_str(text: &str, origin: &str, overrides: &[String]) -> Result<Pipeline, ConfigError> {
-    load_str_with(text, origin, overrides, &StepRegistry::builtin())
+    load_str_with(text, origin, overrides, &builtin_steps())
+}
+
+/// The registered steps every pipeline file may use (the `label` step),
+/// assembled here, above the steps and the registry's own module.
+pub fn builtin_steps() -> StepRegistry {
+    StepRegistry::default().with(crate::label::ENTRY)
 }
 
 /// [`load_str`] with the registered steps of `registry` (library use: a

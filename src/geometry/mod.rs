@@ -21,6 +21,7 @@ pub mod key;
 pub(crate) mod lanes;
 pub mod overlay;
 pub(crate) mod packed;
+pub mod parts;
 pub(crate) mod ring;
 pub mod segment;
 pub mod tolerance;

@@ -239,7 +239,7 @@ pub fn partition(
                 .map_or_else(|| "(no fid)".into(), |f| f.to_string());
             return Err(format!(
                 "the polygon overlaps unit {fid} of `input.neighbours` ({} CRS units² of it lie inside the unit) near ({:.3}, {:.3}); with `partition: {{overlap: cut}}` (the default) the unit's share is cut out of it and given by the rule, or remove the overlap from the coverage",
-                crate::report::sig(area, 4),
+                crate::numbers::sig(area, 4),
                 at.x,
                 at.y
             ));

@@ -10,7 +10,7 @@ use crate::graph::prune::PruneParams;
 use crate::graph::widths::medial_axis_transform;
 use crate::graph::SkeletonGraph;
 use crate::methods::budget::{self, MethodContext};
-use crate::report::sig;
+use crate::numbers::sig;
 use crate::score::{metrics, BarRays};
 use geo::{LineString, MultiLineString};
 use std::sync::atomic::{AtomicBool, Ordering};

@@ -17,10 +17,11 @@ pub mod rows;
 pub mod step;
 mod types;
 
+pub use crate::geometry::parts::polygon_parts;
 pub use candidates::map_in_order;
 pub use outcome::{process, process_checked, process_given};
 pub(crate) use prepare::part_reason;
-pub use prepare::{polygon_parts, prepare, prepare_checked, NotPrepared, PrepareParams};
+pub use prepare::{prepare, prepare_checked, NotPrepared, PrepareParams};
 pub use rows::{feature_rows, FeatureRows, RowOptions, Skeletons, Status};
 pub use types::{
     Candidate, CandidateSkeleton, FeatureOutcome, ProcessParams, Processed, StageTimes, StepTime,

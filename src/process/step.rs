@@ -9,7 +9,7 @@
 //!
 //! ```
 //! use skeletonise::output::{Cell, ColumnType, GeometryKind, StepLayer, StepRow};
-//! use skeletonise::process::step::{FeatureStep, StepEntry, StepInput, StepRegistry};
+//! use skeletonise::process::step::{FeatureStep, StepEntry, StepInput};
 //!
 //! /// Writes each feature's number of polygon parts.
 //! #[derive(Debug)]
@@ -29,7 +29,7 @@
 //!     columns: &[("parts", ColumnType::Int32)],
 //! }];
 //!
-//! let registry = StepRegistry::builtin().with(StepEntry {
+//! let registry = skeletonise::config::builtin_steps().with(StepEntry {
 //!     name: "parts",
 //!     after: "select",
 //!     description: "the number of polygon parts of every feature",
@@ -164,19 +164,16 @@ pub fn step_options<T: serde::de::DeserializeOwned + Default>(
     })
 }
 
-/// The registered steps: the `label` step, and what a caller adds (the
-/// other built-in steps are the variants of `config::Step`).
+/// Registered steps: those every pipeline file may use
+/// ([`crate::config::builtin_steps`], assembled above the steps), and what a
+/// caller adds (the other built-in steps are the variants of
+/// `config::Step`).
 #[derive(Debug, Clone, Default)]
 pub struct StepRegistry {
     entries: Vec<StepEntry>,
 }
 
 impl StepRegistry {
-    /// The steps every pipeline file may use.
-    pub fn builtin() -> Self {
-        Self::default().with(crate::label::ENTRY)
-    }
-
     /// This registry and `entry`.
     pub fn with(mut self, entry: StepEntry) -> Self {
         self.entries.retain(|e| e.name != entry.name);

@@ -38,7 +38,6 @@ mod draw;
 mod page;
 pub mod summary;
 
-pub(crate) use draw::sig;
 pub use draw::{section_bound, BARS_PER_METHOD, POLYGON_VERTICES, SKELETON_VERTICES, Z_CLASSES};
 pub use summary::{by_feature, disagreement, ranked, summarise, Key, MethodSummary, Selection};
 

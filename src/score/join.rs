@@ -6,8 +6,8 @@
 //! a join that joins nothing at all is an error with the reasons
 //! ([`Unjoined::nothing_joined`]).
 
+use crate::geometry::parts::polygon_parts;
 use crate::geometry::PreparedPolygon;
-use crate::process::polygon_parts;
 use geo::{BoundingRect, Geometry, LineString};
 use rstar::AABB;
 use std::collections::HashMap;
@@ -67,7 +67,7 @@ impl Unjoined {
 pub fn lines_of(g: Option<&Geometry<f64>>) -> Vec<LineString<f64>> {
     let mut ls = Vec::new();
     if let Some(g) = g {
-        crate::connect::lines_of(g, &mut ls);
+        crate::geometry::parts::lines_of(g, &mut ls);
     }
     ls
 }

@@ -22,54 +22,14 @@
 //! already is a path keeps both ends, and legs of a component with cycles
 //! (a polygon with holes) are removed down to the cycles.
 
+use super::work::Work;
 use super::{LegMeasure, PruneParams};
 use crate::geometry::tolerance::ON_BOUNDARY_END;
 use crate::geometry::Boundary;
 use crate::graph::cut::cut_ends;
-use crate::graph::line::point_at;
 use crate::graph::{EdgeId, NodeId, SkeletonGraph};
-use geo::Coord;
 use std::cmp::{Ordering, Reverse};
 use std::collections::BinaryHeap;
-
-/// A branch of the working graph: an original edge of the merged graph, or
-/// two pieces joined at a former degree-2 node (a binary tree, so joining is
-/// O(1) however long the chain).
-#[derive(Debug, Clone, Copy)]
-pub(super) struct Piece {
-    u: NodeId,
-    v: NodeId,
-    pub(super) len: f64,
-    kind: Kind,
-}
-
-#[derive(Debug, Clone, Copy)]
-enum Kind {
-    Orig(EdgeId),
-    /// Pieces `a` (from `u`) and `b` (to `v`) joined at node `at`.
-    Join {
-        a: u32,
-        b: u32,
-        at: NodeId,
-    },
-}
-
-/// Mutable multigraph over pieces (numbered in the order made; piece `i`
-/// of the first `edges().len()` is edge `i`). Invariant: `adj[n]` lists the
-/// alive pieces incident to node n (a loop twice), and an alive piece's
-/// originals are kept.
-pub(super) struct Work<'a> {
-    pub(super) graph: &'a SkeletonGraph,
-    pub(super) boundary: &'a Boundary,
-    pub(super) pieces: Vec<Piece>,
-    pub(super) alive: Vec<bool>,
-    pub(super) adj: Vec<Vec<u32>>,
-    keep: Vec<bool>,
-    /// How far the skeleton (with its discs) reached beyond each leaf before
-    /// pruning: r_ℓ for an original leaf, the extent of the legs removed
-    /// behind a junction that became a leaf.
-    pub(super) reach: Vec<f64>,
-}
 
 /// Heap entry; ordered by (key, leaf x, leaf y, piece id).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -97,107 +57,7 @@ impl Ord for Entry {
     }
 }
 
-impl<'a> Work<'a> {
-    fn new(graph: &'a SkeletonGraph, boundary: &'a Boundary) -> Self {
-        let mut w = Work {
-            graph,
-            boundary,
-            pieces: Vec::with_capacity(graph.edges().len() * 2),
-            alive: Vec::new(),
-            adj: vec![Vec::new(); graph.nodes().len()],
-            keep: vec![true; graph.edges().len()],
-            reach: graph.nodes().iter().map(|n| n.radius.max(0.0)).collect(),
-        };
-        for (i, e) in graph.edges().iter().enumerate() {
-            let len = graph.edge_length(EdgeId::from_index(i));
-            w.push_piece(e.a, e.b, len, Kind::Orig(EdgeId::from_index(i)));
-        }
-        w
-    }
-
-    fn push_piece(&mut self, u: NodeId, v: NodeId, len: f64, kind: Kind) -> u32 {
-        let id = self.pieces.len() as u32;
-        self.pieces.push(Piece { u, v, len, kind });
-        self.alive.push(true);
-        self.adj[u.index()].push(id);
-        self.adj[v.index()].push(id);
-        id
-    }
-
-    pub(super) fn deg(&self, n: NodeId) -> usize {
-        self.adj[n.index()].len()
-    }
-
-    pub(super) fn other(&self, p: u32, n: NodeId) -> NodeId {
-        let pc = &self.pieces[p as usize];
-        if pc.u == n {
-            pc.v
-        } else {
-            pc.u
-        }
-    }
-
-    /// `(leaf, junction)` when piece `p` is a leg at a junction of degree ≥ 3.
-    fn leg(&self, p: u32) -> Option<(NodeId, NodeId)> {
-        let pc = &self.pieces[p as usize];
-        if pc.u == pc.v {
-            return None;
-        }
-        match (self.deg(pc.u), self.deg(pc.v)) {
-            (1, d) if d >= 3 => Some((pc.u, pc.v)),
-            (d, 1) if d >= 3 => Some((pc.v, pc.u)),
-            _ => None,
-        }
-    }
-
-    /// Removes piece `p` and drops its originals from the result.
-    pub(super) fn remove(&mut self, p: u32) {
-        self.alive[p as usize] = false;
-        let Piece { u, v, .. } = self.pieces[p as usize];
-        self.adj[u.index()].retain(|&q| q != p);
-        self.adj[v.index()].retain(|&q| q != p);
-        let mut stack = vec![p];
-        while let Some(q) = stack.pop() {
-            match self.pieces[q as usize].kind {
-                Kind::Orig(e) => self.keep[e.index()] = false,
-                Kind::Join { a, b, .. } => stack.extend([a, b]),
-            }
-        }
-    }
-
-    /// Joins the two distinct pieces at degree-2 node `j` into one.
-    fn join(&mut self, j: NodeId) -> Option<u32> {
-        let (p1, p2) = (self.adj[j.index()][0], self.adj[j.index()][1]);
-        if p1 == p2 {
-            return None; // a loop: j anchors a pure cycle
-        }
-        let (u, v) = (self.other(p1, j), self.other(p2, j));
-        let len = self.pieces[p1 as usize].len + self.pieces[p2 as usize].len;
-        let id = self.pieces.len() as u32;
-        self.pieces.push(Piece {
-            u,
-            v,
-            len,
-            kind: Kind::Join {
-                a: p1,
-                b: p2,
-                at: j,
-            },
-        });
-        self.alive.push(true);
-        self.alive[p1 as usize] = false;
-        self.alive[p2 as usize] = false;
-        self.adj[j.index()].clear();
-        for (n, old) in [(u, p1), (v, p2)] {
-            let slot = self.adj[n.index()]
-                .iter_mut()
-                .find(|q| **q == old)
-                .expect("adjacency lists every alive piece");
-            *slot = id;
-        }
-        Some(id)
-    }
-
+impl Work<'_> {
     /// After a removal at `j` (of branches reaching `removed_extent` from
     /// it): when `j` is left with two branches, the sibling leg
     /// insignificant at `j` goes too (j becomes a leaf keeping the reach of
@@ -237,12 +97,6 @@ impl<'a> Work<'a> {
         }
     }
 
-    /// Extent of leg `p` seen from its junction: its length plus the reach
-    /// of its leaf.
-    fn extent(&self, p: u32, leaf: NodeId) -> f64 {
-        self.pieces[p as usize].len + self.reach[leaf.index()]
-    }
-
     /// Piece `p` is a leg whose leaf is not `j` and which is insignificant
     /// when judged at `j` (radius r_j).
     fn insignificant_at(&self, p: u32, j: NodeId, params: &PruneParams) -> bool {
@@ -271,53 +125,6 @@ impl<'a> Work<'a> {
             };
         }
         leg
-    }
-
-    /// The interior points of piece `p` (every original edge it joins, with
-    /// the nodes where they were joined).
-    pub(super) fn piece_coords(&self, p: u32) -> Vec<Coord<f64>> {
-        let mut out = Vec::new();
-        let mut stack = vec![p];
-        while let Some(q) = stack.pop() {
-            match self.pieces[q as usize].kind {
-                Kind::Orig(e) => out.extend(self.graph.edge(e).interior.iter().copied()),
-                Kind::Join { a, b, at } => {
-                    out.push(self.graph.node(at).pos);
-                    stack.extend([a, b]);
-                }
-            }
-        }
-        out
-    }
-
-    /// The point at arc length `s` along piece `p` walked from its end `from`.
-    pub(super) fn point_at(&self, p: u32, from: NodeId, s: f64) -> Coord<f64> {
-        let (mut p, mut from, mut s) = (p, from, s);
-        loop {
-            let pc = self.pieces[p as usize];
-            match pc.kind {
-                Kind::Orig(e) => {
-                    let coords = self.graph.oriented_coords(e, from);
-                    return point_at(&coords, s);
-                }
-                Kind::Join { a, b, at } => {
-                    // `a` runs from `u` to `at`, `b` from `at` to `v`.
-                    let (first, second) = if from == pc.u { (a, b) } else { (b, a) };
-                    let l1 = self.pieces[first as usize].len;
-                    if s <= l1 {
-                        p = first;
-                    } else {
-                        p = second;
-                        from = at;
-                        s -= l1;
-                    }
-                }
-            }
-        }
-    }
-
-    pub(super) fn radius(&self, n: NodeId) -> f64 {
-        self.graph.node(n).radius
     }
 
     fn entry(&self, p: u32, params: &PruneParams) -> Option<Entry> {
@@ -604,6 +411,6 @@ fn params_may_need_mouth(leg: &LegMeasure) -> bool {
 /// `r_j`) leaves the junction's disc; at its far end when it is shorter.
 /// What the pruning worker measures piece by piece, for the tests.
 #[cfg(test)]
-pub(crate) fn mouth_radius(coords: &[Coord<f64>], r_j: f64, boundary: &Boundary) -> f64 {
-    boundary.distance(point_at(coords, r_j))
+pub(crate) fn mouth_radius(coords: &[geo::Coord<f64>], r_j: f64, boundary: &Boundary) -> f64 {
+    boundary.distance(crate::graph::line::point_at(coords, r_j))
 }

@@ -84,6 +84,7 @@ pub(crate) mod legs;
 pub(crate) mod network;
 mod sides;
 pub(crate) mod trunk;
+mod work;
 
 use super::SkeletonGraph;
 use crate::geometry::Boundary;

@@ -48,7 +48,7 @@
 //! side is never cut down to a leaf here, and the cycles around holes are
 //! never peeled.
 
-use super::legs::Work;
+use super::work::Work;
 use super::{LegMeasure, PruneParams};
 use crate::geometry::vector::hypot;
 use crate::graph::NodeId;
