@@ -7,6 +7,7 @@
 //! on through the polygon. The lines themselves are not modified; the
 //! `connections` layer lists every leg with the line it serves.
 
+use crate::geometry::CoordKey;
 use crate::geometry::PreparedPolygon;
 use crate::graph::{GraphBuilder, SkeletonGraph};
 use crate::layer::{col, fid, text, Attributes, ColumnType, GeometryKind, LayerDef, Shape, When};
@@ -547,10 +548,7 @@ pub fn skeleton_rows(
 ) -> Vec<NetworkRow> {
     // Each leg by its two ends (the first leg listed for a pair).
     let key = |a: Coord<f64>, b: Coord<f64>| {
-        let (a, b) = (
-            (a.x.to_bits(), a.y.to_bits()),
-            (b.x.to_bits(), b.y.to_bits()),
-        );
+        let (a, b) = (CoordKey::from(a), CoordKey::from(b));
         (a.min(b), a.max(b))
     };
     let mut by_ends: std::collections::HashMap<_, &ConnectionLeg> = Default::default();

@@ -11,6 +11,7 @@ use crate::geometry::arrangement::{self, Face};
 use crate::geometry::segment::{lines_meet, properly_cross, segment_parameter};
 use crate::geometry::tolerance::SAME_POINT;
 use crate::geometry::vector::norm;
+use crate::geometry::CoordKey;
 use crate::geometry::PreparedPolygon;
 use crate::graph::GraphBuilder;
 use geo::{Coord, LineString};
@@ -257,9 +258,9 @@ impl Pieces {
         for &(a, b, run) in &self.pieces {
             parts[usize::from(!collapsed(run))].segment(a, b);
         }
-        let inserted: HashSet<(u64, u64)> = (0..s.pos.len())
+        let inserted: HashSet<CoordKey> = (0..s.pos.len())
             .filter(|&i| s.inserted[i])
-            .map(|i| (s.pos[i].x.to_bits(), s.pos[i].y.to_bits()))
+            .map(|i| CoordKey::from(s.pos[i]))
             .collect();
         let [c, k] = parts.map(|b| {
             b.finish_raw()
@@ -272,9 +273,7 @@ impl Pieces {
                         l.0.iter()
                             .enumerate()
                             .filter(|&(j, p)| {
-                                j == 0
-                                    || j == n - 1
-                                    || !inserted.contains(&(p.x.to_bits(), p.y.to_bits()))
+                                j == 0 || j == n - 1 || !inserted.contains(&CoordKey::from(p))
                             })
                             .map(|(_, p)| *p)
                             .collect(),

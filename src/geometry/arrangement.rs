@@ -19,6 +19,7 @@
 use super::tolerance::{SAME_POINT, VERTEX_SNAP};
 use super::vector::{cross, norm};
 use super::PreparedPolygon;
+use crate::geometry::CoordKey;
 use geo::{Coord, LineString, Polygon};
 use rustc_hash::FxHashMap;
 
@@ -49,7 +50,7 @@ struct HalfEdge {
 /// The planar graph of rings and chords.
 struct Graph {
     pos: Vec<Coord<f64>>,
-    ids: FxHashMap<(u64, u64), VertexId>,
+    ids: FxHashMap<CoordKey, VertexId>,
     half: Vec<HalfEdge>,
     /// The edges made, each once (a chord laid twice on the same points).
     made: rustc_hash::FxHashSet<(VertexId, VertexId)>,
@@ -57,7 +58,7 @@ struct Graph {
 
 impl Graph {
     fn vertex(&mut self, c: Coord<f64>) -> VertexId {
-        let key = (c.x.to_bits(), c.y.to_bits());
+        let key = CoordKey::from(c);
         if let Some(&v) = self.ids.get(&key) {
             return v;
         }
@@ -146,11 +147,11 @@ fn split_with(
 ) -> Result<Vec<Face>, SplitError> {
     let rings: Vec<&LineString<f64>> = p.rings().collect();
     // Every point of every chord, for the ends that meet another chord.
-    let mut on_chords: FxHashMap<(u64, u64), u32> = FxHashMap::default();
+    let mut on_chords: FxHashMap<CoordKey, u32> = FxHashMap::default();
     if network {
         for c in chords {
             for q in &c.0 {
-                *on_chords.entry((q.x.to_bits(), q.y.to_bits())).or_default() += 1;
+                *on_chords.entry(CoordKey::from(q)).or_default() += 1;
             }
         }
     }
@@ -166,9 +167,7 @@ fn split_with(
         }
         for end in [0, pts.len() - 1] {
             let q = pts[end];
-            let shared = on_chords
-                .get(&(q.x.to_bits(), q.y.to_bits()))
-                .is_some_and(|&n| n > 1);
+            let shared = on_chords.get(&CoordKey::from(q)).is_some_and(|&n| n > 1);
             match attach(p, q) {
                 Some((edge, at)) => {
                     pts[end] = at;

@@ -15,6 +15,22 @@ impl From<Coord<f64>> for CoordKey {
     }
 }
 
+impl From<&Coord<f64>> for CoordKey {
+    fn from(c: &Coord<f64>) -> Self {
+        Self::from(*c)
+    }
+}
+
+impl CoordKey {
+    /// The coordinate back.
+    pub fn coord(self) -> Coord<f64> {
+        Coord {
+            x: f64::from_bits(self.0),
+            y: f64::from_bits(self.1),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -26,5 +42,6 @@ mod tests {
         assert_ne!(k(1.5, -2.0), k(-2.0, 1.5));
         assert_ne!(k(0.0, 1.0), k(-0.0, 1.0));
         assert_eq!(k(-0.0 + 0.0, 1.0), k(0.0, 1.0));
+        assert_eq!(k(-0.0, 2.5).coord().x.to_bits(), (-0.0f64).to_bits());
     }
 }

@@ -34,16 +34,17 @@ use super::ring::normalise_polygon;
 use super::segment::{closest_on_segment, crossing_point, inner_points_along, properly_cross};
 use super::vector::norm;
 use super::Boundary;
+use crate::geometry::CoordKey;
 use geo::{Area, Coord, LineString, MultiPolygon, Polygon};
 use rstar::primitives::{GeomWithData, Rectangle};
 use rstar::{RTree, AABB};
 use rustc_hash::{FxHashMap, FxHashSet};
 
 /// A coordinate by its bits.
-type Key = (u64, u64);
+type Key = CoordKey;
 
 fn key(c: Coord<f64>) -> Key {
-    (c.x.to_bits(), c.y.to_bits())
+    CoordKey::from(c)
 }
 
 /// An edge of a polygon set: (polygon, ring — 0 the exterior —, index of

@@ -24,6 +24,7 @@ pub mod widths;
 pub use handle::{EdgeId, NodeId};
 
 use crate::geometry::Boundary;
+use crate::geometry::CoordKey;
 use geo::{Coord, LineString, MultiLineString};
 use rustc_hash::FxHashMap as HashMap;
 
@@ -607,7 +608,7 @@ impl std::ops::Index<usize> for Adjacency {
 #[derive(Debug, Default)]
 pub struct GraphBuilder {
     graph: SkeletonGraph,
-    index: HashMap<(u64, u64), NodeId>,
+    index: HashMap<CoordKey, NodeId>,
 }
 
 impl GraphBuilder {
@@ -628,7 +629,10 @@ impl GraphBuilder {
     /// The node at `p`, created when absent (radius set by [`GraphBuilder::finish`]).
     pub fn node(&mut self, p: Coord<f64>) -> NodeId {
         // +0.0 normalises −0.0 so both zeros share a node.
-        let key = ((p.x + 0.0).to_bits(), (p.y + 0.0).to_bits());
+        let key = CoordKey::from(Coord {
+            x: p.x + 0.0,
+            y: p.y + 0.0,
+        });
         let g = &mut self.graph;
         *self
             .index

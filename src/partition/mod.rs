@@ -44,6 +44,7 @@ pub use split::Owner;
 
 use crate::collapse::CollapseParams;
 use crate::geometry::vector::norm;
+use crate::geometry::CoordKey;
 use crate::geometry::{tolerance::SAME_POINT, PreparedPolygon};
 use crate::graph::SkeletonGraph;
 use crate::methods::medial_axis::{cells::cell_edges, ArcTolerance};
@@ -378,10 +379,10 @@ fn assemble_part(
         }
     }
     out.remainders = crate::geometry::arrangement::coverage_union(&unowned);
-    let cut_ends: rustc_hash::FxHashSet<(u64, u64)> = cuts
+    let cut_ends: rustc_hash::FxHashSet<CoordKey> = cuts
         .iter()
         .flat_map(|l| [l[0], l[l.len() - 1]])
-        .map(|c| (c.x.to_bits(), c.y.to_bits()))
+        .map(CoordKey::from)
         .collect();
     out.wide = crate::geometry::arrangement::coverage_union(&wide)
         .into_iter()
@@ -391,7 +392,7 @@ fn assemble_part(
                 .0
                 .iter()
                 .chain(w.interiors().iter().flat_map(|r| &r.0))
-                .filter(|c| cut_ends.contains(&(c.x.to_bits(), c.y.to_bits())))
+                .filter(|c| cut_ends.contains(&CoordKey::from(**c)))
                 .count();
             (w, n / 2)
         })
@@ -400,7 +401,7 @@ fn assemble_part(
 }
 
 /// An edge by the bits of its two ends.
-type EdgeKey = ((u64, u64), (u64, u64));
+type EdgeKey = (CoordKey, CoordKey);
 
 /// Which faces meet along which chord edges: every directed edge of a
 /// face's rings (the face on its left) whose reverse is another face's.
@@ -411,7 +412,7 @@ struct Adjacency {
 
 impl Adjacency {
     fn of(faces: &[split::OwnedFace]) -> Self {
-        let key = |c: Coord<f64>| (c.x.to_bits(), c.y.to_bits());
+        let key = |c: Coord<f64>| CoordKey::from(c);
         let mut by_edge: FxHashMap<EdgeKey, usize> = FxHashMap::default();
         fn rings(f: &split::OwnedFace) -> impl Iterator<Item = &LineString<f64>> {
             let p = &f.face.polygon;
@@ -520,17 +521,17 @@ fn boundaries(pieces: Vec<split::Piece>) -> Vec<NewBoundary> {
 /// left).
 fn join(lines: Vec<Vec<geo::Coord<f64>>>) -> Vec<Vec<geo::Coord<f64>>> {
     use rustc_hash::FxHashMap;
-    let key = |c: &geo::Coord<f64>| (c.x.to_bits(), c.y.to_bits());
-    let mut degree: FxHashMap<(u64, u64), usize> = FxHashMap::default();
-    let mut starting: FxHashMap<(u64, u64), usize> = FxHashMap::default();
-    let mut ending: FxHashMap<(u64, u64), usize> = FxHashMap::default();
+    let key = |c: &geo::Coord<f64>| CoordKey::from(c);
+    let mut degree: FxHashMap<CoordKey, usize> = FxHashMap::default();
+    let mut starting: FxHashMap<CoordKey, usize> = FxHashMap::default();
+    let mut ending: FxHashMap<CoordKey, usize> = FxHashMap::default();
     for (i, l) in lines.iter().enumerate() {
         *degree.entry(key(&l[0])).or_default() += 1;
         *degree.entry(key(&l[l.len() - 1])).or_default() += 1;
         starting.insert(key(&l[0]), i);
         ending.insert(key(&l[l.len() - 1]), i);
     }
-    let joins = |k: &(u64, u64)| degree[k] == 2;
+    let joins = |k: &CoordKey| degree[k] == 2;
     let mut used = vec![false; lines.len()];
     let mut out = Vec::new();
     for i in 0..lines.len() {

@@ -6,6 +6,7 @@
 use crate::feature::Value;
 use crate::geometry::segment::{closest_on_segment, inner_points_along};
 use crate::geometry::vector::norm;
+use crate::geometry::CoordKey;
 use crate::geometry::{Boundary, PreparedPolygon};
 use geo::{BoundingRect, Coord, LineString, MultiPolygon, Polygon};
 use rstar::primitives::{GeomWithData, Line};
@@ -164,10 +165,10 @@ pub struct Owned {
 }
 
 /// An edge by the bits of its two ends.
-type EdgeKey = ((u64, u64), (u64, u64));
+type EdgeKey = (CoordKey, CoordKey);
 
-fn key(c: Coord<f64>) -> (u64, u64) {
-    (c.x.to_bits(), c.y.to_bits())
+fn key(c: Coord<f64>) -> CoordKey {
+    CoordKey::from(c)
 }
 
 impl Owned {
@@ -226,7 +227,7 @@ impl Owned {
     }
 
     /// The owners of the edges into and out of every vertex.
-    pub fn at_vertices(&self) -> FxHashMap<(u64, u64), VertexOwners> {
+    pub fn at_vertices(&self) -> FxHashMap<CoordKey, VertexOwners> {
         let mut out = FxHashMap::default();
         for r in std::iter::once(self.polygon.exterior()).chain(self.polygon.interiors()) {
             let n = r.0.len() - 1;
@@ -296,9 +297,9 @@ fn with_t_junctions(p: &PreparedPolygon, cov: &Coverage, tol: f64) -> Polygon<f6
     let b = p.boundary();
     let (lo, hi) = (b.bbox_min(), b.bbox_max());
     let mut inserts = Inserts::default();
-    let mut moves: FxHashMap<(u64, u64), Coord<f64>> = FxHashMap::default();
+    let mut moves: FxHashMap<CoordKey, Coord<f64>> = FxHashMap::default();
     // A unit vertex that is one of the polygon's is where it should be.
-    let own: rustc_hash::FxHashSet<(u64, u64)> = p
+    let own: rustc_hash::FxHashSet<CoordKey> = p
         .rings()
         .flat_map(|r| r.0.iter().map(|&c| key(c)))
         .collect();

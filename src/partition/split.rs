@@ -14,6 +14,7 @@
 use super::owners::{Owned, VertexOwners};
 use crate::geometry::arrangement::{split_network, Face};
 use crate::geometry::vector::{cross, norm};
+use crate::geometry::CoordKey;
 use crate::geometry::PreparedPolygon;
 use crate::methods::medial_axis::cells::{CellEdge, CellSite};
 use geo::{Coord, LineString};
@@ -42,17 +43,17 @@ pub struct OwnedFace {
     pub owner: Owner,
 }
 
-fn key(c: Coord<f64>) -> (u64, u64) {
-    (c.x.to_bits(), c.y.to_bits())
+fn key(c: Coord<f64>) -> CoordKey {
+    CoordKey::from(c)
 }
 
 /// The owners at every vertex, and how the cells of the vertices where two
 /// units meet are split.
 pub struct Vertices {
-    owners: FxHashMap<(u64, u64), VertexOwners>,
+    owners: FxHashMap<CoordKey, VertexOwners>,
     /// The split of a vertex's cell: the direction from the vertex along
     /// which it is split, and one towards the side of the edge before.
-    splits: FxHashMap<(u64, u64), (Coord<f64>, Coord<f64>)>,
+    splits: FxHashMap<CoordKey, (Coord<f64>, Coord<f64>)>,
 }
 
 impl Vertices {
@@ -142,7 +143,7 @@ pub fn pieces(owned: &Owned, mut edges: Vec<CellEdge>) -> (Vec<Piece>, Vertices)
 /// for the ray to meet one exactly, the vertex of its far edges nearest in
 /// angle).
 fn split_cells(vertices: &mut Vertices, edges: &mut [CellEdge]) -> Vec<Piece> {
-    let mut by_vertex: FxHashMap<(u64, u64), Vec<usize>> = FxHashMap::default();
+    let mut by_vertex: FxHashMap<CoordKey, Vec<usize>> = FxHashMap::default();
     for (k, e) in edges.iter().enumerate() {
         for s in e.sites {
             if let CellSite::Vertex(v) = s {
@@ -157,10 +158,7 @@ fn split_cells(vertices: &mut Vertices, edges: &mut [CellEdge]) -> Vec<Piece> {
         let Some(o) = vertices.owners.get(&vk).copied() else {
             continue;
         };
-        let v = Coord {
-            x: f64::from_bits(vk.0),
-            y: f64::from_bits(vk.1),
-        };
+        let v = vk.coord();
         if o.before == o.after {
             continue;
         }

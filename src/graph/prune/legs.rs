@@ -26,6 +26,7 @@ use super::work::Work;
 use super::{LegMeasure, PruneParams};
 use crate::geometry::tolerance::ON_BOUNDARY_END;
 use crate::geometry::Boundary;
+use crate::geometry::CoordKey;
 use crate::graph::cut::cut_ends;
 use crate::graph::{EdgeId, NodeId, SkeletonGraph};
 use std::cmp::{Ordering, Reverse};
@@ -384,19 +385,19 @@ fn deepest_pair(m: &SkeletonGraph, labels: &[usize], c: usize) -> Option<(NodeId
 fn hull_leaves(m: &SkeletonGraph, leaves: &[NodeId]) -> Vec<NodeId> {
     use geo::ConvexHull;
     let points: geo::MultiPoint<f64> = leaves.iter().map(|&n| geo::Point(m.node(n).pos)).collect();
-    let corners: std::collections::HashSet<(u64, u64)> = points
+    let corners: std::collections::HashSet<CoordKey> = points
         .convex_hull()
         .exterior()
         .0
         .iter()
-        .map(|c| (c.x.to_bits(), c.y.to_bits()))
+        .map(CoordKey::from)
         .collect();
     leaves
         .iter()
         .copied()
         .filter(|&n| {
             let p = m.node(n).pos;
-            corners.contains(&(p.x.to_bits(), p.y.to_bits()))
+            corners.contains(&CoordKey::from(p))
         })
         .collect()
 }

@@ -140,11 +140,144 @@ fn between(
     keep: &mut [bool],
     expired: &dyn Fn() -> bool,
 ) -> Option<()> {
-    let n = m.nodes().len();
     let adj = m.adjacency();
-    let (block, count) = blocks(m, &adj);
-    // Each block's edges, then its vertices; a vertex in two blocks or
-    // more is a cut vertex.
+    let tree = BlockTree::of(m, &adj, terminals);
+    // Each block's portals; a block with two or more keeps the shortest
+    // paths between them.
+    let len: Vec<f64> = (0..m.edges().len())
+        .map(|i| m.edge_length(EdgeId::from_index(i)))
+        .collect();
+    let mut search = BlockSearch::new(m.nodes().len(), m.edges().len());
+    for b in 0..tree.members.len() {
+        let portals = tree.portals(b);
+        if portals.len() < 2 {
+            continue;
+        }
+        if let [e] = tree.edges_of[b][..] {
+            keep[e.index()] = true; // a bridge between two terminals' sides
+            continue;
+        }
+        if expired() {
+            return None;
+        }
+        let block = &tree.block;
+        search.keep_between(m, &adj, &len, block, b as u32, &portals, keep, expired)?;
+    }
+    Some(())
+}
+
+/// The block–cut tree of a merged graph (tree nodes: its blocks, then its
+/// cut vertices), rooted per component, with the terminals below each
+/// tree node.
+struct BlockTree {
+    /// The block of each edge (`LOOP` for a loop).
+    block: Vec<u32>,
+    /// Each block's edges.
+    edges_of: Vec<Vec<EdgeId>>,
+    /// Each block's vertices.
+    members: Vec<Vec<NodeId>>,
+    /// How many blocks each vertex lies in (two or more: a cut vertex).
+    in_blocks: Vec<u32>,
+    is_terminal: Vec<bool>,
+    /// Each cut vertex's tree node.
+    tree_id: Vec<u32>,
+    /// Each tree node's parent (`u32::MAX` at a root).
+    parent: Vec<u32>,
+    /// The terminals in each tree node's subtree.
+    below: Vec<usize>,
+    /// Each tree node's root.
+    root_of: Vec<u32>,
+}
+
+impl BlockTree {
+    fn of(m: &SkeletonGraph, adj: &crate::graph::Adjacency, terminals: &[NodeId]) -> Self {
+        let n = m.nodes().len();
+        let (block, count) = blocks(m, adj);
+        let (edges_of, members, in_blocks) = block_members(m, &block, count);
+        let mut is_terminal = vec![false; n];
+        terminals.iter().for_each(|v| is_terminal[v.index()] = true);
+        let mut tree = Self {
+            block,
+            edges_of,
+            members,
+            in_blocks,
+            is_terminal,
+            tree_id: vec![u32::MAX; n],
+            parent: Vec::new(),
+            below: Vec::new(),
+            root_of: Vec::new(),
+        };
+        let mut cuts: Vec<NodeId> = Vec::new();
+        for v in (0..n).map(NodeId::from_index) {
+            if tree.is_cut(v) {
+                tree.tree_id[v.index()] = (count + cuts.len()) as u32;
+                cuts.push(v);
+            }
+        }
+        let size = count + cuts.len();
+        let mut tree_adj: Vec<Vec<u32>> = vec![Vec::new(); size];
+        let mut weight = vec![0usize; size];
+        for (b, vs) in tree.members.iter().enumerate() {
+            for &v in vs {
+                if tree.is_cut(v) {
+                    let c = tree.tree_id[v.index()];
+                    tree_adj[b].push(c);
+                    tree_adj[c as usize].push(b as u32);
+                } else if tree.is_terminal[v.index()] {
+                    weight[b] += 1;
+                }
+            }
+        }
+        for (k, v) in cuts.iter().enumerate() {
+            weight[count + k] = usize::from(tree.is_terminal[v.index()]);
+        }
+        let (parent, root_of, order) = rooted(&tree_adj);
+        let mut below = weight;
+        for &x in order.iter().rev() {
+            let p = parent[x as usize];
+            if p != u32::MAX {
+                below[p as usize] += below[x as usize];
+            }
+        }
+        (tree.parent, tree.below, tree.root_of) = (parent, below, root_of);
+        tree
+    }
+
+    fn is_cut(&self, v: NodeId) -> bool {
+        self.in_blocks[v.index()] >= 2
+    }
+
+    /// Block `b`'s portals: its terminals, and its cut vertices with a
+    /// terminal behind them.
+    fn portals(&self, b: usize) -> Vec<NodeId> {
+        let total = self.below[self.root_of[b] as usize];
+        self.members[b]
+            .iter()
+            .copied()
+            .filter(|v| {
+                if !self.is_cut(*v) {
+                    return self.is_terminal[v.index()];
+                }
+                let c = self.tree_id[v.index()] as usize;
+                let behind = if self.parent[b] == c as u32 {
+                    total - self.below[b]
+                } else {
+                    self.below[c]
+                };
+                behind > 0
+            })
+            .collect()
+    }
+}
+
+/// Each block's edges and vertices (in the order its edges meet them), and
+/// how many blocks each vertex lies in.
+fn block_members(
+    m: &SkeletonGraph,
+    block: &[u32],
+    count: usize,
+) -> (Vec<Vec<EdgeId>>, Vec<Vec<NodeId>>, Vec<u32>) {
+    let n = m.nodes().len();
     let mut edges_of: Vec<Vec<EdgeId>> = vec![Vec::new(); count];
     for (i, &k) in block.iter().enumerate() {
         if k != LOOP {
@@ -153,7 +286,7 @@ fn between(
     }
     let mut last = vec![u32::MAX; n];
     let mut in_blocks = vec![0u32; n];
-    let members: Vec<Vec<NodeId>> = edges_of
+    let members = edges_of
         .iter()
         .enumerate()
         .map(|(b, es)| {
@@ -171,42 +304,15 @@ fn between(
             vs
         })
         .collect();
-    let is_cut = |v: NodeId| in_blocks[v.index()] >= 2;
-    let is_terminal = {
-        let mut t = vec![false; n];
-        terminals.iter().for_each(|v| t[v.index()] = true);
-        t
-    };
-    // Tree nodes: blocks, then cut vertices.
-    let mut tree_id = vec![u32::MAX; n];
-    let mut cuts: Vec<NodeId> = Vec::new();
-    for v in (0..n).map(NodeId::from_index) {
-        if is_cut(v) {
-            tree_id[v.index()] = (count + cuts.len()) as u32;
-            cuts.push(v);
-        }
-    }
-    let size = count + cuts.len();
-    let mut tree_adj: Vec<Vec<u32>> = vec![Vec::new(); size];
-    let mut weight = vec![0usize; size];
-    for (b, vs) in members.iter().enumerate() {
-        for &v in vs {
-            if is_cut(v) {
-                let c = tree_id[v.index()];
-                tree_adj[b].push(c);
-                tree_adj[c as usize].push(b as u32);
-            } else if is_terminal[v.index()] {
-                weight[b] += 1;
-            }
-        }
-    }
-    for (k, v) in cuts.iter().enumerate() {
-        weight[count + k] = usize::from(is_terminal[v.index()]);
-    }
-    // Terminals below each tree node (rooted per component), and each
-    // component's total.
+    (edges_of, members, in_blocks)
+}
+
+/// A forest given by adjacency lists, rooted at the lowest node of each
+/// tree: each node's parent (`u32::MAX` at a root) and root, and the nodes
+/// in breadth-first order.
+fn rooted(tree_adj: &[Vec<u32>]) -> (Vec<u32>, Vec<u32>, Vec<u32>) {
+    let size = tree_adj.len();
     let mut parent = vec![u32::MAX; size];
-    let mut below = weight.clone();
     let mut root_of = vec![0u32; size];
     let mut order: Vec<u32> = Vec::with_capacity(size);
     let mut seen = vec![false; size];
@@ -231,49 +337,7 @@ fn between(
             i += 1;
         }
     }
-    for &x in order.iter().rev() {
-        let p = parent[x as usize];
-        if p != u32::MAX {
-            below[p as usize] += below[x as usize];
-        }
-    }
-    // Each block's portals; a block with two or more keeps the shortest
-    // paths between them.
-    let len: Vec<f64> = (0..m.edges().len())
-        .map(|i| m.edge_length(EdgeId::from_index(i)))
-        .collect();
-    let mut search = BlockSearch::new(n, m.edges().len());
-    for (b, vs) in members.iter().enumerate() {
-        let total = below[root_of[b] as usize];
-        let portals: Vec<NodeId> = vs
-            .iter()
-            .copied()
-            .filter(|v| {
-                if !is_cut(*v) {
-                    return is_terminal[v.index()];
-                }
-                let c = tree_id[v.index()] as usize;
-                let behind = if parent[b] == c as u32 {
-                    total - below[b]
-                } else {
-                    below[c]
-                };
-                behind > 0
-            })
-            .collect();
-        if portals.len() < 2 {
-            continue;
-        }
-        if let [e] = edges_of[b][..] {
-            keep[e.index()] = true; // a bridge between two terminals' sides
-            continue;
-        }
-        if expired() {
-            return None;
-        }
-        search.keep_between(m, &adj, &len, &block, b as u32, &portals, keep, expired)?;
-    }
-    Some(())
+    (parent, root_of, order)
 }
 
 /// Searches inside one block, with buffers reused across blocks.

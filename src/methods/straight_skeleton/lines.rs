@@ -96,6 +96,39 @@ impl Class {
         let n = self.normal;
         (n.x * p.x + n.y * p.y, n.x * p.y - n.y * p.x)
     }
+
+    /// The fastest closing speed on a vertex moving along unit `dir` at
+    /// `speed` of a line of the class (its normal furthest from the
+    /// vertex's direction), widened for rounding.
+    fn closing(&self, dir: Coord<f64>, speed: f64) -> f64 {
+        let (cos_phi, sin_phi) = (dot(self.normal, dir), cross(self.normal, dir).abs());
+        let worst = if cos_phi < -self.cos_h {
+            -1.0
+        } else {
+            cos_phi * self.cos_h - sin_phi * self.sin_h
+        };
+        1.0 - speed * worst + 1e-9 * (1.0 + speed)
+    }
+
+    /// The box of `corners` in the class's frame, grown by `pad`.
+    fn frame_box(&self, corners: &[Coord<f64>], pad: f64) -> Bbox {
+        let mut b = [
+            f64::INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NEG_INFINITY,
+        ];
+        for &p in corners {
+            let (u, v) = self.frame(p);
+            b = [
+                b[0].min(u - pad),
+                b[1].min(v - pad),
+                b[2].max(u + pad),
+                b[3].max(v + pad),
+            ];
+        }
+        b
+    }
 }
 
 /// The original edges (line `i` is edge `i`), with removal.
@@ -288,36 +321,14 @@ impl LineIndex {
             if c.tree.len() == 0 {
                 continue;
             }
-            // The fastest closing speed of a line of the class: its normal
-            // furthest from the vertex's direction.
-            let (cos_phi, sin_phi) = (dot(c.normal, dir), cross(c.normal, dir).abs());
-            let worst = if cos_phi < -c.cos_h {
-                -1.0
-            } else {
-                cos_phi * c.cos_h - sin_phi * c.sin_h
-            };
-            let closing = 1.0 - speed * worst + 1e-9 * (1.0 + speed);
+            let closing = c.closing(dir, speed);
             if closing <= 1e-12 {
                 continue;
             }
             let hi = band.t0 + closing * span + pad;
             let (us, vs) = c.frame(band.start);
             let (cos_h, sin_h) = (c.cos_h, c.sin_h);
-            let mut frame_env = [
-                f64::INFINITY,
-                f64::INFINITY,
-                f64::NEG_INFINITY,
-                f64::NEG_INFINITY,
-            ];
-            for p in corners {
-                let (u, v) = c.frame(p);
-                frame_env = [
-                    frame_env[0].min(u - pad),
-                    frame_env[1].min(v - pad),
-                    frame_env[2].max(u + pad),
-                    frame_env[3].max(v + pad),
-                ];
-            }
+            let frame_env = c.frame_box(&corners, pad);
             c.tree.visit(
                 |b| {
                     if !boxes_meet(b, &frame_env) {
