@@ -128,8 +128,13 @@ def score(
     (both key lists) or by location; what ``Pipeline.run`` returns, and ``unjoined`` (why some
     line rows joined no polygon). Raises ValueError when no line joins any polygon."""
 
-def reserved(collapse: bool = False, partition: bool = False) -> list[str]:
-    """The names for which a source field is written as ``src_<name>`` (in every layer alike), with or without a collapse step."""
+def reserved(collapse: bool = False, partition: bool = False, neighbours: bool = False) -> list[str]:
+    """The names for which a source field is written as ``src_<name>`` (in every layer alike), with or without a
+    collapse or partition step; with ``neighbours``, those of a field of the units."""
+
+def source_names(names: list[str], reserved: list[str]) -> list[str]:
+    """The names source fields ``names`` are written under beside the tool's columns ``reserved``: ``src_``
+    repeated until the name is free, as the command line's writer names them."""
 
 def describe() -> str:
     """The methods and every step's options with their defaults."""
