@@ -11,7 +11,7 @@ use skeletonise::feature::Feature;
 use skeletonise::output::columns::{self as table, ColumnData, Item, Values};
 use skeletonise::output::{ColumnType, Layer, Plan, Rows, When, CANDIDATE_LAYER, SKELETON_LAYER};
 use skeletonise::process::{
-    feature_rows, map_in_order, FeatureRows, ProcessParams, RowOptions, Skeletons, Status,
+    feature_rows, map_in_order, FeatureRows, ProcessParams, RowOptions, Run, Skeletons,
 };
 use std::time::Instant;
 
@@ -214,7 +214,7 @@ pub(crate) fn features(
 /// layer, or an empty row for a rejected or filtered feature) and the
 /// reason of each rejected one.
 fn outputs(
-    results: Vec<FeatureRows>,
+    results: Vec<Rows>,
     feats: &[Feature],
     layer: &dyn Layer,
 ) -> (Vec<i64>, Rows, Vec<Item>, Vec<Option<String>>) {
@@ -222,8 +222,8 @@ fn outputs(
     let mut all = Rows::default();
     for (i, (r, f)) in results.into_iter().zip(feats).enumerate() {
         let before = layer.count(&all);
-        let rejected: Vec<String> = r.rows.rejected.iter().map(|j| j.reason.clone()).collect();
-        all.append(r.rows);
+        let rejected: Vec<String> = r.rejected.iter().map(|j| j.reason.clone()).collect();
+        all.append(r);
         let after = layer.count(&all);
         for k in before..after {
             idx.push(i as i64);
@@ -273,6 +273,37 @@ pub fn step_holds(collapse: bool, partition: bool) -> Vec<When> {
     holds
 }
 
+/// Adjacent features merged into one (with `partition`, as the command
+/// line's reader merges them), and the input row of every merged feature:
+/// its smallest member's, whose FID it takes.
+fn merged(feats: Vec<Feature>) -> (Vec<Feature>, Option<Vec<i64>>) {
+    let by_fid: std::collections::HashMap<u64, i64> = feats
+        .iter()
+        .enumerate()
+        .filter_map(|(i, f)| f.fid.map(|x| (x, i as i64)))
+        .collect();
+    let feats = skeletonise::process::merge::merge_adjacent_exactly(feats, None);
+    let rows = feats
+        .iter()
+        .map(|f| f.fid.and_then(|x| by_fid.get(&x).copied()).unwrap_or(-1))
+        .collect();
+    (feats, Some(rows))
+}
+
+/// The skeleton lines as GeoArrow (`geoarrow`) or WKB, one per row.
+fn encoded(lines: &[Option<geo::MultiLineString<f64>>], geoarrow: bool, par: bool) -> Encoded {
+    if geoarrow {
+        return Encoded::Ragged(table::ragged(lines));
+    }
+    Encoded::Wkb(map_in_order(lines, par, |_, g| {
+        g.as_ref().map(|m| {
+            let mut out = Vec::new();
+            wkb::write_lines(m, &mut out);
+            out
+        })
+    }))
+}
+
 fn work(
     input: &Input<'_>,
     fids: Option<&[i64]>,
@@ -284,24 +315,11 @@ fn work(
     // a small polygon's work); a large one still splits its own work.
     let par = opts.threads != Some(1) && input.len() > 1;
     let t0 = Instant::now();
-    let mut feats = features(input, fids, repaired, par);
-    // The input row of every feature: merging (with `partition`) makes one
-    // feature of adjacent ones, which takes its smallest member's FID.
-    let mut input_rows: Option<Vec<i64>> = None;
-    if opts.partition {
-        let by_fid: std::collections::HashMap<u64, i64> = feats
-            .iter()
-            .enumerate()
-            .filter_map(|(i, f)| f.fid.map(|x| (x, i as i64)))
-            .collect();
-        feats = skeletonise::process::merge::merge_adjacent_exactly(feats, None);
-        input_rows = Some(
-            feats
-                .iter()
-                .map(|f| f.fid.and_then(|x| by_fid.get(&x).copied()).unwrap_or(-1))
-                .collect(),
-        );
-    }
+    let feats = features(input, fids, repaired, par);
+    let (feats, input_rows) = match opts.partition {
+        true => merged(feats),
+        false => (feats, None),
+    };
     let t1 = Instant::now();
     let row_opts = RowOptions {
         explode: opts.explode,
@@ -332,60 +350,35 @@ fn work(
         return Err(Stop::Cancelled);
     };
     let t2 = Instant::now();
-    if opts.fail {
-        if let Some((f, rej)) = feats
-            .iter()
-            .zip(&results)
-            .find_map(|(f, r)| r.rows.rejected.first().map(|j| (f, j)))
-        {
-            let fid = f.fid.map_or_else(|| "(no fid)".into(), |x| x.to_string());
-            return Err(Stop::Rejected(skeletonise::config::rejected_under_fail(
-                &fid,
-                &rej.reason,
-            )));
-        }
+    // The one run driver of the command line: counts, `on_error: fail`,
+    // and the rows made after the last feature (the grown coverage).
+    let mut run = Run::new(params, opts.fail);
+    let mut kept = Vec::with_capacity(results.len());
+    for (f, r) in feats.iter().zip(results) {
+        let rows = run.add(f, r).map_err(|e| {
+            Stop::Rejected(skeletonise::config::rejected_under_fail(&e.fid, &e.reason))
+        })?;
+        kept.push(rows);
     }
-    let mut counts = [input.len() as u64, 0, 0, 0];
-    for (r, f) in results.iter().zip(&feats) {
-        let n = f.source_count();
-        match r.status {
-            Status::Written(_) => counts[1] += n,
-            Status::Rejected => counts[2] += n,
-            Status::Filtered => counts[3] += n,
-        }
-    }
+    let (finished, c) = run
+        .finish()
+        .map_err(|e| Stop::Coverage(format!("partition: {e}")))?;
+    let counts = [input.len() as u64, c.written, c.rejected, c.filtered];
     let plan = plan_of(opts);
     let layer: &dyn Layer = if opts.candidates {
         &CANDIDATE_LAYER
     } else {
         &SKELETON_LAYER
     };
-    let (mut rows, mut all, items, rejected) = outputs(results, &feats, layer);
+    let (mut rows, mut all, items, rejected) = outputs(kept, &feats, layer);
     if let Some(input_rows) = &input_rows {
         for r in &mut rows {
             *r = input_rows[*r as usize];
         }
     }
-    if let (true, Some(cov)) = (opts.partition, &params.neighbours) {
-        // The partitioned coverage, once every polygon is done: every
-        // unit, grown by what it received.
-        all.coverage =
-            skeletonise::partition::assemble(cov.units(), std::mem::take(&mut all.grown))
-                .map_err(|e| Stop::Coverage(format!("partition: {e}")))?;
-    }
+    all.append(finished);
     let columns = table::columns(layer, &plan, &all, &items);
-    let lines = table::lines(layer, &all, &items);
-    let geometry = if opts.geoarrow_out {
-        Encoded::Ragged(table::ragged(&lines))
-    } else {
-        Encoded::Wkb(map_in_order(&lines, par, |_, g| {
-            g.as_ref().map(|m| {
-                let mut out = Vec::new();
-                wkb::write_lines(m, &mut out);
-                out
-            })
-        }))
-    };
+    let geometry = encoded(&table::lines(layer, &all, &items), opts.geoarrow_out, par);
     let layers = if opts.candidates {
         Vec::new()
     } else {

@@ -26,7 +26,7 @@ use geo::MultiLineString;
 use order::in_order;
 use progress::Progress;
 use rayon::prelude::*;
-use record::{finish_run, Counts};
+use record::finish_run;
 use source::{merge_field, read_batches, read_neighbours, read_network, reader_gone, Merge};
 use std::collections::HashMap;
 use std::sync::mpsc;
@@ -317,14 +317,7 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
             Ok(Err(e)) => return Err(e.into()),
             Err(_) => return Err(reader_gone(reader)),
         };
-        let mut params = job.params.clone();
-        if !params.extra.is_empty() {
-            params.lonlat = info
-                .srs_wkt
-                .as_deref()
-                .and_then(crate::io::lonlat::lonlat_of);
-        }
-        let neighbours = second_inputs(job, &info, &mut params)?;
+        let (params, neighbours) = params_for(job, &info)?;
         let params = &params;
         let writer = Writer::create(
             &job.plan,
@@ -339,44 +332,13 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
         let every = opts.progress_every.unwrap_or(PROGRESS_EVERY);
         let mut progress = Progress::new(opts.progress, info.selected, every);
         let row_opts = RowOptions::of(&job.plan);
-        let mut counts = Counts::default();
         let workers = Workers {
             job,
             params,
             pool: &pool,
             row_opts,
         };
-        let mut gathered = Gathered::default();
-        let mut result = workers.compute(
-            &batch_rx,
-            &rows_tx,
-            &mut counts,
-            &mut progress,
-            &mut gathered,
-        );
-        progress.finish();
-        // The network's lines, split where they met the polygons.
-        if let (Ok(()), Some(net)) = (&result, &params.connect) {
-            let rows = Rows {
-                network: net.rows(&gathered.met),
-                ..Rows::default()
-            };
-            if rows_tx.send(rows).is_err() {
-                result = Ok(());
-            }
-        }
-        let grown = gathered.grown;
-        // The partitioned coverage: every unit, grown by what it received.
-        if let (Ok(()), Some(cov)) = (&result, &params.neighbours) {
-            match grown_coverage(cov, grown, &mut counts) {
-                Ok(rows) => {
-                    if rows_tx.send(rows).is_err() {
-                        result = Ok(());
-                    }
-                }
-                Err(e) => result = Err(e),
-            }
-        }
+        let (result, counts) = workers.run(&batch_rx, &rows_tx, &mut progress);
         // Stop the reader (if still reading) and let the writer drain.
         drop(batch_rx);
         drop(rows_tx);
@@ -388,7 +350,6 @@ pub fn run_job(job: &Job<'_>, opts: &RunOptions) -> Result<RunSummary, RunError>
         });
         let _ = reader.join();
         let writer = settled(result, written)?;
-        counts.network = params.connect.as_ref().map(|n| n.len() as u64);
         finish_run(job, &info, counts, threads, started, clock, writer)
     })
 }
@@ -420,6 +381,24 @@ fn merge_of(job: &Job<'_>) -> Merge {
     } else {
         Merge::None
     }
+}
+
+/// The run's parameters for the source found: longitude and latitude for
+/// the registered steps, the network and the coverage read (with the
+/// coverage's source, for the writer).
+fn params_for(
+    job: &Job<'_>,
+    info: &SourceInfo,
+) -> Result<(ProcessParams, Option<SourceInfo>), RunError> {
+    let mut params = job.params.clone();
+    if !params.extra.is_empty() {
+        params.lonlat = info
+            .srs_wkt
+            .as_deref()
+            .and_then(crate::io::lonlat::lonlat_of);
+    }
+    let neighbours = second_inputs(job, info, &mut params)?;
+    Ok((params, neighbours))
 }
 
 /// The run's second inputs, read before any feature: the line network of
@@ -454,17 +433,10 @@ fn log_start(job: &Job<'_>, info: &SourceInfo, threads: usize) {
     );
 }
 
-/// The partitioned coverage, once every polygon is done: every unit, grown
-/// by what it received (counted and logged).
-fn grown_coverage(
-    cov: &crate::partition::Coverage,
-    grown: Vec<(Option<u64>, crate::partition::Growth)>,
-    counts: &mut Counts,
-) -> Result<Rows, RunError> {
-    let clock = crate::clock::CpuClock::start();
-    let coverage = crate::partition::assemble(cov.units(), grown).map_err(RunError::Coverage)?;
-    counts.partition_time += clock.elapsed();
-    counts.units = Some(coverage.len() as u64);
+/// Logs what the partition gave: how many units grew and by how much, what
+/// they held of the collapsed polygons before, and the units that lie wholly
+/// in them.
+fn log_coverage(coverage: &[crate::partition::CoverageRow]) {
     let grew: Vec<f64> = coverage
         .iter()
         .map(|c| c.received)
@@ -493,7 +465,6 @@ fn grown_coverage(
             held.iter().sum::<f64>()
         );
     }
-    counts.area_held = held.iter().sum::<f64>() + 0.0;
     let landless: Vec<String> = coverage
         .iter()
         .filter(|c| c.held > 0.0 && c.geometry.0.is_empty())
@@ -510,20 +481,6 @@ fn grown_coverage(
             landless.join(", ")
         );
     }
-    Ok(Rows {
-        coverage,
-        ..Rows::default()
-    })
-}
-
-/// What the run gathers from every feature for the rows written once,
-/// after the features.
-#[derive(Default)]
-struct Gathered {
-    /// The pieces given to each unit of the partitioned coverage.
-    grown: Vec<(Option<u64>, crate::partition::Growth)>,
-    /// The connection points met by each network line (its FID).
-    met: Vec<(Option<u64>, geo::Coord<f64>)>,
 }
 
 /// What the worker threads need for every batch.
@@ -535,6 +492,34 @@ struct Workers<'a> {
 }
 
 impl Workers<'_> {
+    /// Every feature through the run driver ([`crate::process::Run`]),
+    /// then the rows it makes once after the last feature — the network's
+    /// lines split where they met the polygons, the partitioned coverage —
+    /// handed to the writer too; the result and the counts.
+    fn run(
+        &self,
+        batches: &mpsc::Receiver<Batch>,
+        rows_tx: &mpsc::SyncSender<Rows>,
+        progress: &mut Progress,
+    ) -> (Result<(), RunError>, crate::process::RunCounts) {
+        let mut run = crate::process::Run::new(self.params, self.job.on_error == OnError::Fail);
+        let result = self.compute(batches, rows_tx, &mut run, progress);
+        progress.finish();
+        match result.map(|()| run.finish()) {
+            Ok(Ok((rows, counts))) => {
+                if self.params.neighbours.is_some() {
+                    log_coverage(&rows.coverage);
+                }
+                // A closed channel: the writer stopped on an error; it
+                // says which after the workers.
+                let _ = rows_tx.send(rows);
+                (Ok(()), counts)
+            }
+            Ok(Err(e)) => (Err(RunError::Coverage(e)), Default::default()),
+            Err(e) => (Err(e), Default::default()),
+        }
+    }
+
     /// The workers' loop: every batch computed on the pool in parallel,
     /// counted, and handed to the writer in the order read. Up to
     /// [`IN_FLIGHT`] batches are computed at once, so a worker that has
@@ -545,9 +530,8 @@ impl Workers<'_> {
         &self,
         batches: &mpsc::Receiver<Batch>,
         rows_tx: &mpsc::SyncSender<Rows>,
-        counts: &mut Counts,
+        run: &mut crate::process::Run<'_>,
         progress: &mut Progress,
-        gathered: &mut Gathered,
     ) -> Result<(), RunError> {
         let (job, params, row_opts) = (self.job, self.params, self.row_opts);
         let next = || batches.recv().ok().map(|b| b.map_err(RunError::from));
@@ -558,18 +542,19 @@ impl Workers<'_> {
                 .collect()
         };
         in_order(self.pool, next, work, |features, done| {
-            counts.read += features.iter().map(Feature::source_count).sum::<u64>();
             let mut rows = Rows::default();
             for (f, r) in features.iter().zip(done) {
-                counts.add(f, &r, job.on_error)?;
-                rows.append(r.rows);
+                if job.on_error != OnError::Fail {
+                    for rej in &r.rows.rejected {
+                        tracing::warn!(fid = rej.src_fid, reason = %rej.reason, "feature rejected");
+                    }
+                }
+                let kept = run.add(f, r).map_err(|e| RunError::Rejected {
+                    fid: e.fid,
+                    reason: e.reason,
+                })?;
+                rows.append(kept);
             }
-            gathered.grown.append(&mut rows.grown);
-            gathered.met.extend(
-                rows.connections
-                    .iter()
-                    .filter_map(|c| c.geometry.0.last().map(|&p| (c.line_fid, p))),
-            );
             // A closed channel: the writer stopped on an error; it says
             // which after the workers.
             let more = rows_tx.send(rows).is_ok();

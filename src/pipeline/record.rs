@@ -2,85 +2,18 @@
 //! (`skeletonise_runs`), written before the file is renamed into place.
 
 use super::{ConnectCounts, Job, RunError, RunSummary};
-use crate::config::OnError;
-use crate::feature::Feature;
 use crate::io::writer::Writer;
 use crate::io::SourceInfo;
 use crate::methods::MethodId;
 use crate::output::RunRecord;
-use crate::process::{FeatureRows, StageTimes, Status};
+use crate::process::{RunCounts, StageTimes};
 use std::time::Instant;
-
-/// Counts of a run so far.
-#[derive(Debug, Default)]
-pub(super) struct Counts {
-    pub(super) read: u64,
-    written: u64,
-    rejected: u64,
-    filtered: u64,
-    rows: u64,
-    methods: std::collections::BTreeMap<String, u64>,
-    stages: Vec<(MethodId, StageTimes)>,
-    connections: u64,
-    lines_used: std::collections::BTreeSet<Option<u64>>,
-    /// Lines of `input.connect`, when the run has a network.
-    pub(super) network: Option<u64>,
-    /// Units of the partitioned coverage written, when the run partitions.
-    pub(super) units: Option<u64>,
-    /// With a partition: the area the units held of the collapsed polygons.
-    pub(super) area_held: f64,
-    /// The `partition` step's CPU time: the polygons, and the coverage
-    /// assembled at the end.
-    pub(super) partition_time: std::time::Duration,
-}
-
-impl Counts {
-    /// Counts one feature; under `on_error: fail` a rejection is the error.
-    pub(super) fn add(
-        &mut self,
-        f: &Feature,
-        r: &FeatureRows,
-        on_error: OnError,
-    ) -> Result<(), RunError> {
-        if let (OnError::Fail, Some(rej)) = (on_error, r.rows.rejected.first()) {
-            return Err(RunError::Rejected {
-                fid: f.fid.map_or_else(|| "(no fid)".into(), |x| x.to_string()),
-                reason: rej.reason.clone(),
-            });
-        }
-        for rej in &r.rows.rejected {
-            tracing::warn!(fid = rej.src_fid, reason = %rej.reason, "feature rejected");
-        }
-        match &r.status {
-            Status::Rejected => self.rejected += f.source_count(),
-            Status::Filtered => self.filtered += f.source_count(),
-            Status::Written(methods) => {
-                self.written += f.source_count();
-                for m in methods {
-                    *self.methods.entry(m.clone()).or_default() += 1;
-                }
-            }
-        }
-        self.rows += r.rows.skeletons.len() as u64;
-        self.connections += r.rows.connections.len() as u64;
-        self.lines_used
-            .extend(r.rows.connections.iter().map(|c| c.line_fid));
-        self.partition_time += r.partition_time;
-        for (m, t) in &r.times {
-            match self.stages.iter_mut().find(|(x, _)| x == m) {
-                Some((_, total)) => *total += *t,
-                None => self.stages.push((*m, *t)),
-            }
-        }
-        Ok(())
-    }
-}
 
 /// Records the run in the output and renames it into place.
 pub(super) fn finish_run(
     job: &Job<'_>,
     info: &SourceInfo,
-    mut counts: Counts,
+    mut counts: RunCounts,
     threads: usize,
     started: chrono::DateTime<chrono::Utc>,
     clock: Instant,

@@ -6,14 +6,17 @@
 //! The files run one way: `types` (parameters, candidates, outcomes) →
 //! `prepare` → `candidates` (every method's skeleton, pruned, extended and
 //! scored) → `outcome` (the choice and the steps after it) → `rows` (the
-//! output rows of a feature); `step` holds the registered steps, `merge` the
-//! dissolving of adjacent polygons (for the reader thread).
+//! output rows of a feature) → `run` (the run driver every caller shares:
+//! counts, `on_error`, and the rows made once after the last feature);
+//! `step` holds the registered steps, `merge` the dissolving of adjacent
+//! polygons (for the reader thread).
 
 mod candidates;
 pub mod merge;
 mod outcome;
 mod prepare;
 pub mod rows;
+pub mod run;
 pub mod step;
 mod types;
 
@@ -23,6 +26,7 @@ pub use outcome::{process, process_checked, process_given};
 pub(crate) use prepare::part_reason;
 pub use prepare::{prepare, prepare_checked, NotPrepared, PrepareParams};
 pub use rows::{feature_rows, FeatureRows, RowOptions, Skeletons, Status};
+pub use run::{FailedFeature, Run, RunCounts};
 pub use types::{
     Candidate, CandidateSkeleton, FeatureOutcome, ProcessParams, Processed, StageTimes, StepTime,
 };

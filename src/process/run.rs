@@ -1,0 +1,160 @@
+//! The run driver every caller shares — the command line's pipeline and the
+//! Python module (and so Dask and QGIS): features go in, in read order, as
+//! [`FeatureRows`] (computed by [`super::feature_rows`] on any thread); the
+//! run counts them, applies `on_error: fail`, keeps what the steps need
+//! after the last feature (the pieces each unit received, the points where
+//! the network's lines met the polygons), and [`Run::finish`] makes those
+//! rows once: the network's lines split at the polygons, the partitioned
+//! coverage. No I/O: the caller reads, writes and logs.
+
+use super::{FeatureRows, ProcessParams, StageTimes, Status};
+use crate::feature::Feature;
+use crate::methods::MethodId;
+use crate::output::Rows;
+use std::collections::{BTreeMap, BTreeSet};
+use std::time::Duration;
+
+/// Counts of a run so far, by source feature (a feature merged from several
+/// adjacent ones counts each).
+#[derive(Debug, Default, Clone, PartialEq)]
+pub struct RunCounts {
+    /// Features read.
+    pub read: u64,
+    /// Features written.
+    pub written: u64,
+    /// Features rejected.
+    pub rejected: u64,
+    /// Features filtered (`min_area`).
+    pub filtered: u64,
+    /// Skeleton rows written.
+    pub rows: u64,
+    /// Rows per chosen method.
+    pub methods: BTreeMap<String, u64>,
+    /// Each method's step times, summed over the features.
+    pub stages: Vec<(MethodId, StageTimes)>,
+    /// Connection legs made.
+    pub connections: u64,
+    /// The network lines (FIDs) a leg was made for.
+    pub lines_used: BTreeSet<Option<u64>>,
+    /// Lines of `input.connect`, when the run has a network (set by
+    /// [`Run::finish`]).
+    pub network: Option<u64>,
+    /// Units of the partitioned coverage, when the run partitions (set by
+    /// [`Run::finish`]).
+    pub units: Option<u64>,
+    /// With a partition: the area the units held of the collapsed polygons
+    /// before (set by [`Run::finish`]).
+    pub area_held: f64,
+    /// The `partition` step's CPU time: the polygons, and the coverage
+    /// assembled at the end.
+    pub partition_time: Duration,
+}
+
+/// A feature rejected under `on_error: fail`: the run stops.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FailedFeature {
+    /// Its FID, or `(no fid)`.
+    pub fid: String,
+    /// Why it was rejected.
+    pub reason: String,
+}
+
+/// One run's counts and what it gathers for after the last feature.
+#[derive(Debug)]
+pub struct Run<'a> {
+    params: &'a ProcessParams,
+    fail: bool,
+    counts: RunCounts,
+    grown: Vec<(Option<u64>, crate::partition::Growth)>,
+    met: Vec<(Option<u64>, geo::Coord<f64>)>,
+}
+
+impl<'a> Run<'a> {
+    /// A run of `params`; with `fail` (`on_error: fail`) the first
+    /// rejected feature stops it.
+    pub fn new(params: &'a ProcessParams, fail: bool) -> Self {
+        Self {
+            params,
+            fail,
+            counts: RunCounts::default(),
+            grown: Vec::new(),
+            met: Vec::new(),
+        }
+    }
+
+    /// Counts feature `f` with its rows `r` (features in read order) and
+    /// keeps what [`Self::finish`] needs; returns the rows to write, or the
+    /// rejection that stops the run under `on_error: fail`.
+    pub fn add(&mut self, f: &Feature, r: FeatureRows) -> Result<Rows, FailedFeature> {
+        let c = &mut self.counts;
+        c.read += f.source_count();
+        if let (true, Some(rej)) = (self.fail, r.rows.rejected.first()) {
+            return Err(FailedFeature {
+                fid: f.fid.map_or_else(|| "(no fid)".into(), |x| x.to_string()),
+                reason: rej.reason.clone(),
+            });
+        }
+        match &r.status {
+            Status::Rejected => c.rejected += f.source_count(),
+            Status::Filtered => c.filtered += f.source_count(),
+            Status::Written(methods) => {
+                c.written += f.source_count();
+                for m in methods {
+                    *c.methods.entry(m.clone()).or_default() += 1;
+                }
+            }
+        }
+        let mut rows = r.rows;
+        c.rows += rows.skeletons.len() as u64;
+        c.connections += rows.connections.len() as u64;
+        c.lines_used
+            .extend(rows.connections.iter().map(|l| l.line_fid));
+        c.partition_time += r.partition_time;
+        for (m, t) in &r.times {
+            match c.stages.iter_mut().find(|(x, _)| x == m) {
+                Some((_, total)) => *total += *t,
+                None => c.stages.push((*m, *t)),
+            }
+        }
+        self.grown.append(&mut rows.grown);
+        self.met.extend(
+            rows.connections
+                .iter()
+                .filter_map(|l| l.geometry.0.last().map(|&p| (l.line_fid, p))),
+        );
+        Ok(rows)
+    }
+
+    /// The counts so far.
+    pub fn counts(&self) -> &RunCounts {
+        &self.counts
+    }
+
+    /// After the last feature: the network's lines split where they met the
+    /// polygons (with `input.connect`), the partitioned coverage — every
+    /// unit grown by what it received — (with `partition`), and the counts.
+    /// Fails when a unit of the coverage cannot be written valid.
+    pub fn finish(mut self) -> Result<(Rows, RunCounts), String> {
+        let mut rows = Rows::default();
+        if let Some(net) = &self.params.connect {
+            rows.network = net.rows(&self.met);
+            self.counts.network = Some(net.len() as u64);
+        }
+        if let (Some(_), Some(cov)) = (&self.params.partition, &self.params.neighbours) {
+            let clock = crate::clock::CpuClock::start();
+            let grown = std::mem::take(&mut self.grown);
+            rows.coverage = crate::partition::assemble(cov.units(), grown)?;
+            let c = &mut self.counts;
+            c.partition_time += clock.elapsed();
+            c.units = Some(rows.coverage.len() as u64);
+            c.area_held = rows
+                .coverage
+                .iter()
+                .map(|u| u.held)
+                .filter(|&a| a > 0.0)
+                .sum::<f64>()
+                + 0.0;
+        }
+        Ok((rows, self.counts))
+    }
+}
