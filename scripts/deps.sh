@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs the system packages skeletonise needs (Debian/Ubuntu): GDAL ≥ 3.6 with its
 # headers (the gdal crate links to it), pkg-config (to find it) and gdal-bin (ogrinfo).
-# With --browser also Chromium, in which the report's test opens the report (tests/report.rs).
+# With --browser also Chromium, in which the report's test opens the report (tests/all/report.rs).
 set -euo pipefail
 need=()
 command -v gdal-config >/dev/null 2>&1 || need+=(libgdal-dev)

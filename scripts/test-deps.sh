@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs what the tests need beyond the build (Debian/Ubuntu): PostgreSQL with PostGIS for the
-# test that reads a real PostGIS source (tests/postgis.rs starts a throw-away cluster itself).
+# test that reads a real PostGIS source (tests/all/postgis.rs starts a throw-away cluster itself).
 set -euo pipefail
 need=()
 ls /usr/lib/postgresql/*/bin/initdb >/dev/null 2>&1 || need+=(postgresql)

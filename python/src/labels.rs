@@ -13,6 +13,7 @@ use geo::{Coord, Geometry};
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
 use rayon::prelude::*;
+use skeletonise::feature::Feature;
 use skeletonise::label::{Label, LabelParams, Labelled};
 use skeletonise::process::{prepare_checked, NotPrepared, PrepareParams};
 
@@ -33,7 +34,6 @@ type Row = (usize, Option<usize>, Result<Option<Labelled>, String>);
 /// reason in `rejected`.
 #[pyfunction]
 #[pyo3(signature = (wkbs, options, threads = None, *, repaired = None, make_valid = false))]
-#[allow(clippy::type_complexity)]
 pub fn labels<'py>(
     py: Python<'py>,
     wkbs: Vec<Option<Vec<u8>>>,
@@ -41,16 +41,7 @@ pub fn labels<'py>(
     threads: Option<usize>,
     repaired: Option<Vec<bool>>,
     make_valid: bool,
-) -> PyResult<(
-    Vec<usize>,
-    Vec<Option<usize>>,
-    Vec<Option<&'static str>>,
-    Vec<Option<f64>>,
-    Vec<Option<f64>>,
-    Vec<Option<f64>>,
-    Vec<Option<Bound<'py, PyBytes>>>,
-    Vec<Option<String>>,
-)> {
+) -> PyResult<Columns<'py>> {
     let params: LabelParams = serde_json::from_str(options)
         .map_err(|e| crate::PipelineError::new_err(format!("label options: {e}")))?;
     params
@@ -69,28 +60,9 @@ pub fn labels<'py>(
         max_vertices: 0,
     };
     let input = Input::Wkb(wkbs.iter().map(Option::as_deref).collect());
-    let work = || -> Vec<Row> {
+    let work = || {
         let feats = features(&input, None, repaired.as_deref(), input.len() > 1);
-        feats
-            .par_iter()
-            .enumerate()
-            .flat_map_iter(|(i, f)| -> Vec<Row> {
-                if let Some(e) = &f.geometry_error {
-                    return vec![(i, None, Err(e.clone()))];
-                }
-                match prepare_checked(f.geometry.as_ref(), &prep, f.checked) {
-                    Ok(parts) => params
-                        .labels(&parts)
-                        .into_iter()
-                        .map(|(k, l)| (i, Some(k), Ok(l)))
-                        .collect(),
-                    Err(NotPrepared::Rejected(r)) => vec![(i, None, Err(r))],
-                    Err(NotPrepared::Filtered) => {
-                        vec![(i, None, Err("no polygon part".into()))]
-                    }
-                }
-            })
-            .collect()
+        label_rows(&feats, &params, &prep)
     };
     let rows: Vec<Row> = match threads {
         Some(n) => {
@@ -99,58 +71,88 @@ pub fn labels<'py>(
         }
         None => py.detach(work),
     };
+    Ok(columns(py, rows))
+}
+
+/// The columns `labels` returns: `(row, polygon_part, kind, length,
+/// max_width, elongation, wkb, rejected)`.
+type Columns<'py> = (
+    Vec<usize>,
+    Vec<Option<usize>>,
+    Vec<Option<&'static str>>,
+    Vec<Option<f64>>,
+    Vec<Option<f64>>,
+    Vec<Option<f64>>,
+    Vec<Option<Bound<'py, PyBytes>>>,
+    Vec<Option<String>>,
+);
+
+/// Every feature's labels (one row per labelled part), or one row with
+/// the reason a feature cannot be prepared.
+fn label_rows(feats: &[Feature], params: &LabelParams, prep: &PrepareParams) -> Vec<Row> {
+    feats
+        .par_iter()
+        .enumerate()
+        .flat_map_iter(|(i, f)| -> Vec<Row> {
+            if let Some(e) = &f.geometry_error {
+                return vec![(i, None, Err(e.clone()))];
+            }
+            match prepare_checked(f.geometry.as_ref(), prep, f.checked) {
+                Ok(parts) => params
+                    .labels(&parts)
+                    .into_iter()
+                    .map(|(k, l)| (i, Some(k), Ok(l)))
+                    .collect(),
+                Err(NotPrepared::Rejected(r)) => vec![(i, None, Err(r))],
+                Err(NotPrepared::Filtered) => vec![(i, None, Err("no polygon part".into()))],
+            }
+        })
+        .collect()
+}
+
+/// The rows as the columns Python reads.
+fn columns(py: Python<'_>, rows: Vec<Row>) -> Columns<'_> {
     let n = rows.len();
-    let (mut row, mut part, mut kind) = (
+    let mut c: Columns<'_> = (
+        Vec::with_capacity(n),
+        Vec::with_capacity(n),
+        Vec::with_capacity(n),
+        Vec::with_capacity(n),
+        Vec::with_capacity(n),
         Vec::with_capacity(n),
         Vec::with_capacity(n),
         Vec::with_capacity(n),
     );
-    let (mut length, mut width, mut elongation) = (
-        Vec::with_capacity(n),
-        Vec::with_capacity(n),
-        Vec::with_capacity(n),
-    );
-    let (mut geometry, mut rejected) = (Vec::with_capacity(n), Vec::with_capacity(n));
     for (i, k, l) in rows {
-        row.push(i);
-        part.push(k);
-        let (g, reason) = match l {
+        c.0.push(i);
+        c.1.push(k);
+        let (kind, measures, g, reason) = match l {
             Ok(Some(l)) => {
-                kind.push(Some(match l.label {
-                    Label::Line(_) => "line",
-                    Label::Point(_) => "point",
-                }));
-                length.push(Some(l.length));
-                width.push(Some(l.max_width));
-                elongation.push(Some(l.elongation));
                 let mut out = Vec::new();
-                match &l.label {
-                    Label::Line(line) => write(&Geometry::LineString(line.clone()), &mut out),
-                    Label::Point(c) => write(&Geometry::Point(c.to_owned().into()), &mut out),
-                }
-                (Some(PyBytes::new(py, &out)), None)
+                let kind = match &l.label {
+                    Label::Line(line) => {
+                        write(&Geometry::LineString(line.clone()), &mut out);
+                        "line"
+                    }
+                    Label::Point(p) => {
+                        write(&Geometry::Point(p.to_owned().into()), &mut out);
+                        "point"
+                    }
+                };
+                let m = [Some(l.length), Some(l.max_width), Some(l.elongation)];
+                (Some(kind), m, Some(PyBytes::new(py, &out)), None)
             }
-            Ok(None) => {
-                kind.push(Some("none"));
-                length.push(None);
-                width.push(None);
-                elongation.push(None);
-                (None, None)
-            }
-            Err(r) => {
-                kind.push(None);
-                length.push(None);
-                width.push(None);
-                elongation.push(None);
-                (None, Some(r))
-            }
+            Ok(None) => (Some("none"), [None; 3], None, None),
+            Err(r) => (None, [None; 3], None, Some(r)),
         };
-        geometry.push(g);
-        rejected.push(reason);
+        c.2.push(kind);
+        c.3.push(measures[0]);
+        c.4.push(measures[1]);
+        c.5.push(measures[2]);
+        c.6.push(g);
+        c.7.push(reason);
     }
-    Ok((
-        row, part, kind, length, width, elongation, geometry, rejected,
-    ))
+    c
 }
 
 /// A point or a line as little-endian ISO WKB.

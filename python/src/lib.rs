@@ -115,6 +115,45 @@ impl Pipeline {
         })
     }
 
+    /// The coverage of a `partition` step (`partition`) from the units
+    /// `neighbours` (WKB) and their FIDs, with `neighbour_snap` or else the
+    /// pipeline file's `input.neighbours.snap`; an error when the one is
+    /// given without the other.
+    fn units(
+        &self,
+        partition: bool,
+        neighbours: Option<Vec<Option<Vec<u8>>>>,
+        neighbour_fids: Option<Vec<i64>>,
+        neighbour_snap: Option<f64>,
+    ) -> PyResult<Option<std::sync::Arc<skeletonise::partition::Coverage>>> {
+        match (partition, neighbours) {
+            (true, Some(units)) => {
+                let from_file = self
+                    .steps
+                    .file
+                    .input
+                    .as_ref()
+                    .and_then(|i| i.neighbours.as_ref())
+                    .and_then(|n| n.snap);
+                let snap = neighbour_snap.or(from_file);
+                if snap.is_some_and(|s| !(s.is_finite() && s >= 0.0)) {
+                    return Err(PipelineError::new_err(
+                        "`neighbour_snap` must be ≥ 0 (CRS units of the polygons); leave it out for 1e-7 × each polygon's extent",
+                    ));
+                }
+                let cov = coverage(&units, neighbour_fids.as_deref())?.with_snap(snap);
+                Ok(Some(std::sync::Arc::new(cov)))
+            }
+            (true, None) => Err(PipelineError::new_err(
+                "the `partition` step gives the polygons' area to the units of a coverage: give it as `neighbours` (the polygons of `input.neighbours`)",
+            )),
+            (false, Some(_)) => Err(PipelineError::new_err(
+                "`neighbours` is the coverage of a `partition` step, and the pipeline has none",
+            )),
+            (false, None) => Ok(None),
+        }
+    }
+
     /// What the command line refuses of a file whose `input` lacks the
     /// lines (`connect`: they are given): `prune: {mode: network}` without
     /// `input.connect`, with the command line's message. Without this a
@@ -284,38 +323,7 @@ impl Pipeline {
         self.refuse_without_lines(connect.is_some())?;
         let mut params = self.steps.process_params();
         let partition = params.partition.is_some();
-        match (partition, neighbours) {
-            (true, Some(units)) => {
-                // `neighbour_snap`, else the pipeline file's `input.neighbours.snap`.
-                let from_file = self
-                    .steps
-                    .file
-                    .input
-                    .as_ref()
-                    .and_then(|i| i.neighbours.as_ref())
-                    .and_then(|n| n.snap);
-                let snap = neighbour_snap.or(from_file);
-                if snap.is_some_and(|s| !(s.is_finite() && s >= 0.0)) {
-                    return Err(PipelineError::new_err(
-                        "`neighbour_snap` must be ≥ 0 (CRS units of the polygons); leave it out for 1e-7 × each polygon's extent",
-                    ));
-                }
-                params.neighbours = Some(std::sync::Arc::new(
-                    coverage(&units, neighbour_fids.as_deref())?.with_snap(snap),
-                ));
-            }
-            (true, None) => {
-                return Err(PipelineError::new_err(
-                    "the `partition` step gives the polygons' area to the units of a coverage: give it as `neighbours` (the polygons of `input.neighbours`)",
-                ))
-            }
-            (false, Some(_)) => {
-                return Err(PipelineError::new_err(
-                    "`neighbours` is the coverage of a `partition` step, and the pipeline has none",
-                ))
-            }
-            (false, None) => {}
-        }
+        params.neighbours = self.units(partition, neighbours, neighbour_fids, neighbour_snap)?;
         // A partition merges adjacent polygons by FID: positions stand in for missing FIDs.
         let positions: Option<numpy::PyReadonlyArray1<'py, i64>> = match (&fids, partition) {
             (None, true) => {

@@ -304,6 +304,42 @@ fn encoded(lines: &[Option<geo::MultiLineString<f64>>], geoarrow: bool, par: boo
     }))
 }
 
+/// Every feature's rows, in order (`None`: cancelled by the caller's flag,
+/// read before each feature).
+fn feature_rows_of(
+    feats: &[Feature],
+    params: &ProcessParams,
+    opts: &Options,
+    par: bool,
+) -> Option<Vec<FeatureRows>> {
+    let row_opts = RowOptions {
+        explode: opts.explode,
+        candidates: opts.candidates || opts.with_candidates,
+        bars: false,
+        widths: false,
+        measures: false,
+        network: false,
+    };
+    let cancelled = || {
+        opts.cancel
+            .as_ref()
+            .is_some_and(|c| c.load(std::sync::atomic::Ordering::Relaxed))
+    };
+    let results: Vec<Option<FeatureRows>> = map_in_order(feats, par, |i, f| {
+        (!cancelled()).then(|| {
+            let skeletons = match &opts.given {
+                None => Skeletons::Computed,
+                Some(g) => Skeletons::Given {
+                    label: &g.label,
+                    lines: g.lines.get(i),
+                },
+            };
+            feature_rows(f, skeletons, params, row_opts)
+        })
+    });
+    results.into_iter().collect()
+}
+
 fn work(
     input: &Input<'_>,
     fids: Option<&[i64]>,
@@ -321,34 +357,7 @@ fn work(
         false => (feats, None),
     };
     let t1 = Instant::now();
-    let row_opts = RowOptions {
-        explode: opts.explode,
-        candidates: opts.candidates || opts.with_candidates,
-        bars: false,
-        widths: false,
-        measures: false,
-        network: false,
-    };
-    let cancelled = || {
-        opts.cancel
-            .as_ref()
-            .is_some_and(|c| c.load(std::sync::atomic::Ordering::Relaxed))
-    };
-    let results: Vec<Option<FeatureRows>> = map_in_order(&feats, par, |i, f| {
-        (!cancelled()).then(|| {
-            let skeletons = match &opts.given {
-                None => Skeletons::Computed,
-                Some(g) => Skeletons::Given {
-                    label: &g.label,
-                    lines: g.lines.get(i),
-                },
-            };
-            feature_rows(f, skeletons, params, row_opts)
-        })
-    });
-    let Some(results) = results.into_iter().collect::<Option<Vec<FeatureRows>>>() else {
-        return Err(Stop::Cancelled);
-    };
+    let results = feature_rows_of(&feats, params, opts, par).ok_or(Stop::Cancelled)?;
     let t2 = Instant::now();
     // The one run driver of the command line: counts, `on_error: fail`,
     // and the rows made after the last feature (the grown coverage).
@@ -520,6 +529,59 @@ struct RaggedArrays<'py> {
     null: Option<PyReadonlyArray1<'py, bool>>,
 }
 
+/// The ragged arrays of geometry type `type_id` (3: polygons, two offset
+/// levels; 6: multipolygons, three) as the run's input, checked.
+fn ragged_input<'a>(type_id: i32, arrays: &'a RaggedArrays<'_>) -> PyResult<Input<'a>> {
+    let multi = match (type_id, arrays.offsets.len()) {
+        (3, 2) => false,
+        (6, 3) => true,
+        _ => {
+            return Err(PyValueError::new_err(format!(
+                "ragged arrays of geometry type {type_id} with {} offset levels: only polygons (3, two levels) and multipolygons (6, three levels)",
+                arrays.offsets.len()
+            )))
+        }
+    };
+    let coords = arrays.coords.as_slice().map_err(value_error)?;
+    let offsets = arrays
+        .offsets
+        .iter()
+        .map(|o| o.as_slice())
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(value_error)?;
+    check_offsets(coords.len() / 2, &offsets).map_err(PyValueError::new_err)?;
+    let null = arrays
+        .null
+        .as_ref()
+        .map(|n| n.as_slice())
+        .transpose()
+        .map_err(value_error)?;
+    Ok(Input::Ragged {
+        multi,
+        coords,
+        offsets,
+        null,
+    })
+}
+
+/// Fails unless `fids`, `repaired` and the ragged input's `null` (when
+/// given) have one entry per geometry.
+fn check_lengths(input: &Input<'_>, fids: Option<usize>, repaired: Option<usize>) -> PyResult<()> {
+    let n = input.len();
+    let null = match input {
+        Input::Ragged { null: Some(nl), .. } => Some(nl.len()),
+        _ => None,
+    };
+    for (what, len) in [("fids", fids), ("repaired", repaired), ("null", null)] {
+        if let Some(len) = len.filter(|&l| l != n) {
+            return Err(PyValueError::new_err(format!(
+                "{what} has {len} entries for {n} geometries"
+            )));
+        }
+    }
+    Ok(())
+}
+
 /// `Pipeline.run`.
 pub fn run<'py>(
     py: Python<'py>,
@@ -544,41 +606,12 @@ pub fn run<'py>(
     let arrays: RaggedArrays<'py>;
     let input = if let Ok(t) = geometry.cast::<PyTuple>() {
         let (type_id, coords, offsets, null): RaggedTuple<'py> = t.extract()?;
-        let multi = match (type_id, offsets.len()) {
-            (3, 2) => false,
-            (6, 3) => true,
-            _ => {
-                return Err(PyValueError::new_err(format!(
-                    "ragged arrays of geometry type {type_id} with {} offset levels: only polygons (3, two levels) and multipolygons (6, three levels)",
-                    offsets.len()
-                )))
-            }
-        };
         arrays = RaggedArrays {
             coords,
             offsets,
             null,
         };
-        let coords = arrays.coords.as_slice().map_err(value_error)?;
-        let offsets = arrays
-            .offsets
-            .iter()
-            .map(|o| o.as_slice())
-            .collect::<Result<Vec<_>, _>>()
-            .map_err(value_error)?;
-        check_offsets(coords.len() / 2, &offsets).map_err(PyValueError::new_err)?;
-        let null = arrays
-            .null
-            .as_ref()
-            .map(|n| n.as_slice())
-            .transpose()
-            .map_err(value_error)?;
-        Input::Ragged {
-            multi,
-            coords,
-            offsets,
-            null,
-        }
+        ragged_input(type_id, &arrays)?
     } else {
         wkbs = geometry.extract()?;
         Input::Wkb(
@@ -587,25 +620,7 @@ pub fn run<'py>(
                 .collect(),
         )
     };
-    let n = input.len();
-    for (what, len) in [
-        ("fids", fids.map(<[i64]>::len)),
-        ("repaired", repaired.map(<[bool]>::len)),
-    ] {
-        if let Some(len) = len.filter(|&l| l != n) {
-            return Err(PyValueError::new_err(format!(
-                "{what} has {len} entries for {n} geometries"
-            )));
-        }
-    }
-    if let Input::Ragged { null: Some(nl), .. } = &input {
-        if nl.len() != n {
-            return Err(PyValueError::new_err(format!(
-                "null has {} entries for {n} geometries",
-                nl.len()
-            )));
-        }
-    }
+    check_lengths(&input, fids.map(<[i64]>::len), repaired.map(<[bool]>::len))?;
     let done = detached(py, &input, fids, repaired, params, opts)?.map_err(|e| match e {
         Stop::Rejected(text) => RejectedError::new_err(text),
         Stop::Cancelled => Cancelled::new_err("cancelled"),

@@ -27,7 +27,7 @@
 //! | [`SHORT_OF_END`] | 10⁻⁶ | × a segment's length | a segment stopped short of ∂P |
 //!
 //! The values are those the outputs were made with; changing one changes
-//! outputs (`tests/golden.rs`).
+//! outputs (`tests/all/golden.rs`).
 
 /// Two points closer than `SAME_POINT × extent` are one, and a point that
 /// close to ∂P is on it (SPEC §3: points within 10⁻⁹ × extent of P count as

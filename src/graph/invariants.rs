@@ -13,7 +13,7 @@ impl SkeletonGraph {
     /// that is broken, and where, or `Ok`.
     ///
     /// Public (not `#[cfg(test)]`) because the integration tests in
-    /// `tests/` and the author of a new method (see `tests/registry.rs`)
+    /// `tests/` and the author of a new method (see `tests/all/registry.rs`)
     /// call it on graphs the library made, and they cannot see the
     /// library's test-only items; hidden from the documentation because it
     /// is a check for tests, not part of the graph's interface. It costs

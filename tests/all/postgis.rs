@@ -7,8 +7,7 @@
 //! them). Without them the test says so and passes, unless
 //! `SKELETONISE_REQUIRE_POSTGIS` is set (as CI sets it).
 
-mod common;
-use common::*;
+use crate::common::*;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 

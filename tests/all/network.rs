@@ -7,9 +7,7 @@
 //! constructed cases.
 #![cfg(all(feature = "cli", feature = "gdal"))]
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use gdal::vector::LayerAccess;
 use geo::{Coord, Geometry, Intersects, LineString, MultiLineString, Polygon};
 use skeletonise::graph::SkeletonGraph;

@@ -4,8 +4,7 @@
 //! outcome: exit code, a fragment of the message, and the run's counts of
 //! features read, written and rejected (from `skeletonise_runs`).
 
-mod common;
-use common::*;
+use crate::common::*;
 use std::path::Path;
 
 /// What a case must give.

@@ -4,9 +4,7 @@
 //! horns, and the roughness of a rim leaves no thicket of legs.
 #![cfg(all(feature = "cli", feature = "gdal"))]
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use geo::{Coord, LineString, MultiLineString, Polygon};
 use skeletonise::geometry::PreparedPolygon;
 use skeletonise::graph::prune::{prune, PruneParams};

@@ -4,11 +4,10 @@
 //! the GeoPackage holds. `SKELETONISE_UPDATE_README=1 cargo test --test
 //! readme` writes the block instead.
 
-mod common;
-use common::*;
+use crate::common::*;
 use gdal::vector::LayerAccess;
 
-const BEGIN: &str = "<!-- demo-rows: made by tests/readme.rs from out/demo.gpkg (SKELETONISE_UPDATE_README=1 cargo test --test readme writes it) -->";
+const BEGIN: &str = "<!-- demo-rows: made by tests/all/readme.rs from out/demo.gpkg (SKELETONISE_UPDATE_README=1 cargo test --test all readme:: writes it) -->";
 const END: &str = "<!-- /demo-rows -->";
 
 /// The example block: the layers, then the first rows of `skeletons`.
@@ -78,5 +77,5 @@ fn the_readme_shows_the_demos_real_rows() {
         std::fs::write(&path, readme.replace(have, &want)).unwrap();
         return;
     }
-    assert_eq!(have, want, "the README's demo rows are not the demo's output: SKELETONISE_UPDATE_README=1 cargo test --test readme writes them");
+    assert_eq!(have, want, "the README's demo rows are not the demo's output: SKELETONISE_UPDATE_README=1 cargo test --test all readme:: writes them");
 }

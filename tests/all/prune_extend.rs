@@ -3,9 +3,8 @@
 // Without GDAL the training-layer tests are left out, and with them some imports.
 #![cfg_attr(not(feature = "gdal"), allow(unused_imports, dead_code))]
 
-mod common;
 #[cfg(feature = "gdal")]
-use common::TRAIN;
+use crate::common::TRAIN;
 use geo::{Coord, LineString, Polygon};
 use skeletonise::geometry::tolerance::SAME_POINT;
 use skeletonise::geometry::PreparedPolygon;
@@ -313,10 +312,10 @@ fn a_lone_method_gets_the_legs_it_has_among_all_five() {
     // methods: CDT or StSk alone draw exactly the lines they have as
     // candidates of the five-method comparison (pruned on its own, a lone
     // method on a rough rim kept thousands of legs).
-    let d = common::tmp();
+    let d = crate::common::tmp();
     let all = d.path().join("all.gpkg");
     let run = |out: &std::path::Path, methods: &str| {
-        let o = common::skeletonise(&[
+        let o = crate::common::skeletonise(&[
             "run",
             "pipelines/compare-methods.yaml",
             "--set",
@@ -327,26 +326,27 @@ fn a_lone_method_gets_the_legs_it_has_among_all_five() {
             out.to_str().unwrap(),
             "-q",
         ]);
-        let (code, err) = common::code_and_err(&o);
+        let (code, err) = crate::common::code_and_err(&o);
         assert_eq!(code, 0, "{err}");
     };
     run(&all, "[MA, StSk, DVD, CDT, VD]");
-    let ds = common::open(&all);
-    let methods = common::strings(&ds, "candidates", "method");
-    let fids = common::ints(&ds, "candidates", "src_fid");
-    let lines = common::wkts(&ds, "candidates");
+    let ds = crate::common::open(&all);
+    let methods = crate::common::strings(&ds, "candidates", "method");
+    let fids = crate::common::ints(&ds, "candidates", "src_fid");
+    let lines = crate::common::wkts(&ds, "candidates");
     for m in ["CDT", "StSk"] {
         let alone = d.path().join(format!("{m}.gpkg"));
         run(&alone, &format!("[{m}]"));
-        let a = common::open(&alone);
+        let a = crate::common::open(&alone);
         let want: Vec<(Option<i64>, Option<String>)> = (0..methods.len())
             .filter(|&i| methods[i].as_deref() == Some(m))
             .map(|i| (fids[i], lines[i].clone()))
             .collect();
-        let got: Vec<(Option<i64>, Option<String>)> = common::ints(&a, "skeletons", "src_fid")
-            .into_iter()
-            .zip(common::wkts(&a, "skeletons"))
-            .collect();
+        let got: Vec<(Option<i64>, Option<String>)> =
+            crate::common::ints(&a, "skeletons", "src_fid")
+                .into_iter()
+                .zip(crate::common::wkts(&a, "skeletons"))
+                .collect();
         assert_eq!(got.len(), 18);
         assert_eq!(got, want, "{m} alone");
     }

@@ -7,8 +7,9 @@
 //! constructed cases — are in `python/tests/test_partition.py`, which has
 //! GEOS's coverage validation at hand.
 
-mod common;
-use common::{code_and_err, first_text, ints, open, pipeline, reals, skeletonise, tmp, wkts};
+use crate::common::{
+    code_and_err, first_text, ints, open, pipeline, reals, skeletonise, tmp, wkts,
+};
 use gdal::vector::LayerAccess;
 
 const COVERAGE: &str = "tests/data/coverage-train.gpkg";
@@ -214,7 +215,7 @@ fn border_run(dir: &std::path::Path, water: &str, units: &str) -> (Vec<f64>, Str
     assert_eq!(code, 0, "{err}");
     let ds = open(&out);
     assert!(
-        ds.layer_by_name("rejected").is_err() || common::count(&ds, "rejected") == 0,
+        ds.layer_by_name("rejected").is_err() || crate::common::count(&ds, "rejected") == 0,
         "{err}"
     );
     let mut cov = ds.layer_by_name("coverage").unwrap();
@@ -256,13 +257,13 @@ fn units_that_cover_a_real_lake_are_cut_and_the_same_in_longitude_latitude() {
 fn a_unit_with_a_nan_coordinate_is_named_and_nothing_panics() {
     let dir = tmp();
     let src = dir.path().join("case.gpkg");
-    common::make_layer(
+    crate::common::make_layer(
         &src,
         "rivers",
         3857,
         &[Some("POLYGON((0 0,100 0,100 10,0 10,0 0))")],
     );
-    common::make_layer(
+    crate::common::make_layer(
         &src,
         "units",
         3857,

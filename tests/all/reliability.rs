@@ -2,8 +2,7 @@
 //! success for a run that did nothing, reject a valid polygon, hang, write
 //! an empty row as a result — each through the real binary.
 
-mod common;
-use common::*;
+use crate::common::*;
 use std::path::Path;
 
 fn out_err(o: &std::process::Output) -> String {

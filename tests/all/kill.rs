@@ -3,8 +3,7 @@
 //! output byte for byte as it was and, once the next run on the same output
 //! has started, no temporary file.
 
-mod common;
-use common::*;
+use crate::common::*;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};

@@ -2,10 +2,9 @@
 //! on the training data, fingerprinted: a change to what any of them writes
 //! fails here. The fingerprints in `tests/golden.txt` come from the real
 //! binary; after an intended change of the output, regenerate them with
-//! `SKELETONISE_BLESS=1 cargo test --test golden` and say why in the commit.
+//! `SKELETONISE_BLESS=1 cargo test --test all golden::` and say why in the commit.
 
-mod common;
-use common::{canonical, fingerprint, root, skeletonise, tmp, TRAIN};
+use crate::common::{canonical, fingerprint, root, skeletonise, tmp, TRAIN};
 use std::collections::BTreeMap;
 
 /// Every run: its name and its command-line arguments (the output is added).
@@ -26,7 +25,7 @@ fn runs() -> Vec<(String, Vec<String>)> {
             ]),
         ));
     }
-    for l in common::LAYERS {
+    for l in crate::common::LAYERS {
         runs.push((
             format!("compare-{l}"),
             s(&[
@@ -118,6 +117,6 @@ fn every_pipeline_and_score_writes_what_it_wrote_before() {
     let _ = TRAIN;
     assert_eq!(
         text, want,
-        "outputs changed; if intended, regenerate with SKELETONISE_BLESS=1 cargo test --test golden"
+        "outputs changed; if intended, regenerate with SKELETONISE_BLESS=1 cargo test --test all golden::"
     );
 }

@@ -8,9 +8,8 @@
 //! `tests/data/fuzz-seeds.wkt` holds the seed corpus (one WKT polygon per
 //! line), always run first. The number of random cases is
 //! `PROPTEST_CASES` (default 48): `PROPTEST_CASES=200000 cargo test --release
-//! --test fuzz` is the long run.
+//! --test all fuzz::` is the long run.
 
-mod common;
 use geo::{Coord, Geometry, LineString, Polygon};
 use proptest::prelude::*;
 use skeletonise::geometry::PreparedPolygon;
@@ -193,7 +192,7 @@ fn polygon_strategy() -> impl Strategy<Value = Polygon<f64>> {
 
 #[test]
 fn the_seed_corpus_goes_through_every_mode() {
-    let text = std::fs::read_to_string(common::root("tests/data/fuzz-seeds.wkt")).unwrap();
+    let text = std::fs::read_to_string(crate::common::root("tests/data/fuzz-seeds.wkt")).unwrap();
     let mut n = 0;
     for line in text
         .lines()

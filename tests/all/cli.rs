@@ -1,7 +1,6 @@
 //! End-to-end tests through the real binary on real GeoPackage files.
 
-mod common;
-use common::*;
+use crate::common::*;
 use gdal::vector::LayerAccess;
 
 #[test]
@@ -445,7 +444,7 @@ fn output_is_identical_for_one_two_and_three_threads() {
             "{}",
             String::from_utf8_lossy(&o.stderr)
         );
-        results.push(common::canonical(&out));
+        results.push(crate::common::canonical(&out));
     }
     assert!(
         results[0].matches('\n').count() > 600 * 5,

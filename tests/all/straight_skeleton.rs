@@ -3,7 +3,6 @@
 // Without GDAL the training-layer tests are left out, and with them some imports.
 #![cfg_attr(not(feature = "gdal"), allow(unused_imports, dead_code))]
 
-mod common;
 use geo::{Coord, LineString, Polygon};
 use proptest::prelude::*;
 use skeletonise::geometry::PreparedPolygon;
@@ -545,7 +544,7 @@ fn every_training_layer() {
         "river_danube",
         "river_lena",
     ] {
-        let feats = skeletonise::io::read_layer_polygons(common::TRAIN, layer).unwrap();
+        let feats = skeletonise::io::read_layer_polygons(crate::common::TRAIN, layer).unwrap();
         let polys: Vec<Polygon<f64>> = feats
             .into_iter()
             .flat_map(|(_, g)| match g {
@@ -593,7 +592,7 @@ fn every_training_layer() {
 #[cfg(feature = "gdal")]
 #[test]
 fn largest_lena_reach() {
-    let feats = skeletonise::io::read_layer_polygons(common::TRAIN, "river_lena").unwrap();
+    let feats = skeletonise::io::read_layer_polygons(crate::common::TRAIN, "river_lena").unwrap();
     let p = feats
         .into_iter()
         .flat_map(|(_, g)| match g {

@@ -4,9 +4,8 @@
 //! one skeleton per method in every section, the summary equal to the
 //! GeoPackage's numbers, pan, zoom, bars and the radius on click).
 
-mod common;
-use common::browser::{base64, find_chromium, Browser};
-use common::*;
+use crate::common::browser::{base64, find_chromium, Browser};
+use crate::common::*;
 use serde_json::Value;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

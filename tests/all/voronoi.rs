@@ -2,9 +2,8 @@
 // Without GDAL the training-layer tests are left out, and with them some imports.
 #![cfg_attr(not(feature = "gdal"), allow(unused_imports, dead_code))]
 
-mod common;
 #[cfg(feature = "gdal")]
-use common::{LAYERS, TRAIN};
+use crate::common::{LAYERS, TRAIN};
 use geo::{Coord, LineString, Polygon};
 #[cfg(feature = "gdal")]
 use rayon::prelude::*;

@@ -6,8 +6,7 @@
 //! stretch shorter than `min_length`, every line end on a cut, on ∂P or on
 //! another line.
 
-mod common;
-use common::{
+use crate::common::{
     code_and_err, count, make_layer, open, pipeline, root, skeletonise, strings, tmp, wkts, TRAIN,
 };
 use gdal::vector::LayerAccess;
@@ -445,7 +444,7 @@ fn real_layer(layer: &str, width: f64) -> Measured {
     ]);
     assert!(o.status.success(), "{}", code_and_err(&o).1);
     assert!(
-        common::count(&open(&out), "widths") > 0,
+        crate::common::count(&open(&out), "widths") > 0,
         "the pipeline writes widths"
     );
     let m = measure(&out, &sources(TRAIN, layer), width);
@@ -500,7 +499,7 @@ fn lakes_scotland_collapse_within_the_bounds() {
 fn beads(out: &Path, limit: f64) -> usize {
     use geo::Area;
     let ds = open(out);
-    let cuts = common::ints(&ds, "areas", "cuts");
+    let cuts = crate::common::ints(&ds, "areas", "cuts");
     rows(out, "areas")
         .iter()
         .zip(cuts)
@@ -514,8 +513,8 @@ fn median_width(out: &Path) -> f64 {
     use geo::{Euclidean, Length};
     let ds = open(out);
     let (a, b) = (
-        common::reals(&ds, "widths", "width_start"),
-        common::reals(&ds, "widths", "width_end"),
+        crate::common::reals(&ds, "widths", "width_start"),
+        crate::common::reals(&ds, "widths", "width_end"),
     );
     let mut w: Vec<(f64, f64)> = rows(out, "widths")
         .iter()
@@ -647,7 +646,7 @@ fn methods_lists_the_collapse_options() {
 fn without_collapse_there_is_no_areas_layer_and_no_collapsed_column() {
     let dir = tmp();
     let out = dir.path().join("plain.gpkg");
-    let text = common::basic_pipeline(TRAIN, "lakes_scotland", &out, "");
+    let text = crate::common::basic_pipeline(TRAIN, "lakes_scotland", &out, "");
     let p = pipeline(dir.path(), "plain.yaml", &text);
     assert!(skeletonise(&["run", p.to_str().unwrap(), "-q"])
         .status
@@ -716,10 +715,13 @@ fn a_river_in_three_adjacent_reaches_gives_one_line_without_gap_or_kink_at_the_s
     assert!(log.contains("3 read, 3 written"), "{log}");
     let ds = open(&out);
     assert_eq!(
-        common::strings(&ds, "skeletons", "members"),
+        crate::common::strings(&ds, "skeletons", "members"),
         vec![Some("1,2,3".to_string())]
     );
-    assert_eq!(common::ints(&ds, "skeletons", "components"), vec![Some(1)]);
+    assert_eq!(
+        crate::common::ints(&ds, "skeletons", "components"),
+        vec![Some(1)]
+    );
     let rows = rows(&out, "skeletons");
     let lines = lines(&rows[0].geometry);
     // One line from one cut end to the other, through both seams.
@@ -761,11 +763,11 @@ fn a_river_in_three_adjacent_reaches_gives_one_line_without_gap_or_kink_at_the_s
     }
     // Only within the same value of a field: every reach has its own `id`.
     run(", merge_adjacent: true, merge_by: id");
-    assert_eq!(common::count(&open(&out), "skeletons"), 3);
+    assert_eq!(crate::common::count(&open(&out), "skeletons"), 3);
     // Without merging, three reaches give three lines.
     run("");
     let ds = open(&out);
-    assert_eq!(common::count(&ds, "skeletons"), 3);
+    assert_eq!(crate::common::count(&ds, "skeletons"), 3);
     assert!(ds
         .layer_by_name("skeletons")
         .unwrap()
@@ -968,7 +970,7 @@ fn the_report_of_a_collapse_run_draws_each_feature_once_with_all_its_lines() {
         ]);
         assert!(o.status.success(), "{}", code_and_err(&o).1);
         (
-            common::count(&open(&out), "skeletons"),
+            crate::common::count(&open(&out), "skeletons"),
             std::fs::read_to_string(&html).unwrap(),
         )
     };
@@ -1288,6 +1290,6 @@ fn a_star_of_a_hundred_spikes_gets_a_hundred_cuts() {
     let areas = rows(&out, "areas");
     assert_eq!(areas.len(), 1, "the disc");
     let ds = open(&out);
-    assert_eq!(common::ints(&ds, "areas", "cuts"), [Some(100)]);
+    assert_eq!(crate::common::ints(&ds, "areas", "cuts"), [Some(100)]);
     check_areas(&out, &sources(&src, "shapes"));
 }

@@ -1,7 +1,6 @@
 //! The reader on the real training data.
 
-mod common;
-use common::TRAIN;
+use crate::common::TRAIN;
 use skeletonise::io::{read_layer_polygons, InputSpec, IoError, LayerRef, Reader};
 
 #[test]
@@ -55,7 +54,7 @@ fn missing_layer_lists_the_available_ones() {
 /// GEOS's IsValid and MakeValid as before: the same geometries either way.
 #[test]
 fn make_valid_checks_simple_polygons_itself_and_repairs_the_rest_with_geos() {
-    let dir = common::tmp();
+    let dir = crate::common::tmp();
     let path = dir.path().join("shapes.geojson");
     let feature = |name: &str, wkt: &str| {
         let g = gdal::vector::Geometry::from_wkt(wkt)

@@ -5,9 +5,7 @@
 //! the largest inscribed disc.
 #![cfg(all(feature = "cli", feature = "gdal"))]
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use gdal::vector::LayerAccess;
 use geo::{Contains, Coord, Geometry, LineString, Polygon};
 use skeletonise::geometry::PreparedPolygon;

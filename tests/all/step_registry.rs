@@ -5,8 +5,7 @@
 //! the run the binary makes (`pipeline::run`: the GeoPackage) and the
 //! table the Python package builds (`output::columns`).
 
-mod common;
-use common::{open, reals, tmp, DEMO};
+use crate::common::{open, reals, tmp, DEMO};
 use gdal::vector::LayerAccess;
 use skeletonise::output::{
     columns::{columns, Item, Values},
@@ -73,7 +72,7 @@ mod toy {
 fn pipeline_text(out: &std::path::Path, toy: &str) -> String {
     format!(
         "input: {{ source: {}, layer: demo }}\nsteps:\n  - skeleton: {{ methods: [MA, CDT] }}\n  - prune: {{}}\n  - extend: {{}}\n  - score: {{}}\n  - select: {{}}\n{toy}output: {{ path: {}, overwrite: true }}\n",
-        common::root(DEMO),
+        crate::common::root(DEMO),
         out.display()
     )
 }
@@ -104,7 +103,7 @@ fn a_registered_step_writes_its_own_layer_through_the_run_and_the_python_table()
         "{fields:?}"
     );
     let scaled = reals(&ds, "toy", "scaled_length");
-    let fids = common::ints(&ds, "toy", "src_fid");
+    let fids = crate::common::ints(&ds, "toy", "src_fid");
     assert_eq!(scaled.len(), 17);
     let mut l = ds.layer_by_name("skeletons").unwrap();
     let at = l.defn().field_index("src_fid").unwrap();
