@@ -58,6 +58,7 @@ pub mod io;
 pub mod label;
 pub mod layer;
 pub mod methods;
+pub mod narrow;
 pub mod numbers;
 pub mod output;
 pub mod partition;

@@ -42,12 +42,12 @@ pub use layer::{BoundaryRow, CoverageRow, GivenRow, BOUNDARIES, COVERAGE, GIVEN}
 pub use owners::{unit_geometry, Coverage, Unit, DEFAULT_SNAP};
 pub use split::Owner;
 
-use crate::collapse::CollapseParams;
 use crate::geometry::vector::norm;
 use crate::geometry::CoordKey;
 use crate::geometry::{tolerance::SAME_POINT, PreparedPolygon};
 use crate::graph::SkeletonGraph;
 use crate::methods::medial_axis::{cells::cell_edges, ArcTolerance};
+use crate::narrow::CollapseParams;
 use geo::{Area, Coord, LineString, MultiLineString, Polygon};
 use rustc_hash::FxHashMap;
 use schemars::JsonSchema;
@@ -121,7 +121,7 @@ impl PartitionParams {
             width,
             tolerance: self.tolerance,
             min_length: self.min_length,
-            mode: crate::collapse::CollapseMode::Partial,
+            mode: crate::narrow::CollapseMode::Partial,
             min_area: 0.0,
         })
     }
@@ -297,7 +297,7 @@ fn partition_cut(
     let mut wide_parts: Vec<Polygon<f64>> = Vec::new();
     if let Some(c) = params.narrow() {
         let ma = ma.ok_or("a partition with `width` needs the part's medial axis")?;
-        let n = crate::collapse::collapse(ma, original, &c, &[]);
+        let n = crate::narrow::collapse(ma, original, &c, &[]);
         if n.collapsed.is_empty() {
             // Wide everywhere: nothing is given away.
             return Ok(PartPartition {

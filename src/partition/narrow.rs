@@ -1,6 +1,6 @@
 //! A partial partition (`width`): only the narrow parts of a collapsed
 //! polygon are given away. What is narrow is decided as `collapse` decides
-//! it, on the medial axis's discs (`crate::collapse`): its cuts — the two
+//! it, on the medial axis's discs (`crate::narrow`): its cuts — the two
 //! radii from a change point to the bank — are added to the new
 //! boundaries, noded with them (a point where a cut crosses a boundary is
 //! put into both, with one coordinate), and the faces that lie in the
