@@ -711,7 +711,7 @@ def _reserved(pipeline: "_core.Pipeline", neighbours: bool = False) -> list:
     """The tool's column names beside which a source column (of ``input``, or with ``neighbours``
     of ``neighbours``) is renamed, as the command line's writer renames them; a frame of ``input``
     has a ``rejected`` column too."""
-    names = list(_core.reserved(pipeline.collapse, pipeline.partition, neighbours))
+    names = list(pipeline.reserved(neighbours))
     return names if neighbours else names + ["rejected"]
 
 
@@ -769,11 +769,16 @@ def apply_layers(
     the function for pipelines with the ``collapse`` or ``partition`` step, which :func:`apply`
     refuses (their layers do not fit in one frame).
 
-    Returns a dict of GeoDataFrames by the GeoPackage's layer names: ``skeletons`` (as
+    Returns a dict of GeoDataFrames by the GeoPackage's layer names — the layers and columns the
+    command line writes for the same pipeline file (its plan), but ``rejected`` (the skeleton
+    frame's ``rejected`` column), bars, widths and the run record: ``skeletons`` (as
     :func:`apply` returns it), ``candidates`` with ``candidates=True``, and the steps' layers —
     ``areas`` (the kept areas of ``collapse``; a partition's remainders), ``coverage`` (the units
     of ``neighbours`` grown by what they received, with their columns), ``boundaries`` (the new
-    boundaries) and ``given`` (what each unit received of each polygon). ``connect`` (a
+    boundaries), ``given`` (what each unit received of each polygon), ``connections`` and
+    ``network`` with ``connect``, and a registered step's layers (``labels`` of the ``label``
+    step; its ``minzoom`` is empty here: it needs the CRS's latitudes, which
+    :func:`labels` computes). ``connect`` (a
     GeoDataFrame or GeoSeries of lines: the line network of ``input.connect``, ``snap`` its snap
     distance) and ``neighbours`` (a GeoDataFrame of polygons: the coverage of
     ``input.neighbours``; ``neighbour_snap`` its ``snap``: unit vertices and edges within it of a

@@ -9,7 +9,7 @@
 //! prepares them (`prepare_checked`).
 
 use crate::run::{features, Input};
-use geo::{Coord, Geometry};
+use geo::Geometry;
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
 use rayon::prelude::*;
@@ -131,11 +131,11 @@ fn columns(py: Python<'_>, rows: Vec<Row>) -> Columns<'_> {
                 let mut out = Vec::new();
                 let kind = match &l.label {
                     Label::Line(line) => {
-                        write(&Geometry::LineString(line.clone()), &mut out);
+                        crate::wkb::write_geometry(&Geometry::LineString(line.clone()), &mut out);
                         "line"
                     }
                     Label::Point(p) => {
-                        write(&Geometry::Point(p.to_owned().into()), &mut out);
+                        crate::wkb::write_geometry(&Geometry::Point(p.to_owned().into()), &mut out);
                         "point"
                     }
                 };
@@ -153,27 +153,4 @@ fn columns(py: Python<'_>, rows: Vec<Row>) -> Columns<'_> {
         c.7.push(reason);
     }
     c
-}
-
-/// A point or a line as little-endian ISO WKB.
-fn write(g: &Geometry<f64>, out: &mut Vec<u8>) {
-    let xy = |c: &Coord<f64>, out: &mut Vec<u8>| {
-        out.extend_from_slice(&c.x.to_le_bytes());
-        out.extend_from_slice(&c.y.to_le_bytes());
-    };
-    out.push(1);
-    match g {
-        Geometry::Point(p) => {
-            out.extend_from_slice(&1u32.to_le_bytes());
-            xy(&p.0, out);
-        }
-        Geometry::LineString(l) => {
-            out.extend_from_slice(&2u32.to_le_bytes());
-            out.extend_from_slice(&(l.0.len() as u32).to_le_bytes());
-            for c in &l.0 {
-                xy(c, out);
-            }
-        }
-        _ => unreachable!("labels are points and lines"),
-    }
 }

@@ -259,6 +259,20 @@ impl Pipeline {
         self.steps.process_params().prepare.make_valid
     }
 
+    /// The names for which a source field is written as `src_<name>` by a
+    /// call of this pipeline (every layer of its plan that carries the
+    /// source's fields — a registered step's too — as the command line's
+    /// writer renames them); with `neighbours`, those of a field of the
+    /// units.
+    #[pyo3(signature = (neighbours = false, connect = false))]
+    fn reserved(&self, neighbours: bool, connect: bool) -> Vec<&'static str> {
+        let plan = self.steps.call_plan(self.explode(), connect);
+        match neighbours {
+            true => plan.reserved_neighbour_names(),
+            false => plan.reserved_names(),
+        }
+    }
+
     /// One row per polygon part (`output.explode`).
     #[getter]
     fn explode(&self) -> bool {
@@ -336,6 +350,7 @@ impl Pipeline {
             _ => None,
         };
         let fids = fids.or(positions);
+        let connect_given = connect.is_some();
         if let Some(lines) = connect {
             params.connect = Some(std::sync::Arc::new(network(
                 &lines,
@@ -357,7 +372,9 @@ impl Pipeline {
                     )))
                 }
             },
-            collapse: params.collapse.is_some(),
+            plan: self
+                .steps
+                .call_plan(explode.unwrap_or_else(|| self.explode()), connect_given),
             partition,
             with_candidates,
             cancel: cancel.map(|c| c.0.clone()),
@@ -438,7 +455,7 @@ fn score<'py>(
         threads,
         fail: false,
         geoarrow_out: output == "geoarrow",
-        collapse: false,
+        plan: run::bare_plan(),
         partition: false,
         with_candidates: false,
         cancel: cancel.map(|c| c.0.clone()),

@@ -27,9 +27,9 @@ pub struct Options {
     pub fail: bool,
     /// Return geometries as GeoArrow buffers (else WKB).
     pub geoarrow_out: bool,
-    /// The pipeline has a `collapse` step: the skeletons have `collapsed`,
-    /// and the kept areas come back too (layer `areas`).
-    pub collapse: bool,
+    /// The layers and columns of the call: the pipeline's own plan
+    /// (`config::Steps::call_plan`), as the command line's for the same file.
+    pub plan: Plan,
     /// The pipeline has a `partition` step (with the coverage in the
     /// parameters): adjacent input polygons are merged exactly first, as
     /// the command line's reader merges them, and the layers `coverage`,
@@ -246,15 +246,14 @@ fn outputs(
     (idx, all, items, reasons)
 }
 
-/// The plan of a call: the skeleton layer (with `polygon_part` when
-/// exploded) or the candidates layer (which always has it).
-pub fn plan_of(opts: &Options) -> Plan {
-    let mut holds = vec![When::Candidates];
-    if opts.explode {
-        holds.push(When::Explode);
-    }
-    holds.extend(step_holds(opts.collapse, opts.partition));
-    Plan::new(skeletonise::output::SKELETONS.name, holds, &[])
+/// The plan of a call without a pipeline (`score`): the skeleton layer
+/// and the candidates layer.
+pub fn bare_plan() -> Plan {
+    Plan::new(
+        skeletonise::output::SKELETONS.name,
+        vec![When::Candidates],
+        &[],
+    )
 }
 
 /// What the `collapse` and `partition` steps add to a plan (as the
@@ -312,13 +311,12 @@ fn feature_rows_of(
     opts: &Options,
     par: bool,
 ) -> Option<Vec<FeatureRows>> {
+    // The call's plan, as the command line's (the network's skeleton rows
+    // with `input.connect`), with the candidates only when asked for.
     let row_opts = RowOptions {
         explode: opts.explode,
         candidates: opts.candidates || opts.with_candidates,
-        bars: false,
-        widths: false,
-        measures: false,
-        network: false,
+        ..RowOptions::of(&opts.plan)
     };
     let cancelled = || {
         opts.cancel
@@ -373,7 +371,7 @@ fn work(
         .finish()
         .map_err(|e| Stop::Coverage(format!("partition: {e}")))?;
     let counts = [input.len() as u64, c.written, c.rejected, c.filtered];
-    let plan = plan_of(opts);
+    let plan = &opts.plan;
     let layer: &dyn Layer = if opts.candidates {
         &CANDIDATE_LAYER
     } else {
@@ -386,12 +384,12 @@ fn work(
         }
     }
     all.append(finished);
-    let columns = table::columns(layer, &plan, &all, &items);
+    let columns = table::columns(layer, plan, &all, &items);
     let geometry = encoded(&table::lines(layer, &all, &items), opts.geoarrow_out, par);
     let layers = if opts.candidates {
         Vec::new()
     } else {
-        other_layers(&plan, &all, opts.with_candidates)
+        other_layers(plan, &all, opts.with_candidates)
     };
     let t3 = Instant::now();
     Ok(Done {
@@ -438,10 +436,14 @@ fn other_layers(plan: &Plan, all: &Rows, candidates: bool) -> Vec<LayerOut> {
                         Shape::MultiPolygon(m) => wkb::write_polygons(m, &mut out),
                         Shape::Lines(m) | Shape::LinesM(m, _) => wkb::write_lines(m, &mut out),
                         Shape::Line(l) => {
-                            wkb::write_lines(&geo::MultiLineString(vec![l]), &mut out)
+                            wkb::write_geometry(&geo::Geometry::LineString(l), &mut out);
                         }
                         Shape::Wkb(w) => out.extend_from_slice(w),
-                        Shape::Geometry(_) => return None,
+                        Shape::Geometry(g) => {
+                            if !wkb::write_geometry(g, &mut out) {
+                                return None;
+                            }
+                        }
                     }
                     Some(out)
                 })

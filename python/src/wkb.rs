@@ -216,6 +216,30 @@ pub fn write_polygon(p: &Polygon<f64>, out: &mut Vec<u8>) {
     }
 }
 
+/// Writes a point, a line or any areal or lineal geometry as little-endian
+/// ISO WKB, appending to `out`; `false` (nothing written) for other kinds.
+pub fn write_geometry(g: &Geometry<f64>, out: &mut Vec<u8>) -> bool {
+    match g {
+        Geometry::Point(p) => {
+            out.push(1);
+            out.extend_from_slice(&1u32.to_le_bytes());
+            out.extend_from_slice(&p.0.x.to_le_bytes());
+            out.extend_from_slice(&p.0.y.to_le_bytes());
+        }
+        Geometry::LineString(l) => {
+            // A LINESTRING: the MULTILINESTRING's one member, header and all.
+            let mut m = Vec::new();
+            write_lines(&MultiLineString(vec![l.clone()]), &mut m);
+            out.extend_from_slice(&m[9..]);
+        }
+        Geometry::MultiLineString(m) => write_lines(m, out),
+        Geometry::Polygon(p) => write_polygon(p, out),
+        Geometry::MultiPolygon(m) => write_polygons(m, out),
+        _ => return false,
+    }
+    true
+}
+
 /// The areal parts of a repaired geometry, as the command line's reader
 /// keeps them after MakeValid: a polygon or multipolygon as it is, the
 /// polygons of a collection as a multipolygon, or the reason there are none.

@@ -181,6 +181,20 @@ pub fn plan_of(
     input: Option<&InputSpec>,
     steps: &[Step],
 ) -> crate::output::Plan {
+    let merge = input.is_some_and(|i| i.merge_adjacent);
+    let connect = input.is_some_and(|i| i.connect.is_some());
+    plan_with(output, steps, merge, connect)
+}
+
+/// [`plan_of`] for a caller that brings its own data (the Python binding):
+/// `merge` when adjacent polygons are merged (`input.merge_adjacent`), and
+/// `connect` when a line network is given (`input.connect`).
+pub fn plan_with(
+    output: &OutputSpec,
+    steps: &[Step],
+    merge: bool,
+    connect: bool,
+) -> crate::output::Plan {
     use crate::output::When;
     let mut holds = Vec::new();
     let mut flag = |on: bool, w: When| {
@@ -198,11 +212,8 @@ pub fn plan_of(
     flag(collapse, When::Collapse);
     flag(partition, When::Partition);
     flag(collapse || partition, When::Areas);
-    flag(
-        input.is_some_and(|i| i.merge_adjacent) || partition,
-        When::Merge,
-    );
-    flag(input.is_some_and(|i| i.connect.is_some()), When::Connect);
+    flag(merge || partition, When::Merge);
+    flag(connect, When::Connect);
     let mut layers = Vec::new();
     for s in steps {
         if let Step::Extra(e) = s {
@@ -258,7 +269,12 @@ impl Steps {
     /// The output plan of the steps: the skeleton layer and what the file's
     /// `output` section (when it has one) asks for.
     pub fn plan(&self) -> crate::output::Plan {
-        let output = self.file.output.clone().unwrap_or_else(|| OutputSpec {
+        plan_of(&self.output(), None, &self.file.steps)
+    }
+
+    /// The file's `output` section, or the defaults without one.
+    fn output(&self) -> OutputSpec {
+        self.file.output.clone().unwrap_or_else(|| OutputSpec {
             path: String::new(),
             layer: crate::output::SKELETONS.name.into(),
             overwrite: false,
@@ -268,8 +284,22 @@ impl Steps {
             widths: false,
             measures: Measures::None,
             report: None,
-        });
-        plan_of(&output, None, &self.file.steps)
+        })
+    }
+
+    /// The output plan of one call of the steps on a caller's data (the
+    /// Python binding): the candidates' columns always (the call returns
+    /// them on request), `explode` as asked, and the layers of
+    /// `input.connect` when lines are given — the layers and columns the
+    /// command line would write for the same pipeline.
+    pub fn call_plan(&self, explode: bool, connect: bool) -> crate::output::Plan {
+        let mut output = self.output();
+        output.layer = crate::output::SKELETONS.name.into();
+        output.candidates = true;
+        output.explode = explode;
+        (output.bars, output.widths) = (false, false);
+        output.measures = Measures::None;
+        plan_with(&output, &self.file.steps, false, connect)
     }
 
     /// The per-feature parameters of the steps.
