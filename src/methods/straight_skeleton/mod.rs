@@ -90,6 +90,14 @@
 //!   then every edge; the exhaustive pass takes every edge whose offset
 //!   line the ray reaches before it leaves P, a proven superset).
 //!
+//! # Files
+//!
+//! This file is the event loop (`Propagation`: events in time order, the
+//! vertex, edge and split events, the wavefront relinked); `search` finds a
+//! reflex vertex's split candidates, `verify` checks a pass's traces,
+//! `events` holds the queue and the event times, `lines` the index of the
+//! original edges by direction class, `wavefront` the vertices and lines.
+//!
 //! # Tolerance policy
 //!
 //! Coordinates are shifted by [`PreparedPolygon::origin`] before any
@@ -127,6 +135,8 @@
 
 pub(crate) mod events;
 pub(crate) mod lines;
+mod search;
+mod verify;
 pub(crate) mod wavefront;
 
 use super::{MethodContext, MethodError, MethodId, SkeletonMethod};
@@ -141,6 +151,7 @@ use events::{edge_collapse_time, split_candidates, EventKind, EventQueue, Held, 
 use geo::Coord;
 use lines::LineIndex;
 use std::ops::ControlFlow;
+use verify::verify;
 use wavefront::{Line, LineId, VertexId, Wavefront, FOLD_EPS};
 
 /// The straight-skeleton method.
@@ -1102,295 +1113,6 @@ impl<'a> Propagation<'a> {
         self.w.link(v2, b);
         Ok(())
     }
-
-    /// How far reflex vertex `z`'s ray reaches inside P (the bound of its
-    /// split candidates), and the length of its first search band.
-    fn ray_reach(&self, z: VertexId) -> Option<(f64, f64)> {
-        let vx = *self.w.v(z);
-        let s = vx.vel?;
-        let speed = hypot(s);
-        let start = vx.start + self.origin;
-        let reach = self
-            .boundary
-            .first_hit(start, s / speed, self.tol, 4.0 * self.extent)
-            .map_or(2.0 * self.extent, |h| h.t);
-        let (l, r) = (self.w.line(vx.left), self.w.line(vx.right));
-        let step = hypot(l.b - l.a).min(hypot(r.b - r.a));
-        Some((reach, (2.0 * step).clamp(reach / 4096.0, reach)))
-    }
-
-    /// The original edges reflex vertex `z`'s split candidates up to
-    /// distance `upto` along its ray are taken from (all, or those near
-    /// that part of the ray; with `directed`: without those near it that
-    /// cannot be candidates, see [`LineIndex::near_ray`], whose `dense` it
-    /// is), and the latest time such a candidate may have.
-    /// The lines are written into `into` (cleared first; a buffer reused
-    /// from band to band).
-    fn candidate_lines(
-        &self,
-        z: VertexId,
-        upto: f64,
-        directed: Option<&mut bool>,
-        into: Vec<LineId>,
-    ) -> Option<(Vec<LineId>, f64)> {
-        let vx = *self.w.v(z);
-        let s = vx.vel?;
-        let speed = hypot(s);
-        let dir = s / speed;
-        let t_max = vx.t0 + upto / speed;
-        let lines = match self.search {
-            Search::Near(factor) => {
-                // Faces of edges whose ends are reflex widen away from the
-                // edge: search a margin proportional to the reach.
-                let end = vx.start + dir * upto;
-                let m = factor * upto + self.tol;
-                let env = [
-                    vx.start.x.min(end.x) - m,
-                    vx.start.y.min(end.y) - m,
-                    vx.start.x.max(end.x) + m,
-                    vx.start.y.max(end.y) + m,
-                ];
-                // In any order: the candidates are sorted.
-                let mut lines = into;
-                lines.clear();
-                if let Some(dense) = directed {
-                    let band = lines::Band {
-                        start: vx.start,
-                        t0: vx.t0,
-                        vel: s,
-                        t_max,
-                    };
-                    *dense = self.index.near_ray(
-                        &self.w.lines,
-                        &env,
-                        &band,
-                        self.tol,
-                        *dense,
-                        &mut lines,
-                    );
-                } else {
-                    self.index.near(&env, &mut lines);
-                }
-                lines
-            }
-            Search::All => {
-                let mut lines = into;
-                lines.clear();
-                lines.extend((0..self.w.lines.len()).map(LineId::from_index));
-                lines
-            }
-        };
-        Some((lines, t_max))
-    }
-
-    /// Searches the next band of reflex vertex `z`'s ray for split
-    /// candidates and appends them to its list; `false` when the ray has
-    /// been searched to its end. Bands double in length from twice the
-    /// vertex's shorter edge (the exhaustive search has one band, the whole
-    /// ray), and a band is searched only when the vertex has tried every
-    /// candidate of the bands before and lives to reach the end of the
-    /// part searched ([`Propagation::next_candidate`]; the candidates on
-    /// edges gone from the wavefront do not count): most reflex vertices of
-    /// a rough rim end within their first bands, so their search stays
-    /// local where a search of the whole ray (which can cross the polygon)
-    /// made the propagation quadratic. A band keeps the candidates that come after
-    /// the list's last in time order (earlier ones are past). Fails when all
-    /// the polygon's candidates together pass the memory budget.
-    fn search_band(&mut self, z: VertexId) -> Result<bool, MethodError> {
-        let band = &mut self.bands[z.index()];
-        if band.searched >= band.reach {
-            return Ok(false);
-        }
-        let upto = match (self.search, band.searched > 0.0) {
-            (Search::All, _) => band.reach,
-            (Search::Near(_), false) => band.first,
-            (Search::Near(_), true) => {
-                let next = 2.0 * band.searched;
-                if next >= 0.5 * band.reach {
-                    band.reach
-                } else {
-                    next
-                }
-            }
-        };
-        band.searched = upto;
-        let mut dense = band.dense;
-        let scratch = std::mem::take(&mut self.scratch);
-        let found = self.candidate_lines(z, upto, Some(&mut dense), scratch);
-        self.bands[z.index()].dense = dense;
-        let Some((lines, t_max)) = found else {
-            return Ok(false);
-        };
-        self.ctx.check(MethodId::STSK)?;
-        self.stats.tried += lines.len();
-        let last = self.candidates[z.index()].last().copied();
-        let c = split_candidates(&self.w, z, lines.iter().copied(), t_max, self.tol, last);
-        self.scratch = lines;
-        let list = &mut self.candidates[z.index()];
-        self.stats.candidates += c.len();
-        list.extend(c);
-        if self.stats.candidates > self.max_candidates {
-            return Err(MethodError::OverBudget {
-                method: MethodId::STSK,
-                reason: format!(
-                    "needed more than {:.0} MB for the split events of this polygon, more than `skeleton.max_memory_mb`",
-                    (self.max_candidates * CANDIDATE_BYTES) as f64 / 1e6
-                ),
-            });
-        }
-        Ok(true)
-    }
-
-    /// Makes reflex vertex `v`'s candidate `i` known if its ray has one up
-    /// to time `until`, searching further bands as needed (a band whose
-    /// part of the ray the vertex reaches after `until` holds no candidate
-    /// before it).
-    fn reach_candidate(&mut self, v: VertexId, i: usize, until: f64) -> Result<(), MethodError> {
-        while i >= self.candidates[v.index()].len()
-            && self.band_end(v).is_none_or(|t| t <= until)
-            && self.search_band(v)?
-        {}
-        Ok(())
-    }
-
-    /// The cost of the propagation, predicted from a sample of the input's
-    /// reflex vertices: (edges to try, candidates to keep) over all of them,
-    /// each as if it searched its whole ray among every edge. That is an
-    /// upper estimate: a vertex searches band after band only while it
-    /// lives, among the edges still in the wavefront (on a rough rim it ends
-    /// early and most edges near it are gone, and a band with many edges
-    /// near skips those that cannot be candidates: 280–620× fewer tries
-    /// than predicted on the rough polygon of `scripts/make_rough_polygon.py`
-    /// at 100 000–200 000 vertices (80× before the search by direction);
-    /// about as predicted on a raster staircase; see [`LIKELY_SHARE`]).
-    /// The first eighth of the sample is spread over the whole polygon;
-    /// when its estimate already makes `hopeless` true (far beyond the
-    /// budget), that estimate is returned without the rest — on a huge
-    /// polygon each sampled vertex can cost a scan of every edge.
-    fn predict(&self, hopeless: impl Fn((f64, f64)) -> bool) -> (f64, f64) {
-        let reflex: Vec<VertexId> = (0..self.w.vertices.len())
-            .map(VertexId::from_index)
-            .filter(|&v| self.w.v(v).reflex)
-            .collect();
-        if reflex.is_empty() {
-            return (0.0, 0.0);
-        }
-        let step = reflex.len().div_ceil(PREDICTION_SAMPLE);
-        let sample: Vec<VertexId> = reflex.iter().copied().step_by(step).collect();
-        // Every eighth sampled vertex first, then the others.
-        let first = sample.iter().step_by(8).copied();
-        let rest = sample
-            .iter()
-            .enumerate()
-            .filter(|(i, _)| i % 8 != 0)
-            .map(|(_, &z)| z);
-        let (mut tried, mut kept, mut sampled) = (0usize, 0usize, 0usize);
-        let estimate = |tried: usize, kept: usize, sampled: usize| {
-            let scale = reflex.len() as f64 / sampled.max(1) as f64;
-            (tried as f64 * scale, kept as f64 * scale)
-        };
-        let first_count = sample.len().div_ceil(8);
-        for z in first.chain(rest) {
-            let Some((upto, _)) = self.ray_reach(z) else {
-                continue;
-            };
-            if let Some((lines, t_max)) = self.candidate_lines(z, upto, None, Vec::new()) {
-                tried += lines.len();
-                kept +=
-                    split_candidates(&self.w, z, lines.into_iter(), t_max, self.tol, None).len();
-            }
-            sampled += 1;
-            if sampled == first_count && sampled < sample.len() {
-                let partial = estimate(tried, kept, sampled);
-                if hopeless(partial) {
-                    return partial;
-                }
-            }
-        }
-        estimate(tried, kept, sampled)
-    }
-
-    /// Queues reflex vertex `v`'s split candidate `i`, or the first after it
-    /// whose line is still in the wavefront (on a staircase most original
-    /// edges are gone before a vertex's candidate on them comes up).
-    fn push_candidate(&mut self, v: VertexId, i: u32) -> Result<(), MethodError> {
-        if let Some((t, i)) = self.next_candidate(v, i)? {
-            self.q.push(t, split(v, i));
-        }
-        Ok(())
-    }
-
-    /// The time and index of the candidate [`Self::push_candidate`] queues.
-    /// When the candidates of the bands searched so far are used up and the
-    /// vertex reaches the end of the searched part of its ray only later,
-    /// the index is one past the list and the time is that later time: the
-    /// next band is searched then, if the vertex still lives
-    /// ([`Self::searched_on`]), not now.
-    fn next_candidate(&mut self, v: VertexId, i: u32) -> Result<Option<(f64, u32)>, MethodError> {
-        let mut i = i as usize;
-        loop {
-            if i >= self.candidates[v.index()].len() {
-                if let Some(t) = self.band_end(v).filter(|&t| t > self.now) {
-                    return Ok(Some((t, i as u32)));
-                }
-                if !self.search_band(v)? {
-                    return Ok(None);
-                }
-                continue;
-            }
-            let c = self.candidates[v.index()][i];
-            if self.w.line_alive(c.line) {
-                return Ok(Some((c.t.max(self.now), i as u32)));
-            }
-            i += 1;
-        }
-    }
-
-    /// When reflex vertex `v` reaches the end of the part of its ray
-    /// searched so far (`None` before the first band).
-    fn band_end(&self, v: VertexId) -> Option<f64> {
-        let band = self.bands[v.index()];
-        let vx = self.w.v(v);
-        let speed = hypot(vx.vel?);
-        (band.searched > 0.0).then(|| vx.t0 + band.searched / speed)
-    }
-
-    /// Whether the queue's head is a vertex's deferred search (see
-    /// [`Self::next_candidate`]); if so, searches the vertex's next band now
-    /// and puts its next candidate in the head's place (or takes the head),
-    /// and returns `true`. A deferred search is never held or grouped.
-    fn searched_on(
-        &mut self,
-        queued: bool,
-        v: VertexId,
-        candidate: u32,
-    ) -> Result<bool, MethodError> {
-        if (candidate as usize) < self.candidates[v.index()].len() {
-            return Ok(false);
-        }
-        // Its time has come (it may be up to `tol` after `now` while the
-        // events of a time are pulled).
-        let next = if self.search_band(v)? {
-            self.next_candidate(v, candidate)?
-        } else {
-            None
-        };
-        self.follow_with(queued, v, next);
-        Ok(true)
-    }
-
-    /// Queues vertex `v`'s `next` split candidate (time, index) in place of
-    /// the event just handled: at the queue's head when that event is
-    /// there (`queued`: one sift instead of a pop and a push), else pushed;
-    /// with no next candidate the head is taken.
-    fn follow_with(&mut self, queued: bool, v: VertexId, next: Option<(f64, u32)>) {
-        match (queued, next) {
-            (true, Some((t, i))) => self.q.replace_head(t, split(v, i)),
-            (true, None) => self.take(true),
-            (false, Some((t, i))) => self.q.push(t, split(v, i)),
-            (false, None) => {}
-        }
-    }
 }
 
 /// A ring's vertices without those within `tol` of the vertex kept before
@@ -1451,121 +1173,6 @@ fn propagate(
     Ok((arcs, stats))
 }
 
-/// Checks that hold for every straight skeleton and that a missed split
-/// event breaks: every trace stays in P and no two traces cross (a vertex
-/// that ran through a wavefront edge leaves its face, so its trace crosses
-/// the traces bounding that face or leaves P). Crossings closer than
-/// `1e-6 · extent` to an end of either trace are rounding, not misses.
-fn verify(polygon: &PreparedPolygon, arcs: &[Arc]) -> Result<(), MethodError> {
-    let tol = TRACE_CROSSING * polygon.extent();
-    if let Some(a) = arcs
-        .iter()
-        .find(|a| !polygon.boundary().contains_with_tolerance(a.to, tol))
-    {
-        return Err(fail(format!(
-            "straight skeleton left the polygon near ({}, {}) (a missed event in a degenerate configuration)",
-            a.to.x, a.to.y
-        )));
-    }
-    // Every pair of traces with pieces whose boxes meet; the first crossing
-    // in trace order is reported.
-    let (traces, boxes) = trace_pieces(arcs, tol);
-    let mut first: Option<(usize, usize, Coord<f64>)> = None;
-    PackedTree::pairs_of(&boxes, |i, j| {
-        let (i, j) = (traces[i as usize], traces[j as usize]);
-        if i == j {
-            return ControlFlow::Continue(());
-        }
-        let (i, j) = (i.min(j), i.max(j));
-        if first.is_none_or(|(fi, fj, _)| (i, j) < (fi, fj)) {
-            let (a, b) = (&arcs[i], &arcs[j]);
-            if let Some(x) = crossing(a.from, a.to, b.from, b.to, tol) {
-                first = Some((i, j, x));
-            }
-        }
-        ControlFlow::<()>::Continue(())
-    });
-    if let Some((_, _, x)) = first {
-        return Err(fail(format!(
-            "straight skeleton traces cross near ({}, {}) (a missed split event)",
-            x.x, x.y
-        )));
-    }
-    Ok(())
-}
-
-/// The point where segments `pq` and `ab` cross, when it is farther than
-/// `tol` from all four ends and neither segment lies within `tol` of the
-/// other's line (near-collinear overlaps, as collapsed strips of nearly
-/// parallel banks give, are rounding too).
-/// The boxes the crossing check of [`verify`] pairs: one per trace of
-/// non-zero length, or several along a trace longer than
-/// [`PIECE_OF_MEAN`] times the mean — each box around a stretch of it that
-/// long, widened by `pad` (so rounding in the stretches' ends cannot lose
-/// a crossing) — with the trace of each box. A fast reflex vertex draws a
-/// long trace across a rough rim: the box around all of it met those of
-/// thousands of short traces (58 M pairs on the rough polygon of
-/// `scripts/make_rough_polygon.py` at 200 000 vertices, four times as many
-/// as at 100 000), the boxes along it few of them.
-fn trace_pieces(arcs: &[Arc], pad: f64) -> (Vec<usize>, Vec<Bbox>) {
-    let traces: Vec<usize> = (0..arcs.len())
-        .filter(|&i| arcs[i].from != arcs[i].to)
-        .collect();
-    let length = |i: usize| {
-        let d = arcs[i].to - arcs[i].from;
-        (d.x * d.x + d.y * d.y).sqrt()
-    };
-    let total: f64 = traces.iter().map(|&i| length(i)).sum();
-    let step = PIECE_OF_MEAN * total / traces.len().max(1) as f64;
-    let (mut owners, mut boxes) = (Vec::with_capacity(traces.len()), Vec::new());
-    for &i in &traces {
-        let (p, q) = (arcs[i].from, arcs[i].to);
-        let pieces = (length(i) / step).ceil().clamp(1.0, 1e6) as usize;
-        if pieces == 1 {
-            owners.push(i);
-            boxes.push(segment_box(p, q));
-            continue;
-        }
-        let at = |k: usize| p + (q - p) * (k as f64 / pieces as f64);
-        for k in 0..pieces {
-            let b = segment_box(at(k), if k + 1 == pieces { q } else { at(k + 1) });
-            owners.push(i);
-            boxes.push([b[0] - pad, b[1] - pad, b[2] + pad, b[3] + pad]);
-        }
-    }
-    (owners, boxes)
-}
-
-/// A trace longer than this many times the mean trace length is boxed in
-/// stretches this long for the crossing check ([`trace_pieces`]).
-const PIECE_OF_MEAN: f64 = 4.0;
-
-fn crossing(
-    p: Coord<f64>,
-    q: Coord<f64>,
-    a: Coord<f64>,
-    b: Coord<f64>,
-    tol: f64,
-) -> Option<Coord<f64>> {
-    if !properly_cross(p, q, a, b) {
-        return None;
-    }
-    let d = q - p;
-    let (s, _) = lines_meet(p, d, a, b)?;
-    let x = p + d * s;
-    let far = |c: Coord<f64>| {
-        // `hypot > tol`, the hypot only when no component alone decides.
-        let d = c - x;
-        d.x.abs() > tol || d.y.abs() > tol || hypot(d) > tol
-    };
-    let off = |u: Coord<f64>, v: Coord<f64>, c: Coord<f64>| {
-        let w = v - u;
-        cross(w, c - u).abs() / hypot(w)
-    };
-    let apart = off(p, q, a).max(off(p, q, b)) > tol && off(a, b, p).max(off(a, b, q)) > tol;
-    (apart && far(p) && far(q) && far(a) && far(b)).then_some(x)
-}
-
 /// The straight skeleton of `polygon` and the propagation's counts, within
 /// the budget of `ctx`.
 ///
@@ -1622,6 +1229,7 @@ impl SkeletonMethod for StraightSkeleton {
 
 #[cfg(test)]
 mod tests {
+    use super::verify::trace_pieces;
     use super::*;
     use geo::polygon;
 
