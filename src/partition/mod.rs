@@ -206,14 +206,47 @@ enum Side {
     Wide,
 }
 
-/// What [`partition`] says when `expired()` stopped it (the caller, which
-/// owns the clock, gives the reason).
-pub const STOPPED: &str = "partition stopped: its time is up";
+/// Why a polygon part cannot be partitioned (the text is the feature's
+/// rejection reason).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PartitionError {
+    /// The polygon overlaps a unit and `overlap: reject` asks to refuse it.
+    #[error("the polygon overlaps unit {fid} of `input.neighbours` ({area} CRS units² of it lie inside the unit) near ({x:.3}, {y:.3}); with `partition: {{overlap: cut}}` (the default) the unit's share is cut out of it and given by the rule, or remove the overlap from the coverage")]
+    Overlap {
+        /// The unit's FID, or `(no fid)`.
+        fid: String,
+        /// The area inside the unit, to four significant digits.
+        area: String,
+        /// Where (x).
+        x: f64,
+        /// Where (y).
+        y: f64,
+    },
+    /// A unit near the polygon cannot be cut exactly by it.
+    #[error("{0}")]
+    Unit(String),
+    /// With `width`, the part's medial axis is needed and missing.
+    #[error("a partition with `width` needs the part's medial axis")]
+    NoMedialAxis,
+    /// The polygon, its cells or its faces could not be made (a bug or a
+    /// degenerate polygon: the text says which).
+    #[error("{0}")]
+    Geometry(String),
+    /// `expired()` stopped the partition (the caller, which owns the
+    /// clock, gives the reason).
+    #[error("partition stopped: its time is up")]
+    Stopped,
+}
 
-/// Fails with [`STOPPED`] once `expired()`.
-fn stop_if(expired: &dyn Fn() -> bool) -> Result<(), String> {
+/// A geometry step's error as the reason.
+fn geometry_error(e: impl std::fmt::Display) -> PartitionError {
+    PartitionError::Geometry(e.to_string())
+}
+
+/// Fails with [`PartitionError::Stopped`] once `expired()`.
+fn stop_if(expired: &dyn Fn() -> bool) -> Result<(), PartitionError> {
     match expired() {
-        true => Err(STOPPED.into()),
+        true => Err(PartitionError::Stopped),
         false => Ok(()),
     }
 }
@@ -223,34 +256,35 @@ fn stop_if(expired: &dyn Fn() -> bool) -> Result<(), String> {
 /// part's medial axis (its discs say what is narrow). `expired()` is asked
 /// between the stages (the units near the part, the narrow parts, the
 /// cells, the faces); once it says the time is up the partition stops with
-/// [`STOPPED`].
+/// [`PartitionError::Stopped`].
 pub fn partition(
     p: &PreparedPolygon,
     cov: &Coverage,
     params: &PartitionParams,
     ma: Option<&SkeletonGraph>,
     expired: &dyn Fn() -> bool,
-) -> Result<PartPartition, String> {
+) -> Result<PartPartition, PartitionError> {
     let tol = SAME_POINT * p.extent();
-    let near = cut::Near::of(p, cov, cov.snap_for(p.extent()), tol)?;
+    let near =
+        cut::Near::of(p, cov, cov.snap_for(p.extent()), tol).map_err(PartitionError::Unit)?;
     if params.overlap == Overlap::Reject {
         if let Some((k, area, at)) = near.first_overlap(tol) {
             let fid = cov.units()[k as usize]
                 .fid
                 .map_or_else(|| "(no fid)".into(), |f| f.to_string());
-            return Err(format!(
-                "the polygon overlaps unit {fid} of `input.neighbours` ({} CRS units² of it lie inside the unit) near ({:.3}, {:.3}); with `partition: {{overlap: cut}}` (the default) the unit's share is cut out of it and given by the rule, or remove the overlap from the coverage",
-                crate::numbers::sig(area, 4),
-                at.x,
-                at.y
-            ));
+            return Err(PartitionError::Overlap {
+                fid,
+                area: crate::numbers::sig(area, 4),
+                x: at.x,
+                y: at.y,
+            });
         }
     }
     let local = near.coverage(cov);
     stop_if(expired)?;
     let snapped = match near.polygon == *p.polygon() {
         true => None,
-        false => Some(PreparedPolygon::new(&near.polygon).map_err(|e| e.to_string())?),
+        false => Some(PreparedPolygon::new(&near.polygon).map_err(geometry_error)?),
     };
     let mut out = partition_cut(
         snapped.as_ref().unwrap_or(p),
@@ -290,13 +324,13 @@ fn partition_cut(
     params: &PartitionParams,
     ma: Option<&SkeletonGraph>,
     expired: &dyn Fn() -> bool,
-) -> Result<PartPartition, String> {
+) -> Result<PartPartition, PartitionError> {
     let tol = SAME_POINT * p.extent();
     let mut owned = owners::owned(p, cov, tol);
     let mut cuts: Vec<Vec<Coord<f64>>> = Vec::new();
     let mut wide_parts: Vec<Polygon<f64>> = Vec::new();
     if let Some(c) = params.narrow() {
-        let ma = ma.ok_or("a partition with `width` needs the part's medial axis")?;
+        let ma = ma.ok_or(PartitionError::NoMedialAxis)?;
         let n = crate::narrow::collapse(ma, original, &c, &[]);
         if n.collapsed.is_empty() {
             // Wide everywhere: nothing is given away.
@@ -322,8 +356,8 @@ fn partition_cut(
         }
     }
     stop_if(expired)?;
-    let prepared = PreparedPolygon::new(&owned.polygon).map_err(|e| e.to_string())?;
-    let edges = cell_edges(&prepared, ArcTolerance::default()).map_err(|e| e.to_string())?;
+    let prepared = PreparedPolygon::new(&owned.polygon).map_err(geometry_error)?;
+    let edges = cell_edges(&prepared, ArcTolerance::default()).map_err(geometry_error)?;
     stop_if(expired)?;
     let (pieces, vertices) = split::pieces(&owned, edges);
     let mut lines: Vec<Vec<Coord<f64>>> = pieces.into_iter().map(|q| q.line).collect();
@@ -334,7 +368,8 @@ fn partition_cut(
         .map(LineString)
         .collect();
     stop_if(expired)?;
-    let faces = split::faces(&prepared, &owned, &vertices, &chords)?;
+    let faces =
+        split::faces(&prepared, &owned, &vertices, &chords).map_err(PartitionError::Geometry)?;
     stop_if(expired)?;
     let mut sides: Vec<Side> = faces
         .iter()
@@ -692,8 +727,16 @@ mod tests {
             ..PartitionParams::default()
         };
         let e = partition(&p, &cov, &reject, None, &|| false).unwrap_err();
+        assert!(matches!(e, PartitionError::Overlap { .. }), "{e:?}");
+        let e = e.to_string();
         assert!(e.contains("overlaps unit 9"), "{e}");
         assert!(e.contains("80 CRS units²"), "{e}");
+        // A partition whose time is up stops with its own variant.
+        let r = PartitionParams::default();
+        assert_eq!(
+            partition(&p, &cov, &r, None, &|| true).unwrap_err(),
+            PartitionError::Stopped
+        );
     }
 
     /// The canal's units with the legal line inside the water, at y = 3.
