@@ -488,7 +488,8 @@ def _run(
     if attributes is not None and len(attributes.columns) and _core.columns(layer, False)[1]:
         frame = pd.DataFrame(tool, index=out_index)
         # Source fields first, renamed where they clash with the tool's (as the writer does).
-        source = _renamed(attributes.iloc[rows], _reserved(pipeline))
+        connect = "connect" in (extra or {})
+        source = _renamed(attributes.iloc[rows], _reserved(pipeline, connect=connect, explode=explode))
         source.index = out_index
         frame = pd.concat([source, frame], axis=1)
         frame = gpd.GeoDataFrame(
@@ -707,11 +708,14 @@ def _run_frame(gdf, p: "_core.Pipeline", *, candidates: bool, threads: int | Non
 __all__.append("load_pipeline")
 
 
-def _reserved(pipeline: "_core.Pipeline", neighbours: bool = False) -> list:
+def _reserved(
+    pipeline: "_core.Pipeline", neighbours: bool = False, connect: bool = False, explode: bool | None = None
+) -> list:
     """The tool's column names beside which a source column (of ``input``, or with ``neighbours``
-    of ``neighbours``) is renamed, as the command line's writer renames them; a frame of ``input``
-    has a ``rejected`` column too."""
-    names = list(pipeline.reserved(neighbours))
+    of ``neighbours``) is renamed in a call of ``pipeline`` (``connect``: lines given; ``explode``
+    as the call asks), as the command line's writer renames them; a frame of ``input`` has a
+    ``rejected`` column too."""
+    names = list(pipeline.reserved(neighbours, connect, explode))
     return names if neighbours else names + ["rejected"]
 
 
@@ -808,7 +812,8 @@ def apply_layers(
     if neighbours is not None and hasattr(neighbours, "geometry"):
         sources["neighbours"] = neighbours.drop(columns=[neighbours.geometry.name])
     out = {"skeletons": frame}
-    reserved = {"input": _reserved(p), "neighbours": _reserved(p, neighbours=True)}
+    given = connect is not None
+    reserved = {"input": _reserved(p, connect=given), "neighbours": _reserved(p, neighbours=True, connect=given)}
     for name, layer in done.get("layers", {}).items():
         out[name] = _layer_frame(layer, gdf.crs, sources, reserved)
     return out

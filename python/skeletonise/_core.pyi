@@ -42,7 +42,7 @@ class Pipeline:
         """Raises PipelineError, with the command line's message, for what the command line refuses
         of the inputs: ``prune: {mode: network}`` without the lines of ``input.connect``
         (``connect``: they are given). ``run`` makes the same check."""
-    def reserved(self, neighbours: bool = False, connect: bool = False) -> list[str]:
+    def reserved(self, neighbours: bool = False, connect: bool = False, explode: Optional[bool] = None) -> list[str]:
         """The names for which a source field is written as ``src_<name>`` by a call of this pipeline
         (every layer of its plan that carries the source's fields, a registered step's too); with
         ``neighbours``, those of a field of the units."""

@@ -263,10 +263,18 @@ impl Pipeline {
     /// call of this pipeline (every layer of its plan that carries the
     /// source's fields — a registered step's too — as the command line's
     /// writer renames them); with `neighbours`, those of a field of the
-    /// units.
-    #[pyo3(signature = (neighbours = false, connect = false))]
-    fn reserved(&self, neighbours: bool, connect: bool) -> Vec<&'static str> {
-        let plan = self.steps.call_plan(self.explode(), connect);
+    /// units. `connect`: lines are given; `explode`: one row per part
+    /// (default the file's `output.explode`), as for `run`.
+    #[pyo3(signature = (neighbours = false, connect = false, explode = None))]
+    fn reserved(
+        &self,
+        neighbours: bool,
+        connect: bool,
+        explode: Option<bool>,
+    ) -> Vec<&'static str> {
+        let plan = self
+            .steps
+            .call_plan(explode.unwrap_or_else(|| self.explode()), connect);
         match neighbours {
             true => plan.reserved_neighbour_names(),
             false => plan.reserved_names(),

@@ -229,7 +229,8 @@ class _Algorithm(QgsProcessingAlgorithm):
                     extra["neighbour_snap"] = neighbour_snap
         features = bridge.read(source, pipeline.make_valid, feedback)
         carried = bridge.source_fields(source.fields(), skip)
-        reserved = bridge.core().reserved(collapse, partition)
+        # The pipeline's own plan (a registered step's layers too), as the command line's writer.
+        reserved = pipeline.reserved(connect=connect is not None, explode=explode)
         names = [p.name() for p in self.parameterDefinitions()]
         sinks = [("OUTPUT", "skeletons", QgsWkbTypes.MultiLineString)]
         if "CANDIDATES" in names and parameters.get("CANDIDATES") is not None:

@@ -663,6 +663,32 @@ class Partition(Case):
         for a, b in zip(areas, want):
             self.assertAlmostEqual(a, b, delta=1e-6 * b)
 
+    def test_a_pipeline_with_a_label_step_renames_fields_as_the_command_line(self):
+        # The `labels` layer carries the source's fields and has a `kind` column: the command line
+        # writes a source field `kind` as `src_kind` in every layer, the skeletons too; so does QGIS.
+        from qgis.core import QgsCoordinateTransformContext, QgsVectorFileWriter
+
+        mem = QgsVectorLayer("Polygon?crs=EPSG:32630&field=kind:string", "lakes", "memory")
+        f = QgsFeature(mem.fields())
+        f["kind"] = "loch"
+        f.setGeometry(QgsGeometry.fromWkt("POLYGON((0 0,4000 0,4000 400,0 400,0 0))"))
+        mem.dataProvider().addFeatures([f])
+        path = self.out("kind.gpkg")
+        options = QgsVectorFileWriter.SaveVectorOptions()
+        options.driverName, options.layerName = "GPKG", "lakes"
+        err = QgsVectorFileWriter.writeAsVectorFormatV3(mem, path, QgsCoordinateTransformContext(), options)
+        self.assertEqual(err[0], QgsVectorFileWriter.NoError, err)
+        pipeline = os.path.join(ROOT, "pipelines", "lake-labels.yaml")
+        cli("run", pipeline, "-i", path, "-l", "lakes", "-o", self.out("cli.gpkg"))
+        res = processing.run(
+            "skeletonise:pipeline", {"INPUT": f"{path}|layername=lakes", "PIPELINE": pipeline, "OUTPUT": self.out("q.gpkg")}
+        )
+        want = rows(self.out("cli.gpkg"), "skeletons")
+        got = rows(res["OUTPUT"])
+        self.assertEqual(want[0]["src_kind"], "loch")
+        self.assertEqual([k for k in got[0] if k != "rejected"], list(want[0]))
+        self.assertEqual(got[0]["src_kind"], "loch")
+
     def test_a_pipeline_file_with_a_partition_step_needs_the_neighbours(self):
         cov = os.path.join(ROOT, "tests", "data", "coverage-train.gpkg")
         with self.assertRaises(QgsProcessingException) as e:
