@@ -8,6 +8,8 @@
 //! [`crate::output::Plan`].
 
 use crate::feature::Value;
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
 
 /// The type of a column.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -261,4 +263,40 @@ pub struct StepLayer {
     pub attributes: bool,
     /// The step's columns (after `src_fid`), in order.
     pub columns: &'static [(&'static str, ColumnType)],
+}
+
+/// A layer chosen by name or by index.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(untagged)]
+pub enum LayerRef {
+    /// Zero-based layer index.
+    Index(usize),
+    /// Layer name.
+    Name(String),
+}
+
+impl std::fmt::Display for LayerRef {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            LayerRef::Index(i) => write!(f, "#{i}"),
+            LayerRef::Name(n) => write!(f, "`{n}`"),
+        }
+    }
+}
+
+/// A layer of any OGR source read beside the polygons: the coverage of
+/// `input.neighbours`, the lines of `input.connect`, or a registered
+/// step's side input (its option named by [`crate::process::step::Needs::side`]).
+/// Read through one path, reprojected to the polygons' CRS.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct LayerSource {
+    /// Any OGR data source string (may be the same file as `input.source`).
+    pub source: String,
+    /// Layer name or zero-based index; default the first layer.
+    #[serde(default)]
+    pub layer: Option<LayerRef>,
+    /// OGR SQL attribute filter: only these features are read.
+    #[serde(default, rename = "where")]
+    pub where_: Option<String>,
 }

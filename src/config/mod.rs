@@ -19,9 +19,9 @@ mod parse;
 mod sections;
 mod validate;
 
-pub use describe::{describe, describe_with, json_schema};
+pub use describe::{describe, describe_with, json_schema, json_schema_with};
 pub use sections::{
-    ConnectSpec, InputSpec, LayerRef, Measures, NeighboursSpec, OutputSpec, ReportSpec,
+    ConnectSpec, InputSpec, LayerRef, LayerSource, Measures, NeighboursSpec, OutputSpec, ReportSpec,
 };
 
 use crate::process::step::{Extra, StepRegistry};

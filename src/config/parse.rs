@@ -243,6 +243,7 @@ fn take_registered(
                 entry,
                 options,
                 step,
+                side: None,
             },
         ));
         index += 1;

@@ -1,28 +1,10 @@
 //! The `input` and `output` sections of a pipeline file.
 
+pub use crate::layer::{LayerRef, LayerSource};
 use crate::report::Selection;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
-
-/// A layer chosen by name or by index.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(untagged)]
-pub enum LayerRef {
-    /// Zero-based layer index.
-    Index(usize),
-    /// Layer name.
-    Name(String),
-}
-
-impl std::fmt::Display for LayerRef {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            LayerRef::Index(i) => write!(f, "#{i}"),
-            LayerRef::Name(n) => write!(f, "`{n}`"),
-        }
-    }
-}
 
 /// The `input` section of a pipeline file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
@@ -74,20 +56,19 @@ pub struct NeighboursSpec {
 }
 
 impl NeighboursSpec {
-    /// The coverage as an input of its own, reprojected to `crs` (the CRS
-    /// the polygons are handed out in, as WKT; `None` when they have none).
-    pub fn input(&self, crs: Option<&str>) -> InputSpec {
-        InputSpec {
+    /// The coverage's layer.
+    pub fn layer_source(&self) -> LayerSource {
+        LayerSource {
             source: self.source.clone(),
             layer: self.layer.clone(),
             where_: self.where_.clone(),
-            bbox: None,
-            reproject: crs.map(str::to_string),
-            merge_adjacent: false,
-            merge_by: None,
-            connect: None,
-            neighbours: None,
         }
+    }
+
+    /// The coverage as an input of its own, reprojected to `crs` (the CRS
+    /// the polygons are handed out in, as WKT; `None` when they have none).
+    pub fn input(&self, crs: Option<&str>) -> InputSpec {
+        self.layer_source().input(crs)
     }
 }
 
@@ -106,14 +87,31 @@ pub struct ConnectSpec {
 }
 
 impl ConnectSpec {
+    /// The network's layer.
+    pub fn layer_source(&self) -> LayerSource {
+        LayerSource {
+            source: self.source.clone(),
+            layer: self.layer.clone(),
+            where_: None,
+        }
+    }
+
     /// The network's lines as an input of their own, reprojected to `crs`
     /// (a definition GDAL reads: the CRS the polygons are handed out in,
     /// as WKT; `None` when they have none).
     pub fn input(&self, crs: Option<&str>) -> InputSpec {
+        self.layer_source().input(crs)
+    }
+}
+
+impl LayerSource {
+    /// The layer as an input of its own, reprojected to `crs` (the CRS the
+    /// polygons are handed out in, as WKT; `None` when they have none).
+    pub fn input(&self, crs: Option<&str>) -> InputSpec {
         InputSpec {
             source: self.source.clone(),
             layer: self.layer.clone(),
-            where_: None,
+            where_: self.where_.clone(),
             bbox: None,
             reproject: crs.map(str::to_string),
             merge_adjacent: false,

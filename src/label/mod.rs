@@ -29,14 +29,15 @@ use crate::graph::prune::PruneParams;
 use crate::graph::SkeletonGraph;
 use crate::layer::{Cell, ColumnType, GeometryKind, StepLayer, StepRow};
 use crate::methods::{MethodContext, MethodId, SkeletonParams};
-use crate::process::step::{FeatureStep, LonLat, OptionError, StepEntry, StepInput};
-use serde::Deserialize;
+use crate::process::step::{FeatureStep, LonLat, Needs, OptionError, StepEntry, StepInput};
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
 use std::sync::Arc;
 
 pub use line::{Label, Labelled};
 
 /// Which polygon parts of a feature get a label.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "lowercase")]
 pub enum Parts {
     /// Every part its own label.
@@ -47,17 +48,20 @@ pub enum Parts {
 }
 
 /// Options of the `label` step.
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields, default)]
 pub struct LabelParams {
     /// The most the line may turn over a stretch one local width long
     /// (degrees): the curve a label's letters still follow.
+    #[schemars(range(max = 180), extend("exclusiveMinimum" = 0))]
     pub smooth: f64,
     /// The line keeps at least this fraction of the local radius from the
-    /// shore.
+    /// shore (below 1).
+    #[schemars(range(min = 0), extend("exclusiveMaximum" = 1))]
     pub margin: f64,
     /// A part whose medial-axis path is shorter than this many times its
-    /// largest width gets a point instead of a line.
+    /// largest width gets a point instead of a line (0: every part a line).
+    #[schemars(range(min = 0))]
     pub min_elongation: f64,
     /// Every part, or only the largest part of a feature.
     pub parts: Parts,
@@ -65,6 +69,7 @@ pub struct LabelParams {
     /// many pixels long (256-pixel tiles, at the feature's latitude); a
     /// point from the zoom at which its largest disc is this many pixels
     /// wide (column `minzoom`).
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub min_pixels: f64,
 }
 
@@ -279,10 +284,6 @@ impl FeatureStep for LabelParams {
             })
             .collect()
     }
-
-    fn uses_medial_axis(&self) -> bool {
-        true
-    }
 }
 
 /// The `label` step's entry in the step registry.
@@ -290,13 +291,13 @@ pub const ENTRY: StepEntry = StepEntry {
     name: "label",
     after: "skeleton",
     description: "one label per polygon part: a smooth line along the medial axis where the part is elongated, else the centre of its largest inscribed disc (layer `labels`)",
-    options: &[
-        ("smooth", "most the line turns over one local width, degrees (60)"),
-        ("margin", "fraction of the local radius kept from the shore (0.9: the line stays within 0.1 r of the medial axis)"),
-        ("min_elongation", "length / largest width below which a part gets a point (3)"),
-        ("parts", "`each` (default) or `largest`: which parts of a feature get a label"),
-        ("min_pixels", "pixels a line must be long (a point's disc wide) on the web map from `minzoom` on (64)"),
-    ],
+    schema: || schemars::schema_for!(LabelParams),
+    needs: Needs {
+        medial_axis: true,
+        lonlat: true,
+        side: None,
+        finish: false,
+    },
     layers: LABELS,
     build: |v| {
         let p: LabelParams = crate::process::step::step_options(v)?;

@@ -391,11 +391,27 @@ fn params_for(
     info: &SourceInfo,
 ) -> Result<(ProcessParams, Option<SourceInfo>), RunError> {
     let mut params = job.params.clone();
-    if !params.extra.is_empty() {
+    if params.extra.iter().any(|e| e.entry.needs.lonlat) {
         params.lonlat = info
             .srs_wkt
             .as_deref()
             .and_then(crate::io::lonlat::lonlat_of);
+    }
+    for e in &mut params.extra {
+        if let Some((key, src)) = e.side_source() {
+            let key = format!("steps.{}.{key}", e.entry.name);
+            let src = src.map_err(|why| {
+                RunError::Io(crate::io::IoError::Read {
+                    source_name: key.clone(),
+                    reason: format!(
+                        "`{key}` is no layer: {why}; give `{{ source: …, layer: …, where: … }}`"
+                    ),
+                })
+            })?;
+            e.side = Some(std::sync::Arc::new(source::read_step_side(
+                &src, &key, info,
+            )?));
+        }
     }
     let neighbours = second_inputs(job, info, &mut params)?;
     Ok((params, neighbours))

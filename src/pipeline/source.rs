@@ -3,7 +3,8 @@
 //! the line network of `input.connect`.
 
 use super::{Batch, RunError};
-use crate::config::InputSpec;
+use crate::config::{InputSpec, LayerSource};
+use crate::feature::Feature;
 use crate::io::reader::Reader;
 use crate::io::{IoError, SourceInfo};
 use std::sync::mpsc;
@@ -63,57 +64,85 @@ pub(super) fn merge_field(input: &InputSpec, info: &SourceInfo) -> Result<Option
         })
 }
 
+/// Every feature of a layer read beside the polygons — `input.connect`,
+/// `input.neighbours`, a registered step's side input — reprojected to the
+/// CRS the polygons are handed out in (`polygons`), and what its source
+/// holds. `key` (`input.connect`, `steps.<step>.<option>`) names it in
+/// errors, with its own `layer` and `where` to fix, not the polygons'.
+pub(super) fn read_side(
+    src: &LayerSource,
+    key: &str,
+    polygons: &SourceInfo,
+) -> Result<(Vec<Feature>, SourceInfo), RunError> {
+    let error = |reason: String| {
+        RunError::Io(IoError::Read {
+            source_name: src.source.clone(),
+            reason,
+        })
+    };
+    let mut reader = Reader::open(&src.input(polygons.srs_wkt.as_deref()))
+        .map_err(|e| error(side_error(key, e)))?;
+    let mut all = Vec::new();
+    reader.read::<IoError>(1024, false, |batch| {
+        all.extend(batch);
+        Ok(())
+    })?;
+    Ok((all, reader.info().clone()))
+}
+
+/// A registered step's side input layer: its features' FIDs and geometries.
+pub(super) fn read_step_side(
+    src: &LayerSource,
+    key: &str,
+    polygons: &SourceInfo,
+) -> Result<crate::process::step::SideLayer, RunError> {
+    let (features, info) = read_side(src, key, polygons)?;
+    tracing::info!(source = %src.source, layer = %info.layer, features = features.len(), "{key}: side input read");
+    Ok(crate::process::step::SideLayer::new(
+        features
+            .into_iter()
+            .filter_map(|f| Some((f.fid, f.geometry?)))
+            .collect(),
+    ))
+}
+
 /// The lines of `input.connect`, reprojected to the CRS the polygons are
 /// handed out in (`polygons`); a layer without lines is an error.
 pub(super) fn read_network(
     c: &crate::config::ConnectSpec,
     polygons: &SourceInfo,
 ) -> Result<crate::connect::Network, RunError> {
-    let mut reader =
-        Reader::open(&c.input(polygons.srs_wkt.as_deref())).map_err(|e| connect_error(c, e))?;
+    let (features, info) = read_side(&c.layer_source(), "input.connect", polygons)?;
     let mut lines = Vec::new();
-    let mut features = 0;
-    reader.read::<IoError>(1024, false, |batch| {
-        features += batch.len();
-        for f in batch {
-            let mut ls = Vec::new();
-            if let Some(g) = &f.geometry {
-                crate::connect::lines_of(g, &mut ls);
-            }
-            lines.extend(ls.into_iter().map(|l| (f.fid, l)));
+    for f in &features {
+        let mut ls = Vec::new();
+        if let Some(g) = &f.geometry {
+            crate::connect::lines_of(g, &mut ls);
         }
-        Ok(())
-    })?;
-    if lines.is_empty() {
-        return Err(no_lines(c, reader.info(), features));
+        lines.extend(ls.into_iter().map(|l| (f.fid, l)));
     }
-    tracing::info!(source = %c.source, layer = %reader.info().layer, crs = %reader.info().crs_name, lines = lines.len(), "connect: line network read");
+    if lines.is_empty() {
+        return Err(no_lines(c, &info, features.len()));
+    }
+    tracing::info!(source = %c.source, layer = %info.layer, crs = %info.crs_name, lines = lines.len(), "connect: line network read");
     Ok(crate::connect::Network::new(lines, c.snap))
 }
 
-/// An error opening `input.connect`, said to be about it.
-fn connect_error(c: &crate::config::ConnectSpec, e: IoError) -> RunError {
-    RunError::Io(IoError::Read {
-        source_name: c.source.clone(),
-        reason: second_input_error("connect", e),
-    })
-}
-
-/// Why a second input (`input.<what>`) could not be opened, with the keys
-/// of that input to fix (its `layer`, its `where`), not the polygons'.
-fn second_input_error(what: &str, e: IoError) -> String {
+/// Why a layer read beside the polygons (`key`) could not be opened, with
+/// the keys of that layer to fix (its `layer`, its `where`).
+fn side_error(key: &str, e: IoError) -> String {
     match e {
         IoError::NoLayer {
             source_name,
             layer,
             available,
         } => format!(
-            "`input.{what}`: layer {layer} not found in `{source_name}`; available layers: {available}; choose one with `input.{what}.layer`"
+            "`{key}`: layer {layer} not found in `{source_name}`; available layers: {available}; choose one with `{key}.layer`"
         ),
         IoError::BadWhere { filter, reason } => format!(
-            "`input.{what}`: invalid `input.{what}.where` filter `{filter}`: {reason}; use OGR SQL syntax, e.g. \"area_m2 > 1e6\""
+            "`{key}`: invalid `{key}.where` filter `{filter}`: {reason}; use OGR SQL syntax, e.g. \"area_m2 > 1e6\""
         ),
-        e => format!("`input.{what}`: {e}"),
+        e => format!("`{key}`: {e}"),
     }
 }
 
@@ -188,43 +217,36 @@ pub(super) fn read_neighbours(
             reason,
         })
     };
-    let mut reader = Reader::open(&n.input(polygons.srs_wkt.as_deref()))
-        .map_err(|e| error(second_input_error("neighbours", e)))?;
+    let (features, info) = read_side(&n.layer_source(), "input.neighbours", polygons)?;
     let mut units = Vec::new();
     let mut bad = None;
-    reader.read::<IoError>(1024, false, |batch| {
-        for f in batch {
-            match crate::partition::unit_geometry(f.fid, f.geometry.as_ref()) {
-                Ok(geometry) => units.push(Unit {
-                    fid: f.fid,
-                    geometry,
-                    attributes: f.attributes,
-                }),
-                Err(why) => {
-                    bad.get_or_insert(why);
-                }
+    for f in features {
+        match crate::partition::unit_geometry(f.fid, f.geometry.as_ref()) {
+            Ok(geometry) => units.push(Unit {
+                fid: f.fid,
+                geometry,
+                attributes: f.attributes,
+            }),
+            Err(why) => {
+                bad.get_or_insert(why);
             }
         }
-        Ok(())
-    })?;
+    }
     if let Some(why) = bad {
         return Err(error(format!(
             "`input.neighbours`: {why} (layer `{}`; filter units out with `input.neighbours.where`)",
-            reader.info().layer
+            info.layer
         )));
     }
     if units.is_empty() {
         return Err(error(format!(
             "`input.neighbours`: layer `{}` has no units (after its `where`); give the coverage whose units take the area",
-            reader.info().layer
+            info.layer
         )));
     }
     units.sort_by_key(|u| u.fid);
-    tracing::info!(source = %n.source, layer = %reader.info().layer, units = units.len(), "partition: coverage read");
-    Ok((
-        Coverage::new(units).with_snap(n.snap),
-        reader.info().clone(),
-    ))
+    tracing::info!(source = %n.source, layer = %info.layer, units = units.len(), "partition: coverage read");
+    Ok((Coverage::new(units).with_snap(n.snap), info))
 }
 
 /// Why the reader thread stops before the end of the source.

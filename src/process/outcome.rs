@@ -98,18 +98,20 @@ fn after_select(
         partition_chosen(o, prepared, pp, cov, &clock)?;
     }
     for e in &params.extra {
+        let needs = e.entry.needs;
         let medial_axis = o
             .candidates
             .iter()
-            .find(|c| c.method == MethodId::MA)
+            .find(|c| c.method == MethodId::MA && needs.medial_axis)
             .and_then(|c| c.result.as_ref().ok())
             .map(|c| c.raw.as_slice())
             .filter(|raw| raw.len() == prepared.len());
         let rows = e.step.rows(&step::StepInput {
             parts: prepared,
             outcome: o,
-            lonlat: params.lonlat.as_ref(),
+            lonlat: params.lonlat.as_ref().filter(|_| needs.lonlat),
             medial_axis,
+            side: e.side.as_deref(),
             budget: &clock.0,
         });
         clock.check(e.entry.name)?;
@@ -586,6 +588,7 @@ mod tests {
             entry: crate::label::ENTRY,
             options: serde_json::Value::Null,
             step: (crate::label::ENTRY.build)(&serde_json::Value::Null).unwrap(),
+            side: None,
         };
         let kept = |params: &ProcessParams| -> usize {
             let Processed::Done(o) = process(Some(&Geometry::Polygon(long.clone())), params) else {

@@ -9,6 +9,7 @@
 
 use super::{FeatureRows, ProcessParams, StageTimes, Status};
 use crate::feature::Feature;
+use crate::layer::StepRow;
 use crate::methods::MethodId;
 use crate::output::Rows;
 use std::collections::{BTreeMap, BTreeSet};
@@ -67,6 +68,9 @@ pub struct Run<'a> {
     counts: RunCounts,
     grown: Vec<(Option<u64>, crate::partition::Growth)>,
     met: Vec<(Option<u64>, geo::Coord<f64>)>,
+    /// The per-feature rows of each registered step whose finish reads
+    /// them (by its index in `params.extra`).
+    kept: Vec<Vec<(Option<u64>, &'static str, StepRow)>>,
 }
 
 impl<'a> Run<'a> {
@@ -79,6 +83,7 @@ impl<'a> Run<'a> {
             counts: RunCounts::default(),
             grown: Vec::new(),
             met: Vec::new(),
+            kept: vec![Vec::new(); params.extra.len()],
         }
     }
 
@@ -116,6 +121,7 @@ impl<'a> Run<'a> {
                 None => c.stages.push((*m, *t)),
             }
         }
+        self.keep_for_finish(&rows);
         self.grown.append(&mut rows.grown);
         self.met.extend(
             rows.connections
@@ -125,6 +131,19 @@ impl<'a> Run<'a> {
         Ok(rows)
     }
 
+    /// Keeps the rows of the registered steps whose finish reads them.
+    fn keep_for_finish(&mut self, rows: &Rows) {
+        for (e, kept) in self.params.extra.iter().zip(&mut self.kept) {
+            if !e.entry.needs.finish {
+                continue;
+            }
+            for layer in e.entry.layers {
+                let own = rows.extra.get(layer.name).into_iter().flatten();
+                kept.extend(own.map(|r| (r.src_fid, layer.name, r.row.clone())));
+            }
+        }
+    }
+
     /// The counts so far.
     pub fn counts(&self) -> &RunCounts {
         &self.counts
@@ -132,10 +151,30 @@ impl<'a> Run<'a> {
 
     /// After the last feature: the network's lines split where they met the
     /// polygons (with `input.connect`), the partitioned coverage — every
-    /// unit grown by what it received — (with `partition`), and the counts.
+    /// unit grown by what it received — (with `partition`), the registered
+    /// steps' [finish](super::step::FeatureStep::finish) rows (of the
+    /// layers each declares; without source fields), and the counts.
     /// Fails when a unit of the coverage cannot be written valid.
     pub fn finish(mut self) -> Result<(Rows, RunCounts), String> {
         let mut rows = Rows::default();
+        for (e, kept) in self.params.extra.iter().zip(std::mem::take(&mut self.kept)) {
+            let input = super::step::FinishInput {
+                rows: &kept,
+                side: e.side.as_deref(),
+            };
+            for (layer, row) in e.step.finish(&input) {
+                if e.entry.layers.iter().any(|l| l.name == layer) {
+                    rows.extra
+                        .entry(layer)
+                        .or_default()
+                        .push(crate::output::ExtraRow {
+                            src_fid: None,
+                            attributes: Vec::new(),
+                            row,
+                        });
+                }
+            }
+        }
         if let Some(net) = &self.params.connect {
             rows.network = net.rows(&self.met);
             self.counts.network = Some(net.len() as u64);

@@ -1,11 +1,16 @@
 //! Steps registered beside the built-in ones: a step is one [`StepEntry`] —
-//! its name, its place in the step order, its options (parsed from the
-//! pipeline file by its own `build`), the layers it writes
+//! its name, its place in the step order, its options (a type of its own:
+//! their JSON Schema for `skeletonise schema`, `skeletonise methods` and
+//! QGIS, parsed from the pipeline file by its own `build`), what it
+//! [needs](Needs) beyond the feature (the medial axis's raw skeleton,
+//! longitude and latitude, a side input layer), the layers it writes
 //! ([`StepLayer`]s, declared next to its code) — and a [`FeatureStep`] that
-//! turns each feature's outcome into rows of those layers. Parsing
-//! (`config::load_with`), validation, the output plan, the writer, the
-//! Python table and `skeletonise methods` follow from the entry, as a
-//! method follows from its `MethodEntry`.
+//! turns each feature's outcome into rows of those layers and, after the
+//! last feature, may add rows of its own ([`FeatureStep::finish`]).
+//! Parsing (`config::load_with`), validation, the output plan, the run
+//! driver (`process::Run`), the writer, the Python table and
+//! `skeletonise methods` follow from the entry, as a method follows from
+//! its `MethodEntry`.
 //!
 //! ```
 //! use skeletonise::output::{Cell, ColumnType, GeometryKind, StepLayer, StepRow};
@@ -33,7 +38,8 @@
 //!     name: "parts",
 //!     after: "select",
 //!     description: "the number of polygon parts of every feature",
-//!     options: &[],
+//!     schema: || schemars::json_schema!({ "type": ["object", "null"] }),
+//!     needs: skeletonise::process::step::Needs::NOTHING,
 //!     layers: LAYERS,
 //!     build: |_| Ok(std::sync::Arc::new(Parts)),
 //! });
@@ -42,7 +48,7 @@
 
 use super::FeatureOutcome;
 use crate::geometry::PreparedPolygon;
-use crate::layer::{StepLayer, StepRow};
+use crate::layer::{LayerSource, StepLayer, StepRow};
 use crate::methods::MethodContext;
 use std::sync::Arc;
 
@@ -56,13 +62,17 @@ pub struct StepInput<'a> {
     /// The outcome so far.
     pub outcome: &'a FeatureOutcome,
     /// The run's coordinates as longitude and latitude (degrees), when the
-    /// run knows its CRS (a GDAL source does; a library caller may not).
+    /// step [needs them](Needs::lonlat) and the run knows its CRS (a GDAL
+    /// source does; a library caller may not).
     pub lonlat: Option<&'a LonLat>,
     /// The medial axis's raw skeleton of every polygon part, as the
-    /// `skeleton` step made it with MA's default options, when a step
-    /// [uses it](FeatureStep::uses_medial_axis) and MA succeeded; `None`
-    /// otherwise (the step makes its own).
+    /// `skeleton` step made it with MA's default options, when the step
+    /// [needs it](Needs::medial_axis) and MA succeeded; `None` otherwise
+    /// (the step makes its own).
     pub medial_axis: Option<&'a [std::sync::Arc<crate::graph::SkeletonGraph>]>,
+    /// The step's side input layer, when it [has one](Needs::side) and the
+    /// pipeline gives it.
+    pub side: Option<&'a SideLayer>,
     /// The clock of the steps after `select` on this feature
     /// (`skeleton.timeout_s` once more): a step with long work asks
     /// [`MethodContext::expired`] and stops; rows that come after the
@@ -119,12 +129,108 @@ pub trait FeatureStep: Send + Sync + std::fmt::Debug + std::panic::RefUnwindSafe
     /// The rows of the step's layers for one feature.
     fn rows(&self, input: &StepInput<'_>) -> Vec<(&'static str, StepRow)>;
 
-    /// True when the step reads the medial axis's raw skeleton
-    /// ([`StepInput::medial_axis`]): the `skeleton` step then keeps the one
-    /// it made (with MA among its methods and MA's default options) rather
-    /// than the step making it again.
-    fn uses_medial_axis(&self) -> bool {
-        false
+    /// Rows of the step's layers made once, after the last feature (a
+    /// summary, what is left of the side input): written without source
+    /// fields, `src_fid` NULL. `input.rows` holds the step's per-feature
+    /// rows when its entry [keeps them](Needs::finish).
+    fn finish(&self, input: &FinishInput<'_>) -> Vec<(&'static str, StepRow)> {
+        let _ = input;
+        Vec::new()
+    }
+}
+
+/// What a registered step's [`FeatureStep::finish`] sees: the rows it made
+/// for every feature (with the feature's FID, in read order) when its entry
+/// keeps them, and its side input.
+#[derive(Debug, Clone, Copy)]
+pub struct FinishInput<'a> {
+    /// `(src_fid, layer, row)` of every feature, when [`Needs::finish`].
+    pub rows: &'a [(Option<u64>, &'static str, StepRow)],
+    /// The step's side input layer, when it has one.
+    pub side: Option<&'a SideLayer>,
+}
+
+/// What a registered step needs beyond its feature's polygon parts and the
+/// outcome of the steps before it. The run gives exactly what the steps of
+/// a pipeline need together: the `skeleton` step keeps MA's raw skeleton
+/// only for a step that reads it, longitude and latitude are made only for
+/// a step that reads them, and a side input is read only for a step that
+/// has one.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Needs {
+    /// The medial axis's raw skeleton of every part ([`StepInput::medial_axis`]).
+    pub medial_axis: bool,
+    /// Longitude and latitude of the run's coordinates ([`StepInput::lonlat`]).
+    pub lonlat: bool,
+    /// The key of the step's option that names a side input layer (a
+    /// [`LayerSource`]: `source`, `layer`, `where`), read through the same
+    /// path as `input.neighbours` and `input.connect`, reprojected to the
+    /// polygons' CRS ([`StepInput::side`]); the Python package takes it as
+    /// a GeoDataFrame, QGIS as a layer parameter.
+    pub side: Option<&'static str>,
+    /// The run keeps the step's per-feature rows for its
+    /// [`FeatureStep::finish`].
+    pub finish: bool,
+}
+
+impl Needs {
+    /// Nothing beyond the feature.
+    pub const NOTHING: Needs = Needs {
+        medial_axis: false,
+        lonlat: false,
+        side: None,
+        finish: false,
+    };
+}
+
+/// A side input layer's features, reprojected to the polygons' CRS, with an
+/// index of their bounding boxes.
+#[derive(Debug, Default)]
+pub struct SideLayer {
+    features: Vec<(Option<u64>, geo::Geometry<f64>)>,
+    index: rstar::RTree<
+        rstar::primitives::GeomWithData<rstar::primitives::Rectangle<[f64; 2]>, usize>,
+    >,
+}
+
+impl SideLayer {
+    /// The layer of `features` (FID and geometry; empty geometries are kept
+    /// but never near anything).
+    pub fn new(features: Vec<(Option<u64>, geo::Geometry<f64>)>) -> Self {
+        use geo::BoundingRect;
+        use rstar::primitives::{GeomWithData, Rectangle};
+        let boxes = features
+            .iter()
+            .enumerate()
+            .filter_map(|(i, (_, g))| {
+                let r = g.bounding_rect()?;
+                let rect = Rectangle::from_corners([r.min().x, r.min().y], [r.max().x, r.max().y]);
+                Some(GeomWithData::new(rect, i))
+            })
+            .collect();
+        Self {
+            features,
+            index: rstar::RTree::bulk_load(boxes),
+        }
+    }
+
+    /// Every feature: FID and geometry, in read order.
+    pub fn features(&self) -> &[(Option<u64>, geo::Geometry<f64>)] {
+        &self.features
+    }
+
+    /// The indices (into [`Self::features`]) of the features whose bounding
+    /// boxes meet `rect`, ascending.
+    pub fn near(&self, rect: geo::Rect<f64>) -> Vec<usize> {
+        let env =
+            rstar::AABB::from_corners([rect.min().x, rect.min().y], [rect.max().x, rect.max().y]);
+        let mut found: Vec<usize> = self
+            .index
+            .locate_in_envelope_intersecting(&env)
+            .map(|g| g.data)
+            .collect();
+        found.sort_unstable();
+        found
     }
 }
 
@@ -140,8 +246,12 @@ pub struct StepEntry {
     pub after: &'static str,
     /// One line for `skeletonise methods`.
     pub description: &'static str,
-    /// Its options: name and meaning, for `skeletonise methods`.
-    pub options: &'static [(&'static str, &'static str)],
+    /// The JSON Schema of its options (e.g. `|| schemars::schema_for!(T)`):
+    /// `skeletonise schema` and `skeletonise methods` list them, QGIS makes
+    /// its parameters from them.
+    pub schema: fn() -> schemars::Schema,
+    /// What it needs beyond the feature.
+    pub needs: Needs,
     /// The layers it writes.
     pub layers: &'static [StepLayer],
     /// The step from its options (the YAML mapping under its key, as JSON).
@@ -149,15 +259,16 @@ pub struct StepEntry {
 }
 
 /// A registered step's options as `T`, from the YAML mapping under its key
-/// (as JSON; null: `T::default()`): a wrong value is reported at its key
-/// (`parts`, not the step), with serde's reason.
-pub fn step_options<T: serde::de::DeserializeOwned + Default>(
+/// (as JSON; null as an empty mapping): a wrong value is reported at its
+/// key (`parts`, not the step), with serde's reason.
+pub fn step_options<T: serde::de::DeserializeOwned>(
     v: &serde_json::Value,
 ) -> Result<T, OptionError> {
-    if v.is_null() {
-        return Ok(T::default());
-    }
-    serde_path_to_error::deserialize(v.clone()).map_err(|e| {
+    let v = match v {
+        serde_json::Value::Null => serde_json::json!({}),
+        v => v.clone(),
+    };
+    serde_path_to_error::deserialize(v).map_err(|e| {
         let key = e.path().to_string();
         let key = if key == "." { String::new() } else { key };
         (key, e.into_inner().to_string())
@@ -201,6 +312,22 @@ pub struct Extra {
     pub options: serde_json::Value,
     /// The step.
     pub step: Arc<dyn FeatureStep>,
+    /// Its side input layer, once the caller has read it (or been given
+    /// it): see [`Needs::side`].
+    pub side: Option<Arc<SideLayer>>,
+}
+
+impl Extra {
+    /// The side input layer its options name, when the step has one and the
+    /// pipeline file gives it: `(its key, the layer)`.
+    pub fn side_source(&self) -> Option<(&'static str, Result<LayerSource, String>)> {
+        let key = self.entry.needs.side?;
+        let v = self.options.get(key).filter(|v| !v.is_null())?;
+        Some((
+            key,
+            serde_json::from_value(v.clone()).map_err(|e| e.to_string()),
+        ))
+    }
 }
 
 impl PartialEq for Extra {

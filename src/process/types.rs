@@ -59,7 +59,7 @@ impl ProcessParams {
     /// registered step that reads it (`label`): MA is among the methods and
     /// has its default options (what the step would make itself).
     pub fn keeps_raw_medial_axis(&self) -> bool {
-        self.extra.iter().any(|e| e.step.uses_medial_axis())
+        self.extra.iter().any(|e| e.entry.needs.medial_axis)
             && self
                 .skeleton
                 .methods

@@ -1,9 +1,12 @@
 //! A new step is one module and one registration line: a deliberately
-//! trivial `toy` step — its own option (`scale`), its own layer (`toy`)
-//! and column (`scaled_length`: the chosen skeleton's length times the
-//! option) — runs through the pipeline file, its validation and `--set`,
-//! the run the binary makes (`pipeline::run`: the GeoPackage) and the
-//! table the Python package builds (`output::columns`).
+//! trivial `toy` step — its own options (`scale`, and `near`: a side input
+//! layer), its own layers (`toy`, with the chosen skeleton as geometry and
+//! `scaled_length`, the skeleton's length times the option, and `near`, the
+//! side layer's features whose boxes meet the polygon's; `toy_total`, one
+//! row made after the last feature) — runs through the pipeline file, its
+//! JSON Schema, validation and `--set`, the run the binary makes
+//! (`pipeline::run`: the GeoPackage) and the run driver the Python package
+//! uses (`process::Run`, `output::columns`).
 
 use crate::common::{open, reals, tmp, DEMO};
 use gdal::vector::LayerAccess;
@@ -11,18 +14,24 @@ use skeletonise::output::{
     columns::{columns, Item, Values},
     Cell, ColumnType, GeometryKind, Rows, StepLayer, StepRow,
 };
-use skeletonise::process::step::{FeatureStep, StepEntry, StepInput};
+use skeletonise::process::step::{FeatureStep, FinishInput, Needs, StepEntry, StepInput};
 
 /// The module of the toy step: everything it is, in one place.
 mod toy {
     use super::*;
-    use geo::{Euclidean, Length};
+    use geo::{BoundingRect, Euclidean, Length};
 
     /// Its options.
-    #[derive(Debug, serde::Deserialize)]
+    #[derive(Debug, serde::Deserialize, schemars::JsonSchema)]
     #[serde(deny_unknown_fields)]
-    struct Options {
+    pub struct Options {
+        /// The factor.
         scale: f64,
+        /// A layer whose features near each polygon are counted (read by
+        /// the run, which hands it to the step: `Needs::side`).
+        #[serde(default)]
+        #[allow(dead_code)]
+        near: Option<skeletonise::config::LayerSource>,
     }
 
     /// The step.
@@ -33,34 +42,83 @@ mod toy {
         fn rows(&self, input: &StepInput<'_>) -> Vec<(&'static str, StepRow)> {
             let (_, chosen) = input.outcome.chosen();
             let length: f64 = chosen.geometry.0.iter().map(|l| Euclidean.length(l)).sum();
+            let near = match (input.side, input.parts.first()) {
+                (Some(side), Some(p)) => {
+                    let rect = p.polygon().bounding_rect().expect("a polygon has a box");
+                    Cell::Int(side.near(rect).len() as i64)
+                }
+                _ => Cell::Null,
+            };
             vec![(
                 "toy",
                 StepRow {
                     geometry: Some(geo::Geometry::MultiLineString(chosen.geometry.clone())),
-                    cells: vec![Cell::Real(self.0 * length)],
+                    cells: vec![Cell::Real(self.0 * length), near],
+                },
+            )]
+        }
+
+        fn finish(&self, input: &FinishInput<'_>) -> Vec<(&'static str, StepRow)> {
+            let total: f64 = input
+                .rows
+                .iter()
+                .filter_map(|(_, _, r)| match r.cells[0] {
+                    Cell::Real(x) => Some(x),
+                    _ => None,
+                })
+                .sum();
+            let side = input
+                .side
+                .map_or(Cell::Null, |s| Cell::Int(s.features().len() as i64));
+            let cells = vec![Cell::Int(input.rows.len() as i64), Cell::Real(total), side];
+            vec![(
+                "toy_total",
+                StepRow {
+                    geometry: None,
+                    cells,
                 },
             )]
         }
     }
 
-    /// Its layer.
-    pub const LAYERS: &[StepLayer] = &[StepLayer {
-        name: "toy",
-        geometry: GeometryKind::MultiLineString,
-        attributes: true,
-        columns: &[("scaled_length", ColumnType::Real)],
-    }];
+    /// Its layers.
+    pub const LAYERS: &[StepLayer] = &[
+        StepLayer {
+            name: "toy",
+            geometry: GeometryKind::MultiLineString,
+            attributes: true,
+            columns: &[
+                ("scaled_length", ColumnType::Real),
+                ("near", ColumnType::Int32),
+            ],
+        },
+        StepLayer {
+            name: "toy_total",
+            geometry: GeometryKind::None,
+            attributes: false,
+            columns: &[
+                ("features", ColumnType::Int32),
+                ("scaled_length", ColumnType::Real),
+                ("side_features", ColumnType::Int32),
+            ],
+        },
+    ];
 
     /// Its registry entry.
     pub const ENTRY: StepEntry = StepEntry {
         name: "toy",
         after: "select",
         description: "the chosen skeleton's length times `scale` (a test step)",
-        options: &[("scale", "the factor")],
+        schema: || schemars::schema_for!(Options),
+        needs: Needs {
+            medial_axis: false,
+            lonlat: false,
+            side: Some("near"),
+            finish: true,
+        },
         layers: LAYERS,
         build: |v| {
-            let o: Options =
-                serde_json::from_value(v.clone()).map_err(|e| (String::new(), e.to_string()))?;
+            let o: Options = skeletonise::process::step::step_options(v)?;
             if !(o.scale.is_finite() && o.scale > 0.0) {
                 return Err(("scale".into(), "scale must be a positive number".into()));
             }
@@ -77,12 +135,30 @@ fn pipeline_text(out: &std::path::Path, toy: &str) -> String {
     )
 }
 
+/// The boxes of the demo's lakes.
+fn demo_boxes() -> Vec<geo::Rect<f64>> {
+    use geo::BoundingRect;
+    let ds = open(std::path::Path::new(&crate::common::root(DEMO)));
+    let mut l = ds.layer_by_name("demo").unwrap();
+    l.set_attribute_filter("kind = 'lake'").unwrap();
+    l.features()
+        .map(|f| {
+            let g: geo::Geometry<f64> = f.geometry().unwrap().to_geo().unwrap();
+            g.bounding_rect().unwrap()
+        })
+        .collect()
+}
+
 #[test]
-fn a_registered_step_writes_its_own_layer_through_the_run_and_the_python_table() {
+fn a_registered_step_writes_its_own_layers_through_the_run_and_the_python_table() {
     let registry = skeletonise::config::builtin_steps().with(toy::ENTRY);
     let d = tmp();
     let out = d.path().join("toy.gpkg");
-    let text = pipeline_text(&out, "  - toy: { scale: 2 }\n");
+    let near = format!(
+        "{{ source: {}, layer: demo, where: \"kind = 'lake'\" }}",
+        crate::common::root(DEMO)
+    );
+    let text = pipeline_text(&out, &format!("  - toy: {{ scale: 2, near: {near} }}\n"));
     let p = skeletonise::config::load_str_with(
         &text,
         "toy.yaml",
@@ -99,7 +175,7 @@ fn a_registered_step_writes_its_own_layer_through_the_run_and_the_python_table()
     let fields: Vec<String> = layer.defn().fields().map(|f| f.name()).collect();
     assert!(
         fields.contains(&"kind".to_string())
-            && fields.ends_with(&["src_fid".into(), "scaled_length".into()]),
+            && fields.ends_with(&["src_fid".into(), "scaled_length".into(), "near".into()]),
         "{fields:?}"
     );
     let scaled = reals(&ds, "toy", "scaled_length");
@@ -123,19 +199,67 @@ fn a_registered_step_writes_its_own_layer_through_the_run_and_the_python_table()
             "{fid}: {ts:?} vs 3 × {len}"
         );
     }
-    // The same rows as the Python package's table: the per-feature path
-    // in memory, the layer's columns from the plan.
+    // The side input: read with its own `where`, each feature given the
+    // number of those features whose boxes meet its own.
+    use geo::Intersects;
+    let boxes = demo_boxes();
+    assert_eq!(boxes.len(), 4);
+    let mut demo = ds.layer_by_name("toy").unwrap();
+    let near_at = demo.defn().field_index("near").unwrap();
+    let near: Vec<i64> = demo
+        .features()
+        .map(|f| f.field_as_integer64(near_at).unwrap().unwrap())
+        .collect();
+    let src = open(std::path::Path::new(&crate::common::root(DEMO)));
+    let mut srcl = src.layer_by_name("demo").unwrap();
+    let expected: Vec<i64> = srcl
+        .features()
+        .map(|f| {
+            use geo::BoundingRect;
+            let g: geo::Geometry<f64> = f.geometry().unwrap().to_geo().unwrap();
+            let r = g.bounding_rect().unwrap();
+            boxes.iter().filter(|b| b.intersects(&r)).count() as i64
+        })
+        .collect();
+    assert_eq!(near, expected);
+    assert!(near.contains(&0) && near.iter().any(|&n| n > 0), "{near:?}");
+    // The finish: one row after the last feature, from every feature's rows
+    // and the side input, without source fields.
+    let total = ds.layer_by_name("toy_total").unwrap();
+    let fields: Vec<String> = total.defn().fields().map(|f| f.name()).collect();
+    assert_eq!(
+        fields,
+        ["src_fid", "features", "scaled_length", "side_features"]
+    );
+    assert_eq!(
+        crate::common::ints(&ds, "toy_total", "features"),
+        [Some(17)]
+    );
+    assert_eq!(
+        crate::common::ints(&ds, "toy_total", "side_features"),
+        [Some(4)]
+    );
+    assert_eq!(crate::common::ints(&ds, "toy_total", "src_fid"), [None]);
+    let sum: f64 = scaled.iter().map(|x| x.unwrap()).sum();
+    let t = reals(&ds, "toy_total", "scaled_length")[0].unwrap();
+    assert!((t - sum).abs() < 1e-9 * sum, "{t} vs {sum}");
+    // The same rows through the run driver the Python package uses: the
+    // per-feature path in memory, `Run` (its finish included), the
+    // layers' columns from the plan.
     let plan = p.plan();
-    let params = p.process_params();
-    let features = skeletonise::io::reader::Reader::open(&p.file.input).unwrap();
+    let mut params = p.process_params();
+    params.extra[0].side = Some(std::sync::Arc::new(
+        skeletonise::process::step::SideLayer::new(Vec::new()),
+    ));
+    let mut reader = skeletonise::io::reader::Reader::open(&p.file.input).unwrap();
     let mut all = Vec::new();
-    let mut reader = features;
     reader
         .read::<skeletonise::io::IoError>(64, true, |b| {
             all.extend(b);
             Ok(())
         })
         .unwrap();
+    let mut run = skeletonise::process::Run::new(&params, false);
     let mut rows = Rows::default();
     for f in &all {
         let r = skeletonise::process::feature_rows(
@@ -144,22 +268,36 @@ fn a_registered_step_writes_its_own_layer_through_the_run_and_the_python_table()
             &params,
             skeletonise::process::RowOptions::of(&plan),
         );
-        rows.append(r.rows);
+        rows.append(run.add(f, r).unwrap());
     }
-    let layer = plan
-        .layers()
-        .into_iter()
-        .find(|l| l.name() == "toy")
-        .expect("the plan has the toy layer");
-    let items: Vec<Item> = (0..layer.count(&rows)).map(Item::Row).collect();
-    let table = columns(layer, &plan, &rows, &items);
-    let names: Vec<&str> = table.iter().map(|c| c.name).collect();
-    assert_eq!(names, ["src_fid", "scaled_length"]);
-    let Values::Real(v) = &table[1].values else {
+    rows.append(run.finish().unwrap().0);
+    let table = |name: &str| {
+        let layer = plan
+            .layers()
+            .into_iter()
+            .find(|l| l.name() == name)
+            .expect("the plan has the toy's layers");
+        let items: Vec<Item> = (0..layer.count(&rows)).map(Item::Row).collect();
+        columns(layer, &plan, &rows, &items)
+    };
+    let toy = table("toy");
+    let names: Vec<&str> = toy.iter().map(|c| c.name).collect();
+    assert_eq!(names, ["src_fid", "scaled_length", "near"]);
+    let Values::Real(v) = &toy[1].values else {
         panic!("a real column")
     };
     let from_gpkg: Vec<f64> = scaled.iter().map(|x| x.unwrap()).collect();
     assert_eq!(v, &from_gpkg);
+    // Here the side layer given was empty: no feature has one near.
+    let Values::Int(n, null) = &toy[2].values else {
+        panic!("an integer column")
+    };
+    assert!(n.iter().all(|x| *x == 0) && !null.contains(&true), "{n:?}");
+    let total = table("toy_total");
+    let Values::Int(side, _) = &total[3].values else {
+        panic!("an integer column")
+    };
+    assert_eq!(side, &[0]);
 }
 
 #[test]
@@ -194,8 +332,50 @@ fn a_registered_steps_options_and_place_are_checked_like_the_others() {
     )
     .unwrap_err();
     assert!(e.message.contains("unknown variant `toy`"), "{e}");
-    // `skeletonise methods` lists it with its option.
+    // `skeletonise methods` lists it with its options, from its schema.
     let d =
         skeletonise::config::describe_with(&skeletonise::methods::Registry::builtin(), &registry);
-    assert!(d.contains("toy") && d.contains("scale"), "{d}");
+    assert!(
+        d.contains("toy") && d.contains("scale") && d.contains("The factor."),
+        "{d}"
+    );
+    // The pipeline file's JSON Schema has it as a step, after `select`.
+    let schema = skeletonise::config::json_schema_with(&registry);
+    let steps = schema["$defs"]["Step"]["oneOf"].as_array().unwrap();
+    let at = |name: &str| {
+        steps
+            .iter()
+            .position(|s| s["properties"].get(name).is_some())
+            .unwrap()
+    };
+    assert_eq!(at("toy"), at("select") + 1);
+    let options = &schema["$defs"]["toy_options"];
+    assert_eq!(options["required"], serde_json::json!(["scale"]));
+    assert!(
+        options["properties"]["near"]
+            .to_string()
+            .contains("LayerSource"),
+        "{options}"
+    );
+    // A side input that is not there: the run says which key to fix.
+    let text = pipeline_text(
+        &out,
+        &format!(
+            "  - toy: {{ scale: 1, near: {{ source: {}, layer: nope }} }}\n",
+            crate::common::root(DEMO)
+        ),
+    );
+    let p = skeletonise::config::load_str_with(&text, "toy.yaml", &[], &registry).unwrap();
+    let e = skeletonise::pipeline::run(&p, &skeletonise::pipeline::RunOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("`steps.toy.near`: layer `nope` not found")
+            && e.contains("`steps.toy.near.layer`"),
+        "{e}"
+    );
+    assert!(
+        !out.exists(),
+        "no output for a run that could not read its side input"
+    );
 }
