@@ -422,6 +422,26 @@ def _fids(index: pd.Index | None, n: int) -> np.ndarray:
     return np.arange(n, dtype=np.int64)
 
 
+@functools.lru_cache(maxsize=16)
+def _proj_of(crs: Any) -> str | None:
+    """``crs`` as a PROJ string, for the steps that need longitude and latitude (the ``label``
+    step's ``minzoom``: the core transforms with it, on its worker threads); None without a CRS
+    or where PROJ cannot write one."""
+    if crs is None:
+        return None
+    import warnings
+
+    import pyproj
+
+    try:
+        with warnings.catch_warnings():
+            # "You will likely lose important projection information": only the latitude is used.
+            warnings.simplefilter("ignore")
+            return pyproj.CRS.from_user_input(crs).to_proj4()
+    except pyproj.exceptions.CRSError:
+        return None
+
+
 def _check_call(crs: Any, threads: Any) -> None:
     """What the command line refuses before any work: a geographic CRS (radii
     and scores would be in degrees) and a number of threads out of range."""
@@ -474,6 +494,7 @@ def _run(
         explode=explode,
         threads=threads,
         output=output,
+        proj=_proj_of(crs),
         **(extra or {}),
     )
     t2 = time.perf_counter()
@@ -768,6 +789,7 @@ def apply_layers(
     neighbour_snap: float | None = None,
     candidates: bool = False,
     threads: int | None = None,
+    sides: Mapping[str, Any] | None = None,
 ) -> dict:
     """Runs the steps of a pipeline file on a GeoDataFrame, every layer of the output included:
     the function for pipelines with the ``collapse`` or ``partition`` step, which :func:`apply`
@@ -781,8 +803,10 @@ def apply_layers(
     of ``neighbours`` grown by what they received, with their columns), ``boundaries`` (the new
     boundaries), ``given`` (what each unit received of each polygon), ``connections`` and
     ``network`` with ``connect``, and a registered step's layers (``labels`` of the ``label``
-    step; its ``minzoom`` is empty here: it needs the CRS's latitudes, which
-    :func:`labels` computes). ``connect`` (a
+    step, its ``minzoom`` from ``gdf``'s CRS as on the command line), the rows a step makes after
+    the last feature included. ``sides`` gives a registered step's side input layer by the
+    step's name (a GeoDataFrame or GeoSeries, reprojected to ``gdf``'s CRS; the pipeline file's
+    ``source`` of it is not opened here). ``connect`` (a
     GeoDataFrame or GeoSeries of lines: the line network of ``input.connect``, ``snap`` its snap
     distance) and ``neighbours`` (a GeoDataFrame of polygons: the coverage of
     ``input.neighbours``; ``neighbour_snap`` its ``snap``: unit vertices and edges within it of a
@@ -807,6 +831,9 @@ def apply_layers(
             extra["neighbour_snap"] = float(neighbour_snap)
     if candidates:
         extra["with_candidates"] = True
+    if sides:
+        given = {name: _side_input(layer, gdf.crs, f"sides[{name!r}]") for name, layer in sides.items()}
+        extra["sides"] = {name: (wkbs, fids.tolist()) for name, (wkbs, fids) in given.items()}
     frame, done = _run_frame(gdf, p, candidates=False, threads=threads, extra=extra, with_done=True)
     sources: dict[str, Any] = {"input": gdf.drop(columns=[gdf.geometry.name])}
     if neighbours is not None and hasattr(neighbours, "geometry"):
@@ -820,11 +847,6 @@ def apply_layers(
 
 
 __all__.append("apply_layers")
-
-
-# The label's own columns (and the output's geometry column): a source column so named is
-# written as `src_<name>`.
-_LABEL_COLUMNS = ("polygon_part", "kind", "length", "max_width", "elongation", "minzoom", "rejected", "geometry")
 
 
 def labels(
@@ -847,6 +869,9 @@ def labels(
     axis; otherwise the centre of the part's largest inscribed disc (the pole
     of inaccessibility). Holes (islands) are respected.
 
+    It runs the pipeline ``prepare: {make_valid, min_area: 0}``, ``skeleton: {methods: [MA]}``,
+    ``label: {...}`` through the same run as :func:`apply_layers` and the command line.
+
     Parameters
     ----------
     geometries
@@ -865,110 +890,66 @@ def labels(
         Worker threads (``None``: one per core).
 
     Returns a GeoDataFrame with one row per labelled part: the input's index
-    (repeated for the parts of a multipolygon), a GeoDataFrame's own columns,
+    (repeated for the parts of a multipolygon), a GeoDataFrame's own columns
+    (renamed ``src_<name>`` where the command line renames them),
     ``polygon_part``, ``kind`` (``line``, ``point``, or ``none`` for a part
     thinner than the axis's grid), ``length``, ``max_width`` (2r),
     ``elongation``, ``minzoom`` (the smallest web-map zoom at which the line
     is ``min_pixels`` long, or a point's disc that wide, at the label's
     latitude; NA without a CRS) and ``rejected`` (why a feature has no label:
-    NULL, not a polygon, invalid), and the label as geometry (same CRS).
-    Every input row gives at least one output row.
+    NULL, not a polygon, invalid, no medial axis), and the label as geometry
+    (same CRS). Every input row gives at least one output row.
     """
     import geopandas as gpd
-    from geopandas.array import from_shapely
 
-    arr, index, crs = _geometry_array(geometries)
-    _check_call(crs, threads)
-    arr, repaired, _ = _prepare(arr, make_valid)
-    options = {
-        "smooth": smooth,
-        "margin": margin,
-        "min_elongation": min_elongation,
-        "parts": parts,
-        "min_pixels": min_pixels,
+    doc = {
+        "steps": [
+            {"prepare": {"make_valid": bool(make_valid), "min_area": 0.0}},
+            {"skeleton": {"methods": ["MA"]}},
+            {"label": {"smooth": smooth, "margin": margin, "min_elongation": min_elongation,
+                       "parts": parts, "min_pixels": min_pixels}},
+        ]
     }
-    # A repaired geometry keeps MakeValid's polygons (a spike's line left out), as the command line's
-    # reader keeps them.
-    row, part, kind, length, width, elong, wkb, rejected = _core.labels(
-        _encode(arr, "wkb"),
-        json.dumps(options, default=_json_default),
-        threads,
-        repaired=repaired.tolist(),
-        make_valid=make_valid,
-    )
-    row = np.asarray(row, dtype=np.intp)
-    idx = (index if index is not None else pd.RangeIndex(len(arr)))[row]
-    columns = _source_columns(geometries, row) if isinstance(geometries, gpd.GeoDataFrame) else {}
-    length, width = _nullable(length, np.float64), _nullable(width, np.float64)
-    geometry = shapely.from_wkb(np.asarray(wkb, dtype=object))
-    columns.update(
-        polygon_part=_nullable(part, np.int32),
-        kind=pd.array(kind, dtype="string"),
-        length=length,
-        max_width=width,
-        elongation=_nullable(elong, np.float64),
-        minzoom=_minzoom(geometry, length.to_numpy(np.float64, na_value=np.nan),
-                         width.to_numpy(np.float64, na_value=np.nan), crs, min_pixels),
-        rejected=pd.array(rejected, dtype="string"),
-        geometry=from_shapely(geometry, crs=crs),
-    )
-    return _geo_frame(columns, idx)
-
-
-def _source_columns(frame: Any, row: np.ndarray) -> dict[str, Any]:
-    """A GeoDataFrame's own columns (not its active geometry) at the rows ``row``, each
-    renamed ``src_<name>`` where it is named like a column of the label's own (as the
-    command line's ``labels`` layer does)."""
-    name = frame.geometry.name
-    # pandas' own accessor of a column's array (no Series made: half the time of `items()`).
-    column = getattr(frame, "_get_column_array", None) or (lambda i: frame.iloc[:, i].array)
-    own = [(i, c) for i, c in enumerate(frame.columns) if c != name]
-    names = _core.source_names([str(c) for _, c in own], list(_LABEL_COLUMNS))
-    return {(c if str(c) == n else n): column(i).take(row) for (i, c), n in zip(own, names)}
-
-
-def _nullable(values: list[Any], dtype: Any) -> Any:
-    """A pandas nullable array (``Float64``, ``Int32``) of a list with ``None``s."""
-    raw = np.array(values, dtype=np.float64)
-    missing = np.isnan(raw)
-    if np.dtype(dtype).kind == "f":
-        return pd.arrays.FloatingArray(raw, missing)
-    return pd.arrays.IntegerArray(np.where(missing, 0, raw).astype(dtype), missing)
-
-
-# Metres per pixel at zoom 0 on the equator (256-pixel tiles, 2π · 6 378 137 m / 256), as the
-# command line's `label` step.
-_EQUATOR_M_PER_PIXEL = 156_543.033928041
-
-
-@functools.lru_cache(maxsize=16)
-def _to_lonlat(crs: Any) -> Any:
-    """The transformer from ``crs`` to longitude and latitude (made once per CRS: a tile
-    pipeline calls :func:`labels` per tile)."""
-    import pyproj
-
-    return pyproj.Transformer.from_crs(crs, 4326, always_xy=True)
-
-
-def _minzoom(geometry: np.ndarray, length: np.ndarray, width: np.ndarray, crs: Any, pixels: float) -> Any:
-    """The ``minzoom`` of each label: the smallest web-map zoom (0–24) at which a line is
-    ``pixels`` long (a point's disc that wide) at the latitude of the line's middle (the point)."""
-    zoom = np.zeros(len(geometry), dtype=np.int32)
-    missing = np.ones(len(geometry), dtype=bool)
-    present = ~shapely.is_missing(geometry)
-    if crs is not None and present.any():
-        lines = present & (shapely.get_type_id(geometry) == int(shapely.GeometryType.LINESTRING))
-        anchors = geometry.copy()
-        anchors[lines] = shapely.line_interpolate_point(geometry[lines], 0.5, normalized=True)
-        lat = np.full(len(geometry), np.nan)
-        x, y = shapely.get_x(anchors[present]), shapely.get_y(anchors[present])
-        lat[present] = _to_lonlat(crs).transform(x, y)[1]
-        metres = np.where(lines, length, width)
-        ok = present & np.isfinite(lat) & (metres > 0)
-        z = np.ceil(np.log2(pixels * _EQUATOR_M_PER_PIXEL * np.cos(np.radians(lat[ok])) / metres[ok]))
-        zoom[ok] = np.clip(z, 0, 24)
-        missing[ok] = False
-    return pd.arrays.IntegerArray(zoom, missing)
+    try:
+        p = _core.Pipeline.from_options(json.dumps(doc, default=_json_default), "labels()")
+    except PipelineError as e:
+        raise PipelineError(str(e).replace("steps[2].label.", "")) from None
+    arr, index, crs = _geometry_array(geometries)
+    frame, done = _run(p, arr, index, crs, candidates=False, explode=False, threads=threads,
+                       exchange="wkb", output="wkb", with_done=True)
+    n = len(arr)
+    index = index if index is not None else pd.RangeIndex(n)
+    layer = done.get("layers", {}).get("labels")
+    own = _layer_frame(layer, crs, {}, {}) if layer is not None else gpd.GeoDataFrame(geometry=[], crs=crs)
+    by_fid = pd.Series(np.arange(n), index=_fids(index, n))
+    at = by_fid.reindex(own["src_fid"].astype("Int64").to_numpy(na_value=-1)).to_numpy().astype(np.int64)
+    own = own.drop(columns=["src_fid"])
+    own["rejected"] = pd.array([None] * len(own), dtype="string")
+    # A rejected feature: one row with the reason (the skeleton frame's rows are in input order).
+    bad = frame["rejected"].notna().to_numpy()
+    rows = np.asarray(done["row"], dtype=np.int64)[bad]
+    lost = gpd.GeoDataFrame({"rejected": frame["rejected"].to_numpy()[bad]}, geometry=[None] * len(rows), crs=crs)
+    both = pd.concat([own.reset_index(drop=True), lost.reset_index(drop=True)], ignore_index=True)
+    position = np.concatenate([at, rows])
+    order = np.argsort(position, kind="stable")
+    both = both.iloc[order].reset_index(drop=True)
+    position = position[order]
+    tool = {
+        "polygon_part": both["polygon_part"].astype("Int32").array,
+        "kind": both["kind"].astype("string").array,
+        "length": both["length"].astype("Float64").array,
+        "max_width": both["max_width"].astype("Float64").array,
+        "elongation": both["elongation"].astype("Float64").array,
+        "minzoom": both["minzoom"].astype("Int32").array,
+        "rejected": both["rejected"].astype("string").array,
+    }
+    columns: dict[str, Any] = {}
+    if isinstance(geometries, gpd.GeoDataFrame):
+        source = _renamed(geometries.drop(columns=[geometries.geometry.name]), _reserved(p) + ["geometry"])
+        columns = {c: source[c].array.take(position) for c in source.columns}
+    columns.update(tool)
+    columns["geometry"] = gpd.array.GeometryArray(np.asarray(both.geometry.values, dtype=object), crs=crs)
+    return _geo_frame(columns, index.take(position))
 
 
 __all__.append("labels")

@@ -85,6 +85,8 @@ class Pipeline:
         neighbour_fids: Optional[Sequence[int]] = None,
         neighbour_snap: Optional[float] = None,
         with_candidates: bool = False,
+        proj: Optional[str] = None,
+        sides: Optional[dict[str, tuple[list[bytes | None], Optional[list[int]]]]] = None,
     ) -> dict[str, Any]:
         """Runs the steps with the GIL released.
 
@@ -146,26 +148,3 @@ def describe() -> str:
 def schema() -> str:
     """The JSON Schema of the pipeline file, as JSON text."""
 
-def labels(
-    wkbs: list[bytes | None],
-    options: str,
-    threads: int | None = None,
-    *,
-    repaired: Optional[Sequence[bool]] = None,
-    make_valid: bool = False,
-) -> tuple[
-    list[int],
-    list[int | None],
-    list[str | None],
-    list[float | None],
-    list[float | None],
-    list[float | None],
-    list[bytes | None],
-    list[str | None],
-]:
-    """The ``label`` step on every feature (WKB in, ``options`` the step's keys as JSON):
-    the columns ``(row, polygon_part, kind, length, max_width, elongation, wkb, rejected)``,
-    one row per labelled part, one row with the reason for a feature that cannot be
-    prepared. ``repaired``: which geometries MakeValid repaired (of those only the
-    polygons are labelled, as the command line keeps them); ``make_valid``: the
-    ``prepare`` step's option. Raises PipelineError for a wrong option."""

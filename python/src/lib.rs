@@ -9,7 +9,7 @@
 //! back the columns of the `skeletons` (or `candidates`) layer as the
 //! declarative tables of `skeletonise::output` describe them.
 
-mod labels;
+mod lonlat;
 mod run;
 mod wkb;
 
@@ -281,6 +281,51 @@ impl Pipeline {
         }
     }
 
+    /// The columns of layer `name` of a call of this pipeline (its plan: a
+    /// registered step's layers too) as `(name, type)` pairs, type one of
+    /// `int32`, `int64`, `real`, `text`, and whether the layer carries the
+    /// source's fields; `connect` and `explode` as for `run`.
+    #[pyo3(signature = (name, connect = false, explode = None))]
+    fn layer_columns(
+        &self,
+        name: &str,
+        connect: bool,
+        explode: Option<bool>,
+    ) -> PyResult<(Vec<(&'static str, &'static str)>, bool)> {
+        let plan = self
+            .steps
+            .call_plan(explode.unwrap_or_else(|| self.explode()), connect);
+        let layers = plan.layers();
+        let Some(layer) = layers.iter().find(|l| l.name() == name) else {
+            let names: Vec<String> = layers.iter().map(|l| format!("`{}`", l.name())).collect();
+            return Err(PyValueError::new_err(format!(
+                "the pipeline writes no layer `{name}`; its layers are {}",
+                names.join(", ")
+            )));
+        };
+        let cols = plan
+            .columns(*layer)
+            .into_iter()
+            .map(|(_, name, ty)| (name, type_name(ty)))
+            .collect();
+        Ok((
+            cols,
+            layer.fields() == Some(skeletonise::layer::Fields::Input),
+        ))
+    }
+
+    /// Whether a registered step of the pipeline adds rows after the last
+    /// feature from every feature's rows: its features must go through one
+    /// call (as a partition's).
+    #[getter]
+    fn finishes(&self) -> bool {
+        self.steps
+            .process_params()
+            .extra
+            .iter()
+            .any(|e| e.entry.needs.finish)
+    }
+
     /// One row per polygon part (`output.explode`).
     #[getter]
     fn explode(&self) -> bool {
@@ -320,8 +365,12 @@ impl Pipeline {
     /// `input.neighbours` (`neighbour_snap` its `snap`, default the pipeline
     /// file's), and the result's `layers` hold `coverage`,
     /// `boundaries`, `given` and `areas`. `with_candidates`: the
-    /// `candidates` layer too, among `layers`, from the same pass.
-    #[pyo3(signature = (geometry, *, fids = None, repaired = None, candidates = false, explode = None, threads = None, output = "geoarrow", cancel = None, connect = None, connect_fids = None, snap = 0.0, neighbours = None, neighbour_fids = None, neighbour_snap = None, with_candidates = false))]
+    /// `candidates` layer too, among `layers`, from the same pass. `proj`:
+    /// the geometries' CRS as a PROJ string, for the steps that need
+    /// longitude and latitude (`label`'s `minzoom`). `sides`: each
+    /// registered step's side input layer by the step's name, `(WKB
+    /// geometries, FIDs or None)`.
+    #[pyo3(signature = (geometry, *, fids = None, repaired = None, candidates = false, explode = None, threads = None, output = "geoarrow", cancel = None, connect = None, connect_fids = None, snap = 0.0, neighbours = None, neighbour_fids = None, neighbour_snap = None, with_candidates = false, proj = None, sides = None))]
     #[allow(clippy::too_many_arguments)]
     fn run<'py>(
         &self,
@@ -341,9 +390,15 @@ impl Pipeline {
         neighbour_fids: Option<Vec<i64>>,
         neighbour_snap: Option<f64>,
         with_candidates: bool,
+        proj: Option<&str>,
+        sides: Option<SideInputs>,
     ) -> PyResult<Bound<'py, PyAny>> {
         self.refuse_without_lines(connect.is_some())?;
         let mut params = self.steps.process_params();
+        if params.extra.iter().any(|e| e.entry.needs.lonlat) {
+            params.lonlat = proj.and_then(lonlat::lonlat_of);
+        }
+        side_inputs(&mut params, sides.unwrap_or_default())?;
         let partition = params.partition.is_some();
         params.neighbours = self.units(partition, neighbours, neighbour_fids, neighbour_snap)?;
         // A partition merges adjacent polygons by FID: positions stand in for missing FIDs.
@@ -510,6 +565,62 @@ fn coverage(
     Ok(skeletonise::partition::Coverage::new(out))
 }
 
+/// Registered steps' side input layers by step name: WKB geometries and
+/// their FIDs (`None`: positions).
+type SideInputs = std::collections::HashMap<String, (Vec<Option<Vec<u8>>>, Option<Vec<i64>>)>;
+
+/// Gives each registered step of `params` its side input layer from
+/// `sides`; a step whose pipeline file names a side input that is not
+/// given, or a layer given for a step without one, is an error.
+fn side_inputs(
+    params: &mut skeletonise::process::ProcessParams,
+    mut sides: SideInputs,
+) -> PyResult<()> {
+    for e in &mut params.extra {
+        let Some(key) = e.entry.needs.side else {
+            continue;
+        };
+        let name = e.entry.name;
+        match sides.remove(name) {
+            Some((wkbs, fids)) => {
+                if fids.as_ref().is_some_and(|f| f.len() != wkbs.len()) {
+                    return Err(PyValueError::new_err(format!(
+                        "sides[{name:?}]: one FID per geometry"
+                    )));
+                }
+                let mut features = Vec::with_capacity(wkbs.len());
+                for (i, w) in wkbs.iter().enumerate() {
+                    let fid = fids
+                        .as_ref()
+                        .map_or(Some(i as u64), |f| u64::try_from(f[i]).ok());
+                    let Some(w) = w else { continue };
+                    let g = wkb::read(w).map_err(|err| {
+                        PyValueError::new_err(format!(
+                            "sides[{name:?}]: feature {i}: unsupported geometry: {err}"
+                        ))
+                    })?;
+                    features.push((fid, g));
+                }
+                e.side = Some(std::sync::Arc::new(
+                    skeletonise::process::step::SideLayer::new(features),
+                ));
+            }
+            None if e.side_source().is_some() => {
+                return Err(PipelineError::new_err(format!(
+                    "the `{name}` step reads a layer (`steps.{name}.{key}`), which the Python package does not open: pass it as sides={{{name:?}: frame}}"
+                )));
+            }
+            None => {}
+        }
+    }
+    match sides.into_keys().next() {
+        Some(name) => Err(PyValueError::new_err(format!(
+            "sides[{name:?}]: the pipeline has no registered step `{name}` that reads a side input"
+        ))),
+        None => Ok(()),
+    }
+}
+
 /// The line network of `input.connect` from WKB lines (any line or
 /// polygon geometry: its lines), each with its source FID.
 fn network(
@@ -653,7 +764,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(source_names, m)?)?;
     m.add_function(wrap_pyfunction!(describe, m)?)?;
     m.add_function(wrap_pyfunction!(schema, m)?)?;
-    m.add_function(wrap_pyfunction!(labels::labels, m)?)?;
     Ok(())
 }
 

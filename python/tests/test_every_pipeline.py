@@ -23,10 +23,6 @@ PIPELINES = sorted(p.name for p in (ROOT / "pipelines").glob("*.yaml"))
 # `rejected` column in Python; bars, widths and the run record belong to the GeoPackage and the
 # report.
 CLI_ONLY = {"rejected", "bars", "widths", "skeletonise_runs"}
-# Columns the Python call leaves empty: a label's `minzoom` needs the longitude and latitude of the
-# source's CRS, which the command line has from GDAL and the GDAL-free core of the Python package
-# does not (`skeletonise.labels` computes it with pyproj).
-PYTHON_EMPTY = {("labels", "minzoom")}
 
 
 def _value(text: str) -> str:
@@ -66,10 +62,5 @@ def test_every_pipeline_gives_the_command_lines_rows(name, tmp_path):
         if lname == "skeletons":
             got = got[frame["rejected"].isna() & frame["method"].notna()]
         want = pyogrio.read_dataframe(out, layer=cli_name)
-        for layer_name, column in PYTHON_EMPTY:
-            if layer_name == lname:
-                assert got[column].isna().all(), (lname, column)
-                got = got.drop(columns=[column])
-                want = want.drop(columns=[column])
         assert [c for c in got.columns if c in want.columns] == [c for c in want.columns], (lname, list(got.columns), list(want.columns))
-        same_rows(got, out, cli_name, skip=[c for (n, c) in PYTHON_EMPTY if n == lname])
+        same_rows(got, out, cli_name)

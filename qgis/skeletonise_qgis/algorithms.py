@@ -8,6 +8,7 @@ the feedback.
 """
 
 import json
+import math
 import os
 
 import numpy as np
@@ -39,7 +40,6 @@ METHODS = ["MA", "StSk", "DVD", "CDT", "VD"]
 PRUNE = ["significance", "length", "trunk", "none"]
 EXTEND = ["centred", "ray", "nearest", "none"]
 SELECT = ["distortion", "deviation", "deviation_parts", "distortion_sum"]
-PARTS = ["each", "largest"]
 COLLAPSE_MODES = ["partial", "whole"]
 UNOWNED = ["keep", "nearest"]
 OVERLAP = ["cut", "reject"]
@@ -255,8 +255,9 @@ class _Algorithm(QgsProcessingAlgorithm):
                 outputs[key] = (sink, layer, keep)
                 results[key] = dest
         counts = {"read": len(features), "written": 0, "rejected": 0}
-        # A partition merges adjacent polygons and grows the coverage once all are done: one call.
-        parts = [(0, len(features))] if partition else list(bridge.batches(features))
+        # A partition merges adjacent polygons and grows the coverage once all are done, and a
+        # registered step's finish reads every feature's rows: one call.
+        parts = [(0, len(features))] if partition or pipeline.finishes else list(bridge.batches(features))
         by_fid = {fid: i for i, fid in enumerate(features.fids)}
         for k, (start, end) in enumerate(parts):
             done = {}
@@ -593,6 +594,77 @@ class PipelineAlgorithm(_Algorithm):
         return self._pipeline_rows(pipeline, parameters, context, feedback, pipeline.explode, snap)
 
 
+def _step_options(step):
+    """The options of the registered step ``step`` from the pipeline file's JSON Schema (the
+    wheel's ``schema()``, which ``skeletonise schema`` prints): ``(key, schema)`` pairs, each
+    schema resolved; empty without the wheel (the algorithm then says what to install)."""
+    try:
+        schema = json.loads(bridge.core().schema())
+    except QgsProcessingException:
+        return []
+    defs = schema["$defs"]
+    props = defs.get(f"{step}_options", {}).get("properties", {})
+
+    def resolve(v):
+        ref = v.get("$ref", "")
+        return defs[ref.rsplit("/", 1)[-1]] if ref.startswith("#/$defs/") else v
+
+    return [(key, dict(resolve(v), default=v.get("default"), description=v.get("description", "")))
+            for key, v in props.items()]
+
+
+def _choices(option):
+    """The values of an option that is one of a few texts, or None."""
+    if "enum" in option:
+        return [str(v) for v in option["enum"]]
+    if "oneOf" in option and all("const" in o for o in option["oneOf"]):
+        return [str(o["const"]) for o in option["oneOf"]]
+    return None
+
+
+def _step_parameters(alg, step):
+    """The parameters of a registered step's options, from its schema: names (the key in capitals),
+    defaults, ranges (an exclusive bound as the nearest number inside it) and help."""
+    for key, option in _step_options(step):
+        label = _tr(key.replace("_", " ").capitalize())
+        choices = _choices(option)
+        if choices is not None:
+            default = choices.index(option["default"]) if option["default"] in choices else 0
+            p = QgsProcessingParameterEnum(key.upper(), label, options=choices, defaultValue=default)
+        elif option.get("type") in ("number", "integer"):
+            bounds = {}
+            for name, plain, exclusive, towards in (("minValue", "minimum", "exclusiveMinimum", math.inf),
+                                                    ("maxValue", "maximum", "exclusiveMaximum", -math.inf)):
+                if plain in option:
+                    bounds[name] = float(option[plain])
+                elif exclusive in option:
+                    bounds[name] = math.nextafter(float(option[exclusive]), towards)
+            kind = QgsProcessingParameterNumber.Integer if option["type"] == "integer" else QgsProcessingParameterNumber.Double
+            p = QgsProcessingParameterNumber(key.upper(), label, kind, option["default"], **bounds)
+        elif option.get("type") == "boolean":
+            p = QgsProcessingParameterBoolean(key.upper(), label, bool(option["default"]))
+        else:
+            continue
+        p.setHelp(_tr(option["description"]))
+        alg.addParameter(p)
+
+
+def _step_values(alg, step, parameters, context):
+    """The registered step's options as the user set them (the keys of its schema)."""
+    out = {}
+    for key, option in _step_options(step):
+        choices = _choices(option)
+        if choices is not None:
+            out[key] = choices[alg.parameterAsEnum(parameters, key.upper(), context)]
+        elif option.get("type") == "integer":
+            out[key] = alg.parameterAsInt(parameters, key.upper(), context)
+        elif option.get("type") == "number":
+            out[key] = alg.parameterAsDouble(parameters, key.upper(), context)
+        elif option.get("type") == "boolean":
+            out[key] = alg.parameterAsBool(parameters, key.upper(), context)
+    return out
+
+
 class LabelAlgorithm(_Algorithm):
     """One label line (or point) per polygon part, for curved labels."""
 
@@ -601,32 +673,29 @@ class LabelAlgorithm(_Algorithm):
     HELP = (
         "One label per polygon part, as the command line's label step: a smooth line along the medial "
         "axis where the part is elongated enough to carry a curved name, otherwise the centre of its "
-        "largest inscribed disc (the pole of inaccessibility). Holes (islands) are respected.\n\n"
+        "largest inscribed disc (the pole of inaccessibility). Holes (islands) are respected. The "
+        "options are the label step's (their help is the tooltip of each).\n\n"
         "<b>Polygons</b>: a polygon layer in a projected CRS.\n"
-        "<b>Smooth</b>: the most the line may turn (degrees) over any stretch one local width long.\n"
-        "<b>Margin</b>: how close to the axis the line stays, as a fraction of the local radius (0.9: "
-        "within a tenth of the radius of the axis).\n"
-        "<b>Minimum elongation</b>: a line where its length is at least this many times the largest "
-        "width, else a point.\n"
-        "<b>Parts</b>: each (a label per polygon part) or largest (one per feature).\n"
-        "<b>Minimum pixels</b>: minzoom is the smallest web-map zoom at which the line is this many "
-        "pixels long (a point's disc this wide) at its latitude.\n"
         "<b>Label lines</b>: the parts labelled along a line (kind = line), and the parts without a "
         "label (no geometry: kind = none for a part thinner than the axis's grid, or the reason in "
         "rejected); columns: the source's fields, src_fid, polygon_part, kind, length, max_width, "
-        "elongation, minzoom, rejected.\n"
+        "elongation, minzoom (the smallest web-map zoom at which the label is shown, at its latitude), "
+        "rejected.\n"
         "<b>Label points</b>: the parts labelled at a point (kind = point), the same columns. Together "
         "the two layers are the command line's labels layer: one row per polygon part."
     )
 
+    def shortHelpString(self):  # noqa: N802
+        """The help text, with each option of the label step explained by its schema."""
+        options = "".join(
+            f"\n<b>{key.replace('_', ' ').capitalize()}</b>: {option['description']}"
+            for key, option in _step_options("label")
+        )
+        return _tr(self.HELP) + _tr(options)
+
     def initAlgorithm(self, config=None):  # noqa: N802
         _polygons(self)
-        number = QgsProcessingParameterNumber.Double
-        self.addParameter(QgsProcessingParameterNumber("SMOOTH", _tr("Smooth (degrees)"), number, 60.0, minValue=1.0, maxValue=180.0))
-        self.addParameter(QgsProcessingParameterNumber("MARGIN", _tr("Margin (fraction of the local radius)"), number, 0.9, minValue=0.0, maxValue=1.0))
-        self.addParameter(QgsProcessingParameterNumber("MIN_ELONGATION", _tr("Minimum elongation"), number, 3.0, minValue=0.0))
-        self.addParameter(QgsProcessingParameterEnum("PARTS", _tr("Parts"), options=PARTS, defaultValue=0))
-        self.addParameter(QgsProcessingParameterNumber("MIN_PIXELS", _tr("Minimum pixels (for minzoom)"), number, 64.0, minValue=0.0))
+        _step_parameters(self, "label")
         # Two layers of one geometry type each: QGIS cannot make a temporary layer of mixed
         # geometries, and lines and points are styled apart.
         self.addParameter(QgsProcessingParameterFeatureSink("OUTPUT", _tr("Label lines"), QgsProcessing.TypeVectorLine))
@@ -635,25 +704,16 @@ class LabelAlgorithm(_Algorithm):
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802
         source, skip = self._input(parameters, context)
-        options = {
-            "smooth": self.parameterAsDouble(parameters, "SMOOTH", context),
-            "margin": self.parameterAsDouble(parameters, "MARGIN", context),
-            "min_elongation": self.parameterAsDouble(parameters, "MIN_ELONGATION", context),
-            "parts": PARTS[self.parameterAsEnum(parameters, "PARTS", context)],
-            "min_pixels": self.parameterAsDouble(parameters, "MIN_PIXELS", context),
-        }
+        options = _step_values(self, "label", parameters, context)
+        # The command line's pipeline: repaired geometries keep their polygons (a spike's line left
+        # out), the medial axis made once by the skeleton step, the label step's rows.
+        doc = {"steps": [{"prepare": {"make_valid": True, "min_area": 0.0}}, {"skeleton": {"methods": ["MA"]}},
+                         {"label": options}]}
+        pipeline = bridge.options_pipeline(doc, "label")
         features = bridge.read(source, True, feedback)
         carried = bridge.source_fields(source.fields(), skip)
-        tool = [
-            ("src_fid", "int64"),
-            ("polygon_part", "int32"),
-            ("kind", "text"),
-            ("length", "real"),
-            ("max_width", "real"),
-            ("elongation", "real"),
-            ("minzoom", "int32"),
-        ]
-        fields = bridge.output_fields(source.fields(), carried, tool)
+        tool, _ = pipeline.layer_columns("labels")
+        fields = bridge.output_fields(source.fields(), carried, tool, reserved=pipeline.reserved())
         crs = source.sourceCrs()
         sinks, results = {}, {}
         for key, kind in (("OUTPUT", QgsWkbTypes.LineString), ("POINTS", QgsWkbTypes.Point)):
@@ -661,38 +721,42 @@ class LabelAlgorithm(_Algorithm):
             if sink is None:
                 raise QgsProcessingException(self.invalidSinkError(parameters, key))
             sinks[key], results[key] = sink, dest
-        core = bridge.core()
         parts = list(bridge.batches(features))
+        by_fid = {fid: i for i, fid in enumerate(features.fids)}
+        proj = crs.toProj() if crs.isValid() else None
         rejected_count = 0
         for k, (start, end) in enumerate(parts):
-            if feedback.isCanceled():
-                break
             try:
-                # Repaired geometries keep their polygons (a spike's line left out), and are
-                # prepared with make_valid on, as the command line's label step has them.
-                row, part, kind, length, width, elong, wkb, rejected = core.labels(
-                    features.wkbs[start:end],
-                    json.dumps(options),
-                    None,
-                    repaired=features.repaired[start:end],
-                    make_valid=True,
-                )
-            except core.PipelineError as e:
+                done = bridge.run_pipeline(pipeline, features, (start, end), feedback, candidates=False,
+                                           explode=False, proj=proj or None)
+            except bridge.Cancelled:
+                feedback.pushInfo(f"cancelled: the first {start} of {len(features)} features are written")
+                break
+            except (bridge.core().RejectedError, bridge.core().PipelineError) as e:
                 raise QgsProcessingException(str(e)) from None
-            for j, r in enumerate(row):
-                i = start + r
-                g = bridge.geometry(wkb[j])
-                z = bridge.minzoom(g, kind[j], length[j], width[j], crs, options["min_pixels"])
-                attrs = [features.attributes[i][c] for c in carried]
-                attrs += [features.fids[i], part[j], kind[j], length[j], width[j], elong[j], z, rejected[j]]
+            layer = done["layers"]["labels"]
+            cols = bridge.columns(layer)
+            wkbs = layer["geometry"][1]
+            # Each label row at its feature's place, a rejected feature's row (its reason) among them.
+            out = []
+            for j, values in enumerate(zip(*cols)):
+                out.append((by_fid[values[0]], j, list(values) + [None], wkbs[j]))
+            reasons = bridge.columns(done)[-1]
+            for j, r in enumerate(done["row"].tolist()):
+                if reasons[j] is not None:
+                    i = start + r
+                    out.append((i, -1, [features.fids[i]] + [None] * (len(tool) - 1) + [reasons[j]], None))
+                    rejected_count += 1
+                    feedback.reportError(f"feature {features.fids[i]} rejected: {reasons[j]}")
+            for i, _, values, wkb in sorted(out, key=lambda o: (o[0], o[1])):
                 f = QgsFeature()
-                f.setAttributes(attrs)
+                f.setAttributes([features.attributes[i][c] for c in carried] + values)
+                g = bridge.geometry(wkb)
                 if not g.isNull():
                     f.setGeometry(g)
-                sinks["POINTS" if kind[j] == "point" else "OUTPUT"].addFeature(f, QgsFeatureSink.FastInsert)
-                if rejected[j] is not None:
-                    rejected_count += 1
-                    feedback.reportError(f"feature {features.fids[i]} rejected: {rejected[j]}")
+                kind = values[tool.index(("kind", "text"))]
+                if not sinks["POINTS" if kind == "point" else "OUTPUT"].addFeature(f, QgsFeatureSink.FastInsert):
+                    raise QgsProcessingException(f"could not write a feature of FID {features.fids[i]} to the output")
             feedback.setProgress(10 + 90 * (k + 1) / len(parts))
         return dict(results, FEATURES_READ=len(features), FEATURES_REJECTED=rejected_count)
 

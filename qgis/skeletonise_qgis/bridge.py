@@ -15,8 +15,6 @@ import threading
 
 import numpy as np
 from qgis.core import (
-    QgsCoordinateReferenceSystem,
-    QgsCoordinateTransform,
     QgsFeature,
     QgsFeatureRequest,
     QgsFeatureSink,
@@ -25,7 +23,6 @@ from qgis.core import (
     QgsGeometry,
     QgsProcessingException,
     QgsProcessingFeatureSource,
-    QgsProject,
     QgsWkbTypes,
 )
 from qgis.PyQt.QtCore import QVariant
@@ -319,24 +316,3 @@ def options_pipeline(doc, origin):
         return core().Pipeline.from_options(json.dumps(doc), origin)
     except core().PipelineError as e:
         raise QgsProcessingException(str(e)) from None
-
-
-EQUATOR_M_PER_PIXEL = 156_543.033928041
-
-
-def minzoom(geom, kind, length, width, crs, pixels):
-    """The smallest web-map zoom (0–24) at which a line is ``pixels`` long (a
-    point's disc that wide) at the latitude of the line's middle (the point),
-    as the command line's ``label`` step computes it."""
-    if geom is None or geom.isNull() or not crs.isValid():
-        return None
-    metres = length if kind == "line" else width
-    if metres is None or not metres > 0:
-        return None
-    anchor = geom.interpolate(geom.length() / 2) if kind == "line" else geom
-    to_lonlat = QgsCoordinateTransform(crs, QgsCoordinateReferenceSystem("EPSG:4326"), QgsProject.instance())
-    lat = to_lonlat.transform(anchor.asPoint()).y()
-    if not math.isfinite(lat):
-        return None
-    z = math.ceil(math.log2(pixels * EQUATOR_M_PER_PIXEL * math.cos(math.radians(lat)) / metres))
-    return int(min(max(z, 0), 24))

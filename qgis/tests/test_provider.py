@@ -947,6 +947,27 @@ class Pipeline(Case):
 
 
 class Labels(Case):
+    def test_the_label_steps_parameters_are_its_schema(self):
+        # Names, defaults, ranges and help from `skeletonise schema`: nothing copied by hand, so
+        # QGIS cannot allow what the command line refuses (margin 1: the range ends below it).
+        cli_schema = json.loads(cli("schema").stdout)
+        options = cli_schema["$defs"]["label_options"]["properties"]
+        alg = QgsApplication.processingRegistry().algorithmById("skeletonise:label")
+        for key, option in options.items():
+            p = alg.parameterDefinition(key.upper())
+            self.assertIsNotNone(p, key)
+            self.assertEqual(p.help(), option["description"])
+            if key == "parts":
+                self.assertEqual(p.options(), ["each", "largest"])
+            else:
+                self.assertEqual(p.defaultValue(), option["default"], key)
+        margin = alg.parameterDefinition("MARGIN")
+        self.assertLess(margin.maximum(), 1.0)
+        self.assertGreater(margin.maximum(), 0.999999)
+        self.assertEqual(margin.minimum(), 0.0)
+        self.assertGreater(alg.parameterDefinition("MIN_PIXELS").minimum(), 0.0)
+        self.assertEqual(alg.parameterDefinition("SMOOTH").maximum(), 180.0)
+
     def test_labels_give_the_command_lines_rows_with_minzoom(self):
         cli("run", os.path.join(ROOT, "pipelines", "lake-labels.yaml"), "-o", self.out("cli.gpkg"))
         res = processing.run(
