@@ -852,11 +852,11 @@ __all__.append("apply_layers")
 def labels(
     geometries: Any,
     *,
-    smooth: float = 60.0,
-    margin: float = 0.9,
-    min_elongation: float = 3.0,
-    parts: str = "each",
-    min_pixels: float = 64.0,
+    smooth: float | None = None,
+    margin: float | None = None,
+    min_elongation: float | None = None,
+    parts: str | None = None,
+    min_pixels: float | None = None,
     make_valid: bool = True,
     threads: int | None = None,
 ):
@@ -878,7 +878,9 @@ def labels(
         A GeoDataFrame, a GeoSeries, a shapely array or a list of polygons,
         in a projected CRS.
     smooth, margin, min_elongation, parts, min_pixels
-        The ``label`` step's options, as in the pipeline file: ``parts`` is
+        The ``label`` step's options, as in the pipeline file (``None``: the
+        step's default, as :func:`describe` lists them — smooth 60, margin
+        0.9, min_elongation 3, parts ``"each"``, min_pixels 64): ``parts`` is
         ``"each"`` (every polygon part its label) or ``"largest"``;
         ``min_pixels`` sets ``minzoom``.
     make_valid
@@ -906,8 +908,8 @@ def labels(
         "steps": [
             {"prepare": {"make_valid": bool(make_valid), "min_area": 0.0}},
             {"skeleton": {"methods": ["MA"]}},
-            {"label": {"smooth": smooth, "margin": margin, "min_elongation": min_elongation,
-                       "parts": parts, "min_pixels": min_pixels}},
+            {"label": {k: v for k, v in (("smooth", smooth), ("margin", margin), ("min_elongation", min_elongation),
+                                         ("parts", parts), ("min_pixels", min_pixels)) if v is not None}},
         ]
     }
     try:

@@ -175,7 +175,7 @@ enum Encoded {
 
 /// The features of the input (parsed, repaired parts kept as the command
 /// line keeps them: MakeValid's polygons, not the lines and points a
-/// collapsed spike becomes). `Pipeline.run` and `labels` both read them so.
+/// collapsed spike becomes), as `Pipeline.run` and `score` read them.
 pub(crate) fn features(
     input: &Input<'_>,
     fids: Option<&[i64]>,

@@ -316,3 +316,58 @@ fn a_lake_whose_relaxed_line_is_cut_keeps_the_smoothed_one() {
     // here to 0.03.
     assert_eq!(check_layer(BENDS, "bent_lake", 0.03), (1, 0));
 }
+
+/// The `label` step gets the raw medial axis the `skeleton` step made
+/// (kept only for such a step, and only when MA has its default
+/// options: otherwise the step makes its own), and labels from it as
+/// from its own.
+#[test]
+fn the_skeleton_steps_medial_axis_is_kept_for_the_label_step_only() {
+    use geo::polygon;
+    use skeletonise::methods::medial_axis::{ArcTolerance, MedialAxisOptions};
+    use skeletonise::methods::MethodId;
+    use skeletonise::process::{process, ProcessParams, Processed};
+    let long = polygon![(x: 0., y: 0.), (x: 40., y: 0.), (x: 40., y: 4.), (x: 0., y: 4.)];
+    let label = skeletonise::process::step::Extra {
+        entry: skeletonise::label::ENTRY,
+        options: serde_json::Value::Null,
+        step: (skeletonise::label::ENTRY.build)(&serde_json::Value::Null).unwrap(),
+        side: None,
+    };
+    let kept = |params: &ProcessParams| -> usize {
+        let Processed::Done(o) = process(Some(&Geometry::Polygon(long.clone())), params) else {
+            panic!("processed");
+        };
+        let ma = o
+            .candidates
+            .iter()
+            .find(|c| c.method == MethodId::MA)
+            .unwrap();
+        ma.result.as_ref().unwrap().raw.len()
+    };
+    let mut params = ProcessParams::all_steps();
+    assert_eq!(kept(&params), 0, "no step reads it: not kept");
+    params.extra = vec![label];
+    assert_eq!(kept(&params), 1, "kept for the label step");
+    let Processed::Done(o) = process(Some(&Geometry::Polygon(long.clone())), &params) else {
+        panic!("processed");
+    };
+    let own = skeletonise::label::LabelParams::default()
+        .label(&skeletonise::geometry::PreparedPolygon::new(&long).unwrap())
+        .unwrap();
+    let Some((_, row)) = o.extra.first() else {
+        panic!("a label row");
+    };
+    assert_eq!(
+        row.geometry,
+        Some(match own.label {
+            skeletonise::label::Label::Line(l) => Geometry::LineString(l),
+            skeletonise::label::Label::Point(c) => Geometry::Point(c.into()),
+        }),
+        "the label from the kept axis is the library's own"
+    );
+    params.skeleton.medial_axis = MedialAxisOptions {
+        arc_tolerance: ArcTolerance::Relative(0.01),
+    };
+    assert_eq!(kept(&params), 0, "another MA: the step makes its own");
+}
