@@ -15,6 +15,7 @@ pub(crate) mod ends;
 pub mod extend;
 mod handle;
 mod invariants;
+pub mod junctions;
 pub mod line;
 pub mod planar;
 pub mod prune;

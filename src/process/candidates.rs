@@ -348,12 +348,21 @@ impl<'a> PartWork<'a> {
         if let Some(points) = &self.network {
             return crate::connect::through_lines(raw, self.p, points, expired);
         }
-        Some(prune_and_extend(
+        Some(self.junctions(prune_and_extend(
             raw,
             self.p,
             self.prune.as_ref(),
             self.params.extend.as_ref(),
-        ))
+        )))
+    }
+
+    /// `g` with its junctions merged where `prune.junctions` asks it.
+    fn junctions(&self, g: SkeletonGraph) -> SkeletonGraph {
+        use crate::graph::junctions::{merge, Junctions};
+        match self.params.prune.map(|p| p.junctions) {
+            Some(Junctions::Merge) => merge(&g, self.p),
+            _ => g,
+        }
     }
 
     /// Another method's raw skeleton conformed to the reference's structure
@@ -370,7 +379,7 @@ impl<'a> PartWork<'a> {
         let g = crate::graph::structure::conform(raw, s, self.p);
         match &self.network {
             Some(points) => crate::connect::through_lines(&g, self.p, points, expired),
-            None => Some(g),
+            None => Some(self.junctions(g)),
         }
     }
 

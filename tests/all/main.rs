@@ -39,4 +39,5 @@ mod score;
 #[cfg(feature = "gdal")]
 mod step_registry;
 mod straight_skeleton;
+mod streets;
 mod voronoi;

@@ -171,6 +171,8 @@ pub struct PruneParams {
     pub structure: Structure,
     /// With `mode: network`, what a polygon no line meets gets instead.
     pub fallback: Fallback,
+    /// `merge`: junctions whose inscribed discs overlap become one node at the centre of the largest disc, the stubs between them removed and the lines straightened into it — one node per crossing of a street or road network; `keep` (default): every junction stays.
+    pub junctions: crate::graph::junctions::Junctions,
 }
 
 impl Default for PruneParams {
@@ -183,6 +185,7 @@ impl Default for PruneParams {
             min_length: 0.0,
             structure: Structure::Shared,
             fallback: Fallback::Significance,
+            junctions: crate::graph::junctions::Junctions::Keep,
         }
     }
 }

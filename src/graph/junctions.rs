@@ -1,0 +1,359 @@
+//! Junctions of a network of corridors merged into one node each
+//! (`prune: { junctions: merge }`): where streets or roads cross, the medial
+//! axis of the street space has two three-way nodes joined by a short stub
+//! for every four-way crossing, and a small triangle or ladder for a skewed
+//! or wide one. A cartographer's street network has one node per junction.
+//!
+//! The rule: two junctions (nodes of degree ≥ 3) joined by a branch whose
+//! inscribed discs overlap — the branch is no longer than `r_a + r_b`, and
+//! so are the centres apart — are one junction; chains of such pairs are one
+//! cluster. Each cluster of two or more junctions becomes one node at the
+//! centre of its largest inscribed disc (the widest point of the junction
+//! area, inside the polygon), the branches between its members go, and every
+//! other branch that meets it is cut where it leaves that disc and runs
+//! straight to the centre (or straight from the member it started at, whose
+//! disc overlaps the centre's). A straight segment from the centre to the
+//! disc's rim lies inside the disc, and from the centre to a member inside
+//! the two overlapping discs, so the lines stay inside the polygon. A leg
+//! wholly inside the merged disc (a corner of the junction area) goes with
+//! the stubs. A cluster with a member whose disc does not overlap the
+//! centre's is left as it is. Branches that are not between two members of
+//! a cluster keep every vertex beyond the disc.
+
+use super::{Branch, GraphBuilder, NodeId, SkeletonGraph, UnionFind};
+use crate::geometry::vector::norm;
+use crate::geometry::PreparedPolygon;
+use geo::Coord;
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+/// What `prune` does with junctions close to each other.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "lowercase")]
+pub enum Junctions {
+    /// Every junction of the skeleton stays (rivers, lakes, islands).
+    #[default]
+    Keep,
+    /// Junctions whose inscribed discs overlap become one node at the
+    /// centre of the largest disc, the lines straightened into it (street
+    /// and road networks).
+    Merge,
+}
+
+/// One cluster of merged junctions: the centre and radius of its largest
+/// inscribed disc, and the node where its lines meet (inside that disc).
+#[derive(Debug, Clone, Copy)]
+struct Hub {
+    centre: Coord<f64>,
+    radius: f64,
+    node: Coord<f64>,
+}
+
+/// `g` with the junctions whose discs overlap merged (see the module
+/// documentation); `g` itself when no two junctions are that close.
+pub fn merge(g: &SkeletonGraph, polygon: &PreparedPolygon) -> SkeletonGraph {
+    let degrees = g.degrees();
+    let junction = |n: NodeId| degrees[n.index()] >= 3;
+    let branches = g.branches();
+    let (mut hubs, inner) = hubs(g, &branches, &junction);
+    if inner.iter().all(|&x| !x) {
+        return g.clone();
+    }
+    meeting_points(&mut hubs, &branches, &inner);
+    let hub_of = |n: NodeId| hubs[n.index()];
+    let mut b = GraphBuilder::new();
+    for (k, br) in branches.iter().enumerate() {
+        if inner[k] {
+            continue;
+        }
+        let mut coords = br.coords.clone();
+        if let Some(h) = hub_of(br.start) {
+            coords = into_hub(&coords, h);
+        }
+        if let Some(h) = hub_of(br.end) {
+            coords.reverse();
+            coords = into_hub(&coords, h);
+            coords.reverse();
+        }
+        if coords.len() < 2 {
+            // A leg wholly inside the merged disc.
+            continue;
+        }
+        if coords.first() == coords.last() {
+            // A loop from a hub back to it: two edges through its middle.
+            let mid = coords.len() / 2;
+            b.polyline(&coords[..=mid]);
+            b.polyline(&coords[mid..]);
+        } else {
+            b.polyline(&coords);
+        }
+    }
+    let merged = b.finish(polygon.boundary());
+    super::planar::node_crossings(merged, polygon.boundary()).0
+}
+
+/// The hub of every node (the merged cluster it belongs to, when the
+/// cluster has two junctions or more and every member's disc overlaps the
+/// centre's), and which branches lie between two members of one hub.
+fn hubs(
+    g: &SkeletonGraph,
+    branches: &[Branch],
+    junction: &dyn Fn(NodeId) -> bool,
+) -> (Vec<Option<Hub>>, Vec<bool>) {
+    let node = |n: NodeId| g.node(n);
+    let close = |br: &Branch| {
+        let (a, b) = (node(br.start), node(br.end));
+        let reach = a.radius + b.radius;
+        br.start != br.end
+            && junction(br.start)
+            && junction(br.end)
+            && br.length() <= reach
+            && norm(a.pos - b.pos) <= reach
+    };
+    let mut uf = UnionFind::new(g.nodes().len());
+    for br in branches.iter().filter(|br| close(br)) {
+        uf.union(br.start.index(), br.end.index());
+    }
+    let n = g.nodes().len();
+    let root: Vec<usize> = (0..n).map(|i| uf.find(i)).collect();
+    // The member with the largest disc of each cluster (the smallest index
+    // among equals), and the cluster's size.
+    let mut best: Vec<Option<usize>> = vec![None; n];
+    let mut size = vec![0usize; n];
+    for (i, &r) in root.iter().enumerate() {
+        size[r] += 1;
+        let wider = best[r].is_none_or(|b| g.nodes()[i].radius > g.nodes()[b].radius);
+        if wider {
+            best[r] = Some(i);
+        }
+    }
+    let mut hub: Vec<Option<Hub>> = vec![None; n];
+    let mut ok = vec![true; n];
+    for (i, &r) in root.iter().enumerate() {
+        let Some(c) = best[r].filter(|_| size[r] >= 2) else {
+            continue;
+        };
+        let (ci, ni) = (&g.nodes()[c], &g.nodes()[i]);
+        if norm(ni.pos - ci.pos) > ci.radius + ni.radius {
+            ok[r] = false;
+        }
+        hub[i] = Some(Hub {
+            centre: ci.pos,
+            radius: ci.radius,
+            node: ci.pos,
+        });
+    }
+    for (h, &r) in hub.iter_mut().zip(&root) {
+        if !ok[r] {
+            *h = None;
+        }
+    }
+    let inner = branches
+        .iter()
+        .map(|br| {
+            let same = root[br.start.index()] == root[br.end.index()];
+            let merged = hub[br.start.index()].is_some();
+            let inside = |c: &Coord<f64>, h: Hub| norm(*c - h.centre) <= h.radius;
+            // Between two members: a stub (or a short side of a triangle),
+            // or any branch that stays inside the merged disc.
+            merged
+                && same
+                && (close(br)
+                    || hub[br.start.index()]
+                        .is_some_and(|h| br.coords.iter().all(|c| inside(c, h))))
+        })
+        .collect();
+    (hub, inner)
+}
+
+/// Where each hub's lines meet: the point nearest (least squares) to the
+/// lines that continue its incoming branches beyond its disc — the crossing
+/// of the streets' centrelines — kept inside the disc; the disc's centre
+/// where the branches are (nearly) parallel.
+fn meeting_points(hubs: &mut [Option<Hub>], branches: &[Branch], inner: &[bool]) {
+    use std::collections::HashMap;
+    // Per hub (by its centre's bits): Σ (I − d dᵀ) and Σ (I − d dᵀ) q.
+    let mut sums: HashMap<[u64; 2], [f64; 5]> = HashMap::new();
+    let key = |h: &Hub| [h.centre.x.to_bits(), h.centre.y.to_bits()];
+    for (br, _) in branches.iter().zip(inner).filter(|(_, &i)| !i) {
+        for (n, coords) in [
+            (br.start, br.coords.clone()),
+            (br.end, reversed(&br.coords)),
+        ] {
+            let Some(h) = hubs[n.index()] else { continue };
+            let Some((q, d)) = direction_beyond(&coords, h) else {
+                continue;
+            };
+            let (a, b, c) = (1.0 - d.x * d.x, -d.x * d.y, 1.0 - d.y * d.y);
+            let e = sums.entry(key(&h)).or_insert([0.0; 5]);
+            e[0] += a;
+            e[1] += b;
+            e[2] += c;
+            e[3] += a * q.x + b * q.y;
+            e[4] += b * q.x + c * q.y;
+        }
+    }
+    for h in hubs.iter_mut().flatten() {
+        let Some(&[a, b, c, u, v]) = sums.get(&key(h)) else {
+            continue;
+        };
+        let det = a * c - b * b;
+        // Nearly parallel lines (a straight street through a widening):
+        // no crossing to speak of.
+        if det.is_nan() || det <= 0.05 * (a + c) * (a + c) / 4.0 {
+            continue;
+        }
+        let x = Coord {
+            x: (c * u - b * v) / det,
+            y: (a * v - b * u) / det,
+        };
+        let off = x - h.centre;
+        let l = norm(off);
+        h.node = if l <= h.radius {
+            x
+        } else {
+            h.centre + off * (h.radius / l)
+        };
+    }
+}
+
+/// `coords` reversed.
+fn reversed(coords: &[Coord<f64>]) -> Vec<Coord<f64>> {
+    coords.iter().rev().copied().collect()
+}
+
+/// Where a branch leaving hub `h` (`coords` from the hub) crosses its
+/// disc's rim, and its direction beyond: towards its point one disc radius
+/// further along (or its end).
+fn direction_beyond(coords: &[Coord<f64>], h: Hub) -> Option<(Coord<f64>, Coord<f64>)> {
+    let (_, rest) = beyond(coords, h)?;
+    let q = rest[0];
+    let mut far = q;
+    let mut left = h.radius;
+    for w in rest.windows(2) {
+        let l = norm(w[1] - w[0]);
+        if l >= left {
+            far = w[0] + (w[1] - w[0]) * (left / l);
+            break;
+        }
+        left -= l;
+        far = w[1];
+    }
+    let d = far - q;
+    let l = norm(d);
+    (l > 0.0).then(|| (q, d / l))
+}
+
+/// The part of `coords` (starting at a member of hub `h`) beyond the hub's
+/// disc, from where it first leaves it (a point on the rim), and whether it
+/// started outside the disc already (a member farther than the disc's
+/// radius, whose own disc overlaps it); `None` when it never leaves it.
+fn beyond(coords: &[Coord<f64>], h: Hub) -> Option<(bool, Vec<Coord<f64>>)> {
+    let outside = |c: Coord<f64>| norm(c - h.centre) > h.radius;
+    let first_out = coords.iter().position(|&c| outside(c))?;
+    if first_out == 0 {
+        return Some((true, coords.to_vec()));
+    }
+    let (a, b) = (coords[first_out - 1], coords[first_out]);
+    let mut rest = vec![rim(a, b, h)];
+    rest.extend_from_slice(&coords[first_out..]);
+    rest.dedup();
+    Some((false, rest))
+}
+
+/// `coords` (starting at a member of hub `h`) from the hub's node: cut
+/// where it first leaves the hub's disc and joined to the node by a
+/// straight segment (inside the disc, which is convex and inside the
+/// polygon). A polyline that never leaves the disc is the node alone; one
+/// that starts outside the disc is joined to its start through the disc's
+/// centre (the segment from the centre to the member lies in their two
+/// overlapping discs).
+fn into_hub(coords: &[Coord<f64>], h: Hub) -> Vec<Coord<f64>> {
+    let mut out = vec![h.node];
+    if let Some((outside, rest)) = beyond(coords, h) {
+        if outside {
+            out.push(h.centre);
+        }
+        out.extend(rest);
+    }
+    out.dedup();
+    out
+}
+
+/// Where segment `a`–`b` (`a` inside disc `h`, `b` outside) crosses its rim.
+fn rim(a: Coord<f64>, b: Coord<f64>, h: Hub) -> Coord<f64> {
+    let d = b - a;
+    let f = a - h.centre;
+    let (qa, qb, qc) = (
+        d.x * d.x + d.y * d.y,
+        2.0 * (f.x * d.x + f.y * d.y),
+        f.x * f.x + f.y * f.y - h.radius * h.radius,
+    );
+    let disc = (qb * qb - 4.0 * qa * qc).max(0.0);
+    let t = if qa > 0.0 {
+        ((-qb + disc.sqrt()) / (2.0 * qa)).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    a + d * t
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::graph::GraphBuilder;
+    use geo::polygon;
+
+    fn c(x: f64, y: f64) -> Coord<f64> {
+        Coord { x, y }
+    }
+
+    #[test]
+    fn a_crossing_seen_as_two_three_way_nodes_becomes_one_four_way_node() {
+        // A plus-shaped street space, arms 10 wide: its medial axis as two
+        // three-way nodes 1 apart (as MA gives a crossing that is not
+        // perfectly symmetric), joined by a stub.
+        let p = PreparedPolygon::new(&polygon![
+            (x: -5., y: -50.), (x: 5., y: -50.), (x: 5., y: -5.), (x: 50., y: -5.),
+            (x: 50., y: 5.), (x: 5., y: 5.), (x: 5., y: 50.), (x: -5., y: 50.),
+            (x: -5., y: 5.), (x: -50., y: 5.), (x: -50., y: -5.), (x: -5., y: -5.)
+        ])
+        .unwrap();
+        let mut b = GraphBuilder::new();
+        b.segment(c(-0.5, 0.), c(0.5, 0.));
+        b.polyline(&[c(-0.5, 0.), c(-50., 0.)]);
+        b.polyline(&[c(-0.5, 0.), c(-0.2, 50.)]);
+        b.polyline(&[c(0.5, 0.), c(50., 0.)]);
+        b.polyline(&[c(0.5, 0.), c(0.2, -50.)]);
+        let g = b.finish(p.boundary());
+        assert_eq!(g.degrees().iter().filter(|&&d| d >= 3).count(), 2);
+        let m = merge(&g, &p);
+        let degrees = m.degrees();
+        assert_eq!(degrees.iter().filter(|&&d| d >= 3).count(), 1, "{m:?}");
+        assert_eq!(degrees.iter().filter(|&&d| d == 4).count(), 1);
+        assert_eq!(degrees.iter().filter(|&&d| d == 1).count(), 4);
+        // The arms keep their far ends; the total length lost is the stub.
+        assert!((g.total_length() - m.total_length()).abs() < 2.0);
+        m.check_invariants().unwrap();
+    }
+
+    #[test]
+    fn junctions_farther_apart_than_their_discs_stay() {
+        // Two T-junctions 30 apart along a street 10 wide: two junctions.
+        let p = PreparedPolygon::new(&polygon![
+            (x: -50., y: -5.), (x: 50., y: -5.), (x: 50., y: 5.), (x: 20., y: 5.),
+            (x: 20., y: 50.), (x: 10., y: 50.), (x: 10., y: 5.), (x: -10., y: 5.),
+            (x: -10., y: 50.), (x: -20., y: 50.), (x: -20., y: 5.), (x: -50., y: 5.)
+        ])
+        .unwrap();
+        let mut b = GraphBuilder::new();
+        b.polyline(&[c(-50., 0.), c(-15., 0.)]);
+        b.polyline(&[c(-15., 0.), c(15., 0.)]);
+        b.polyline(&[c(15., 0.), c(50., 0.)]);
+        b.polyline(&[c(-15., 0.), c(-15., 50.)]);
+        b.polyline(&[c(15., 0.), c(15., 50.)]);
+        let g = b.finish(p.boundary());
+        let m = merge(&g, &p);
+        assert_eq!(m, g);
+    }
+}

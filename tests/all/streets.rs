@@ -1,0 +1,150 @@
+//! Street space to a street network: `prune: { junctions: merge }` gives one
+//! node per junction where the street space's medial axis has two three-way
+//! nodes and a stub for every four-way crossing, and a small triangle at a
+//! skewed or five-arm one. Run through the binary on the generated city
+//! quarter of `tests/data/streets.gpkg` (`scripts/make_streets.py`): its
+//! streets' own centrelines are the reference.
+#![cfg(all(feature = "cli", feature = "gdal"))]
+
+use crate::common::*;
+use gdal::vector::LayerAccess;
+use geo::{Coord, Distance, Euclidean, Geometry, MultiLineString, Polygon};
+use skeletonise::geometry::PreparedPolygon;
+use skeletonise::graph::SkeletonGraph;
+use std::path::Path;
+
+const STREETS: &str = "tests/data/streets.gpkg";
+
+/// Every geometry of `layer` in `path`.
+fn geometries(path: &Path, layer: &str) -> Vec<Geometry<f64>> {
+    let ds = open(path);
+    let mut l = ds.layer_by_name(layer).unwrap();
+    l.features()
+        .map(|f| wkt::TryFromWkt::try_from_wkt_str(&f.geometry().unwrap().wkt().unwrap()).unwrap())
+        .collect()
+}
+
+fn points(layer: &str) -> Vec<Coord<f64>> {
+    geometries(Path::new(&root(STREETS)), layer)
+        .into_iter()
+        .map(|g| match g {
+            Geometry::Point(p) => p.0,
+            other => panic!("not a point: {other:?}"),
+        })
+        .collect()
+}
+
+/// The skeleton layer's lines of a run of the quarter with `prune`.
+fn run(dir: &Path, prune: &str) -> MultiLineString<f64> {
+    let out = dir.join(format!("{}.gpkg", prune.len()));
+    let text = format!(
+        "input: {{ source: {}, layer: quarter }}\nsteps:\n  - skeleton: {{}}\n  - prune: {prune}\n  - extend: {{}}\n  - score: {{}}\n  - select: {{}}\noutput: {{ path: {} }}\n",
+        root(STREETS),
+        out.display()
+    );
+    let p = pipeline(dir, "streets.yaml", &text);
+    let o = skeletonise(&["run", p.to_str().unwrap(), "-q"]);
+    assert_eq!(code_and_err(&o).0, 0, "{}", code_and_err(&o).1);
+    let mut lines = Vec::new();
+    for g in geometries(&out, "skeletons") {
+        match g {
+            Geometry::MultiLineString(m) => lines.extend(m.0),
+            Geometry::LineString(l) => lines.push(l),
+            other => panic!("not lines: {other:?}"),
+        }
+    }
+    MultiLineString(lines)
+}
+
+/// The nodes of `lines` of degree ≥ 3, and their line ends.
+fn junctions_and_ends(lines: &MultiLineString<f64>) -> (Vec<Coord<f64>>, Vec<Coord<f64>>) {
+    let g = SkeletonGraph::from_lines(lines);
+    let d = g.degrees();
+    let at = |f: fn(usize) -> bool| -> Vec<Coord<f64>> {
+        (0..d.len())
+            .filter(|&i| f(d[i]))
+            .map(|i| g.nodes()[i].pos)
+            .collect()
+    };
+    (at(|x| x >= 3), at(|x| x == 1))
+}
+
+/// How the output's junctions match the reference's: for each reference
+/// junction, the output junctions within its local width (2r); the output
+/// junctions near none; pairs of output junctions closer than the local width.
+fn matching(
+    space: &PreparedPolygon,
+    reference: &[Coord<f64>],
+    out: &[Coord<f64>],
+) -> (Vec<usize>, usize, usize) {
+    let width = |c: Coord<f64>| 2.0 * space.boundary().distance(c);
+    let dist = |a: Coord<f64>, b: Coord<f64>| Euclidean.distance(geo::Point(a), geo::Point(b));
+    let each = reference
+        .iter()
+        .map(|&r| out.iter().filter(|&&o| dist(o, r) <= width(r)).count())
+        .collect();
+    let extra = out
+        .iter()
+        .filter(|&&o| reference.iter().all(|&r| dist(o, r) > width(r)))
+        .count();
+    let close = (0..out.len())
+        .flat_map(|i| (i + 1..out.len()).map(move |j| (i, j)))
+        .filter(|&(i, j)| dist(out[i], out[j]) < width(out[i]).min(width(out[j])))
+        .count();
+    (each, extra, close)
+}
+
+fn quarter() -> PreparedPolygon {
+    match geometries(Path::new(&root(STREETS)), "quarter").remove(0) {
+        Geometry::Polygon(p) => PreparedPolygon::new(&p).unwrap(),
+        other => panic!("not a polygon: {other:?}"),
+    }
+}
+
+#[test]
+fn merged_junctions_are_the_streets_junctions_one_to_one() {
+    let d = tmp();
+    let space = quarter();
+    let reference = points("quarter_junctions");
+    assert_eq!(reference.len(), 12);
+    // As before (`keep`): a crossing is two nodes and a stub, a skewed or
+    // five-arm one a triangle — several nodes at 4 of the 12 junctions.
+    let kept = run(d.path(), "{}");
+    let (out, _) = junctions_and_ends(&kept);
+    let (each, _, close) = matching(&space, &reference, &out);
+    assert!(
+        each.iter().filter(|&&n| n > 1).count() >= 3 && close > 0,
+        "{each:?} {close}"
+    );
+    // Merged: exactly one node within each junction's local width, none
+    // elsewhere, no two closer than the local width.
+    let merged = run(d.path(), "{ junctions: merge }");
+    let (out, ends) = junctions_and_ends(&merged);
+    let (each, extra, close) = matching(&space, &reference, &out);
+    assert_eq!(each, vec![1; reference.len()], "{out:?}");
+    assert_eq!((extra, close), (0, 0), "{out:?}");
+    // One line end per reference end (the dead end, the cut ends at the
+    // data's edge, which lie on the boundary: no local width there), each
+    // within the widest street's width (16 m) of it.
+    let reference_ends = points("quarter_ends");
+    let near =
+        |a: Coord<f64>, b: Coord<f64>| Euclidean.distance(geo::Point(a), geo::Point(b)) <= 16.0;
+    assert_eq!(ends.len(), reference_ends.len(), "{ends:?}");
+    for r in &reference_ends {
+        assert_eq!(
+            ends.iter().filter(|&&e| near(e, *r)).count(),
+            1,
+            "{r:?}: {ends:?}"
+        );
+    }
+    // The straightened lines stay inside the street space.
+    let poly: &Polygon<f64> = space.polygon();
+    for l in &merged.0 {
+        for c in &l.0 {
+            assert!(
+                geo::Contains::contains(poly, c) || space.boundary().distance(*c) < 1e-6,
+                "{c:?} outside the street space"
+            );
+        }
+    }
+}
