@@ -27,6 +27,7 @@ import sys
 
 import geopandas as gpd
 import shapely
+import shapely.ops
 from shapely import affinity
 from shapely.geometry import LineString, box
 
@@ -80,6 +81,29 @@ def roads():
             cur.append((x, y))
     utm = gpd.GeoSeries(segments, crs=4326).to_crs(32632)
     merged = shapely.line_merge(shapely.node(shapely.union_all(utm.values)))
+    parts = list(getattr(merged, "geoms", [merged]))
+    # A tributary's mouth stops short of its river in the data (up to ~300 m): joined to it, so
+    # that the reference has the junction the roads' space shows.
+    joined = []
+    for i, part in enumerate(parts):
+        others = shapely.union_all([q for j, q in enumerate(parts) if j != i])
+        coords = list(part.coords)
+        for k in (0, -1):
+            end = shapely.Point(coords[k])
+            if 0 < end.distance(others) <= 300.0:
+                foot = shapely.ops.nearest_points(end, others)[1]
+                coords.insert(0 if k == 0 else len(coords), (foot.x, foot.y))
+        joined.append(LineString(coords))
+    # A line that overshoots the one it meets leaves a dangle shorter than the road's width
+    # (400 m here: 20 m once scaled), which is no arm of a junction: dropped.
+    from collections import Counter
+
+    noded = list(shapely.node(shapely.union_all(joined)).geoms)
+    degree = Counter(c for p in noded for c in (p.coords[0], p.coords[-1]))
+    # So is a small loop where a line crosses itself.
+    kept = [p for p in noded
+            if not (p.length < 400.0 and (1 in (degree[p.coords[0]], degree[p.coords[-1]]) or p.is_closed))]
+    merged = shapely.line_merge(shapely.union_all(kept))
     parts = list(getattr(merged, "geoms", [merged]))
     b = shapely.total_bounds(parts)
     parts = [affinity.translate(affinity.scale(p, 0.05, 0.05, origin=(b[0], b[1])), X0 - b[0] + 2_000, Y0 - b[1] + 2_000)

@@ -56,10 +56,30 @@ pub fn merge(g: &SkeletonGraph, polygon: &PreparedPolygon) -> SkeletonGraph {
     let junction = |n: NodeId| degrees[n.index()] >= 3;
     let branches = g.branches();
     let (mut hubs, inner) = hubs(g, &branches, &junction);
-    if inner.iter().all(|&x| !x) {
+    // Every other junction a hub of its own: its lines too meet at one point.
+    for (i, h) in hubs.iter_mut().enumerate() {
+        if h.is_none() && degrees[i] >= 3 {
+            let n = &g.nodes()[i];
+            *h = Some(Hub {
+                centre: n.pos,
+                radius: n.radius,
+                node: n.pos,
+            });
+        }
+    }
+    if hubs.iter().all(Option::is_none) {
         return g.clone();
     }
-    meeting_points(&mut hubs, &branches, &inner);
+    let single: Vec<bool> = (0..hubs.len())
+        .map(|i| {
+            hubs[i].is_some()
+                && !branches
+                    .iter()
+                    .zip(&inner)
+                    .any(|(br, &x)| x && (br.start.index() == i || br.end.index() == i))
+        })
+        .collect();
+    meeting_points(&mut hubs, &branches, &inner, &single, polygon);
     let hub_of = |n: NodeId| hubs[n.index()];
     let mut b = GraphBuilder::new();
     for (k, br) in branches.iter().enumerate() {
@@ -170,10 +190,17 @@ fn hubs(
 /// lines that continue its incoming branches beyond its disc — the crossing
 /// of the streets' centrelines — kept inside the disc; the disc's centre
 /// where the branches are (nearly) parallel.
-fn meeting_points(hubs: &mut [Option<Hub>], branches: &[Branch], inner: &[bool]) {
+fn meeting_points(
+    hubs: &mut [Option<Hub>],
+    branches: &[Branch],
+    inner: &[bool],
+    single: &[bool],
+    polygon: &PreparedPolygon,
+) {
     use std::collections::HashMap;
     // Per hub (by its centre's bits): Σ (I − d dᵀ) and Σ (I − d dᵀ) q.
     let mut sums: HashMap<[u64; 2], [f64; 5]> = HashMap::new();
+    let mut meeting: HashMap<[u64; 2], Coord<f64>> = HashMap::new();
     let key = |h: &Hub| [h.centre.x.to_bits(), h.centre.y.to_bits()];
     for (br, _) in branches.iter().zip(inner).filter(|(_, &i)| !i) {
         for (n, coords) in [
@@ -214,7 +241,47 @@ fn meeting_points(hubs: &mut [Option<Hub>], branches: &[Branch], inner: &[bool])
         } else {
             h.centre + off * (h.radius / l)
         };
+        meeting.insert(key(h), x);
     }
+    // A single junction whose lines meet beyond its disc (a Y whose arms
+    // part at an acute angle: the medial axis forks where the corridors
+    // separate, past where their centrelines meet) moves there when every
+    // line reaches it straight inside the polygon.
+    for (i, slot) in hubs.iter_mut().enumerate() {
+        let Some(h) = slot.as_mut().filter(|_| single[i]) else {
+            continue;
+        };
+        let Some(&x) = meeting.get(&key(h)) else {
+            continue;
+        };
+        let reach = norm(x - h.centre);
+        if reach <= h.radius {
+            continue;
+        }
+        let moved = Hub {
+            centre: x,
+            radius: reach + h.radius,
+            node: x,
+        };
+        let boundary = polygon.boundary();
+        let inside = boundary.contains(x)
+            && ends_at(branches, i).all(|coords| {
+                let cut = into_hub(&coords, moved);
+                cut.len() >= 2 && !boundary.crosses(cut[0], cut[1])
+            });
+        if inside {
+            *h = moved;
+        }
+    }
+}
+
+/// The branches at node `i`, each from it.
+fn ends_at(branches: &[Branch], i: usize) -> impl Iterator<Item = Vec<Coord<f64>>> + '_ {
+    branches.iter().flat_map(move |br| {
+        let from_start = (br.start.index() == i).then(|| br.coords.clone());
+        let from_end = (br.end.index() == i).then(|| reversed(&br.coords));
+        from_start.into_iter().chain(from_end)
+    })
 }
 
 /// `coords` reversed.
@@ -222,26 +289,30 @@ fn reversed(coords: &[Coord<f64>]) -> Vec<Coord<f64>> {
     coords.iter().rev().copied().collect()
 }
 
-/// Where a branch leaving hub `h` (`coords` from the hub) crosses its
-/// disc's rim, and its direction beyond: towards its point one disc radius
-/// further along (or its end).
+/// A branch leaving hub `h` (`coords` from the hub) as a line beyond the
+/// disc: its point one disc radius past the rim, and its direction from
+/// there to its point three radii past the rim (or its end) — clear of the
+/// bend the junction's corners give the medial axis.
 fn direction_beyond(coords: &[Coord<f64>], h: Hub) -> Option<(Coord<f64>, Coord<f64>)> {
     let (_, rest) = beyond(coords, h)?;
-    let q = rest[0];
-    let mut far = q;
-    let mut left = h.radius;
-    for w in rest.windows(2) {
+    let near = along(&rest, h.radius);
+    let far = along(&rest, 3.0 * h.radius);
+    let d = far - near;
+    let l = norm(d);
+    (l > 0.0).then(|| (near, d / l))
+}
+
+/// The point `s` along polyline `c` from its start (its end when shorter).
+fn along(c: &[Coord<f64>], s: f64) -> Coord<f64> {
+    let mut left = s;
+    for w in c.windows(2) {
         let l = norm(w[1] - w[0]);
-        if l >= left {
-            far = w[0] + (w[1] - w[0]) * (left / l);
-            break;
+        if l >= left && l > 0.0 {
+            return w[0] + (w[1] - w[0]) * (left / l);
         }
         left -= l;
-        far = w[1];
     }
-    let d = far - q;
-    let l = norm(d);
-    (l > 0.0).then(|| (q, d / l))
+    c[c.len() - 1]
 }
 
 /// The part of `coords` (starting at a member of hub `h`) beyond the hub's
@@ -354,6 +425,58 @@ mod tests {
         b.polyline(&[c(15., 0.), c(15., 50.)]);
         let g = b.finish(p.boundary());
         let m = merge(&g, &p);
-        assert_eq!(m, g);
+        let d = m.degrees();
+        let mut junctions: Vec<(f64, f64)> = (0..d.len())
+            .filter(|&i| d[i] == 3)
+            .map(|i| (m.nodes()[i].pos.x, m.nodes()[i].pos.y))
+            .collect();
+        junctions.sort_by(|a, b| a.0.total_cmp(&b.0));
+        assert_eq!(junctions, vec![(-15.0, 0.0), (15.0, 0.0)]);
+        assert!((g.total_length() - m.total_length()).abs() < 1e-9);
+        m.check_invariants().unwrap();
+    }
+
+    #[test]
+    fn a_y_whose_arms_part_at_an_acute_angle_meets_where_its_centrelines_do() {
+        // A street 10 wide forks at 30° into two arms 10 wide: the medial
+        // axis forks where the corridors separate, about 19 past where the
+        // centrelines meet (at the origin); merged, the node is there.
+        let (s, c30) = (15f64.to_radians().sin(), 15f64.to_radians().cos());
+        let arm =
+            |side: f64| geo::LineString::from(vec![c(0., 0.), c(side * 200. * s, 200. * c30)]);
+        let trunk = geo::LineString::from(vec![c(0., -200.), c(0., 0.)]);
+        use geo::{BooleanOps, Buffer};
+        let space = trunk
+            .buffer(5.0)
+            .union(&arm(1.0).buffer(5.0))
+            .union(&arm(-1.0).buffer(5.0));
+        let p = PreparedPolygon::new(&space.0[0]).unwrap();
+        let raw = crate::methods::build(
+            crate::methods::MethodId::MA,
+            &crate::methods::SkeletonParams::default(),
+        )
+        .skeletonise(&p, &crate::methods::MethodContext::default())
+        .unwrap();
+        let g = crate::graph::extend::prune_and_extend(
+            &raw,
+            &p,
+            Some(&crate::graph::prune::PruneParams::default()),
+            Some(&crate::graph::extend::ExtendParams::default()),
+        );
+        let fork = |g: &SkeletonGraph| -> Vec<Coord<f64>> {
+            let d = g.degrees();
+            (0..d.len())
+                .filter(|&i| d[i] >= 3)
+                .map(|i| g.nodes()[i].pos)
+                .collect()
+        };
+        let before = fork(&g);
+        assert_eq!(before.len(), 1);
+        assert!(norm(before[0]) > 10.0, "{before:?}");
+        let m = merge(&g, &p);
+        let after = fork(&m);
+        assert_eq!(after.len(), 1, "{after:?}");
+        assert!(norm(after[0]) < 1.0, "{after:?}");
+        m.check_invariants().unwrap();
     }
 }

@@ -34,11 +34,11 @@ fn points(layer: &str) -> Vec<Coord<f64>> {
         .collect()
 }
 
-/// The skeleton layer's lines of a run of the quarter with `prune`.
-fn run(dir: &Path, prune: &str) -> MultiLineString<f64> {
-    let out = dir.join(format!("{}.gpkg", prune.len()));
+/// The skeleton layer's lines of a run of `layer` with `prune`.
+fn run(dir: &Path, layer: &str, prune: &str) -> MultiLineString<f64> {
+    let out = dir.join(format!("{layer}{}.gpkg", prune.len()));
     let text = format!(
-        "input: {{ source: {}, layer: quarter }}\nsteps:\n  - skeleton: {{}}\n  - prune: {prune}\n  - extend: {{}}\n  - score: {{}}\n  - select: {{}}\noutput: {{ path: {} }}\n",
+        "input: {{ source: {}, layer: {layer} }}\nsteps:\n  - skeleton: {{}}\n  - prune: {prune}\n  - extend: {{}}\n  - score: {{}}\n  - select: {{}}\noutput: {{ path: {} }}\n",
         root(STREETS),
         out.display()
     );
@@ -94,11 +94,20 @@ fn matching(
     (each, extra, close)
 }
 
-fn quarter() -> PreparedPolygon {
-    match geometries(Path::new(&root(STREETS)), "quarter").remove(0) {
-        Geometry::Polygon(p) => PreparedPolygon::new(&p).unwrap(),
+fn space(layer: &str) -> Vec<PreparedPolygon> {
+    match geometries(Path::new(&root(STREETS)), layer).remove(0) {
+        Geometry::Polygon(p) => vec![PreparedPolygon::new(&p).unwrap()],
+        Geometry::MultiPolygon(m) => {
+            m.0.iter()
+                .map(|p| PreparedPolygon::new(p).unwrap())
+                .collect()
+        }
         other => panic!("not a polygon: {other:?}"),
     }
+}
+
+fn quarter() -> PreparedPolygon {
+    space("quarter").remove(0)
 }
 
 #[test]
@@ -109,7 +118,7 @@ fn merged_junctions_are_the_streets_junctions_one_to_one() {
     assert_eq!(reference.len(), 12);
     // As before (`keep`): a crossing is two nodes and a stub, a skewed or
     // five-arm one a triangle — several nodes at 4 of the 12 junctions.
-    let kept = run(d.path(), "{}");
+    let kept = run(d.path(), "quarter", "{}");
     let (out, _) = junctions_and_ends(&kept);
     let (each, _, close) = matching(&space, &reference, &out);
     assert!(
@@ -118,7 +127,7 @@ fn merged_junctions_are_the_streets_junctions_one_to_one() {
     );
     // Merged: exactly one node within each junction's local width, none
     // elsewhere, no two closer than the local width.
-    let merged = run(d.path(), "{ junctions: merge }");
+    let merged = run(d.path(), "quarter", "{ junctions: merge }");
     let (out, ends) = junctions_and_ends(&merged);
     let (each, extra, close) = matching(&space, &reference, &out);
     assert_eq!(each, vec![1; reference.len()], "{out:?}");
@@ -147,4 +156,47 @@ fn merged_junctions_are_the_streets_junctions_one_to_one() {
             );
         }
     }
+}
+
+#[test]
+fn on_a_real_network_buffered_as_roads_merged_junctions_match_the_lines_junctions() {
+    // The rivers of 8–12° E, 46–50° N (GSHHG/WDBII) scaled to a 15 × 22 km
+    // network of 16 m roads: 20 junctions in the lines, two of them where a
+    // line crosses itself in a loop narrower than the road (no junction in
+    // the road space). Acute forks are most of the rest: there the medial
+    // axis forks past the lines' meeting point, beyond the local width.
+    let d = tmp();
+    let parts = space("roads");
+    let reference = points("roads_junctions");
+    assert_eq!(reference.len(), 20);
+    let count = |prune: &str| {
+        let (out, _) = junctions_and_ends(&run(d.path(), "roads", prune));
+        // Each junction against the part it lies in.
+        let part = |c: Coord<f64>| {
+            parts
+                .iter()
+                .find(|p| p.boundary().contains(c))
+                .unwrap_or(&parts[0])
+        };
+        let width = |c: Coord<f64>| 2.0 * part(c).boundary().distance(c);
+        let dist = |a: Coord<f64>, b: Coord<f64>| Euclidean.distance(geo::Point(a), geo::Point(b));
+        let one = reference
+            .iter()
+            .filter(|&&r| out.iter().filter(|&&o| dist(o, r) <= width(r)).count() == 1)
+            .count();
+        let extra = out
+            .iter()
+            .filter(|&&o| reference.iter().all(|&r| dist(o, r) > width(r)))
+            .count();
+        (one, extra)
+    };
+    let (kept, kept_extra) = count("{}");
+    let (merged, merged_extra) = count("{ junctions: merge }");
+    // Measured: keep 17 of 20 with one node, 2 nodes with no junction
+    // near; merge 18 of 20, 1 (two parallel roads whose spaces merge).
+    assert!(merged >= 18 && merged >= kept, "{kept} → {merged}");
+    assert!(
+        merged_extra <= 1 && merged_extra <= kept_extra,
+        "{kept_extra} → {merged_extra}"
+    );
 }
