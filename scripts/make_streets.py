@@ -16,7 +16,9 @@ Writes OUT (GeoPackage, EPSG:32633, metres) with two pairs of layers:
 Every polygon has the field `name`; the reference lines `name` and `width` (the street's). Beside
 each pair, `<name>_junctions`: the reference's junctions inside the street space (points where three
 or more lines meet, the lines noded where they cross), with `arms` (their degree); and
-`<name>_ends`: the reference's line ends (dead ends, and where the data's edge cuts a line).
+`<name>_ends`: the reference's line ends (dead ends, and where the data's edge cuts a line). The
+quarter also has `quarter_blocks`: the blocks between its streets (the box minus the street space),
+each with `block` (its number), for the street pieces' `left_fid` and `right_fid`.
 
     scripts/make_streets.py tests/data/streets.gpkg
 """
@@ -57,7 +59,7 @@ def quarter():
         polys.append(line.buffer(width / 2, cap_style="flat", join_style="mitre"))
         lines.append((name, line.intersection(clip), width))
     space = shapely.union_all(polys).intersection(clip)
-    return space, lines
+    return space, lines, list(clip.difference(space).geoms)
 
 
 def roads():
@@ -134,7 +136,7 @@ def nodes(space, lines, crs):
 
 def main(out: str) -> None:
     crs = "EPSG:32633"
-    q_space, q_lines = quarter()
+    q_space, q_lines, q_blocks = quarter()
     q_space = affinity.translate(q_space, X0, Y0)
     frames = {
         "quarter": gpd.GeoDataFrame({"name": ["quarter"]}, geometry=[q_space], crs=crs),
@@ -142,6 +144,8 @@ def main(out: str) -> None:
             {"name": [n for n, _, _ in q_lines], "width": [w for _, _, w in q_lines]},
             geometry=[affinity.translate(g, X0, Y0) for _, g, _ in q_lines], crs=crs),
     }
+    blocks = [affinity.translate(b, X0, Y0) for b in q_blocks]
+    frames["quarter_blocks"] = gpd.GeoDataFrame({"block": list(range(1, len(blocks) + 1))}, geometry=blocks, crs=crs)
     r_space, r_lines = roads()
     frames["roads"] = gpd.GeoDataFrame({"name": ["lena roads"]}, geometry=[r_space], crs=crs)
     frames["roads_lines"] = gpd.GeoDataFrame(

@@ -69,3 +69,4 @@ pub mod report;
 #[cfg(feature = "gdal")]
 pub mod reporting;
 pub mod score;
+pub mod streets;

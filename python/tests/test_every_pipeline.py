@@ -51,6 +51,17 @@ def test_every_pipeline_gives_the_command_lines_rows(name, tmp_path):
         kwargs.update(connect=_frame(inp["connect"]), snap=float(inp["connect"].get("snap", 0.0)))
     if "neighbours" in inp:
         kwargs.update(neighbours=_frame(inp["neighbours"]))
+    # A registered step's side input (an option naming a layer): given as a frame, as the Python
+    # package opens no file.
+    sides = {
+        name: _frame(value)
+        for step in spec["steps"]
+        for name, options in step.items()
+        for value in (options or {}).values()
+        if isinstance(value, dict) and "source" in value
+    }
+    if sides:
+        kwargs["sides"] = sides
     layers = skeletonise.apply_layers(_frame(inp), path, **kwargs)
     written = {name for name, _ in pyogrio.list_layers(out)}
     layer = spec.get("output", {}).get("layer", "skeletons")

@@ -392,10 +392,12 @@ pub fn load_str(text: &str, origin: &str, overrides: &[String]) -> Result<Pipeli
     load_str_with(text, origin, overrides, &builtin_steps())
 }
 
-/// The registered steps every pipeline file may use (the `label` step),
+/// The registered steps every pipeline file may use (`label`, `streets`),
 /// assembled here, above the steps and the registry's own module.
 pub fn builtin_steps() -> StepRegistry {
-    StepRegistry::default().with(crate::label::ENTRY)
+    StepRegistry::default()
+        .with(crate::label::ENTRY)
+        .with(crate::streets::ENTRY)
 }
 
 /// [`load_str`] with the registered steps of `registry` (library use: a

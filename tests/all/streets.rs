@@ -8,7 +8,7 @@
 
 use crate::common::*;
 use gdal::vector::LayerAccess;
-use geo::{Coord, Distance, Euclidean, Geometry, MultiLineString, Polygon};
+use geo::{Coord, Distance, Euclidean, Geometry, LineString, MultiLineString, Polygon};
 use skeletonise::geometry::PreparedPolygon;
 use skeletonise::graph::SkeletonGraph;
 use std::path::Path;
@@ -199,4 +199,134 @@ fn on_a_real_network_buffered_as_roads_merged_junctions_match_the_lines_junction
         merged_extra <= 1 && merged_extra <= kept_extra,
         "{kept_extra} → {merged_extra}"
     );
+}
+
+/// A row of the `streets` layer: line, start and end degree, left and right FID.
+type Piece = (LineString<f64>, i64, i64, Option<i64>, Option<i64>);
+
+#[test]
+fn the_streets_layer_is_the_noded_network_with_the_blocks_on_either_side() {
+    use geo::{Closest, ClosestPoint};
+    let d = tmp();
+    let out = d.path().join("streets.gpkg");
+    let text = format!(
+        "input: {{ source: {src}, layer: quarter }}\nsteps:\n  - skeleton: {{}}\n  - prune: {{ junctions: merge }}\n  - extend: {{}}\n  - score: {{}}\n  - select: {{}}\n  - streets: {{ units: {{ source: {src}, layer: quarter_blocks }} }}\noutput: {{ path: {} }}\n",
+        out.display(),
+        src = root(STREETS),
+    );
+    let p = pipeline(d.path(), "streets.yaml", &text);
+    let o = skeletonise(&["run", p.to_str().unwrap(), "-q"]);
+    assert_eq!(code_and_err(&o).0, 0, "{}", code_and_err(&o).1);
+    let ds = open(&out);
+    let mut layer = ds.layer_by_name("streets").unwrap();
+    let fields: Vec<String> = layer.defn().fields().map(|f| f.name()).collect();
+    assert!(
+        fields.ends_with(
+            &[
+                "src_fid",
+                "piece",
+                "start_degree",
+                "end_degree",
+                "length",
+                "left_fid",
+                "right_fid"
+            ]
+            .map(String::from)
+        ),
+        "{fields:?}"
+    );
+    let int = |f: &gdal::vector::Feature, name: &str| {
+        f.field_as_integer64(f.field_index(name).unwrap()).unwrap()
+    };
+    let pieces: Vec<Piece> = layer
+        .features()
+        .map(|f| {
+            let g: Geometry<f64> =
+                wkt::TryFromWkt::try_from_wkt_str(&f.geometry().unwrap().wkt().unwrap()).unwrap();
+            let Geometry::LineString(l) = g else {
+                panic!("a line")
+            };
+            (
+                l,
+                int(&f, "start_degree").unwrap(),
+                int(&f, "end_degree").unwrap(),
+                int(&f, "left_fid"),
+                int(&f, "right_fid"),
+            )
+        })
+        .collect();
+    // The network of the merged skeleton: 12 junctions, 15 ends; every
+    // piece runs between two of its nodes.
+    let junctions = pieces
+        .iter()
+        .flat_map(|p| [(p.0 .0[0], p.1), (*p.0 .0.last().unwrap(), p.2)])
+        .filter(|(_, deg)| *deg >= 3)
+        .map(|(c, _)| (c.x.to_bits(), c.y.to_bits()))
+        .collect::<std::collections::HashSet<_>>();
+    assert_eq!(junctions.len(), 12);
+    let ends = pieces
+        .iter()
+        .flat_map(|p| [p.1, p.2])
+        .filter(|&d| d == 1)
+        .count();
+    assert_eq!(ends, 15);
+    // Each piece has a block on either side, the two differ, and the one
+    // called left lies to the left of the piece where it is nearest to the
+    // piece's middle, within the street's width of it.
+    let blocks: std::collections::HashMap<i64, Polygon<f64>> = {
+        let src = open(Path::new(&root(STREETS)));
+        let mut b = src.layer_by_name("quarter_blocks").unwrap();
+        b.features()
+            .map(|f| {
+                let g: Geometry<f64> =
+                    wkt::TryFromWkt::try_from_wkt_str(&f.geometry().unwrap().wkt().unwrap())
+                        .unwrap();
+                let Geometry::Polygon(p) = g else {
+                    panic!("a block")
+                };
+                (f.fid().unwrap() as i64, p)
+            })
+            .collect()
+    };
+    // The quarter's box: 500 000–500 600 E, 6 649 960–6 650 370 N.
+    let dead_end = |c: Coord<f64>| {
+        c.x > 500_016.0 && c.x < 500_584.0 && c.y > 6_649_976.0 && c.y < 6_650_354.0
+    };
+    for (line, start, end, left, right) in &pieces {
+        let (Some(left), Some(right)) = (*left, *right) else {
+            panic!("a piece without a block on a side: {line:?} {left:?} {right:?}");
+        };
+        // The same block on both sides only along a dead end (into a block).
+        let into_block = (*start == 1 && dead_end(line.0[0]))
+            || (*end == 1 && dead_end(*line.0.last().unwrap()));
+        assert_eq!(left == right, into_block, "{line:?}");
+        if into_block {
+            continue;
+        }
+        let n = line.0.len();
+        let (a, b) = (line.0[n / 2 - usize::from(n % 2 == 0)], line.0[n / 2]);
+        let (a, b) = if a == b {
+            (line.0[0], line.0[1])
+        } else {
+            (a, b)
+        };
+        let mid = (a + b) * 0.5;
+        for (fid, sign) in [(left, 1.0), (right, -1.0)] {
+            let (Closest::SinglePoint(q) | Closest::Intersection(q)) =
+                blocks[&fid].closest_point(&geo::Point(mid))
+            else {
+                panic!("no closest point")
+            };
+            let (d, v) = (b - a, q.0 - mid);
+            let cross = d.x * v.y - d.y * v.x;
+            assert!(
+                sign * cross > 0.0,
+                "block {fid} is not on that side of {line:?}"
+            );
+            assert!(
+                Euclidean.distance(geo::Point(mid), q) <= 16.0,
+                "block {fid} far from {line:?}"
+            );
+        }
+    }
 }
