@@ -75,3 +75,18 @@ def test_every_pipeline_gives_the_command_lines_rows(name, tmp_path):
         want = pyogrio.read_dataframe(out, layer=cli_name)
         assert [c for c in got.columns if c in want.columns] == [c for c in want.columns], (lname, list(got.columns), list(want.columns))
         same_rows(got, out, cli_name)
+
+
+def test_a_side_input_the_pipeline_names_must_be_given():
+    """The Python package opens no file: a registered step's side input the pipeline file names
+    must be passed as a frame, and a frame for a step that reads none is refused."""
+    path = ROOT / "pipelines" / "streets.yaml"
+    quarter = pyogrio.read_dataframe(ROOT / "tests/data/streets.gpkg", layer="quarter", fid_as_index=True)
+    with pytest.raises(skeletonise.PipelineError, match=r"steps\.streets\.units.*sides="):
+        skeletonise.apply_layers(quarter, path)
+    blocks = pyogrio.read_dataframe(ROOT / "tests/data/streets.gpkg", layer="quarter_blocks", fid_as_index=True)
+    with pytest.raises(ValueError, match="no registered step `label`"):
+        skeletonise.apply_layers(quarter, path, sides={"streets": blocks, "label": blocks})
+    layers = skeletonise.apply_layers(quarter, path, sides={"streets": blocks})
+    streets = layers["streets"]
+    assert streets.left_fid.notna().all() and streets.right_fid.notna().all()
