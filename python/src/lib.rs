@@ -314,6 +314,34 @@ impl Pipeline {
         ))
     }
 
+    /// The side input layers the pipeline file names for its registered
+    /// steps: `(step, option key, source, layer, where)` each, `layer` a
+    /// name, an index or None (the first layer). A caller that can open
+    /// them (QGIS) passes them to `run` as `sides`.
+    #[getter]
+    fn side_inputs<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyAny>>> {
+        let mut out = Vec::new();
+        for e in &self.steps.process_params().extra {
+            let Some((key, Ok(src))) = e.side_source() else {
+                continue;
+            };
+            let layer: Bound<'py, PyAny> = match &src.layer {
+                Some(config::LayerRef::Name(n)) => n.into_pyobject(py)?.into_any(),
+                Some(config::LayerRef::Index(i)) => i.into_pyobject(py)?.into_any(),
+                None => py.None().into_bound(py),
+            };
+            let item = (
+                e.entry.name,
+                key,
+                src.source.clone(),
+                layer,
+                src.where_.clone(),
+            );
+            out.push(item.into_pyobject(py)?.into_any());
+        }
+        Ok(out)
+    }
+
     /// Whether a registered step of the pipeline adds rows after the last
     /// feature from every feature's rows: its features must go through one
     /// call (as a partition's).
@@ -744,6 +772,31 @@ fn describe() -> String {
     config::describe(&skeletonise::methods::Registry::builtin())
 }
 
+/// The layers of the registered steps every pipeline file may use:
+/// `(step, layer, geometry, carries the source's fields)`, geometry one of
+/// `linestring`, `multilinestring`, `polygon`, `multipolygon`, `unknown`
+/// (mixed), `none` (a table): what a host (QGIS) declares outputs for.
+#[pyfunction]
+fn step_layers() -> Vec<(&'static str, &'static str, &'static str, bool)> {
+    use skeletonise::layer::GeometryKind as G;
+    config::builtin_steps()
+        .entries()
+        .iter()
+        .flat_map(|e| e.layers.iter().map(move |l| (e.name, l)))
+        .map(|(step, l)| {
+            let geometry = match l.geometry {
+                G::LineString => "linestring",
+                G::MultiLineString => "multilinestring",
+                G::Polygon => "polygon",
+                G::MultiPolygon => "multipolygon",
+                G::Unknown => "unknown",
+                G::None => "none",
+            };
+            (step, l.name, geometry, l.attributes)
+        })
+        .collect()
+}
+
 /// The JSON Schema of the pipeline file, as JSON text.
 #[pyfunction]
 fn schema() -> String {
@@ -764,6 +817,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(source_names, m)?)?;
     m.add_function(wrap_pyfunction!(describe, m)?)?;
     m.add_function(wrap_pyfunction!(schema, m)?)?;
+    m.add_function(wrap_pyfunction!(step_layers, m)?)?;
     Ok(())
 }
 

@@ -29,6 +29,7 @@ from qgis.core import (
     QgsProcessingParameterFile,
     QgsProcessingParameterNumber,
     QgsProcessingParameterString,
+    QgsVectorLayer,
     QgsWkbTypes,
 )
 from qgis.PyQt.QtCore import QCoreApplication
@@ -162,6 +163,32 @@ class _Algorithm(QgsProcessingAlgorithm):
             wkbs.append(bytes(f.geometry().asWkb()) if f.hasGeometry() else None)
         return wkbs, fids
 
+    def _side_inputs(self, pipeline, path, context, crs):
+        """The side input layers the pipeline file names for its registered steps (`streets.units`),
+        opened by QGIS's OGR provider (a relative source from the working directory, as the
+        command line opens it, else from the pipeline file's folder) with their `where`, in the
+        polygons' CRS: ``{step: (WKB geometries, FIDs)}``."""
+        out = {}
+        for step, key, source, layer, where in pipeline.side_inputs:
+            name = f"steps.{step}.{key}"
+            candidates = [source]
+            if path and not os.path.isabs(source):
+                candidates.append(os.path.join(os.path.dirname(os.path.abspath(path)), source))
+            found = next((c for c in candidates if os.path.exists(c)), source)
+            uri = found if layer is None else f"{found}|layername={layer}" if isinstance(layer, str) else f"{found}|layerid={layer}"
+            side = QgsVectorLayer(uri, name, "ogr")
+            if not side.isValid():
+                raise QgsProcessingException(f"`{name}`: cannot open layer {layer!r} of `{source}`; check its source and layer")
+            if where and not side.setSubsetString(where):
+                raise QgsProcessingException(f"`{name}.where`: invalid filter `{where}`")
+            request = QgsFeatureRequest().setDestinationCrs(crs, context.transformContext())
+            wkbs, fids = [], []
+            for f in side.getFeatures(request):
+                fids.append(int(f.id()))
+                wkbs.append(bytes(f.geometry().asWkb()) if f.hasGeometry() else None)
+            out[step] = (wkbs, fids)
+        return out
+
     def _units(self, parameters, context, crs):
         """The NEIGHBOURS coverage, in the polygons' CRS: (WKB polygons, FIDs, attributes by FID, source)."""
         if parameters.get("NEIGHBOURS") is None:
@@ -210,6 +237,9 @@ class _Algorithm(QgsProcessingAlgorithm):
         extra = {}
         if connect is not None:
             extra = {"connect": connect[0], "connect_fids": connect[1], "snap": snap}
+        sides = self._side_inputs(pipeline, getattr(self, "_path", None), context, crs)
+        if sides:
+            extra["sides"] = sides
         unit_fields, unit_attributes, unit_skip = None, {}, set()
         if partition:
             if "NEIGHBOURS" not in [p.name() for p in self.parameterDefinitions()]:
@@ -238,9 +268,21 @@ class _Algorithm(QgsProcessingAlgorithm):
         for key, (layer, kind) in self.LAYER_SINKS.items():
             if key in names and (layer != "areas" or collapse or partition) and (layer == "areas" or partition):
                 sinks.append((key, layer, kind))
+        # A registered step's layer, when the pipeline has the step and the algorithm the sink.
+        registered = {}
+        for key, layer, kind in _step_sinks():
+            if key in names and parameters.get(key) is not None:
+                try:
+                    registered[layer] = pipeline.layer_columns(layer, connect=connect is not None, explode=explode)
+                except ValueError:
+                    continue
+                sinks.append((key, layer, kind))
         results, outputs = {}, {}
         for key, layer, kind in sinks:
-            tool, carries = core_columns(layer, explode, collapse, partition)
+            if layer in registered:
+                tool, carries = registered[layer]
+            else:
+                tool, carries = core_columns(layer, explode, collapse, partition)
             if layer == "coverage":
                 fields_of, keep = unit_fields, bridge.source_fields(unit_fields, unit_skip)
             else:
@@ -560,6 +602,15 @@ class PipelineAlgorithm(_Algorithm):
         "neighbours."
     )
 
+    def shortHelpString(self):  # noqa: N802
+        """The help text, with a line for each registered step's layer."""
+        layers = "".join(
+            f"\n<b>Layer `{layer}`</b>: the layer of a registered step, written when the pipeline has the step; "
+            "a layer the step reads (e.g. streets.units) is opened from the pipeline file, as the command line opens it."
+            for _key, layer, _kind in _step_sinks()
+        )
+        return _tr(self.HELP) + _tr(layers)
+
     def initAlgorithm(self, config=None):  # noqa: N802
         _polygons(self)
         self.addParameter(
@@ -579,6 +630,16 @@ class PipelineAlgorithm(_Algorithm):
         _sinks(self)
         _areas_sink(self)
         _partition_sinks(self, required=False)
+        for key, layer, kind in _step_sinks():
+            sink = QgsProcessingParameterFeatureSink(
+                key, _tr(f"Layer `{layer}` (of a registered step)"),
+                QgsProcessing.TypeVectorLine if kind in (QgsWkbTypes.LineString, QgsWkbTypes.MultiLineString)
+                else QgsProcessing.TypeVectorPolygon if kind in (QgsWkbTypes.Polygon, QgsWkbTypes.MultiPolygon)
+                else QgsProcessing.TypeVector,
+                optional=True, createByDefault=False,
+            )
+            sink.setHelp(_tr(f"The `{layer}` layer, written when the pipeline has its step."))
+            self.addParameter(sink)
         self._tooltips()
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802
@@ -591,7 +652,28 @@ class PipelineAlgorithm(_Algorithm):
         except (core.PipelineError, OSError) as e:
             raise QgsProcessingException(str(e)) from None
         snap = self.parameterAsDouble(parameters, "SNAP", context)
+        self._path = path
         return self._pipeline_rows(pipeline, parameters, context, feedback, pipeline.explode, snap)
+
+
+_SINK_TYPES = {
+    "linestring": QgsWkbTypes.LineString,
+    "multilinestring": QgsWkbTypes.MultiLineString,
+    "polygon": QgsWkbTypes.Polygon,
+    "multipolygon": QgsWkbTypes.MultiPolygon,
+    "none": QgsWkbTypes.NoGeometry,
+}
+
+
+def _step_sinks():
+    """The registered steps' layers a pipeline algorithm can write (not those of mixed geometry,
+    such as `labels`, which QGIS cannot hold in one layer: the Label lines algorithm writes them):
+    ``(parameter, layer, QGIS geometry type)``; none without the wheel."""
+    try:
+        layers = bridge.core().step_layers()
+    except QgsProcessingException:
+        return []
+    return [(f"STEP_{layer.upper()}", layer, _SINK_TYPES[kind]) for _step, layer, kind, _ in layers if kind in _SINK_TYPES]
 
 
 def _step_options(step):

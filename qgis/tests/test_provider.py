@@ -946,6 +946,22 @@ class Pipeline(Case):
         self.assertEqual(str(e.exception), want)
 
 
+class Streets(Case):
+    def test_the_streets_pipeline_writes_the_command_lines_streets_layer(self):
+        # A registered step with a side input (the blocks, `streets.units`): QGIS opens the layer the
+        # pipeline file names and writes the step's layer, row for row the command line's.
+        path = os.path.join(ROOT, "pipelines", "streets.yaml")
+        cli("run", path, "-o", self.out("cli.gpkg"))
+        src = os.path.join(ROOT, "tests", "data", "streets.gpkg")
+        res = processing.run("skeletonise:pipeline", {
+            "INPUT": f"{src}|layername=quarter", "PIPELINE": path,
+            "OUTPUT": self.out("q.gpkg"), "STEP_STREETS": self.out("s.gpkg"),
+        })
+        got, want = rows(res["STEP_STREETS"]), rows(self.out("cli.gpkg"), "streets")
+        self.assertGreater(len(want), 20)
+        self.assertTrue(all(r["left_fid"] is not None and r["right_fid"] is not None for r in got))
+        self.assertSameRows(got, want, key=("src_fid", "piece"))
+
 class Labels(Case):
     def test_the_label_steps_parameters_are_its_schema(self):
         # Names, defaults, ranges and help from `skeletonise schema`: nothing copied by hand, so
