@@ -48,6 +48,8 @@ pub enum GeometryKind {
     Polygon,
     /// MULTIPOLYGON.
     MultiPolygon,
+    /// POINT.
+    Point,
     /// Any geometry (the `rejected` layer keeps the input's).
     Unknown,
     /// An attribute table.

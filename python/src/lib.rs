@@ -774,7 +774,7 @@ fn describe() -> String {
 
 /// The layers of the registered steps every pipeline file may use:
 /// `(step, layer, geometry, carries the source's fields)`, geometry one of
-/// `linestring`, `multilinestring`, `polygon`, `multipolygon`, `unknown`
+/// `linestring`, `multilinestring`, `polygon`, `multipolygon`, `point`, `unknown`
 /// (mixed), `none` (a table): what a host (QGIS) declares outputs for.
 #[pyfunction]
 fn step_layers() -> Vec<(&'static str, &'static str, &'static str, bool)> {
@@ -789,6 +789,7 @@ fn step_layers() -> Vec<(&'static str, &'static str, &'static str, bool)> {
                 G::MultiLineString => "multilinestring",
                 G::Polygon => "polygon",
                 G::MultiPolygon => "multipolygon",
+                G::Point => "point",
                 G::Unknown => "unknown",
                 G::None => "none",
             };

@@ -635,6 +635,7 @@ class PipelineAlgorithm(_Algorithm):
                 key, _tr(f"Layer `{layer}` (of a registered step)"),
                 QgsProcessing.TypeVectorLine if kind in (QgsWkbTypes.LineString, QgsWkbTypes.MultiLineString)
                 else QgsProcessing.TypeVectorPolygon if kind in (QgsWkbTypes.Polygon, QgsWkbTypes.MultiPolygon)
+                else QgsProcessing.TypeVectorPoint if kind == QgsWkbTypes.Point
                 else QgsProcessing.TypeVector,
                 optional=True, createByDefault=False,
             )
@@ -661,6 +662,7 @@ _SINK_TYPES = {
     "multilinestring": QgsWkbTypes.MultiLineString,
     "polygon": QgsWkbTypes.Polygon,
     "multipolygon": QgsWkbTypes.MultiPolygon,
+    "point": QgsWkbTypes.Point,
     "none": QgsWkbTypes.NoGeometry,
 }
 

@@ -956,11 +956,18 @@ class Streets(Case):
         res = processing.run("skeletonise:pipeline", {
             "INPUT": f"{src}|layername=quarter", "PIPELINE": path,
             "OUTPUT": self.out("q.gpkg"), "STEP_STREETS": self.out("s.gpkg"),
+            "STEP_STREET_NODES": self.out("n.gpkg"),
         })
         got, want = rows(res["STEP_STREETS"]), rows(self.out("cli.gpkg"), "streets")
         self.assertGreater(len(want), 20)
         self.assertTrue(all(r["left_fid"] is not None and r["right_fid"] is not None for r in got))
         self.assertSameRows(got, want, key=("src_fid", "piece"))
+        # The nodes the step makes after the last feature (one call for such a pipeline).
+        got, want = rows(res["STEP_STREET_NODES"]), rows(self.out("cli.gpkg"), "street_nodes")
+        self.assertEqual(len(want), 27)
+        for r in got + want:
+            r["at"] = r["_geom"].asWkt(6)
+        self.assertSameRows(got, want, key=("at",))
 
 class Labels(Case):
     def test_the_label_steps_parameters_are_its_schema(self):

@@ -90,6 +90,7 @@ fn ogr_geometry(g: GeometryKind) -> u32 {
         GeometryKind::LineString => OGRwkbGeometryType::wkbLineString,
         GeometryKind::Polygon => OGRwkbGeometryType::wkbPolygon,
         GeometryKind::MultiPolygon => OGRwkbGeometryType::wkbMultiPolygon,
+        GeometryKind::Point => OGRwkbGeometryType::wkbPoint,
         GeometryKind::Unknown => OGRwkbGeometryType::wkbUnknown,
         GeometryKind::None => OGRwkbGeometryType::wkbNone,
     }

@@ -16,6 +16,12 @@
 //! | `length` | the piece's length |
 //! | `left_fid`, `right_fid` | the unit on the piece's left and right (looking from its start to its end): the unit just beyond the polygon's boundary, across from the piece's middle and its quarter points (the one most of them find); NULL without `units`, or where no unit is there (the data's edge) |
 //!
+//! and, after the last feature, the layer `street_nodes`: one point per
+//! node of the whole network — every feature's pieces together, so that a
+//! street space split into parcels is one network — with `degree` (how
+//! many pieces end there; a node where two parcels' pieces meet has 2) and
+//! `features` (of how many features).
+//!
 //! ```yaml
 //! steps:
 //!   - skeleton: {}
@@ -30,7 +36,7 @@ use crate::geometry::vector::norm;
 use crate::geometry::PreparedPolygon;
 use crate::graph::SkeletonGraph;
 use crate::layer::{Cell, ColumnType, GeometryKind, LayerSource, StepLayer, StepRow};
-use crate::process::step::{FeatureStep, Needs, SideLayer, StepEntry, StepInput};
+use crate::process::step::{FeatureStep, FinishInput, Needs, SideLayer, StepEntry, StepInput};
 use geo::{Coord, LineString};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -45,20 +51,31 @@ pub struct StreetsParams {
     pub units: Option<LayerSource>,
 }
 
-/// The `streets` layer.
-pub const STREETS: &[StepLayer] = &[StepLayer {
-    name: "streets",
-    geometry: GeometryKind::LineString,
-    attributes: true,
-    columns: &[
-        ("piece", ColumnType::Int32),
-        ("start_degree", ColumnType::Int32),
-        ("end_degree", ColumnType::Int32),
-        ("length", ColumnType::Real),
-        ("left_fid", ColumnType::Int64),
-        ("right_fid", ColumnType::Int64),
-    ],
-}];
+/// The `streets` and `street_nodes` layers.
+pub const STREETS: &[StepLayer] = &[
+    StepLayer {
+        name: "streets",
+        geometry: GeometryKind::LineString,
+        attributes: true,
+        columns: &[
+            ("piece", ColumnType::Int32),
+            ("start_degree", ColumnType::Int32),
+            ("end_degree", ColumnType::Int32),
+            ("length", ColumnType::Real),
+            ("left_fid", ColumnType::Int64),
+            ("right_fid", ColumnType::Int64),
+        ],
+    },
+    StepLayer {
+        name: "street_nodes",
+        geometry: GeometryKind::Point,
+        attributes: false,
+        columns: &[
+            ("degree", ColumnType::Int32),
+            ("features", ColumnType::Int32),
+        ],
+    },
+];
 
 /// The step (its options are only the side input, which the run reads).
 #[derive(Debug)]
@@ -93,6 +110,41 @@ impl FeatureStep for Streets {
             rows.push(("streets", StepRow { geometry, cells }));
         }
         rows
+    }
+
+    fn finish(&self, input: &FinishInput<'_>) -> Vec<(&'static str, StepRow)> {
+        use crate::geometry::CoordKey;
+        // Every node of the whole network in the order first met: its
+        // position, degree and the features it is in.
+        let mut index: rustc_hash::FxHashMap<CoordKey, usize> = Default::default();
+        let mut nodes: Vec<(Coord<f64>, i64, Vec<Option<u64>>)> = Vec::new();
+        for (fid, _, row) in input
+            .rows
+            .iter()
+            .filter(|(_, layer, _)| *layer == "streets")
+        {
+            let Some(geo::Geometry::LineString(l)) = &row.geometry else {
+                continue;
+            };
+            for end in [l.0.first(), l.0.last()].into_iter().flatten() {
+                let k = *index.entry(CoordKey::from(*end)).or_insert_with(|| {
+                    nodes.push((*end, 0, Vec::new()));
+                    nodes.len() - 1
+                });
+                nodes[k].1 += 1;
+                if !nodes[k].2.contains(fid) {
+                    nodes[k].2.push(*fid);
+                }
+            }
+        }
+        nodes
+            .into_iter()
+            .map(|(c, degree, features)| {
+                let cells = vec![Cell::Int(degree), crate::layer::int(features.len())];
+                let geometry = Some(geo::Geometry::Point(c.into()));
+                ("street_nodes", StepRow { geometry, cells })
+            })
+            .collect()
     }
 }
 
@@ -199,7 +251,7 @@ pub const ENTRY: StepEntry = StepEntry {
         medial_axis: false,
         lonlat: false,
         side: Some("units"),
-        finish: false,
+        finish: true,
     },
     layers: STREETS,
     build: |v| {

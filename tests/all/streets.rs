@@ -270,6 +270,19 @@ fn the_streets_layer_is_the_noded_network_with_the_blocks_on_either_side() {
         .filter(|&d| d == 1)
         .count();
     assert_eq!(ends, 15);
+    // The nodes of the whole network, made after the last feature: the same
+    // 12 junctions and 15 ends, each node's degree the pieces ending there.
+    let degrees = crate::common::ints(&ds, "street_nodes", "degree");
+    let count = |f: fn(i64) -> bool| degrees.iter().filter(|d| f(d.unwrap())).count();
+    assert_eq!(
+        (count(|d| d >= 3), count(|d| d == 1), degrees.len()),
+        (12, 15, 27)
+    );
+    let ends_total: i64 = degrees.iter().map(|d| d.unwrap()).sum();
+    assert_eq!(ends_total as usize, 2 * pieces.len());
+    assert!(crate::common::ints(&ds, "street_nodes", "features")
+        .iter()
+        .all(|f| *f == Some(1)));
     // Each piece has a block on either side, the two differ, and the one
     // called left lies to the left of the piece where it is nearest to the
     // piece's middle, within the street's width of it.
