@@ -70,15 +70,12 @@ pub fn merge(g: &SkeletonGraph, polygon: &PreparedPolygon) -> SkeletonGraph {
     if hubs.iter().all(Option::is_none) {
         return g.clone();
     }
-    let single: Vec<bool> = (0..hubs.len())
-        .map(|i| {
-            hubs[i].is_some()
-                && !branches
-                    .iter()
-                    .zip(&inner)
-                    .any(|(br, &x)| x && (br.start.index() == i || br.end.index() == i))
-        })
-        .collect();
+    // A junction a hub of its own (no branch between it and another member).
+    let mut single: Vec<bool> = hubs.iter().map(Option::is_some).collect();
+    for (br, _) in branches.iter().zip(&inner).filter(|(_, &x)| x) {
+        single[br.start.index()] = false;
+        single[br.end.index()] = false;
+    }
     meeting_points(&mut hubs, &branches, &inner, &single, polygon);
     let hub_of = |n: NodeId| hubs[n.index()];
     let mut b = GraphBuilder::new();
@@ -243,10 +240,27 @@ fn meeting_points(
         };
         meeting.insert(key(h), x);
     }
-    // A single junction whose lines meet beyond its disc (a Y whose arms
-    // part at an acute angle: the medial axis forks where the corridors
-    // separate, past where their centrelines meet) moves there when every
-    // line reaches it straight inside the polygon.
+    relocate_singles(hubs, branches, single, &meeting, polygon);
+}
+
+/// A single junction whose lines meet beyond its disc (a Y whose arms part
+/// at an acute angle: the medial axis forks where the corridors separate,
+/// past where their centrelines meet, `meeting`) moves there when every
+/// line reaches it straight inside the polygon.
+fn relocate_singles(
+    hubs: &mut [Option<Hub>],
+    branches: &[Branch],
+    single: &[bool],
+    meeting: &std::collections::HashMap<[u64; 2], Coord<f64>>,
+    polygon: &PreparedPolygon,
+) {
+    let key = |h: &Hub| [h.centre.x.to_bits(), h.centre.y.to_bits()];
+    // The branches at each node: (branch, whether it starts there).
+    let mut at: Vec<Vec<(usize, bool)>> = vec![Vec::new(); hubs.len()];
+    for (k, br) in branches.iter().enumerate() {
+        at[br.start.index()].push((k, true));
+        at[br.end.index()].push((k, false));
+    }
     for (i, slot) in hubs.iter_mut().enumerate() {
         let Some(h) = slot.as_mut().filter(|_| single[i]) else {
             continue;
@@ -265,7 +279,11 @@ fn meeting_points(
         };
         let boundary = polygon.boundary();
         let inside = boundary.contains(x)
-            && ends_at(branches, i).all(|coords| {
+            && at[i].iter().all(|&(k, starts)| {
+                let coords = match starts {
+                    true => branches[k].coords.clone(),
+                    false => reversed(&branches[k].coords),
+                };
                 let cut = into_hub(&coords, moved);
                 cut.len() >= 2 && !boundary.crosses(cut[0], cut[1])
             });
@@ -275,14 +293,6 @@ fn meeting_points(
     }
 }
 
-/// The branches at node `i`, each from it.
-fn ends_at(branches: &[Branch], i: usize) -> impl Iterator<Item = Vec<Coord<f64>>> + '_ {
-    branches.iter().flat_map(move |br| {
-        let from_start = (br.start.index() == i).then(|| br.coords.clone());
-        let from_end = (br.end.index() == i).then(|| reversed(&br.coords));
-        from_start.into_iter().chain(from_end)
-    })
-}
 
 /// `coords` reversed.
 fn reversed(coords: &[Coord<f64>]) -> Vec<Coord<f64>> {

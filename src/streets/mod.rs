@@ -149,19 +149,21 @@ impl FeatureStep for Streets {
 }
 
 /// The polygon part a piece lies in: the one holding its middle vertex (or
-/// the nearest).
+/// the nearest), among the parts whose boxes hold it first.
 fn part_of<'a>(parts: &'a [PreparedPolygon], coords: &[Coord<f64>]) -> Option<&'a PreparedPolygon> {
     let mid = middle(coords)?.0;
-    parts.iter().min_by(|a, b| {
-        let d = |p: &PreparedPolygon| {
-            if p.boundary().contains(mid) {
-                0.0
-            } else {
-                p.boundary().distance(mid)
-            }
-        };
-        d(a).total_cmp(&d(b))
-    })
+    let in_box = |p: &PreparedPolygon| {
+        let (lo, hi) = (p.boundary().bbox_min(), p.boundary().bbox_max());
+        lo.x <= mid.x && mid.x <= hi.x && lo.y <= mid.y && mid.y <= hi.y
+    };
+    parts
+        .iter()
+        .find(|p| in_box(p) && p.boundary().contains(mid))
+        .or_else(|| {
+            parts
+                .iter()
+                .min_by(|a, b| a.boundary().distance(mid).total_cmp(&b.boundary().distance(mid)))
+        })
 }
 
 /// The point at fraction `f` of a polyline's length and the direction of
