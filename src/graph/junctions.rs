@@ -293,7 +293,6 @@ fn relocate_singles(
     }
 }
 
-
 /// `coords` reversed.
 fn reversed(coords: &[Coord<f64>]) -> Vec<Coord<f64>> {
     coords.iter().rev().copied().collect()

@@ -139,6 +139,7 @@ pub fn validate(p: &Pipeline) -> Result<crate::io::SourceInfo, RunError> {
     if let Some(n) = &input.neighbours {
         read_neighbours(n, reader.info())?;
     }
+    read_step_sides(&mut p.process_params(), reader.info())?;
     let job = Job::of(p);
     check_output(&p.file.output, &job.protected())?;
     check_report_path(&job)?;
@@ -190,7 +191,18 @@ impl<'a> Job<'a> {
             params: p.process_params(),
             on_error: p.file.on_error,
             given: None,
-            other_inputs: Vec::new(),
+            // The registered steps' side inputs are read too: never written over.
+            other_inputs: p
+                .process_params()
+                .extra
+                .iter()
+                .filter_map(|e| {
+                    Some((
+                        "a registered step's side input",
+                        e.side_source()?.1.ok()?.source,
+                    ))
+                })
+                .collect(),
             plan: p.plan(),
         }
     }
@@ -397,6 +409,14 @@ fn params_for(
             .as_deref()
             .and_then(crate::io::lonlat::lonlat_of);
     }
+    read_step_sides(&mut params, info)?;
+    let neighbours = second_inputs(job, info, &mut params)?;
+    Ok((params, neighbours))
+}
+
+/// Reads the side input layer of every registered step whose options name
+/// one (`steps.<step>.<key>`), reprojected to the polygons' CRS (`info`).
+fn read_step_sides(params: &mut ProcessParams, info: &SourceInfo) -> Result<(), RunError> {
     for e in &mut params.extra {
         if let Some((key, src)) = e.side_source() {
             let key = format!("steps.{}.{key}", e.entry.name);
@@ -413,8 +433,7 @@ fn params_for(
             )?));
         }
     }
-    let neighbours = second_inputs(job, info, &mut params)?;
-    Ok((params, neighbours))
+    Ok(())
 }
 
 /// The run's second inputs, read before any feature: the line network of

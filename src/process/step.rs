@@ -165,8 +165,9 @@ pub struct Needs {
     /// The key of the step's option that names a side input layer (a
     /// [`LayerSource`]: `source`, `layer`, `where`), read through the same
     /// path as `input.neighbours` and `input.connect`, reprojected to the
-    /// polygons' CRS ([`StepInput::side`]); the Python package takes it as
-    /// a GeoDataFrame, QGIS as a layer parameter.
+    /// polygons' CRS ([`StepInput::side`]), checked by `validate` and never
+    /// written over; the Python package takes it as a GeoDataFrame
+    /// (`apply_layers(sides=…)`), QGIS opens it from the pipeline file.
     pub side: Option<&'static str>,
     /// The run keeps the step's per-feature rows for its
     /// [`FeatureStep::finish`].

@@ -160,9 +160,11 @@ fn part_of<'a>(parts: &'a [PreparedPolygon], coords: &[Coord<f64>]) -> Option<&'
         .iter()
         .find(|p| in_box(p) && p.boundary().contains(mid))
         .or_else(|| {
-            parts
-                .iter()
-                .min_by(|a, b| a.boundary().distance(mid).total_cmp(&b.boundary().distance(mid)))
+            parts.iter().min_by(|a, b| {
+                a.boundary()
+                    .distance(mid)
+                    .total_cmp(&b.boundary().distance(mid))
+            })
         })
 }
 

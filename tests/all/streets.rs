@@ -343,3 +343,37 @@ fn the_streets_layer_is_the_noded_network_with_the_blocks_on_either_side() {
         }
     }
 }
+
+#[test]
+fn a_side_input_is_checked_by_validate_and_never_written_over() {
+    let d = tmp();
+    // The blocks copied beside the output, to be written over by mistake.
+    let blocks = d.path().join("blocks.gpkg");
+    std::fs::copy(root(STREETS), &blocks).unwrap();
+    let before = std::fs::read(&blocks).unwrap();
+    let text = |layer: &str, out: &Path| {
+        format!(
+            "input: {{ source: {}, layer: quarter }}\nsteps:\n  - skeleton: {{ methods: [MA] }}\n  - streets: {{ units: {{ source: {}, layer: {layer} }} }}\noutput: {{ path: {}, overwrite: true }}\n",
+            root(STREETS),
+            blocks.display(),
+            out.display()
+        )
+    };
+    // A layer that is not there: `validate` refuses it as `run` does, naming the key.
+    let out = d.path().join("out.gpkg");
+    let p = pipeline(d.path(), "missing.yaml", &text("nope", &out));
+    let (code_v, err_v) = code_and_err(&skeletonise(&["validate", p.to_str().unwrap()]));
+    let (code_r, err_r) = code_and_err(&skeletonise(&["run", p.to_str().unwrap(), "-q"]));
+    assert_eq!(code_v, code_r, "{err_v}\n{err_r}");
+    assert_ne!(code_v, 0);
+    for err in [&err_v, &err_r] {
+        assert!(err.contains("`steps.streets.units`: layer `nope` not found"), "{err}");
+    }
+    assert!(!out.exists());
+    // The output onto the side input, even with `overwrite: true`: refused, the file kept.
+    let p = pipeline(d.path(), "onto.yaml", &text("quarter_blocks", &blocks));
+    let (code, err) = code_and_err(&skeletonise(&["run", p.to_str().unwrap(), "-q"]));
+    assert_ne!(code, 0);
+    assert!(err.contains("side input"), "{err}");
+    assert_eq!(std::fs::read(&blocks).unwrap(), before);
+}
