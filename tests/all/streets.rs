@@ -367,7 +367,10 @@ fn a_side_input_is_checked_by_validate_and_never_written_over() {
     assert_eq!(code_v, code_r, "{err_v}\n{err_r}");
     assert_ne!(code_v, 0);
     for err in [&err_v, &err_r] {
-        assert!(err.contains("`steps.streets.units`: layer `nope` not found"), "{err}");
+        assert!(
+            err.contains("`steps.streets.units`: layer `nope` not found"),
+            "{err}"
+        );
     }
     assert!(!out.exists());
     // The output onto the side input, even with `overwrite: true`: refused, the file kept.
