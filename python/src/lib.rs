@@ -303,15 +303,7 @@ impl Pipeline {
                 names.join(", ")
             )));
         };
-        let cols = plan
-            .columns(*layer)
-            .into_iter()
-            .map(|(_, name, ty)| (name, type_name(ty)))
-            .collect();
-        Ok((
-            cols,
-            layer.fields() == Some(skeletonise::layer::Fields::Input),
-        ))
+        Ok(plan_columns(&plan, *layer))
     }
 
     /// The side input layers the pipeline file names for its registered
@@ -718,15 +710,22 @@ fn columns(
     let mut holds = if explode { vec![When::Explode] } else { vec![] };
     holds.extend(run::step_holds(collapse, partition));
     let plan = Plan::new(skeletonise::output::SKELETONS.name, holds, &[]);
+    Ok(plan_columns(&plan, layer))
+}
+
+/// A layer's columns in `plan` as `(name, type)` pairs, and whether it
+/// carries the source's fields.
+fn plan_columns(
+    plan: &Plan,
+    layer: &dyn skeletonise::output::Layer,
+) -> (Vec<(&'static str, &'static str)>, bool) {
     let cols = plan
         .columns(layer)
         .into_iter()
         .map(|(_, name, ty)| (name, type_name(ty)))
         .collect();
-    Ok((
-        cols,
-        layer.fields() == Some(skeletonise::layer::Fields::Input),
-    ))
+    let carries = layer.fields() == Some(skeletonise::layer::Fields::Input);
+    (cols, carries)
 }
 
 /// The names for which a source field is written as `src_<name>` (in every
