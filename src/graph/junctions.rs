@@ -83,13 +83,14 @@ pub fn merge(g: &SkeletonGraph, polygon: &PreparedPolygon) -> SkeletonGraph {
         if inner[k] {
             continue;
         }
+        let boundary = polygon.boundary();
         let mut coords = br.coords.clone();
         if let Some(h) = hub_of(br.start) {
-            coords = into_hub(&coords, h);
+            coords = straighten(&coords, h, boundary);
         }
         if let Some(h) = hub_of(br.end) {
             coords.reverse();
-            coords = into_hub(&coords, h);
+            coords = straighten(&coords, h, boundary);
             coords.reverse();
         }
         if coords.len() < 2 {
@@ -358,6 +359,39 @@ fn into_hub(coords: &[Coord<f64>], h: Hub) -> Vec<Coord<f64>> {
     }
     out.dedup();
     out
+}
+
+/// `coords` (from a member of hub `h`) into the hub's node: cut at twice
+/// the disc's radius where the straight segment from the node stays clear
+/// of the boundary (half the disc's radius or more all along it: past the
+/// bend the junction's corners give the medial axis), else at the disc
+/// ([`into_hub`]); a branch wholly inside the disc is the node alone.
+fn straighten(
+    coords: &[Coord<f64>],
+    h: Hub,
+    boundary: &crate::geometry::Boundary,
+) -> Vec<Coord<f64>> {
+    let near = into_hub(coords, h);
+    if near.len() < 2 {
+        return near;
+    }
+    let far = into_hub(
+        coords,
+        Hub {
+            radius: 2.0 * h.radius,
+            ..h
+        },
+    );
+    let clear = |a: Coord<f64>, b: Coord<f64>| {
+        !boundary.crosses(a, b)
+            && (0..=8)
+                .all(|k| boundary.distance(a + (b - a) * (f64::from(k) / 8.0)) >= 0.5 * h.radius)
+    };
+    if far.len() >= 2 && clear(far[0], far[1]) {
+        far
+    } else {
+        near
+    }
 }
 
 /// Where segment `a`–`b` (`a` inside disc `h`, `b` outside) crosses its rim.
