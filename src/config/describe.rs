@@ -145,7 +145,22 @@ fn values(defs: &Value, prop: &Value) -> String {
         let names: Vec<&str> = e.iter().filter_map(|x| x.as_str()).collect();
         return names.join(" | ");
     }
-    t["type"].as_str().unwrap_or("value").to_string()
+    // An option that may be left out (`Option<T>`): its alternatives.
+    if let Some(list) = t["anyOf"].as_array() {
+        let names: Vec<String> = list.iter().map(|o| values(defs, o)).collect();
+        return names.join(" | ");
+    }
+    if let Some(keys) = t["properties"].as_object() {
+        let keys: Vec<String> = keys.keys().map(|k| format!("{k}: …")).collect();
+        return format!("{{{}}}", keys.join(", "));
+    }
+    match &t["type"] {
+        Value::Array(types) => {
+            let names: Vec<&str> = types.iter().filter_map(|x| x.as_str()).collect();
+            names.join(" | ")
+        }
+        other => other.as_str().unwrap_or("value").to_string(),
+    }
 }
 
 fn default_of(prop: &Value) -> String {
