@@ -8,21 +8,32 @@
 # The test data lives in tests/data (GSHHG, Wessel & Smith), so a fresh clone needs nothing beside it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# Each stage's own time, printed when it ends (where the ten minutes go).
+mark=$SECONDS
+took() { echo "test.sh: $1 took $((SECONDS - mark)) s"; mark=$SECONDS; }
 scripts/deps.sh
 scripts/test-deps.sh
+took "set-up"
 # Installed above: the PostGIS test must run, not skip.
 export SKELETONISE_REQUIRE_POSTGIS=1
 cargo test --all-targets "$@"
+took "cargo test --all-targets"
 cargo test --doc
+took "doc tests"
 # The API documentation builds without a warning (no link to a private or missing item).
 RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --quiet
+took "API documentation"
 # The patched dependency's own unit tests (vendor/boostvoronoi/PATCHES.md).
 CARGO_TARGET_DIR=$PWD/target/vendor cargo test --quiet --manifest-path vendor/boostvoronoi/Cargo.toml --lib
+took "vendored boostvoronoi"
 # The core without GDAL, as the Python binding builds it (the GDAL-only targets are skipped).
 cargo test --no-default-features --all-targets "$@"
+took "without GDAL"
 # The Python package from its manylinux_2_28 wheel (scripts/build-wheel.sh: zig, checked by
 # auditwheel), release profile: target/zig shares nothing with the builds above, and cold the
 # release build takes about 2.2 min against 5.3 for dev on 2 cores.
 SKELETONISE_WHEEL_PROFILE=${SKELETONISE_WHEEL_PROFILE:-release} scripts/test-python.sh
+took "Python package"
 # The QGIS plugin in Debian's QGIS (installed when missing), with that wheel.
 scripts/test-qgis.sh
+took "QGIS plugin"
