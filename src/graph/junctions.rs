@@ -22,7 +22,7 @@
 
 use super::{Branch, GraphBuilder, NodeId, SkeletonGraph, UnionFind};
 use crate::geometry::vector::norm;
-use crate::geometry::PreparedPolygon;
+use crate::geometry::{CoordKey, PreparedPolygon};
 use geo::Coord;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -196,10 +196,10 @@ fn meeting_points(
     polygon: &PreparedPolygon,
 ) {
     use std::collections::HashMap;
-    // Per hub (by its centre's bits): Σ (I − d dᵀ) and Σ (I − d dᵀ) q.
-    let mut sums: HashMap<[u64; 2], [f64; 5]> = HashMap::new();
-    let mut meeting: HashMap<[u64; 2], Coord<f64>> = HashMap::new();
-    let key = |h: &Hub| [h.centre.x.to_bits(), h.centre.y.to_bits()];
+    // Per hub (by its centre): Σ (I − d dᵀ) and Σ (I − d dᵀ) q.
+    let mut sums: HashMap<CoordKey, [f64; 5]> = HashMap::new();
+    let mut meeting: HashMap<CoordKey, Coord<f64>> = HashMap::new();
+    let key = |h: &Hub| CoordKey::from(h.centre);
     for (br, _) in branches.iter().zip(inner).filter(|(_, &i)| !i) {
         for (n, coords) in [
             (br.start, br.coords.clone()),
@@ -252,10 +252,10 @@ fn relocate_singles(
     hubs: &mut [Option<Hub>],
     branches: &[Branch],
     single: &[bool],
-    meeting: &std::collections::HashMap<[u64; 2], Coord<f64>>,
+    meeting: &std::collections::HashMap<CoordKey, Coord<f64>>,
     polygon: &PreparedPolygon,
 ) {
-    let key = |h: &Hub| [h.centre.x.to_bits(), h.centre.y.to_bits()];
+    let key = |h: &Hub| CoordKey::from(h.centre);
     // The branches at each node: (branch, whether it starts there).
     let mut at: Vec<Vec<(usize, bool)>> = vec![Vec::new(); hubs.len()];
     for (k, br) in branches.iter().enumerate() {
