@@ -18,7 +18,9 @@ each pair, `<name>_junctions`: the reference's junctions inside the street space
 or more lines meet, the lines noded where they cross), with `arms` (their degree); and
 `<name>_ends`: the reference's line ends (dead ends, and where the data's edge cuts a line). The
 quarter also has `quarter_blocks`: the blocks between its streets (the box minus the street space),
-each with `block` (its number), for the street pieces' `left_fid` and `right_fid`.
+each with `block` (its number), for the street pieces' `left_fid` and `right_fid`, and
+`quarter_ragged`: the same street space cut by a rough edge instead of the box (every side a vertex
+each metre, moved across it by up to ±1 m, seeded), whose reference is the quarter's.
 
     scripts/make_streets.py tests/data/streets.gpkg
 """
@@ -36,7 +38,34 @@ from shapely.geometry import LineString, box
 X0, Y0 = 500_000.0, 6_650_000.0
 
 
-def quarter():
+def ragged_box(x0, y0, x1, y1, amp, step, seed):
+    """The box with a vertex every `step` m along its sides, each moved across its side by up to
+    ±`amp` m (seeded): a cut that is not straight, as a digitised or rasterised boundary gives."""
+    import random
+
+    from shapely.geometry import Polygon
+
+    rnd = random.Random(seed)
+
+    def side(a, b):
+        n = max(1, int(round(((b[0] - a[0]) ** 2 + (b[1] - a[1]) ** 2) ** 0.5 / step)))
+        out = []
+        for i in range(n):
+            t = i / n
+            x, y = a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t
+            if i > 0:
+                d = rnd.uniform(-amp, amp)
+                x, y = (x + d, y) if a[0] == b[0] else (x, y + d)
+            out.append((x, y))
+        return out
+
+    corners = [(x0, y0), (x1, y0), (x1, y1), (x0, y1), (x0, y0)]
+    ring = Polygon([c for a, b in zip(corners, corners[1:]) for c in side(a, b)])
+    # Teeth longer than the step may cross near a corner.
+    return ring if ring.is_valid else shapely.make_valid(ring)
+
+
+def quarter(clip=None):
     streets = [
         # (name, line, width)
         ("first", [(-50, 0), (650, 0)], 12),
@@ -52,7 +81,7 @@ def quarter():
         # A dead end off `second`.
         ("dead end", [(180, 160), (180, 250)], 8),
     ]
-    clip = box(0, -40, 600, 370)
+    clip = box(0, -40, 600, 370) if clip is None else clip
     lines, polys = [], []
     for name, coords, width in streets:
         line = LineString(coords)
@@ -146,6 +175,12 @@ def main(out: str) -> None:
     }
     blocks = [affinity.translate(b, X0, Y0) for b in q_blocks]
     frames["quarter_blocks"] = gpd.GeoDataFrame({"block": list(range(1, len(blocks) + 1))}, geometry=blocks, crs=crs)
+    # The same quarter cut by a rough edge: ±1 m every metre (a tenth of a 10 m street's width).
+    ragged, _, _ = quarter(ragged_box(0, -40, 600, 370, 1.0, 1.0, 3))
+    # Where the skewed street leaves the quarter by a corner the teeth cut off slivers: dropped.
+    ragged = max(getattr(ragged, "geoms", [ragged]), key=lambda g: g.area)
+    frames["quarter_ragged"] = gpd.GeoDataFrame({"name": ["quarter"]}, geometry=[affinity.translate(ragged, X0, Y0)],
+                                                crs=crs)
     r_space, r_lines = roads()
     frames["roads"] = gpd.GeoDataFrame({"name": ["lena roads"]}, geometry=[r_space], crs=crs)
     frames["roads_lines"] = gpd.GeoDataFrame(

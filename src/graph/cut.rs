@@ -31,6 +31,28 @@
 //! Pruning keeps a cut end as an end of the skeleton, and the centred
 //! extension ends the line with a straight segment from j square to the
 //! cut, where j's disc touches it (the middle of a rectangle's end side).
+//!
+//! **Rough cuts** (only with `prune: {junctions: merge}`, a network of
+//! corridors, so rivers, lakes and islands keep the rule above): street
+//! space cut by a digitised or rasterised edge is not cut straight. Every
+//! vertex of the cut that stands out gives the medial axis a leg, so the
+//! line forks into the teeth. Then a cut end is also
+//!
+//! * a junction j of any degree with one branch that goes on (the line) and
+//!   the others small trees of legs ending on ∂P, every node within
+//!   [`MAX_REACH`] radii of j; the corners are the two leaves farthest
+//!   apart;
+//! * with the span, slant and line-length tests above, the line reaching
+//!   [`MIN_ROUGH_LINE`] radii before another junction (a bend's rounded
+//!   outer corner gives a fan of legs just as rough, but its line meets
+//!   the bend's junction within a radius), and
+//! * ∂P between the corners within [`MAX_ROUGH`] of the local width 2 r_j of
+//!   the line that fits its vertices best (the corners are as rough as the
+//!   rest; a cut with exactly two legs keeps the chord test).
+//!
+//! The line ends on the first point of ∂P on the way from j square to that
+//! line, and the whole tree of legs goes, as a straight cut's two legs do.
+//! A junction inside another cut's tree is no cut of its own.
 
 use super::line::point_at;
 use super::{Adjacency, EdgeId, NodeId, SkeletonGraph};
@@ -52,17 +74,38 @@ pub const MAX_SLANT_DEG: f64 = 35.0;
 /// Shortest line arriving at a cut's junction, in radii of the junction.
 pub const MIN_LINE: f64 = 0.25;
 
+/// Largest deviation of a rough cut (one whose vertices give more than two
+/// legs) from the chord between its corners, relative to the local width
+/// 2 r_j.
+pub const MAX_ROUGH: f64 = 0.2;
+
+/// Farthest a node of a cut's tree of legs lies from its junction, in radii
+/// of the junction (a square cut's corners lie at √2).
+pub const MAX_REACH: f64 = 2.0;
+
+/// Shortest line arriving at a rough cut's junction before another
+/// junction, in radii of the junction.
+pub const MIN_ROUGH_LINE: f64 = 2.0;
+
+/// Most edges in a cut's tree of legs.
+const MAX_TREE: usize = 64;
+
 /// Most boundary vertices along a cut.
 const MAX_CUT_VERTICES: usize = 256;
 
-/// A cut end: its junction, the two legs into the cut's corners, and where
-/// the line ends on the cut.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// A cut end: its junction, the legs into the cut, and where the line ends
+/// on the cut.
+#[derive(Debug, Clone, PartialEq)]
 pub struct CutEnd {
     /// The junction whose disc touches the cut.
     pub junction: NodeId,
-    /// The legs from the junction into the cut's corners.
-    pub legs: [EdgeId; 2],
+    /// The edges at the junction into the cut: the two legs into its
+    /// corners, or on a rough cut the first edges of the small tree of legs
+    /// its vertices give.
+    pub legs: Vec<EdgeId>,
+    /// Every edge beyond the junction into the cut (`legs` and the edges
+    /// beyond them).
+    pub tree: Vec<EdgeId>,
     /// Where the line ends: the point where the junction's disc touches the
     /// cut (the boundary point nearest to the junction between the two
     /// corners). A segment from the junction to it runs square to the cut,
@@ -70,35 +113,145 @@ pub struct CutEnd {
     pub contact: Coord<f64>,
 }
 
+/// The branches at `j` that end on ∂P (a leg; with `rough` also a small
+/// tree of legs within [`MAX_REACH`] radii of `j`), and the one branch that
+/// does not (the line): `(line, legs, tree edges, leaves)`, or `None` when
+/// not exactly one branch goes on.
+#[allow(clippy::type_complexity)]
+fn branches(
+    m: &SkeletonGraph,
+    adj: &Adjacency,
+    deg: &[usize],
+    j: NodeId,
+    tol: f64,
+    rough: bool,
+) -> Option<(EdgeId, Vec<EdgeId>, Vec<EdgeId>, Vec<NodeId>)> {
+    let mut line = None;
+    let (mut legs, mut tree, mut leaves) = (Vec::new(), Vec::new(), Vec::new());
+    for &first in &adj[j.index()] {
+        match small_branch(m, adj, deg, (j, first), tol, rough) {
+            Some((edges, ends)) => {
+                legs.push(first);
+                tree.extend(edges);
+                leaves.extend(ends);
+            }
+            None if line.is_none() => line = Some(first),
+            None => return None,
+        }
+    }
+    Some((line?, legs, tree, leaves))
+}
+
+/// Where the line from `j` ends on the cut from `p1` to `p2`: where `j`'s
+/// disc touches it (the boundary point nearest to `j` between the corners);
+/// on a rough cut (`line`: a point of its best-fitting line and its
+/// direction) the first boundary point on the way from `j` square to that
+/// line, so the end does not turn into the deepest notch.
+fn contact(
+    boundary: &Boundary,
+    j: Coord<f64>,
+    (p1, p2): (Coord<f64>, Coord<f64>),
+    line: Option<(Coord<f64>, Coord<f64>)>,
+) -> Option<Coord<f64>> {
+    if let Some((origin, dir)) = line {
+        let foot = origin + dir * dot(j - origin, dir);
+        let reach = hypot(foot - j);
+        if let Some(hit) = boundary.first_hit(j, (foot - j) / reach, 0.0, 2.0 * reach) {
+            return Some(hit.point);
+        }
+    }
+    let (u1, u2) = (p1 - j, p2 - j);
+    let (right, left) = if cross(u1, u2) > 0.0 {
+        (u1, u2)
+    } else {
+        (u2, u1)
+    };
+    boundary.nearest_in_sector(j, right, left).map(|(q, _)| q)
+}
+
+/// The branch at `j` through `first`, walked away from `j`, when it is
+/// small: one edge to a leaf on ∂P; with `rough` a tree whose nodes lie
+/// within [`MAX_REACH`] radii of `j`, with every leaf on ∂P, no way back to
+/// `j` and at most [`MAX_TREE`] edges. Its edges and leaves.
+fn small_branch(
+    m: &SkeletonGraph,
+    adj: &Adjacency,
+    deg: &[usize],
+    (j, first): (NodeId, EdgeId),
+    tol: f64,
+    rough: bool,
+) -> Option<(Vec<EdgeId>, Vec<NodeId>)> {
+    let pj = m.node(j).pos;
+    let (reach, most) = if rough {
+        (MAX_REACH * m.node(j).radius, MAX_TREE)
+    } else {
+        (f64::INFINITY, 1)
+    };
+    let (mut edges, mut leaves) = (Vec::new(), Vec::new());
+    let mut stack = vec![(first, j)];
+    while let Some((e, from)) = stack.pop() {
+        let o = m.opposite(e, from);
+        edges.push(e);
+        let node = m.node(o);
+        if o == j || edges.len() > most || hypot(node.pos - pj) > reach {
+            return None;
+        }
+        if deg[o.index()] == 1 {
+            if node.radius > tol {
+                return None;
+            }
+            leaves.push(o);
+        }
+        stack.extend(adj[o.index()].iter().filter(|&&x| x != e).map(|&x| (x, o)));
+    }
+    Some((edges, leaves))
+}
+
+/// The two leaves farthest apart: the cut's corners.
+fn corners(m: &SkeletonGraph, leaves: &[NodeId]) -> Option<(Coord<f64>, Coord<f64>)> {
+    let mut best: Option<(f64, Coord<f64>, Coord<f64>)> = None;
+    for (i, &a) in leaves.iter().enumerate() {
+        for &b in &leaves[i + 1..] {
+            let (pa, pb) = (m.node(a).pos, m.node(b).pos);
+            let d = hypot(pb - pa);
+            if best.is_none_or(|(bd, _, _)| d > bd) {
+                best = Some((d, pa, pb));
+            }
+        }
+    }
+    best.map(|(_, a, b)| (a, b))
+}
+
 /// The cut ends of `m` (a merged graph whose node radii are distances to
-/// ∂P); `tol` is the distance within which a leaf lies on ∂P.
-pub fn cut_ends(m: &SkeletonGraph, boundary: &Boundary, tol: f64) -> Vec<CutEnd> {
+/// ∂P); `tol` is the distance within which a leaf lies on ∂P. With `rough`
+/// (a network of corridors, `prune: {junctions: merge}`) a cut may also be
+/// rough: a junction of any degree whose branches but the line are small
+/// trees of legs into a cut within [`MAX_ROUGH`] of the local width of a
+/// straight line.
+pub fn cut_ends(m: &SkeletonGraph, boundary: &Boundary, tol: f64, rough: bool) -> Vec<CutEnd> {
     let adj = m.adjacency();
     let deg: Vec<usize> = adj.iter().map(<[EdgeId]>::len).collect();
     let rings = RingIndex::new(boundary);
     let mut out = Vec::new();
     for (j, edges) in adj.iter().enumerate() {
-        if edges.len() != 3 {
+        if edges.len() < 3 || (!rough && edges.len() != 3) {
             continue;
         }
         let jn = NodeId::from_index(j);
-        let legs: Vec<(EdgeId, NodeId)> = edges
-            .iter()
-            .map(|&e| (e, m.opposite(e, jn)))
-            .filter(|&(_, o)| o != jn && deg[o.index()] == 1 && m.node(o).radius <= tol)
-            .collect();
-        let [(e1, c1), (e2, c2)] = legs[..] else {
+        let Some((line, legs, tree, leaves)) = branches(m, &adj, &deg, jn, tol, rough) else {
             continue;
         };
-        let (p1, p2) = (m.node(c1).pos, m.node(c2).pos);
+        if !rough && leaves.len() != 2 {
+            continue;
+        }
+        let Some((p1, p2)) = corners(m, &leaves) else {
+            continue;
+        };
         let span = hypot(p2 - p1);
         let rj = m.node(jn).radius;
         if span < MIN_SPAN * 2.0 * rj {
             continue;
         }
-        let Some(&line) = edges.iter().find(|&&e| e != e1 && e != e2) else {
-            continue;
-        };
         let (c, r_far) = course_line(m, &adj, &deg, jn, line, tol, 2.0 * rj);
         // The cut spans the line it ends, not only a bump's own width: a
         // flat-topped bump of a bank ends in a short straight edge too, but
@@ -113,6 +266,13 @@ pub fn cut_ends(m: &SkeletonGraph, boundary: &Boundary, tol: f64) -> Vec<CutEnd>
         if len < MIN_LINE * rj {
             continue;
         }
+        // A rough cut ends a corridor: its line runs on at least
+        // MIN_ROUGH_LINE radii before another junction. The fan of legs
+        // into a bend's rounded outer corner is as rough, but its line
+        // meets the bend's junction within a radius.
+        if rough && len < MIN_ROUGH_LINE * rj {
+            continue;
+        }
         let course = c[0] - point_at(&c, (2.0 * rj).min(len));
         let foot = closest_on_segment(p1, p2, c[0]).0 - c[0];
         let (lc, lf) = (hypot(course), hypot(foot));
@@ -122,23 +282,39 @@ pub fn cut_ends(m: &SkeletonGraph, boundary: &Boundary, tol: f64) -> Vec<CutEnd>
         if dot(course, foot) / (lc * lf) < MAX_SLANT_DEG.to_radians().cos() {
             continue;
         }
-        if !rings.straight_between(boundary, p1, p2, span) {
-            continue;
-        }
-        let (u1, u2) = (p1 - c[0], p2 - c[0]);
-        let (right, left) = if cross(u1, u2) > 0.0 {
-            (u1, u2)
+        // Two legs: ∂P between the corners has no convex vertex, and must
+        // not bow. More: the cut is rough, and must stay within a band of
+        // the local width about its chord.
+        let band = if leaves.len() == 2 {
+            MAX_BOW * span
         } else {
-            (u2, u1)
+            MAX_ROUGH * 2.0 * rj
         };
-        if let Some((contact, _)) = boundary.nearest_in_sector(c[0], right, left) {
+        let toothed = leaves.len() > 2;
+        let Some(cut) = rings.straight_between(boundary, (p1, p2), toothed, band) else {
+            continue;
+        };
+        if let Some(contact) = contact(boundary, c[0], (p1, p2), toothed.then_some(cut)) {
             out.push(CutEnd {
                 junction: jn,
-                legs: [e1, e2],
+                legs,
+                tree,
                 contact,
             });
         }
     }
+    // A rough cut's legs may hang from junctions nested in one tree: the
+    // end is the outermost one, whose tree holds the others.
+    let inner: std::collections::HashSet<NodeId> = out
+        .iter()
+        .flat_map(|c| {
+            c.tree
+                .iter()
+                .flat_map(|&e| [m.edge(e).a, m.edge(e).b])
+                .filter(move |&n| n != c.junction)
+        })
+        .collect();
+    out.retain(|c| !inner.contains(&c.junction));
     out
 }
 
@@ -210,14 +386,24 @@ impl RingIndex {
         Some((ring, if da <= db { at } else { (at + 1) % n }))
     }
 
-    /// True when ∂P runs straight from `p1` to `p2` (both boundary
-    /// vertices of one ring) the shorter way round.
-    fn straight_between(&self, b: &Boundary, p1: Coord<f64>, p2: Coord<f64>, span: f64) -> bool {
+    /// The cut's line (a point on it and its unit direction) when ∂P runs
+    /// straight from `p1` to `p2` (both boundary vertices of one ring) the
+    /// shorter way round: every vertex between them within `band` of the
+    /// chord `p1 p2`, or with `rough` of the line that fits them all best
+    /// (a rough cut's corners are as rough as the rest), and none beyond
+    /// the chord's ends.
+    fn straight_between(
+        &self,
+        b: &Boundary,
+        (p1, p2): (Coord<f64>, Coord<f64>),
+        rough: bool,
+        band: f64,
+    ) -> Option<(Coord<f64>, Coord<f64>)> {
         let (Some((r1, i1)), Some((r2, i2))) = (self.vertex(b, p1), self.vertex(b, p2)) else {
-            return false;
+            return None;
         };
         if r1 != r2 {
-            return false;
+            return None;
         }
         let n = self.start[r1 + 1] - self.start[r1];
         let forward = (i2 + n - i1) % n;
@@ -227,15 +413,113 @@ impl RingIndex {
             (i2, n - forward)
         };
         if steps == 0 || steps > MAX_CUT_VERTICES {
-            return false;
+            return None;
         }
+        let between: Vec<Coord<f64>> = (0..=steps)
+            .map(|k| b.segments()[self.start[r1] + (from + k) % n].a)
+            .collect();
         let d = p2 - p1;
-        (1..steps).all(|k| {
-            let v = b.segments()[self.start[r1] + (from + k) % n].a;
-            let w = v - p1;
-            let off = cross(w, d).abs() / span;
-            let t = dot(w, d) / (span * span);
-            off <= MAX_BOW * span && (0.0..=1.0).contains(&t)
-        })
+        let span = hypot(d);
+        let slack = if rough { band / span } else { 0.0 };
+        let (origin, dir) = if rough {
+            best_line(&between)
+        } else {
+            (p1, d / span)
+        };
+        let within = between[1..steps].iter().all(|&v| {
+            let t = dot(v - p1, d) / (span * span);
+            (-slack..=1.0 + slack).contains(&t)
+        });
+        let near = between[usize::from(!rough)..=steps - usize::from(!rough)]
+            .iter()
+            .all(|&v| cross(v - origin, dir).abs() <= band);
+        (within && near).then_some((origin, dir))
+    }
+}
+
+/// The line that fits `points` best (least squares across it): a point on
+/// it and its unit direction.
+fn best_line(points: &[Coord<f64>]) -> (Coord<f64>, Coord<f64>) {
+    let n = points.len() as f64;
+    let c = points.iter().fold(Coord { x: 0.0, y: 0.0 }, |a, &p| a + p) / n;
+    let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
+    for &p in points {
+        let q = p - c;
+        (sxx, sxy, syy) = (sxx + q.x * q.x, sxy + q.x * q.y, syy + q.y * q.y);
+    }
+    let angle = 0.5 * (2.0 * sxy).atan2(sxx - syy);
+    (
+        c,
+        Coord {
+            x: angle.cos(),
+            y: angle.sin(),
+        },
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::PreparedPolygon;
+    use crate::graph::GraphBuilder;
+
+    fn c(x: f64, y: f64) -> Coord<f64> {
+        Coord { x, y }
+    }
+
+    /// A street 10 wide, its banks with a vertex every 10, cut at x = 100
+    /// by an edge whose teeth stand `out` beyond it (a notch between them).
+    fn street(out: f64) -> PreparedPolygon {
+        let mut ring: Vec<Coord<f64>> = (0..10).map(|i| c(10. * f64::from(i), -5.)).collect();
+        ring.extend([
+            c(100., -5.),
+            c(100. + out, -2.5),
+            c(99.5, 0.),
+            c(100. + out, 2.5),
+        ]);
+        ring.extend((0..=10).rev().map(|i| c(10. * f64::from(i), 5.)));
+        PreparedPolygon::new(&geo::Polygon::new(geo::LineString(ring), vec![])).unwrap()
+    }
+
+    /// The street with teeth `out`, with a medial axis as MA gives it: the
+    /// line to a junction one radius before the cut, legs into the corners
+    /// and a small tree into the teeth.
+    fn toothed(out: f64) -> (PreparedPolygon, SkeletonGraph) {
+        let p = street(out);
+        let mut b = GraphBuilder::new();
+        b.polyline(&[c(5., 0.), c(95., 0.)]);
+        b.segment(c(95., 0.), c(100., 5.));
+        b.segment(c(95., 0.), c(100., -5.));
+        b.segment(c(95., 0.), c(97.5, 0.));
+        b.segment(c(97.5, 0.), c(100. + out, 2.5));
+        b.segment(c(97.5, 0.), c(100. + out, -2.5));
+        let g = b.finish(p.boundary());
+        (p, g.merged())
+    }
+
+    #[test]
+    fn a_rough_cut_is_a_cut_end_only_where_asked() {
+        let (p, m) = toothed(1.0);
+        let tol = 1e-9 * p.extent().max(1.0);
+        let cuts = cut_ends(&m, p.boundary(), tol, true);
+        assert_eq!(cuts.len(), 1, "{cuts:?}");
+        let cut = &cuts[0];
+        assert_eq!(m.node(cut.junction).pos, c(95., 0.));
+        // Three edges at the junction, five into the cut in all.
+        assert_eq!((cut.legs.len(), cut.tree.len()), (3, 5));
+        // The end goes on square to the cut's line, into the notch.
+        assert!(hypot(cut.contact - c(99.5, 0.)) < 1e-9, "{:?}", cut.contact);
+        // The straight rule (rivers, lakes, islands) sees no cut: four
+        // legs, not two.
+        assert!(cut_ends(&m, p.boundary(), tol, false).is_empty());
+    }
+
+    #[test]
+    fn a_cut_rougher_than_a_fifth_of_the_width_is_no_cut() {
+        // The same street with its teeth 3 out of the cut's line (0.3 of
+        // the width): a ragged end, not a cut.
+        let (p, m) = toothed(3.0);
+        let tol = 1e-9 * p.extent().max(1.0);
+        assert!(cut_ends(&m, p.boundary(), tol, true).is_empty());
     }
 }

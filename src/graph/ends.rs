@@ -110,9 +110,15 @@ const TIP_NODES: usize = 5_000;
 ///
 /// `m` is the merged raw graph and `keep` the pruning's kept edges of it
 /// ([`crate::graph::prune::prune_mask`]); the result is the kept graph with
-/// the followed legs and the end segments, merged.
-pub fn centred(m: &SkeletonGraph, keep: Vec<bool>, polygon: &PreparedPolygon) -> SkeletonGraph {
-    let e = Extender::new(m, polygon);
+/// the followed legs and the end segments, merged. With `rough_cuts` a line
+/// ends once on a rough cut too ([`cut_ends`]).
+pub fn centred(
+    m: &SkeletonGraph,
+    keep: Vec<bool>,
+    polygon: &PreparedPolygon,
+    rough_cuts: bool,
+) -> SkeletonGraph {
+    let e = Extender::new(m, polygon, rough_cuts);
     let mut st = State::new(m, keep);
     let leaves: Vec<NodeId> = (0..m.nodes().len())
         .filter(|&n| st.kdeg[n] == 1)
@@ -297,14 +303,14 @@ fn unit(v: Coord<f64>) -> Option<Coord<f64>> {
 }
 
 impl<'a> Extender<'a> {
-    fn new(m: &'a SkeletonGraph, polygon: &'a PreparedPolygon) -> Self {
+    fn new(m: &'a SkeletonGraph, polygon: &'a PreparedPolygon, rough_cuts: bool) -> Self {
         let boundary = polygon.boundary();
         let span = boundary.bbox_max() - boundary.bbox_min();
         let tol = ON_BOUNDARY_END * polygon.extent();
         Self {
             m,
             boundary,
-            cuts: cut_ends(m, boundary, tol)
+            cuts: cut_ends(m, boundary, tol, rough_cuts)
                 .into_iter()
                 .map(|c| (c.junction, c))
                 .collect(),

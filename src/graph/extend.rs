@@ -103,7 +103,7 @@ pub fn extend(
         ExtendMode::Centred => {
             let m = graph.merged();
             let keep = vec![true; m.edges().len()];
-            return super::ends::centred(&m, keep, polygon);
+            return super::ends::centred(&m, keep, polygon, false);
         }
         ExtendMode::Ray | ExtendMode::Nearest => {}
     }
@@ -173,7 +173,9 @@ pub fn prune_and_extend(
             Some(p) => prune_mask(&m, p, boundary),
             None => vec![true; m.edges().len()],
         };
-        super::ends::centred(&m, keep, polygon)
+        // A network of corridors may be cut roughly at the data's edge.
+        let rough = pr.is_some_and(|p| p.junctions == super::junctions::Junctions::Merge);
+        super::ends::centred(&m, keep, polygon, rough)
     } else {
         prune_and_extend_straight(raw, polygon, pr, ex)
     };

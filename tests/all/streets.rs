@@ -159,6 +159,45 @@ fn merged_junctions_are_the_streets_junctions_one_to_one() {
 }
 
 #[test]
+fn a_street_cut_by_a_rough_edge_ends_once_on_it() {
+    // The quarter cut by a rough edge (a vertex every metre, moved across
+    // the edge by up to ±1 m): the medial axis forks into the teeth. Before,
+    // only a straight cut ended once, and a fork stayed at one street's
+    // end (16 ends for 15); merged, a cut within a fifth of the street's
+    // width of a straight line ends once, as a straight one does.
+    let d = tmp();
+    let space = space("quarter_ragged").remove(0);
+    let reference = points("quarter_junctions");
+    let reference_ends = points("quarter_ends");
+    let merged = run(d.path(), "quarter_ragged", "{ junctions: merge }");
+    let (out, ends) = junctions_and_ends(&merged);
+    let (each, extra, close) = matching(&space, &reference, &out);
+    assert_eq!(each, vec![1; reference.len()], "{out:?}");
+    assert_eq!((extra, close), (0, 0), "{out:?}");
+    let near =
+        |a: Coord<f64>, b: Coord<f64>| Euclidean.distance(geo::Point(a), geo::Point(b)) <= 16.0;
+    assert_eq!(ends.len(), reference_ends.len(), "{ends:?}");
+    for r in &reference_ends {
+        assert_eq!(
+            ends.iter().filter(|&&e| near(e, *r)).count(),
+            1,
+            "{r:?}: {ends:?}"
+        );
+        // The end lies on the cut (on the street space's boundary).
+        let e = ends.iter().find(|&&e| near(e, *r)).unwrap();
+        assert!(
+            space.boundary().distance(*e) < 1e-6,
+            "{e:?} short of the cut"
+        );
+    }
+    // Rivers and lakes keep the straight rule: without `merge` the rough
+    // cut is no cut, and its fork stays.
+    let kept = run(d.path(), "quarter_ragged", "{}");
+    let (_, kept_ends) = junctions_and_ends(&kept);
+    assert!(kept_ends.len() > reference_ends.len(), "{kept_ends:?}");
+}
+
+#[test]
 fn on_a_real_network_buffered_as_roads_merged_junctions_match_the_lines_junctions() {
     // The rivers of 8–12° E, 46–50° N (GSHHG/WDBII) scaled to a 15 × 22 km
     // network of 16 m roads: 20 junctions in the lines, two of them where a

@@ -152,8 +152,9 @@ pub fn mask(m: &SkeletonGraph, params: &PruneParams, boundary: &Boundary) -> Vec
     // junction reaches on without limit, so the leg to it is never cut.
     let tol = ON_BOUNDARY_END * boundary.extent();
     if params.mode == super::PruneMode::Significance {
-        for cut in cut_ends(m, boundary, tol) {
-            for leg in cut.legs {
+        let rough = params.junctions == crate::graph::junctions::Junctions::Merge;
+        for cut in cut_ends(m, boundary, tol, rough) {
+            for leg in cut.tree {
                 // Piece `i` of the first ones is edge `i`.
                 if w.alive[leg.index()] {
                     w.remove(leg.index() as u32);
