@@ -35,8 +35,8 @@ pub enum Junctions {
     #[default]
     Keep,
     /// Junctions whose inscribed discs overlap become one node at the
-    /// centre of the largest disc, the lines straightened into it (street
-    /// and road networks).
+    /// centre of the largest disc, the lines straightened into it, and a
+    /// cut that is not quite straight is a cut (street and road networks).
     Merge,
 }
 

@@ -171,7 +171,7 @@ pub struct PruneParams {
     pub structure: Structure,
     /// With `mode: network`, what a polygon no line meets gets instead.
     pub fallback: Fallback,
-    /// `merge`: junctions whose inscribed discs overlap become one node at the centre of the largest disc, the stubs between them removed and the lines straightened into it — one node per crossing of a street or road network; `keep` (default): every junction stays.
+    /// `merge`: junctions whose inscribed discs overlap become one node at the centre of the largest disc, the stubs between them removed and the lines straightened into it — one node per crossing of a street or road network — and a street cut by an edge within a fifth of its width of straight ends once on it; `keep` (default): every junction stays, and only straight cuts are cuts.
     pub junctions: crate::graph::junctions::Junctions,
 }
 
