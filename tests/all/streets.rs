@@ -94,6 +94,21 @@ fn matching(
     (each, extra, close)
 }
 
+/// As many line ends as the reference has, one within the widest street's
+/// width (16 m) of each reference end.
+fn one_end_each(ends: &[Coord<f64>], reference_ends: &[Coord<f64>]) {
+    let near =
+        |a: Coord<f64>, b: Coord<f64>| Euclidean.distance(geo::Point(a), geo::Point(b)) <= 16.0;
+    assert_eq!(ends.len(), reference_ends.len(), "{ends:?}");
+    for r in reference_ends {
+        assert_eq!(
+            ends.iter().filter(|&&e| near(e, *r)).count(),
+            1,
+            "{r:?}: {ends:?}"
+        );
+    }
+}
+
 fn space(layer: &str) -> Vec<PreparedPolygon> {
     match geometries(Path::new(&root(STREETS)), layer).remove(0) {
         Geometry::Polygon(p) => vec![PreparedPolygon::new(&p).unwrap()],
@@ -135,17 +150,7 @@ fn merged_junctions_are_the_streets_junctions_one_to_one() {
     // One line end per reference end (the dead end, the cut ends at the
     // data's edge, which lie on the boundary: no local width there), each
     // within the widest street's width (16 m) of it.
-    let reference_ends = points("quarter_ends");
-    let near =
-        |a: Coord<f64>, b: Coord<f64>| Euclidean.distance(geo::Point(a), geo::Point(b)) <= 16.0;
-    assert_eq!(ends.len(), reference_ends.len(), "{ends:?}");
-    for r in &reference_ends {
-        assert_eq!(
-            ends.iter().filter(|&&e| near(e, *r)).count(),
-            1,
-            "{r:?}: {ends:?}"
-        );
-    }
+    one_end_each(&ends, &points("quarter_ends"));
     // The straightened lines stay inside the street space.
     let poly: &Polygon<f64> = space.polygon();
     for l in &merged.0 {
@@ -174,17 +179,9 @@ fn a_street_cut_by_a_rough_edge_ends_once_on_it() {
     let (each, extra, close) = matching(&space, &reference, &out);
     assert_eq!(each, vec![1; reference.len()], "{out:?}");
     assert_eq!((extra, close), (0, 0), "{out:?}");
-    let near =
-        |a: Coord<f64>, b: Coord<f64>| Euclidean.distance(geo::Point(a), geo::Point(b)) <= 16.0;
-    assert_eq!(ends.len(), reference_ends.len(), "{ends:?}");
-    for r in &reference_ends {
-        assert_eq!(
-            ends.iter().filter(|&&e| near(e, *r)).count(),
-            1,
-            "{r:?}: {ends:?}"
-        );
-        // The end lies on the cut (on the street space's boundary).
-        let e = ends.iter().find(|&&e| near(e, *r)).unwrap();
+    one_end_each(&ends, &reference_ends);
+    // Every end lies on the cut (on the street space's boundary).
+    for e in &ends {
         assert!(
             space.boundary().distance(*e) < 1e-6,
             "{e:?} short of the cut"
