@@ -146,7 +146,8 @@ fn branches(
 /// disc touches it (the boundary point nearest to `j` between the corners);
 /// on a rough cut (`line`: a point of its best-fitting line and its
 /// direction) the first boundary point on the way from `j` square to that
-/// line, so the end does not turn into the deepest notch.
+/// line, so that the end runs square to the cut, not sideways into the
+/// notch nearest to `j`.
 fn contact(
     boundary: &Boundary,
     j: Coord<f64>,
