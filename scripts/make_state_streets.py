@@ -21,15 +21,16 @@ needs: gmt, gmt-dcw (Debian); geopandas, shapely (PyPI)
 from __future__ import annotations
 
 import os
-import subprocess
 import sys
-import tempfile
 from collections import Counter
 
 import geopandas as gpd
 import shapely
 from shapely import affinity
 from shapely.geometry import LineString, Point, Polygon
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from make_streets import gmt_segments  # noqa: E402
 
 STATES = "CO UT AZ NM WY NE KS OK TX ID MT SD ND NV IA MO AR LA MN WI IL".split()
 NEAR = 2_000.0  # metres (EPSG:5070): a shared border lies within this of the neighbour
@@ -39,18 +40,7 @@ X0, Y0 = 500_000.0, 6_650_000.0
 
 
 def state(code: str) -> Polygon:
-    with tempfile.TemporaryDirectory() as d:  # GMT leaves gmt.history behind
-        text = subprocess.run(["gmt", "coast", f"-EUS.{code}", "-M", "-Df"], check=True, capture_output=True,
-                              text=True, cwd=d).stdout
-    rings, cur = [], []
-    for line in text.splitlines() + [">"]:
-        if line.startswith(">"):
-            if len(cur) > 3:
-                rings.append(Polygon(cur))
-            cur = []
-        else:
-            x, y = map(float, line.split()[:2])
-            cur.append((x - 360 if x > 180 else x, y))
+    rings = [Polygon(c) for c in gmt_segments("coast", f"-EUS.{code}", "-M", "-Df") if len(c) > 3]
     return max(rings, key=lambda p: p.area)
 
 

@@ -38,6 +38,25 @@ from shapely.geometry import LineString, box
 X0, Y0 = 500_000.0, 6_650_000.0
 
 
+def gmt_segments(*args: str) -> list[list[tuple[float, float]]]:
+    """The segments (lists of lon/lat points, longitudes in −180…180) GMT prints with `-M` for `args`."""
+    import subprocess
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as d:  # GMT leaves gmt.history behind
+        text = subprocess.run(["gmt", *args], check=True, capture_output=True, text=True, cwd=d).stdout
+    segments, cur = [], []
+    for line in text.splitlines() + [">"]:
+        if line.startswith(">"):
+            if cur:
+                segments.append(cur)
+            cur = []
+        else:
+            x, y = map(float, line.split()[:2])
+            cur.append((x - 360 if x > 180 else x, y))
+    return segments
+
+
 def ragged_box(x0, y0, x1, y1, amp, step, seed):
     """The box with a vertex every `step` m along its sides, each moved across its side by up to
     ±`amp` m (seeded): a cut that is not straight, as a digitised or rasterised boundary gives."""
@@ -95,21 +114,9 @@ def roads():
     """Rivers of GMT's GSHHG/WDBII river layer (all rivers, full resolution) in 8–12° E,
     46–50° N as a real line network: joined where they meet, in UTM 32N, scaled by 1/20 about the
     network's corner (a 15 × 22 km network of 10 junctions), buffered by 8 m."""
-    import subprocess
-
     from shapely.geometry import LineString
 
-    text = subprocess.run(["gmt", "coast", "-R8/12/46/50", "-Ia", "-Df", "-M"], check=True,
-                          capture_output=True, text=True).stdout
-    segments, cur = [], []
-    for line in text.splitlines() + [">"]:
-        if line.startswith(">"):
-            if len(cur) > 1:
-                segments.append(LineString(cur))
-            cur = []
-        else:
-            x, y = map(float, line.split()[:2])
-            cur.append((x, y))
+    segments = [LineString(c) for c in gmt_segments("coast", "-R8/12/46/50", "-Ia", "-Df", "-M") if len(c) > 1]
     utm = gpd.GeoSeries(segments, crs=4326).to_crs(32632)
     merged = shapely.line_merge(shapely.node(shapely.union_all(utm.values)))
     parts = list(getattr(merged, "geoms", [merged]))
