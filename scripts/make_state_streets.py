@@ -74,7 +74,8 @@ def borders(units):
     return [LineString([mean[find(2 * k)], *l.coords[1:-1], mean[find(2 * k + 1)]]) for k, l in enumerate(out)]
 
 
-def main(path: str) -> None:
+def frames() -> dict[str, gpd.GeoDataFrame]:
+    """The four layers, by name."""
     units = list(gpd.GeoSeries([state(s) for s in STATES], crs=4326).to_crs(5070).values)
     lines = borders(units)
     outline = shapely.union_all(units).buffer(NEAR).buffer(-NEAR)
@@ -90,15 +91,23 @@ def main(path: str) -> None:
     junctions = [(Point(p), d) for p, d in degree.items() if d >= 3 and space.contains(Point(p))]
     ends = [Point(p) for p, d in degree.items() if d == 1]
     crs = "EPSG:32633"
+    return {
+        "states": gpd.GeoDataFrame({"name": ["states"]}, geometry=[space], crs=crs),
+        "states_lines": gpd.GeoDataFrame({"width": [WIDTH] * len(lines)}, geometry=lines, crs=crs),
+        "states_junctions": gpd.GeoDataFrame({"arms": [d for _, d in junctions]},
+                                             geometry=[p for p, _ in junctions], crs=crs),
+        "states_ends": gpd.GeoDataFrame({"kind": ["end"] * len(ends)}, geometry=ends, crs=crs),
+    }
+
+
+def main(path: str) -> None:
     if os.path.exists(path):
         os.remove(path)
-    gpd.GeoDataFrame({"name": ["states"]}, geometry=[space], crs=crs).to_file(path, layer="states")
-    gpd.GeoDataFrame({"width": [WIDTH] * len(lines)}, geometry=lines, crs=crs).to_file(path, layer="states_lines")
-    gpd.GeoDataFrame({"arms": [d for _, d in junctions]}, geometry=[p for p, _ in junctions],
-                     crs=crs).to_file(path, layer="states_junctions")
-    gpd.GeoDataFrame({"kind": ["end"] * len(ends)}, geometry=ends, crs=crs).to_file(path, layer="states_ends")
-    print(f"{path}: {len(lines)} streets, {len(junctions)} junctions, {len(ends)} ends")
-
+    layers = frames()
+    for name, frame in layers.items():
+        frame.to_file(path, layer=name, driver="GPKG")
+    print(f"{path}: {len(layers['states_lines'])} streets, {len(layers['states_junctions'])} junctions, "
+          f"{len(layers['states_ends'])} ends")
 
 if __name__ == "__main__":
     if len(sys.argv) != 2:

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Street space and its reference centrelines, for `prune: {junctions: merge}`.
 
-Writes OUT (GeoPackage, EPSG:32633, metres) with two pairs of layers:
+Writes OUT (GeoPackage, EPSG:32633, metres) with these layers:
 
 - `quarter` / `quarter_lines`: a generated city quarter — streets 8 to 16 m wide on a skewed
   grid: four-way crossings, T-junctions, two five-arm junctions where a diagonal street meets a
@@ -21,6 +21,8 @@ quarter also has `quarter_blocks`: the blocks between its streets (the box minus
 each with `block` (its number), for the street pieces' `left_fid` and `right_fid`, and
 `quarter_ragged`: the same street space cut by a rough edge instead of the box (every side a vertex
 each metre, moved across it by up to ±1 m, seeded), whose reference is the quarter's.
+- `states` / `states_lines` / `states_junctions` / `states_ends`: street space between real blocks,
+  21 US states of GMT's DCW as a quarter (`scripts/make_state_streets.py`, which writes these alone).
 
     scripts/make_streets.py tests/data/streets.gpkg
 """
@@ -197,6 +199,9 @@ def main(out: str) -> None:
         space = frames[name].geometry.values[0]
         junctions, ends = nodes(space, list(frames[name + "_lines"].geometry.values), crs)
         frames[name + "_junctions"], frames[name + "_ends"] = junctions, ends
+    # Street space between real blocks (US states of GMT's DCW): scripts/make_state_streets.py.
+    from make_state_streets import frames as state_frames
+    frames.update(state_frames())
     for layer, frame in frames.items():
         frame.to_file(out, layer=layer, driver="GPKG")
 

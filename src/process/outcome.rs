@@ -9,8 +9,7 @@ use crate::collapse::collapse_within;
 use crate::connect;
 use crate::geometry::PreparedPolygon;
 use crate::methods::{MethodContext, MethodId};
-use crate::score::select::select;
-use crate::score::Scores;
+use crate::score::select::{select, Entry};
 use geo::{Geometry, MultiLineString};
 
 /// Processes one feature's geometry through every step.
@@ -334,10 +333,13 @@ fn length_outside(lines: &MultiLineString<f64>, parts: &[PreparedPolygon]) -> (f
 /// The outcome for a feature's candidates: the chosen one by `select` (or
 /// the first with a skeleton), or the rejection when none has one.
 fn choose(candidates: Vec<Candidate>, parts: usize, params: &ProcessParams) -> Processed {
-    let scores: Vec<Option<Scores>> = candidates
+    let scores: Vec<Option<Entry>> = candidates
         .iter()
         .map(|c| match &c.result {
-            Ok(s) if !s.geometry.0.is_empty() => Some(s.scores.unwrap_or_default()),
+            Ok(s) if !s.geometry.0.is_empty() => Some(Entry {
+                scores: s.scores.unwrap_or_default(),
+                components: s.components,
+            }),
             _ => None,
         })
         .collect();

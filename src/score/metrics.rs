@@ -118,9 +118,13 @@ mod tests {
 
     #[test]
     fn no_hit_never_wins_selection() {
-        use crate::score::select::{select, SelectBy, SelectParams};
-        let empty = metrics(&[bar(None)]);
-        let poor = metrics(&[bar(Some((0.0, 5.0, 0))), bar(None)]);
+        use crate::score::select::{select, Entry, SelectBy, SelectParams};
+        let entry = |scores| Entry {
+            scores,
+            components: 1,
+        };
+        let empty = entry(metrics(&[bar(None)]));
+        let poor = entry(metrics(&[bar(Some((0.0, 5.0, 0))), bar(None)]));
         for by in [
             SelectBy::Distortion,
             SelectBy::Deviation,

@@ -10,7 +10,16 @@
 //!    candidate within `coverage_slack` of the best coverage is — a few
 //!    points of coverage (usually from spurs into bays) never outweigh a
 //!    several-fold worse distortion.
-//! 2. **Best**: the smallest `by` among the eligible ones, where values
+//! 2. **Whole**: of the eligible ones, those in the fewest connected pieces
+//!    (`components`). A Voronoi skeleton (VD, DVD) drops the edges that
+//!    cross ∂P, so where the boundary's vertices are farther apart than the
+//!    corridor is wide it falls into pieces and loses the arms between them;
+//!    the metric only sees the bars those arms would have hit, a few percent
+//!    of coverage, and a broken candidate with a lower distortion would win
+//!    over a whole one. A polygon's parts and holes never make a whole
+//!    skeleton broken, so the fewest pieces of any candidate is the number a
+//!    whole one has.
+//! 3. **Best**: the smallest `by` among the whole eligible ones, where values
 //!    within `tie` of the smallest count as equal (`by: distortion` only:
 //!    the medial axis approximates its parabolic arcs within
 //!    `arc_tolerance`, so where StSk or DVD coincide with it their exact
@@ -118,27 +127,41 @@ impl SelectParams {
     }
 }
 
+/// What [`select`] compares of one candidate.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Entry {
+    /// The candidate's scores.
+    pub scores: Scores,
+    /// Connected pieces of its skeleton (summed over polygon parts).
+    pub components: usize,
+}
+
 /// Index of the chosen candidate among `candidates` (in `methods` order;
 /// `None` entries are methods that failed or gave an empty skeleton), per
 /// the rule in the module documentation. Candidates without hits are chosen
 /// only when no candidate has one (then the first of them).
-pub fn select(candidates: &[Option<Scores>], params: &SelectParams) -> Option<usize> {
-    let scored: Vec<(usize, &Scores, f64)> = candidates
+pub fn select(candidates: &[Option<Entry>], params: &SelectParams) -> Option<usize> {
+    let scored: Vec<(usize, &Entry, f64)> = candidates
         .iter()
         .enumerate()
-        .filter_map(|(i, s)| {
-            let s = s.as_ref()?;
-            let v = params.by.value(s);
-            (s.hits > 0 && !v.is_nan()).then_some((i, s, v))
+        .filter_map(|(i, e)| {
+            let e = e.as_ref()?;
+            let v = params.by.value(&e.scores);
+            (e.scores.hits > 0 && !v.is_nan()).then_some((i, e, v))
         })
         .collect();
     if scored.is_empty() {
         return candidates.iter().position(Option::is_some);
     }
-    let c_max = scored.iter().map(|c| c.1.coverage).fold(0.0, f64::max);
+    let c_max = scored
+        .iter()
+        .map(|c| c.1.scores.coverage)
+        .fold(0.0, f64::max);
     let floor = params.min_coverage.min(c_max - params.coverage_slack);
-    let eligible: Vec<&(usize, &Scores, f64)> =
-        scored.iter().filter(|c| c.1.coverage >= floor).collect();
+    let covered = scored.iter().filter(|c| c.1.scores.coverage >= floor);
+    let fewest = covered.clone().map(|c| c.1.components).min();
+    let eligible: Vec<&(usize, &Entry, f64)> =
+        covered.filter(|c| Some(c.1.components) == fewest).collect();
     let best = eligible.iter().map(|c| c.2).fold(f64::INFINITY, f64::min);
     let tie = if params.by == SelectBy::Distortion {
         params.tie
@@ -152,14 +175,21 @@ pub fn select(candidates: &[Option<Scores>], params: &SelectParams) -> Option<us
 mod tests {
     use super::*;
 
-    fn s(coverage: f64, distortion: f64) -> Option<Scores> {
-        Some(Scores {
-            bars: 100,
-            hits: (coverage * 100.0) as usize,
-            coverage,
-            distortion,
-            ..Scores::default()
+    fn s(coverage: f64, distortion: f64) -> Option<Entry> {
+        Some(Entry {
+            scores: Scores {
+                bars: 100,
+                hits: (coverage * 100.0) as usize,
+                coverage,
+                distortion,
+                ..Scores::default()
+            },
+            components: 1,
         })
+    }
+
+    fn broken(coverage: f64, distortion: f64) -> Option<Entry> {
+        s(coverage, distortion).map(|e| Entry { components: 2, ..e })
     }
 
     #[test]
@@ -199,12 +229,38 @@ mod tests {
     #[test]
     fn a_skeleton_without_hits_only_wins_alone() {
         let p = SelectParams::default();
-        let none = Some(Scores {
-            bars: 4,
-            distortion: f64::NAN,
-            ..Scores::default()
+        let none = Some(Entry {
+            scores: Scores {
+                bars: 4,
+                distortion: f64::NAN,
+                ..Scores::default()
+            },
+            components: 1,
         });
         assert_eq!(select(&[none, s(0.2, 0.3)], &p), Some(1));
         assert_eq!(select(&[None, none], &p), Some(1));
+    }
+
+    #[test]
+    fn a_broken_candidate_never_wins_over_a_whole_one() {
+        let p = SelectParams::default();
+        // The states quarter: DVD in two pieces (coverage 0.713, Z 0.0250)
+        // against MA whole (0.722, 0.0266).
+        assert_eq!(
+            select(&[s(0.722, 0.0266), broken(0.713, 0.0250)], &p),
+            Some(0)
+        );
+        assert_eq!(
+            select(&[broken(0.713, 0.0250), s(0.722, 0.0266)], &p),
+            Some(1)
+        );
+        // All in two pieces (a polygon of two parts): the metric decides.
+        assert_eq!(
+            select(&[broken(0.722, 0.0266), broken(0.713, 0.0250)], &p),
+            Some(1)
+        );
+        // A whole candidate the coverage rule excludes does not make the
+        // covered ones ineligible.
+        assert_eq!(select(&[s(0.3, 0.001), broken(0.9, 0.05)], &p), Some(1));
     }
 }
