@@ -6,7 +6,8 @@ The states CO UT AZ NM WY NE KS OK TX ID MT SD ND NV IA MO AR LA MN WI IL, in EP
 of neighbours the part of one's boundary within 2 km of the other is their shared border; the borders'
 ends within 15 km of each other meet at their mean (the junctions; where three states meet, or four at
 Four Corners). Scaled by 1/5000 (a state ~100 m wide), simplified to 0.5 m, each border is the centre
-line of a street 10 m wide (flat ends, mitred joins, limit 2), clipped to the states' outline: the
+line of a street 10 m wide (flat ends, mitred joins, limit 2; a disc of that width at each junction),
+clipped to the states' outline: the
 borders that reach the outline are cut there. Real blocks' irregular shapes and skewed junctions,
 river borders as meandering streets.
 
@@ -85,9 +86,12 @@ def frames() -> dict[str, gpd.GeoDataFrame]:
         return affinity.translate(affinity.scale(g, SCALE, SCALE, origin=(b[0], b[1])), X0 - b[0], Y0 - b[1])
 
     lines = [scaled(l).simplify(0.5) for l in lines]
-    space = shapely.union_all([l.buffer(WIDTH / 2, cap_style="flat", join_style="mitre", mitre_limit=2.0)
-                               for l in lines]).intersection(scaled(outline))
     degree = Counter(c for l in lines for c in (l.coords[0], l.coords[-1]))
+    # Where three borders meet, their flat ends leave a notch on the outer side of the widest angle:
+    # a disc of the street's width fills the junction as a street's corner is.
+    discs = [Point(p).buffer(WIDTH / 2) for p, d in degree.items() if d >= 3]
+    space = shapely.union_all([l.buffer(WIDTH / 2, cap_style="flat", join_style="mitre", mitre_limit=2.0)
+                               for l in lines] + discs).intersection(scaled(outline))
     junctions = [(Point(p), d) for p, d in degree.items() if d >= 3 and space.contains(Point(p))]
     ends = [Point(p) for p, d in degree.items() if d == 1]
     crs = "EPSG:32633"

@@ -17,8 +17,12 @@
 //! the two overlapping discs, so the lines stay inside the polygon. A leg
 //! wholly inside the merged disc (a corner of the junction area) goes with
 //! the stubs. A cluster with a member whose disc does not overlap the
-//! centre's is left as it is. Branches that are not between two members of
-//! a cluster keep every vertex beyond the disc.
+//! centre's is left as it is, and so is one whose members' own streets meet
+//! at points farther apart than their radii (a staggered crossing: side
+//! streets leaving a through street a street's width apart are two
+//! junctions, not the halves of one crossing) or whose merge would run a
+//! line back through the disc's centre. Branches that are not between two
+//! members of a cluster keep every vertex beyond the disc.
 
 use super::{Branch, GraphBuilder, NodeId, SkeletonGraph, UnionFind};
 use crate::geometry::vector::norm;
@@ -55,59 +59,131 @@ pub fn merge(g: &SkeletonGraph, polygon: &PreparedPolygon) -> SkeletonGraph {
     let degrees = g.degrees();
     let junction = |n: NodeId| degrees[n.index()] >= 3;
     let branches = g.branches();
-    let (mut hubs, inner) = hubs(g, &branches, &junction);
+    let (mut hubs, mut inner) = hubs(g, &branches, &junction);
     // Every other junction a hub of its own: its lines too meet at one point.
     for (i, h) in hubs.iter_mut().enumerate() {
         if h.is_none() && degrees[i] >= 3 {
-            let n = &g.nodes()[i];
-            *h = Some(Hub {
-                centre: n.pos,
-                radius: n.radius,
-                node: n.pos,
-            });
+            *h = Some(own_hub(g, i));
         }
     }
     if hubs.iter().all(Option::is_none) {
         return g.clone();
     }
-    // A junction a hub of its own (no branch between it and another member).
-    let mut single: Vec<bool> = hubs.iter().map(Option::is_some).collect();
-    for (br, _) in branches.iter().zip(&inner).filter(|(_, &x)| x) {
-        single[br.start.index()] = false;
-        single[br.end.index()] = false;
+    let mut lines = straightened(&mut hubs, &branches, &inner, polygon);
+    let undo = doubled_back(&hubs, &branches, &inner, &lines);
+    if !undo.is_empty() {
+        let undone: Vec<bool> = hubs
+            .iter()
+            .map(|h| h.is_some_and(|h| undo.contains(&CoordKey::from(h.centre))))
+            .collect();
+        for (i, h) in hubs.iter_mut().enumerate().filter(|(i, _)| undone[*i]) {
+            *h = Some(own_hub(g, i));
+        }
+        for (k, br) in branches.iter().enumerate() {
+            inner[k] &= !undone[br.start.index()];
+        }
+        lines = straightened(&mut hubs, &branches, &inner, polygon);
     }
-    meeting_points(&mut hubs, &branches, &inner, &single, polygon);
-    let hub_of = |n: NodeId| hubs[n.index()];
     let mut b = GraphBuilder::new();
-    for (k, br) in branches.iter().enumerate() {
-        if inner[k] {
-            continue;
-        }
-        let boundary = polygon.boundary();
-        let mut coords = br.coords.clone();
-        if let Some(h) = hub_of(br.start) {
-            coords = straighten(&coords, h, boundary);
-        }
-        if let Some(h) = hub_of(br.end) {
-            coords.reverse();
-            coords = straighten(&coords, h, boundary);
-            coords.reverse();
-        }
-        if coords.len() < 2 {
-            // A leg wholly inside the merged disc.
-            continue;
-        }
+    for (coords, _) in lines.iter().flatten() {
         if coords.first() == coords.last() {
             // A loop from a hub back to it: two edges through its middle.
             let mid = coords.len() / 2;
             b.polyline(&coords[..=mid]);
             b.polyline(&coords[mid..]);
         } else {
-            b.polyline(&coords);
+            b.polyline(coords);
         }
     }
     let merged = b.finish(polygon.boundary());
     super::planar::node_crossings(merged, polygon.boundary()).0
+}
+
+/// Node `i` of `g` a hub of its own.
+fn own_hub(g: &SkeletonGraph, i: usize) -> Hub {
+    let n = &g.nodes()[i];
+    Hub {
+        centre: n.pos,
+        radius: n.radius,
+        node: n.pos,
+    }
+}
+
+/// Every branch that is not between two members of a hub, straightened into
+/// the hubs at its ends (after placing each hub's node where its lines
+/// meet), with whether it reaches the hub at its start and at its end
+/// through the disc's centre; `None` for a leg wholly inside a merged disc.
+type Straightened = Option<(Vec<Coord<f64>>, [bool; 2])>;
+
+fn straightened(
+    hubs: &mut [Option<Hub>],
+    branches: &[Branch],
+    inner: &[bool],
+    polygon: &PreparedPolygon,
+) -> Vec<Straightened> {
+    // A junction a hub of its own (no branch between it and another member).
+    let mut single: Vec<bool> = hubs.iter().map(Option::is_some).collect();
+    for (br, _) in branches.iter().zip(inner).filter(|(_, &x)| x) {
+        single[br.start.index()] = false;
+        single[br.end.index()] = false;
+    }
+    meeting_points(hubs, branches, inner, &single, polygon);
+    let boundary = polygon.boundary();
+    branches
+        .iter()
+        .zip(inner)
+        .map(|(br, &inside)| {
+            if inside {
+                return None;
+            }
+            let mut coords = br.coords.clone();
+            let mut via = [false; 2];
+            if let Some(h) = hubs[br.start.index()] {
+                (coords, via[0]) = straighten(&coords, h, boundary);
+            }
+            if let Some(h) = hubs[br.end.index()] {
+                coords.reverse();
+                (coords, via[1]) = straighten(&coords, h, boundary);
+                coords.reverse();
+            }
+            // Fewer than two points: a leg wholly inside the merged disc.
+            (coords.len() >= 2).then_some((coords, via))
+        })
+        .collect()
+}
+
+/// The hubs (by their centre) whose merge would double a line back: a
+/// branch from a member outside the centre's disc reaches the node through
+/// the centre (its straight way in is not clear of ∂P) while the node lies
+/// off the centre (node → centre → member turns back on itself) or the
+/// member has two such branches (they would share the segment to it). Such
+/// junctions are two junctions, as a staggered crossing's are.
+fn doubled_back(
+    hubs: &[Option<Hub>],
+    branches: &[Branch],
+    inner: &[bool],
+    lines: &[Straightened],
+) -> Vec<CoordKey> {
+    let mut outer = vec![0usize; hubs.len()];
+    for (br, _) in branches.iter().zip(inner).filter(|(_, &x)| !x) {
+        outer[br.start.index()] += 1;
+        outer[br.end.index()] += 1;
+    }
+    let mut undo = Vec::new();
+    for (br, line) in branches.iter().zip(lines) {
+        let Some((_, via)) = line else { continue };
+        for (n, through) in [(br.start, via[0]), (br.end, via[1])] {
+            let Some(h) = hubs[n.index()].filter(|_| through) else {
+                continue;
+            };
+            if h.node != h.centre || outer[n.index()] >= 2 {
+                undo.push(CoordKey::from(h.centre));
+            }
+        }
+    }
+    undo.sort_unstable();
+    undo.dedup();
+    undo
 }
 
 /// The hub of every node (the merged cluster it belongs to, when the
@@ -134,6 +210,7 @@ fn hubs(
     }
     let n = g.nodes().len();
     let root: Vec<usize> = (0..n).map(|i| uf.find(i)).collect();
+    let apart = staggered(g, branches, &close, &root);
     // The member with the largest disc of each cluster (the smallest index
     // among equals), and the cluster's size.
     let mut best: Vec<Option<usize>> = vec![None; n];
@@ -146,7 +223,7 @@ fn hubs(
         }
     }
     let mut hub: Vec<Option<Hub>> = vec![None; n];
-    let mut ok = vec![true; n];
+    let mut ok: Vec<bool> = apart.iter().map(|&a| !a).collect();
     for (i, &r) in root.iter().enumerate() {
         let Some(c) = best[r].filter(|_| size[r] >= 2) else {
             continue;
@@ -209,28 +286,15 @@ fn meeting_points(
             let Some((q, d)) = direction_beyond(&coords, h) else {
                 continue;
             };
-            let (a, b, c) = (1.0 - d.x * d.x, -d.x * d.y, 1.0 - d.y * d.y);
-            let e = sums.entry(key(&h)).or_insert([0.0; 5]);
-            e[0] += a;
-            e[1] += b;
-            e[2] += c;
-            e[3] += a * q.x + b * q.y;
-            e[4] += b * q.x + c * q.y;
+            add_line(sums.entry(key(&h)).or_insert([0.0; 5]), q, d);
         }
     }
     for h in hubs.iter_mut().flatten() {
         let Some(&[a, b, c, u, v]) = sums.get(&key(h)) else {
             continue;
         };
-        let det = a * c - b * b;
-        // Nearly parallel lines (a straight street through a widening):
-        // no crossing to speak of.
-        if det.is_nan() || det <= 0.05 * (a + c) * (a + c) / 4.0 {
+        let Some(x) = meet([a, b, c, u, v]) else {
             continue;
-        }
-        let x = Coord {
-            x: (c * u - b * v) / det,
-            y: (a * v - b * u) / det,
         };
         let off = x - h.centre;
         let l = norm(off);
@@ -242,6 +306,75 @@ fn meeting_points(
         meeting.insert(key(h), x);
     }
     relocate_singles(hubs, branches, single, &meeting, polygon);
+}
+
+/// Adds the line through `q` with unit direction `d` to the least-squares
+/// sums Σ (I − d dᵀ) and Σ (I − d dᵀ) q.
+fn add_line(sums: &mut [f64; 5], q: Coord<f64>, d: Coord<f64>) {
+    let (a, b, c) = (1.0 - d.x * d.x, -d.x * d.y, 1.0 - d.y * d.y);
+    sums[0] += a;
+    sums[1] += b;
+    sums[2] += c;
+    sums[3] += a * q.x + b * q.y;
+    sums[4] += b * q.x + c * q.y;
+}
+
+/// The point nearest (least squares) to the lines summed in `sums`; `None`
+/// when they are nearly parallel (a straight street through a widening: no
+/// crossing to speak of).
+fn meet([a, b, c, u, v]: [f64; 5]) -> Option<Coord<f64>> {
+    let det = a * c - b * b;
+    if det.is_nan() || det <= 0.05 * (a + c) * (a + c) / 4.0 {
+        return None;
+    }
+    Some(Coord {
+        x: (c * u - b * v) / det,
+        y: (a * v - b * u) / det,
+    })
+}
+
+/// Per cluster (by its root in `root`): whether its members' own streets
+/// meet at different points — each member's outer branches (those not
+/// `close` to another member) continued as lines beyond its disc, met by
+/// least squares; two members whose points lie farther apart than the
+/// larger of their radii are two junctions one street apart (a staggered
+/// crossing: two T-junctions whose side streets leave the through street
+/// a street's width apart), not the two halves of one crossing, whose
+/// streets all meet at one point. Members whose outer lines are parallel or
+/// fewer than two give no point.
+fn staggered(
+    g: &SkeletonGraph,
+    branches: &[Branch],
+    close: &dyn Fn(&Branch) -> bool,
+    root: &[usize],
+) -> Vec<bool> {
+    let n = g.nodes().len();
+    let mut sums = vec![[0.0; 5]; n];
+    for br in branches.iter().filter(|br| !close(br)) {
+        for (m, coords) in [
+            (br.start, br.coords.clone()),
+            (br.end, reversed(&br.coords)),
+        ] {
+            let i = m.index();
+            if let Some((q, d)) = direction_beyond(&coords, own_hub(g, i)) {
+                add_line(&mut sums[i], q, d);
+            }
+        }
+    }
+    let mut points: Vec<Vec<(Coord<f64>, f64)>> = vec![Vec::new(); n];
+    for (i, &r) in root.iter().enumerate() {
+        if let Some(x) = meet(sums[i]) {
+            points[r].push((x, g.nodes()[i].radius));
+        }
+    }
+    points
+        .iter()
+        .map(|p| {
+            p.iter()
+                .enumerate()
+                .any(|(k, &(x, rx))| p[k + 1..].iter().any(|&(y, ry)| norm(x - y) > rx.max(ry)))
+        })
+        .collect()
 }
 
 /// A single junction whose lines meet beyond its disc (a Y whose arms part
@@ -285,7 +418,7 @@ fn relocate_singles(
                     true => branches[k].coords.clone(),
                     false => reversed(&branches[k].coords),
                 };
-                let cut = into_hub(&coords, moved);
+                let (cut, _) = into_hub(&coords, moved);
                 cut.len() >= 2 && !boundary.crosses(cut[0], cut[1])
             });
         if inside {
@@ -302,11 +435,17 @@ fn reversed(coords: &[Coord<f64>]) -> Vec<Coord<f64>> {
 /// A branch leaving hub `h` (`coords` from the hub) as a line beyond the
 /// disc: its point one disc radius past the rim, and its direction from
 /// there to its point three radii past the rim (or its end) — clear of the
-/// bend the junction's corners give the medial axis.
+/// bend the junction's corners give the medial axis. A branch ending within
+/// a radius past the rim (a short street between two junctions) is the line
+/// through its two ends: without it a T-junction's through street alone
+/// leaves the meeting point anywhere along it.
 fn direction_beyond(coords: &[Coord<f64>], h: Hub) -> Option<(Coord<f64>, Coord<f64>)> {
     let (_, rest) = beyond(coords, h)?;
-    let near = along(&rest, h.radius);
+    let mut near = along(&rest, h.radius);
     let far = along(&rest, 3.0 * h.radius);
+    if far == near {
+        near = coords[0];
+    }
     let d = far - near;
     let l = norm(d);
     (l > 0.0).then(|| (near, d / l))
@@ -349,16 +488,18 @@ fn beyond(coords: &[Coord<f64>], h: Hub) -> Option<(bool, Vec<Coord<f64>>)> {
 /// that starts outside the disc is joined to its start through the disc's
 /// centre (the segment from the centre to the member lies in their two
 /// overlapping discs).
-fn into_hub(coords: &[Coord<f64>], h: Hub) -> Vec<Coord<f64>> {
+fn into_hub(coords: &[Coord<f64>], h: Hub) -> (Vec<Coord<f64>>, bool) {
     let mut out = vec![h.node];
+    let mut through = false;
     if let Some((outside, rest)) = beyond(coords, h) {
         if outside {
             out.push(h.centre);
+            through = true;
         }
         out.extend(rest);
     }
     out.dedup();
-    out
+    (out, through)
 }
 
 /// `coords` (from a member of hub `h`) into the hub's node: cut at twice
@@ -370,12 +511,12 @@ fn straighten(
     coords: &[Coord<f64>],
     h: Hub,
     boundary: &crate::geometry::Boundary,
-) -> Vec<Coord<f64>> {
+) -> (Vec<Coord<f64>>, bool) {
     let near = into_hub(coords, h);
-    if near.len() < 2 {
+    if near.0.len() < 2 {
         return near;
     }
-    let far = into_hub(
+    let (far, _) = into_hub(
         coords,
         Hub {
             radius: 2.0 * h.radius,
@@ -388,7 +529,7 @@ fn straighten(
                 .all(|k| boundary.distance(a + (b - a) * (f64::from(k) / 8.0)) >= 0.5 * h.radius)
     };
     if far.len() >= 2 && clear(far[0], far[1]) {
-        far
+        (far, false)
     } else {
         near
     }
@@ -521,5 +662,97 @@ mod tests {
         assert_eq!(after.len(), 1, "{after:?}");
         assert!(norm(after[0]) < 1.0, "{after:?}");
         m.check_invariants().unwrap();
+    }
+
+    #[test]
+    fn a_staggered_crossing_stays_two_junctions_without_crossing_lines() {
+        // A street 10 wide (y 47–57) and, one width south, a parallel one
+        // (y 36–46) leaving east from a street running south (x −5–5): the
+        // two three-way nodes are 10 apart, their discs overlap, but the
+        // node where all lines meet would sit on the far rim and the lines
+        // from the northern junction would run back through the centre.
+        use geo::{BooleanOps, Rect};
+        let r = |x0, y0, x1, y1| Rect::new(c(x0, y0), c(x1, y1)).to_polygon();
+        let space = r(-60., 47., 60., 57.)
+            .union(&r(-5., -60., 5., 57.))
+            .union(&r(-5., 36., 60., 46.));
+        let p = PreparedPolygon::new(&space.0[0]).unwrap();
+        let raw = crate::methods::build(
+            crate::methods::MethodId::MA,
+            &crate::methods::SkeletonParams::default(),
+        )
+        .skeletonise(&p, &crate::methods::MethodContext::default())
+        .unwrap();
+        let g = crate::graph::extend::prune_and_extend(
+            &raw,
+            &p,
+            Some(&crate::graph::prune::PruneParams::default()),
+            Some(&crate::graph::extend::ExtendParams::default()),
+        );
+        let m = merge(&g, &p);
+        m.check_invariants().unwrap();
+        let d = m.degrees();
+        let junctions: Vec<Coord<f64>> = (0..d.len())
+            .filter(|&i| d[i] >= 3)
+            .map(|i| m.nodes()[i].pos)
+            .collect();
+        assert_eq!(junctions.len(), 2, "{junctions:?}");
+        // No line doubles back over another.
+        let pieces = m.to_multilinestring();
+        let mut segments: Vec<(CoordKey, CoordKey)> = pieces
+            .0
+            .iter()
+            .flat_map(|l| l.lines())
+            .map(|l| {
+                let (a, b) = (CoordKey::from(l.start), CoordKey::from(l.end));
+                (a.min(b), a.max(b))
+            })
+            .collect();
+        let n = segments.len();
+        segments.sort_unstable();
+        segments.dedup();
+        assert_eq!(segments.len(), n, "a segment twice: {pieces:?}");
+        // Each where its streets' centrelines meet, within a tenth of the width.
+        let mut at = junctions.clone();
+        at.sort_by(|a, b| b.y.total_cmp(&a.y));
+        assert!(norm(at[0] - c(0., 52.)) < 1.0, "{at:?}");
+        assert!(norm(at[1] - c(0., 41.)) < 1.0, "{at:?}");
+    }
+
+    #[test]
+    fn side_streets_a_width_apart_on_a_through_street_stay_two_junctions() {
+        // A street 10 wide running north–south, a side street leaving west
+        // at y 0–10 and one leaving east at y −10–0: the medial axis has a
+        // three-way node for each, 10 apart (their discs touch), but their
+        // streets meet at (0, 5) and (0, −5), not at one point.
+        let p = PreparedPolygon::new(&polygon![
+            (x: -5., y: -60.), (x: 5., y: -60.), (x: 5., y: -10.), (x: 60., y: -10.),
+            (x: 60., y: 0.), (x: 5., y: 0.), (x: 5., y: 60.), (x: -5., y: 60.),
+            (x: -5., y: 10.), (x: -60., y: 10.), (x: -60., y: 0.), (x: -5., y: 0.)
+        ])
+        .unwrap();
+        let raw = crate::methods::build(
+            crate::methods::MethodId::MA,
+            &crate::methods::SkeletonParams::default(),
+        )
+        .skeletonise(&p, &crate::methods::MethodContext::default())
+        .unwrap();
+        let g = crate::graph::extend::prune_and_extend(
+            &raw,
+            &p,
+            Some(&crate::graph::prune::PruneParams::default()),
+            Some(&crate::graph::extend::ExtendParams::default()),
+        );
+        let m = merge(&g, &p);
+        m.check_invariants().unwrap();
+        let d = m.degrees();
+        let mut at: Vec<Coord<f64>> = (0..d.len())
+            .filter(|&i| d[i] >= 3)
+            .map(|i| m.nodes()[i].pos)
+            .collect();
+        at.sort_by(|a, b| b.y.total_cmp(&a.y));
+        assert_eq!(at.len(), 2, "{at:?}");
+        assert!(norm(at[0] - c(0., 5.)) < 1.5, "{at:?}");
+        assert!(norm(at[1] - c(0., -5.)) < 1.5, "{at:?}");
     }
 }

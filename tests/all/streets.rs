@@ -94,6 +94,31 @@ fn matching(
     (each, extra, close)
 }
 
+/// Reference junctions with a node of their own when each output node
+/// serves at most one (nearest pairs first, within the junction's local
+/// width): a node between two junctions serves one of them.
+fn one_to_one(space: &PreparedPolygon, reference: &[Coord<f64>], out: &[Coord<f64>]) -> usize {
+    let dist = |a: Coord<f64>, b: Coord<f64>| Euclidean.distance(geo::Point(a), geo::Point(b));
+    let mut pairs: Vec<(f64, usize, usize)> = reference
+        .iter()
+        .enumerate()
+        .flat_map(|(i, &r)| {
+            out.iter()
+                .enumerate()
+                .map(move |(k, &o)| (dist(o, r), i, k))
+        })
+        .filter(|&(d, i, _)| d <= 2.0 * space.boundary().distance(reference[i]))
+        .collect();
+    pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let (mut served, mut used) = (vec![false; reference.len()], vec![false; out.len()]);
+    for (_, i, k) in pairs {
+        if !served[i] && !used[k] {
+            (served[i], used[k]) = (true, true);
+        }
+    }
+    served.iter().filter(|&&s| s).count()
+}
+
 /// As many line ends as the reference has, one within the widest street's
 /// width (16 m) of each reference end.
 fn one_end_each(ends: &[Coord<f64>], reference_ends: &[Coord<f64>]) {
@@ -238,25 +263,38 @@ fn on_a_real_network_buffered_as_roads_merged_junctions_match_the_lines_junction
 }
 
 #[test]
-fn between_real_blocks_the_chosen_network_is_whole() {
+fn between_real_blocks_merged_junctions_are_whole_and_one_each() {
     // Street space between 21 US states of GMT's DCW as blocks (10 m
-    // streets, 20 junctions): DVD's raw skeleton breaks on the long
-    // straight borders (a point every 25 m) and loses two arms, yet its
-    // distortion is lower than MA's; the selection takes the whole one.
+    // streets, 26 junctions of 3 and 4 arms, borders along rivers as
+    // meandering streets): the chosen network is in one piece (DVD's breaks
+    // on the long straight borders), and two T-junctions one street apart
+    // (a staggered crossing) stay two, each where its streets meet.
     let d = tmp();
     let space = space("states").remove(0);
     let reference = points("states_junctions");
-    assert_eq!(reference.len(), 20);
-    let lines = run(d.path(), "states", "{ junctions: merge }");
-    assert_eq!(SkeletonGraph::from_lines(&lines).components(), 1);
-    let (out, _) = junctions_and_ends(&lines);
-    let (each, extra, _) = matching(&space, &reference, &out);
-    let one = each.iter().filter(|&&n| n == 1).count();
-    let none = each.iter().filter(|&&n| n == 0).count();
-    // Measured: 16 with one node, 3 with two, 1 with none (a junction
-    // whose arms meet beyond its local width); 8 nodes near none.
-    assert!(one >= 16 && none <= 1, "{each:?}");
-    assert!(extra <= 8, "{extra}");
+    assert_eq!(reference.len(), 26);
+    let count = |prune: &str| {
+        let lines = run(d.path(), "states", prune);
+        assert_eq!(SkeletonGraph::from_lines(&lines).components(), 1);
+        let (out, _) = junctions_and_ends(&lines);
+        let (each, extra, _) = matching(&space, &reference, &out);
+        let one = each.iter().filter(|&&n| n == 1).count();
+        let none = each.iter().filter(|&&n| n == 0).count();
+        (one, none, extra, one_to_one(&space, &reference, &out))
+    };
+    let kept = count("{}");
+    let merged = count("{ junctions: merge }");
+    // Measured: keep 23 with one node, 3 with two, 1 node near none, 26
+    // one to one (28 nodes); merge 24, 2, 1, 26 (27 nodes). The two with
+    // two: reference junctions closer to each other than their local width,
+    // each with a node of its own.
+    assert!(
+        merged.0 >= 24 && merged.0 >= kept.0,
+        "{kept:?} → {merged:?}"
+    );
+    assert_eq!(merged.1, 0, "{merged:?}");
+    assert!(merged.2 <= 1, "{merged:?}");
+    assert_eq!(merged.3, 26, "{merged:?}");
 }
 
 /// A row of the `streets` layer: line, start and end degree, left and right FID.
