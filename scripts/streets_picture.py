@@ -1,69 +1,68 @@
-#!/usr/bin/env python3
-"""A picture of street space collapsed to a network: for each run given, the street space (blue), the
-reference centrelines (dashed) and their junctions (green circles), the output lines (red), their
-junction nodes (black) and line ends (magenta squares), side by side.
+"""Draws street space with its reference centrelines (dashed blue), the skeleton lines (red) and
+their junction nodes (black), whole and zoomed on junctions, for two runs side by side: the
+README's picture of `prune: {junctions: merge}`.
 
-usage: streets_picture.py DATA LAYER OUT.png RUN.gpkg [RUN.gpkg...] [--window X0,Y0,X1,Y1]
-  DATA holds LAYER (the street space), LAYER_lines and LAYER_junctions (scripts/make_streets.py);
-  each RUN is a run's output (its `skeletons` layer).
-needs: geopandas, matplotlib (PyPI)
+usage: streets_picture.py OUT.png STREETS.gpkg LAYER KEEP.gpkg MERGE.gpkg [ZOOM_HALF_WIDTH JUNCTION...]
+  JUNCTION = index into LAYER_junctions (one row of zoomed panels each)
+needs: geopandas, shapely, matplotlib (PyPI)
 """
-
-from __future__ import annotations
 
 import sys
 from collections import Counter
 
 import geopandas as gpd
 import matplotlib
+import shapely
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-from shapely.geometry import Point  # noqa: E402
+
+if len(sys.argv) < 6:
+    sys.exit(__doc__)
+out, data, layer, keep, merge = sys.argv[1:6]
+half = float(sys.argv[6]) if len(sys.argv) > 6 else None
+picked = [int(i) for i in sys.argv[7:]]
+
+space = gpd.read_file(data, layer=layer)
+ref = gpd.read_file(data, layer=layer + "_lines")
+junctions = gpd.read_file(data, layer=layer + "_junctions")
 
 
-def nodes(lines) -> tuple[list[Point], list[Point]]:
-    """The junction nodes (degree ≥ 3) and line ends (degree 1) of the lines' pieces."""
+def nodes(frame):
+    """Junctions (degree ≥ 3) of a skeleton layer's lines."""
+    lines = [g for geom in frame.geometry.values for g in getattr(geom, "geoms", [geom])]
     degree = Counter()
-    for g in lines:
-        for piece in getattr(g, "geoms", [g]):
-            degree[piece.coords[0]] += 1
-            degree[piece.coords[-1]] += 1
-    return ([Point(p) for p, n in degree.items() if n >= 3], [Point(p) for p, n in degree.items() if n == 1])
+    for part in lines:
+        cs = list(part.coords)
+        degree[cs[0]] += 1
+        degree[cs[-1]] += 1
+    return [p for p, d in degree.items() if d >= 3]
 
 
-def main(args: list[str]) -> None:
-    window = None
-    if "--window" in args:
-        i = args.index("--window")
-        window = [float(v) for v in args[i + 1].split(",")]
-        args = args[:i] + args[i + 2:]
-    if len(args) < 4:
-        sys.exit(__doc__)
-    data, layer, out, runs = args[0], args[1], args[2], args[3:]
-    space = gpd.read_file(data, layer=layer)
-    lines = gpd.read_file(data, layer=layer + "_lines")
-    junctions = gpd.read_file(data, layer=layer + "_junctions")
-    fig, axes = plt.subplots(1, len(runs), figsize=(7 * len(runs), 6.5), squeeze=False)
-    for ax, run in zip(axes[0], runs):
-        space.plot(ax=ax, color="#cde", edgecolor="#68a", lw=0.4)
-        lines.plot(ax=ax, color="#777", lw=0.7, linestyle="--")
-        junctions.plot(ax=ax, color="g", markersize=70, alpha=0.4)
-        skeleton = gpd.read_file(run, layer="skeletons")
-        skeleton.plot(ax=ax, color="r", lw=1.1)
-        inner, ends = nodes(skeleton.geometry)
-        if inner:
-            gpd.GeoSeries(inner).plot(ax=ax, color="k", markersize=14)
-        if ends:
-            gpd.GeoSeries(ends).plot(ax=ax, color="m", markersize=14, marker="s")
-        if window:
+runs = [(gpd.read_file(keep, layer="skeletons"), "junctions: keep (default)"),
+        (gpd.read_file(merge, layer="skeletons"), "junctions: merge")]
+windows = [None] + [
+    (p.x - half, p.y - half, p.x + half, p.y + half) for p in junctions.geometry.values[picked]
+]
+fig, axes = plt.subplots(len(windows), 2, figsize=(11, 5.2 * len(windows)), squeeze=False)
+for row, window in enumerate(windows):
+    for col, (sk, title) in enumerate(runs):
+        ax = axes[row][col]
+        space.plot(ax=ax, facecolor="#dde", edgecolor="#445", linewidth=0.6)
+        ref.plot(ax=ax, color="#2255cc", linewidth=0.9, linestyle="--")
+        sk.plot(ax=ax, color="#d11", linewidth=1.3)
+        xs = nodes(sk)
+        ax.scatter([p[0] for p in xs], [p[1] for p in xs], color="black", s=14 if window is None else 30, zorder=5)
+        jx = junctions.geometry.values
+        ax.scatter(shapely.get_x(jx), shapely.get_y(jx), facecolor="none", edgecolor="#2255cc",
+                   s=40 if window is None else 120, zorder=4)
+        if window is not None:
             ax.set_xlim(window[0], window[2])
             ax.set_ylim(window[1], window[3])
         ax.set_aspect("equal")
-        ax.set_axis_off()
-        ax.set_title(run.rsplit("/", 1)[-1], fontsize=10)
-    fig.savefig(out, dpi=72, bbox_inches="tight")
-
-
-if __name__ == "__main__":
-    main(sys.argv[1:])
+        ax.set_xticks([])
+        ax.set_yticks([])
+        ax.set_title(f"{title}: {len(xs)} junction nodes" if window is None else title, fontsize=10)
+fig.tight_layout()
+fig.savefig(out, dpi=90)
+print(out)
