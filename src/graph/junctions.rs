@@ -563,6 +563,22 @@ mod tests {
         Coord { x, y }
     }
 
+    /// `p`'s medial axis, pruned and extended with the default options.
+    fn pruned_axis(p: &PreparedPolygon) -> SkeletonGraph {
+        let raw = crate::methods::build(
+            crate::methods::MethodId::MA,
+            &crate::methods::SkeletonParams::default(),
+        )
+        .skeletonise(p, &crate::methods::MethodContext::default())
+        .unwrap();
+        crate::graph::extend::prune_and_extend(
+            &raw,
+            p,
+            Some(&crate::graph::prune::PruneParams::default()),
+            Some(&crate::graph::extend::ExtendParams::default()),
+        )
+    }
+
     #[test]
     fn a_crossing_seen_as_two_three_way_nodes_becomes_one_four_way_node() {
         // A plus-shaped street space, arms 10 wide: its medial axis as two
@@ -635,18 +651,7 @@ mod tests {
             .union(&arm(1.0).buffer(5.0))
             .union(&arm(-1.0).buffer(5.0));
         let p = PreparedPolygon::new(&space.0[0]).unwrap();
-        let raw = crate::methods::build(
-            crate::methods::MethodId::MA,
-            &crate::methods::SkeletonParams::default(),
-        )
-        .skeletonise(&p, &crate::methods::MethodContext::default())
-        .unwrap();
-        let g = crate::graph::extend::prune_and_extend(
-            &raw,
-            &p,
-            Some(&crate::graph::prune::PruneParams::default()),
-            Some(&crate::graph::extend::ExtendParams::default()),
-        );
+        let g = pruned_axis(&p);
         let fork = |g: &SkeletonGraph| -> Vec<Coord<f64>> {
             let d = g.degrees();
             (0..d.len())
@@ -677,18 +682,7 @@ mod tests {
             .union(&r(-5., -60., 5., 57.))
             .union(&r(-5., 36., 60., 46.));
         let p = PreparedPolygon::new(&space.0[0]).unwrap();
-        let raw = crate::methods::build(
-            crate::methods::MethodId::MA,
-            &crate::methods::SkeletonParams::default(),
-        )
-        .skeletonise(&p, &crate::methods::MethodContext::default())
-        .unwrap();
-        let g = crate::graph::extend::prune_and_extend(
-            &raw,
-            &p,
-            Some(&crate::graph::prune::PruneParams::default()),
-            Some(&crate::graph::extend::ExtendParams::default()),
-        );
+        let g = pruned_axis(&p);
         let m = merge(&g, &p);
         m.check_invariants().unwrap();
         let d = m.degrees();
@@ -731,18 +725,7 @@ mod tests {
             (x: -5., y: 10.), (x: -60., y: 10.), (x: -60., y: 0.), (x: -5., y: 0.)
         ])
         .unwrap();
-        let raw = crate::methods::build(
-            crate::methods::MethodId::MA,
-            &crate::methods::SkeletonParams::default(),
-        )
-        .skeletonise(&p, &crate::methods::MethodContext::default())
-        .unwrap();
-        let g = crate::graph::extend::prune_and_extend(
-            &raw,
-            &p,
-            Some(&crate::graph::prune::PruneParams::default()),
-            Some(&crate::graph::extend::ExtendParams::default()),
-        );
+        let g = pruned_axis(&p);
         let m = merge(&g, &p);
         m.check_invariants().unwrap();
         let d = m.degrees();
