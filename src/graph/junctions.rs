@@ -290,10 +290,7 @@ fn meeting_points(
         }
     }
     for h in hubs.iter_mut().flatten() {
-        let Some(&[a, b, c, u, v]) = sums.get(&key(h)) else {
-            continue;
-        };
-        let Some(x) = meet([a, b, c, u, v]) else {
+        let Some(x) = sums.get(&key(h)).and_then(|&sum| meet(sum)) else {
             continue;
         };
         let off = x - h.centre;
@@ -349,14 +346,23 @@ fn staggered(
     root: &[usize],
 ) -> Vec<bool> {
     let n = g.nodes().len();
+    let mut size = vec![0usize; n];
+    for &r in root {
+        size[r] += 1;
+    }
+    // Only members of clusters of two or more have a partner to differ from.
+    let member = |m: NodeId| size[root[m.index()]] >= 2;
     let mut sums = vec![[0.0; 5]; n];
     for br in branches.iter().filter(|br| !close(br)) {
-        for (m, coords) in [
-            (br.start, br.coords.clone()),
-            (br.end, reversed(&br.coords)),
-        ] {
-            let i = m.index();
-            if let Some((q, d)) = direction_beyond(&coords, own_hub(g, i)) {
+        if member(br.start) {
+            let i = br.start.index();
+            if let Some((q, d)) = direction_beyond(&br.coords, own_hub(g, i)) {
+                add_line(&mut sums[i], q, d);
+            }
+        }
+        if member(br.end) {
+            let i = br.end.index();
+            if let Some((q, d)) = direction_beyond(&reversed(&br.coords), own_hub(g, i)) {
                 add_line(&mut sums[i], q, d);
             }
         }
