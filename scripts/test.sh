@@ -40,6 +40,8 @@ took "without GDAL"
 # 105 s against 134 s; the results are the same). target/zig shares nothing with the builds above.
 SKELETONISE_WHEEL_PROFILE=${SKELETONISE_WHEEL_PROFILE:-wheel-test} scripts/test-python.sh
 took "Python package"
+# The wheel is in target/wheels; its build directory is not needed again (CI: 570 MB).
+if [ "${SKELETONISE_FREE_DISK:-}" = 1 ]; then rm -rf target/zig; fi
 # The QGIS plugin in Debian's QGIS (installed when missing), with that wheel.
 scripts/test-qgis.sh
 took "QGIS plugin"
