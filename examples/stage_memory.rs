@@ -1,7 +1,8 @@
-//! Peak heap of the stages after a method's raw skeleton — pruning and
-//! extension, then scoring — per raw-skeleton node and per boundary vertex,
-//! on every polygon of a layer: the figures behind the memory budget's
-//! predictions for those stages (`skeleton.max_memory_mb`).
+//! Peak heap of each stage of one method on every polygon of a layer — the
+//! prepared polygon, the raw skeleton (its peak, and what the graph keeps),
+//! pruning and extension, then scoring — with pruning's per raw-skeleton
+//! node and scoring's per boundary vertex: the figures behind the memory
+//! budget's predictions (`skeleton.max_memory_mb`).
 //!
 //! ```text
 //! cargo run --release --example stage_memory -- target/bench/rough-input-1000000.gpkg rough [MA|VD|CDT|DVD]
@@ -67,15 +68,19 @@ fn main() {
             eprintln!("{e}");
             std::process::exit(1)
         });
-    println!("vertices\tnodes\tfinished_nodes\tprune_s\tprune_MB\tprune_B_per_node\tscore_MB\tscore_B_per_vertex");
+    println!("vertices\tinput_MB\tskeleton_MB\traw_MB\tnodes\tfinished_nodes\tprune_s\tprune_MB\tprune_B_per_node\tscore_MB\tscore_B_per_vertex");
     for (_, g) in &feats {
         for p in skeletonise::process::polygon_parts(Some(g)).unwrap_or_default() {
-            let Ok(pp) = PreparedPolygon::new(&p) else {
+            let (pp, input) = peak_of(|| PreparedPolygon::new(&p));
+            let Ok(pp) = pp else {
                 continue;
             };
-            let Ok(raw) = method.skeletonise(&pp, &MethodContext::default()) else {
+            let live = LIVE.load(Relaxed);
+            let (raw, skeleton) = peak_of(|| method.skeletonise(&pp, &MethodContext::default()));
+            let Ok(raw) = raw else {
                 continue;
             };
+            let kept = LIVE.load(Relaxed) - live;
             let t = std::time::Instant::now();
             let (fin, prune) = peak_of(|| {
                 prune_and_extend(
@@ -93,7 +98,10 @@ fn main() {
             });
             let (v, n) = (pp.vertex_count(), raw.nodes().len());
             println!(
-                "{v}\t{n}\t{}\t{prune_s:.2}\t{:.1}\t{:.0}\t{:.1}\t{:.0}",
+                "{v}\t{:.1}\t{:.1}\t{:.1}\t{n}\t{}\t{prune_s:.2}\t{:.1}\t{:.0}\t{:.1}\t{:.0}",
+                input as f64 / 1e6,
+                skeleton as f64 / 1e6,
+                kept as f64 / 1e6,
                 fin.nodes().len(),
                 prune as f64 / 1e6,
                 prune as f64 / n.max(1) as f64,

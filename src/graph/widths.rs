@@ -45,8 +45,8 @@ impl MatSegment {
 /// End nodes carry their radius. Interior polyline vertices (edges merged by
 /// pruning, for instance) get their distance to ∂P from `boundary` when given
 /// (exact on the medial axis), otherwise a radius interpolated linearly by
-/// length between the edge's end nodes. On MA's raw output every polyline
-/// vertex is a node, so no boundary is needed.
+/// length between the edge's end nodes. MA's raw output has its parabolic
+/// arcs' vertices as edge interiors: give the boundary for their exact radii.
 pub fn medial_axis_transform(
     graph: &SkeletonGraph,
     boundary: Option<&Boundary>,

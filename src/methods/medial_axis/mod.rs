@@ -6,9 +6,10 @@
 //! ∂P (all rings) and their endpoints, without the edges that come out of
 //! concave (reflex) vertices — in the segment Voronoi diagram those are
 //! exactly the *secondary* edges, between a segment and its own endpoint.
-//! Every node carries its disc radius, so the graph with its radii is the
-//! Medial Axis Transform; [`crate::graph::widths::medial_axis_transform`]
-//! lists it segment by segment with the local width.
+//! Every node carries its disc radius, and an arc's interior vertices have
+//! theirs as their distance to ∂P, so the graph is the Medial Axis
+//! Transform; [`crate::graph::widths::medial_axis_transform`] (given the
+//! boundary) lists it segment by segment with the local width.
 //!
 //! # How
 //!
@@ -36,8 +37,11 @@
 //! 3. **Arcs.** Edges between a vertex and a segment are parabolic. They are
 //!    replaced by polylines whose Hausdorff distance to the exact parabola is
 //!    at most the [`ArcTolerance`] (by default 1 % of the local disc radius,
-//!    so the quality does not depend on the feature's size); every polyline
-//!    vertex is a node with its exact disc radius.
+//!    so the quality does not depend on the feature's size). An arc is one
+//!    edge: the polyline's inner vertices are its interior, its ends are
+//!    nodes with their exact disc radius. (They were nodes each until a
+//!    rough rim's millions of arc vertices made the graph its run's largest
+//!    allocation; every step merges such chains into one edge anyway.)
 //! 4. **Radii.** A node's radius is its distance to its Voronoi sites (the
 //!    quantised ∂P), which equals its distance to ∂P within the resolution.
 //!
@@ -191,7 +195,11 @@ impl SkeletonMethod for MedialAxis {
         self.tolerance.validate().map_err(fail)?;
         match quantised(polygon)? {
             Some((grid, segs, diagram)) => {
-                Extractor::new(&diagram, &segs, &grid, self.tolerance).run()
+                let plan = Extractor::new(&diagram, &segs, &grid, self.tolerance).plan()?;
+                // The diagram (48 bytes a half-edge, six half-edges a
+                // boundary vertex) is not needed for the graph.
+                drop(diagram);
+                Ok(plan.graph(&segs, &grid, self.tolerance))
             }
             None => Ok(SkeletonGraph::new()),
         }
@@ -316,9 +324,6 @@ struct Extractor<'a> {
     segs: &'a [Seg],
     grid: &'a Grid,
     tolerance: ArcTolerance,
-    graph: SkeletonGraph,
-    /// Graph node of each Voronoi vertex, once used.
-    node_of: Vec<Option<NodeId>>,
     /// Whether a vertex's cell lies inside P, once known.
     point_cell_inside: Vec<Option<bool>>,
 }
@@ -330,8 +335,6 @@ impl<'a> Extractor<'a> {
             segs,
             grid,
             tolerance,
-            graph: SkeletonGraph::new(),
-            node_of: vec![None; diagram.vertices().len()],
             point_cell_inside: vec![None; diagram.cells().len()],
         }
     }
@@ -356,7 +359,10 @@ impl<'a> Extractor<'a> {
         [v.x(), v.y()]
     }
 
-    fn run(mut self) -> Result<SkeletonGraph, MethodError> {
+    /// What the graph is made of, read from the diagram (which the caller
+    /// may then drop): the kept edges between two clusters and the
+    /// clusters' nodes in the order the graph makes them.
+    fn plan(mut self) -> Result<Plan, MethodError> {
         let kept = self.inside_edges(false)?;
         let mut rep = self.representatives(&kept);
         // The kept edges between two clusters, with their ends.
@@ -371,41 +377,24 @@ impl<'a> Extractor<'a> {
                 })
             })
             .collect();
-        // The arcs' samples first (on every core for a large diagram: a
-        // rough rim's medial axis has millions of them), then the graph in
-        // the edges' order, with room for all of it.
-        let (segs, grid, tolerance) = (self.segs, self.grid, self.tolerance);
-        let sample = |j: &Joined| {
-            j.kept
-                .curved
-                .then(|| arc_samples(segs, grid, tolerance, j.p, j.kept.s0, j.kept.s1))
-                .flatten()
-        };
-        let arcs: Vec<Option<Vec<Sample>>> = if joined.len() >= ARCS_IN_PARALLEL {
-            use rayon::prelude::*;
-            joined.par_iter().map(sample).collect()
-        } else {
-            joined.iter().map(sample).collect()
-        };
-        let inner: usize = arcs.iter().flatten().map(Vec::len).sum();
-        self.graph.reserve(
-            (2 * joined.len()).min(self.node_of.len()) + inner,
-            joined.len() + inner,
-        );
-        for (j, arc) in joined.iter().zip(arcs) {
-            let n0 = self.node(j.r[0], j.kept.s0);
-            let n1 = self.node(j.r[1], j.kept.s0);
-            let mut prev = n0;
-            for smp in arc.into_iter().flatten() {
-                let n = self
-                    .graph
-                    .add_node(grid.world(smp.x, smp.y), grid.length(smp.r), None);
-                self.graph.add_edge(prev, n, Vec::new());
-                prev = n;
+        drop((kept, rep));
+        // A cluster's node is made where an edge first reaches it, placed
+        // by that edge's first site.
+        let mut made = vec![false; self.diagram.vertices().len()];
+        let mut nodes = Vec::new();
+        for j in &joined {
+            for v in j.r {
+                if !std::mem::replace(&mut made[v], true) {
+                    let (pos, r) = self.position(v, j.kept.s0);
+                    nodes.push((pos, self.grid.length(r)));
+                }
             }
-            self.graph.add_edge(prev, n1, Vec::new());
         }
-        Ok(self.graph)
+        Ok(Plan {
+            joined,
+            nodes,
+            vertices: made.len(),
+        })
     }
 
     /// The representative of every Voronoi vertex after contracting the
@@ -550,17 +539,6 @@ impl<'a> Extractor<'a> {
         };
         (pos, r)
     }
-
-    /// The graph node of Voronoi vertex `v`, whose disc touches `site`.
-    fn node(&mut self, v: usize, site: Site) -> NodeId {
-        if let Some(n) = self.node_of[v] {
-            return n;
-        }
-        let (pos, r) = self.position(v, site);
-        let n = self.graph.add_node(pos, self.grid.length(r), None);
-        self.node_of[v] = Some(n);
-        n
-    }
 }
 
 /// A kept edge of the Voronoi diagram between the clusters `r` (their
@@ -575,6 +553,98 @@ struct Joined {
 /// on (fewer: on the calling thread — most polygons, in a run that has a
 /// thread per feature already).
 const ARCS_IN_PARALLEL: usize = 1 << 15;
+
+/// The arcs are sampled this many edges at a time, each batch stored in
+/// one vector of the exact size: no vector per arc, no doubling slack.
+const ARC_BATCH: usize = 1 << 16;
+
+/// The skeleton graph's parts, without the Voronoi diagram they came from.
+struct Plan {
+    joined: Vec<Joined>,
+    /// The clusters' nodes (position, radius in CRS units), in the order
+    /// the edges first reach them.
+    nodes: Vec<(geo::Coord<f64>, f64)>,
+    /// The diagram's number of vertices.
+    vertices: usize,
+}
+
+/// The interior samples of a batch of edges, edge after edge: edge `i`'s
+/// are `samples[ends[i - 1]..ends[i]]` (from 0 for the first).
+struct Arcs {
+    samples: Vec<Sample>,
+    ends: Vec<usize>,
+}
+
+impl Plan {
+    /// The graph: every joined edge in order, its clusters' nodes made where
+    /// it first reaches them, its arc's samples as its interior.
+    fn graph(self, segs: &[Seg], grid: &Grid, tolerance: ArcTolerance) -> SkeletonGraph {
+        let Plan {
+            joined,
+            nodes,
+            vertices,
+        } = self;
+        let sample = |j: &Joined| {
+            j.kept
+                .curved
+                .then(|| arc_samples(segs, grid, tolerance, j.p, j.kept.s0, j.kept.s1))
+                .flatten()
+                .unwrap_or_default()
+        };
+        // The arcs' samples first (on every core for a large diagram: a
+        // rough rim's medial axis has millions of them), then the graph,
+        // with room for exactly all of it.
+        let batches: Vec<Arcs> = joined
+            .chunks(ARC_BATCH)
+            .map(|batch| {
+                let arcs: Vec<Vec<Sample>> = if joined.len() >= ARCS_IN_PARALLEL {
+                    use rayon::prelude::*;
+                    batch.par_iter().map(sample).collect()
+                } else {
+                    batch.iter().map(sample).collect()
+                };
+                let mut samples = Vec::with_capacity(arcs.iter().map(Vec::len).sum());
+                let ends = arcs
+                    .into_iter()
+                    .map(|a| {
+                        samples.extend(a);
+                        samples.len()
+                    })
+                    .collect();
+                Arcs { samples, ends }
+            })
+            .collect();
+        let clusters: Vec<[usize; 2]> = joined.iter().map(|j| j.r).collect();
+        drop(joined);
+        let mut graph = SkeletonGraph::new();
+        graph.reserve(nodes.len(), clusters.len());
+        let mut node_of: Vec<Option<NodeId>> = vec![None; vertices];
+        let mut nodes = nodes.into_iter();
+        let mut node = |graph: &mut SkeletonGraph, v: usize| {
+            *node_of[v].get_or_insert_with(|| {
+                let (pos, r) = nodes.next().expect("the plan has a node for every cluster");
+                graph.add_node(pos, r, None)
+            })
+        };
+        let arcs = batches.iter().flat_map(|b| {
+            b.ends.iter().scan(0, |start, &end| {
+                Some(&b.samples[std::mem::replace(start, end)..end])
+            })
+        });
+        // An arc's samples are its edge's interior vertices: a rough rim's
+        // medial axis has six times as many of them as Voronoi vertices.
+        // Their radius is their distance to ∂P; the largest radius on an
+        // arc is at one of its ends (a parabola's distance to its focus
+        // grows away from its apex), so the widest node is still a node.
+        for (r, arc) in clusters.iter().zip(arcs) {
+            let n0 = node(&mut graph, r[0]);
+            let n1 = node(&mut graph, r[1]);
+            let interior = arc.iter().map(|smp| grid.world(smp.x, smp.y)).collect();
+            graph.add_edge(n0, n1, interior);
+        }
+        graph
+    }
+}
 
 /// The interior samples of the parabolic edge from `p[0]` to `p[1]`
 /// between sites `s0` and `s1` (grid units), or `None` when it is drawn
