@@ -233,55 +233,78 @@ pub fn cut_ends(m: &SkeletonGraph, boundary: &Boundary, tol: f64, rough: bool) -
     let adj = m.adjacency();
     let deg: Vec<usize> = adj.iter().map(<[EdgeId]>::len).collect();
     let rings = RingIndex::new(boundary);
-    let mut out = Vec::new();
-    for (j, edges) in adj.iter().enumerate() {
-        if edges.len() < 3 || (!rough && edges.len() != 3) {
-            continue;
-        }
-        let jn = NodeId::from_index(j);
-        let Some((line, legs, tree, leaves)) = branches(m, &adj, &deg, jn, tol, rough) else {
-            continue;
-        };
+    let graph = Around {
+        m,
+        adj: &adj,
+        deg: &deg,
+        boundary,
+        rings: &rings,
+    };
+    let out: Vec<CutEnd> = (0..adj.len())
+        .filter(|&j| adj[j].len() == 3 || (rough && adj[j].len() > 3))
+        .filter_map(|j| graph.cut_at(NodeId::from_index(j), tol, rough))
+        .collect();
+    outermost(m, out)
+}
+
+/// A graph with what finding its cut ends reads around each junction.
+struct Around<'a> {
+    m: &'a SkeletonGraph,
+    adj: &'a Adjacency,
+    deg: &'a [usize],
+    boundary: &'a Boundary,
+    rings: &'a RingIndex,
+}
+
+impl Around<'_> {
+    /// The cut end at junction `jn`, if the line through it ends on a cut.
+    fn cut_at(&self, jn: NodeId, tol: f64, rough: bool) -> Option<CutEnd> {
+        let Self {
+            m,
+            adj,
+            deg,
+            boundary,
+            rings,
+        } = *self;
+        let (line, legs, tree, leaves) = branches(m, adj, deg, jn, tol, rough)?;
         if !rough && leaves.len() != 2 {
-            continue;
+            return None;
         }
-        let Some((p1, p2)) = corners(m, &leaves) else {
-            continue;
-        };
+        let (p1, p2) = corners(m, &leaves)?;
         let span = hypot(p2 - p1);
         let rj = m.node(jn).radius;
         if span < MIN_SPAN * 2.0 * rj {
-            continue;
+            return None;
         }
-        let (c, r_far) = course_line(m, &adj, &deg, jn, line, tol, 2.0 * rj);
+        let (c, r_far) = course_line(m, adj, deg, jn, line, tol, 2.0 * rj);
         // The cut spans the line it ends, not only a bump's own width: a
         // flat-topped bump of a bank ends in a short straight edge too, but
         // its line joins a much wider one.
         if span < MIN_SPAN * 2.0 * r_far {
-            continue;
+            return None;
         }
         // A line shorter than a quarter radius makes j one node of a
         // cluster (a square's centre split by rounding): no single line
         // arrives there, so there is no cut to end on.
         let len = super::polyline_length(&c);
         if len < MIN_LINE * rj {
-            continue;
+            return None;
         }
         // A rough cut ends a corridor: its line runs on at least
         // MIN_ROUGH_LINE radii before another junction. The fan of legs
         // into a bend's rounded outer corner is as rough, but its line
         // meets the bend's junction within a radius.
         if rough && len < MIN_ROUGH_LINE * rj {
-            continue;
+            return None;
         }
         let course = c[0] - point_at(&c, (2.0 * rj).min(len));
         let foot = closest_on_segment(p1, p2, c[0]).0 - c[0];
         let (lc, lf) = (hypot(course), hypot(foot));
         if lc == 0.0 || lf == 0.0 {
-            continue;
+            return None;
         }
         if dot(course, foot) / (lc * lf) < MAX_SLANT_DEG.to_radians().cos() {
-            continue;
+            return None;
         }
         // Two legs: ∂P between the corners has no convex vertex, and must
         // not bow. More: the cut is rough, and must stay within a band of
@@ -292,18 +315,19 @@ pub fn cut_ends(m: &SkeletonGraph, boundary: &Boundary, tol: f64, rough: bool) -
             MAX_ROUGH * 2.0 * rj
         };
         let toothed = leaves.len() > 2;
-        let Some(cut) = rings.straight_between(boundary, (p1, p2), toothed, band) else {
-            continue;
-        };
-        if let Some(contact) = contact(boundary, c[0], (p1, p2), toothed.then_some(cut)) {
-            out.push(CutEnd {
-                junction: jn,
-                legs,
-                tree,
-                contact,
-            });
-        }
+        let cut = rings.straight_between(boundary, (p1, p2), toothed, band)?;
+        let contact = contact(boundary, c[0], (p1, p2), toothed.then_some(cut))?;
+        Some(CutEnd {
+            junction: jn,
+            legs,
+            tree,
+            contact,
+        })
     }
+}
+
+/// `out` without the cut ends nested in another's tree.
+fn outermost(m: &SkeletonGraph, mut out: Vec<CutEnd>) -> Vec<CutEnd> {
     // A rough cut's legs may hang from junctions nested in one tree: the
     // end is the outermost one, whose tree holds the others.
     let inner: std::collections::HashSet<NodeId> = out
