@@ -50,6 +50,54 @@ pub struct VertexIndex(u32);
 
 pub type ColorType = u32;
 
+/// An index that fits in a `u32` (skeletonise's patch: [`Packed`]).
+pub(crate) trait Index32: Copy {
+    fn from_u32(i: u32) -> Self;
+    fn to_u32(self) -> u32;
+}
+
+macro_rules! index32 {
+    ($($t:ident),*) => {$(
+        impl Index32 for $t {
+            #[inline(always)]
+            fn from_u32(i: u32) -> Self {
+                Self(i)
+            }
+            #[inline(always)]
+            fn to_u32(self) -> u32 {
+                self.0
+            }
+        }
+    )*};
+}
+index32!(CellIndex, EdgeIndex, VertexIndex);
+
+/// An optional index in four bytes, `u32::MAX` for none (skeletonise's
+/// patch: an `Option<u32>` takes eight, and a half-edge holds five of them;
+/// the builder's indices are `u32` and `u32::MAX` is already its invalid
+/// index).
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[derive(Copy, Clone, PartialEq, Eq)]
+pub(crate) struct Packed<T>(u32, std::marker::PhantomData<T>);
+
+impl<T: Index32> Packed<T> {
+    /// No index.
+    pub(crate) const NONE: Self = Self(u32::MAX, std::marker::PhantomData);
+
+    /// The index, if any.
+    #[inline(always)]
+    pub(crate) fn get(self) -> Option<T> {
+        (self.0 != u32::MAX).then(|| T::from_u32(self.0))
+    }
+}
+
+impl<T: Index32> From<Option<T>> for Packed<T> {
+    #[inline(always)]
+    fn from(i: Option<T>) -> Self {
+        Self(i.map_or(u32::MAX, T::to_u32), std::marker::PhantomData)
+    }
+}
+
 /// Represents category of the input source that forms Voronoi cell.
 // Todo: sort out all of these bits, seems like they overlap in functionality
 #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
@@ -85,7 +133,7 @@ pub struct Cell {
     id_: CellIndex,
     // source_index/initial_index of the site event
     source_index_: SourceIndex,
-    incident_edge_: Option<EdgeIndex>,
+    incident_edge_: Packed<EdgeIndex>,
     color_: ColorType,
 }
 
@@ -101,7 +149,7 @@ pub struct Vertex {
     pub(crate) id_: VertexIndex,
     pub(crate) x_: f64,
     pub(crate) y_: f64,
-    pub(crate) incident_edge_: Option<EdgeIndex>,
+    pub(crate) incident_edge_: Packed<EdgeIndex>,
     pub(crate) color_: ColorType,
 }
 
@@ -119,11 +167,11 @@ pub struct Vertex {
 #[derive(Copy, Clone)]
 pub struct Edge {
     id_: EdgeIndex,
-    cell_: Option<CellIndex>,
-    vertex_: Option<VertexIndex>,
-    twin_: Option<EdgeIndex>,
-    next_ccw_: Option<EdgeIndex>,
-    prev_ccw_: Option<EdgeIndex>,
+    cell_: Packed<CellIndex>,
+    vertex_: Packed<VertexIndex>,
+    twin_: Packed<EdgeIndex>,
+    next_ccw_: Packed<EdgeIndex>,
+    prev_ccw_: Packed<EdgeIndex>,
     color_: ColorType,
 }
 

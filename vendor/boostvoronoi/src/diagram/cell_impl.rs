@@ -11,7 +11,7 @@
 
 // Ported from C++ boost 1.76.0 to Rust in 2020/2021, 2025 by Eadf (github.com/eadf)
 
-use super::{ColorBits, SourceCategory};
+use super::{ColorBits, Packed, SourceCategory};
 use crate::prelude::*;
 
 impl CellIndex {
@@ -31,7 +31,7 @@ impl Cell {
         Cell {
             id_: id,
             source_index_: source_index,
-            incident_edge_: None,
+            incident_edge_: Packed::NONE,
             color_: source_category,
         }
     }
@@ -97,12 +97,12 @@ impl Cell {
 
     /// Degenerate cells don't have any incident edges.
     pub fn is_degenerate(&self) -> bool {
-        self.incident_edge_.is_none()
+        self.incident_edge_.get().is_none()
     }
 
     /// returns a random edge defined by this cell.
     #[inline(always)]
     pub fn get_incident_edge(&self) -> Option<EdgeIndex> {
-        self.incident_edge_
+        self.incident_edge_.get()
     }
 }

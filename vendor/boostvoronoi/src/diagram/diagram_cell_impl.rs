@@ -74,7 +74,7 @@ impl Diagram {
 
     #[inline(always)]
     pub(super) fn cell_get_incident_edge_(&self, cell_id: CellIndex) -> Option<EdgeIndex> {
-        self.cell_(cell_id).and_then(|cell| cell.incident_edge_)
+        self.cell_(cell_id).and_then(|cell| cell.incident_edge_.get())
     }
 
     #[inline(always)]
@@ -88,7 +88,7 @@ impl Diagram {
     #[inline]
     pub(super) fn edge_set_cell_(&mut self, edge_id: EdgeIndex, cell_id: CellIndex) {
         if let Some(edge) = self.edges_.get_mut(edge_id.usize()) {
-            edge.cell_ = Some(cell_id);
+            edge.cell_ = Some(cell_id).into();
         }
     }
 
@@ -110,7 +110,7 @@ impl Diagram {
     #[inline(always)]
     pub(super) fn cell_set_incident_edge_(&mut self, cell_id: CellIndex, edge: Option<EdgeIndex>) {
         if let Some(cell) = self.cells_.get_mut(cell_id.usize()) {
-            cell.incident_edge_ = edge;
+            cell.incident_edge_ = edge.into();
         }
     }
 }

@@ -201,7 +201,7 @@ impl Diagram {
     #[inline]
     pub(crate) fn edge_set_twin_(&mut self, edge_id: EdgeIndex, twin_id: EdgeIndex) {
         if let Some(edge) = self.edges_.get_mut(edge_id.usize()) {
-            edge.twin_ = Some(twin_id);
+            edge.twin_ = Some(twin_id).into();
         }
     }
 
@@ -328,7 +328,7 @@ impl Diagram {
 
     pub(super) fn edge_set_vertex0_(&mut self, edge_id: EdgeIndex, vertex_id: Option<VertexIndex>) {
         if let Some(edge) = self.edges_.get_mut(edge_id.usize()) {
-            edge.vertex_ = vertex_id;
+            edge.vertex_ = vertex_id.into();
         }
     }
 
@@ -358,14 +358,14 @@ impl Diagram {
     #[inline]
     pub(super) fn edge_set_prev_(&mut self, edge_id: EdgeIndex, prev_id: Option<EdgeIndex>) {
         if let Some(edge) = self.edges_.get_mut(edge_id.usize()) {
-            edge.prev_ccw_ = prev_id;
+            edge.prev_ccw_ = prev_id.into();
         }
     }
 
     #[inline]
     pub(super) fn edge_set_next_(&mut self, edge_id: EdgeIndex, next_id: Option<EdgeIndex>) {
         if let Some(edge) = self.edges_.get_mut(edge_id.usize()) {
-            edge.next_ccw_ = next_id;
+            edge.next_ccw_ = next_id.into();
         }
     }
 

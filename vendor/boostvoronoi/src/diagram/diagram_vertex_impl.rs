@@ -82,14 +82,14 @@ impl Diagram {
         edge: Option<EdgeIndex>,
     ) {
         if let Some(vertex) = self.vertices_.get_mut(vertex_id.usize()) {
-            vertex.incident_edge_ = edge;
+            vertex.incident_edge_ = edge.into();
         }
     }
 
     /// return one of the edges originating at the vertex
     #[inline(always)]
     pub fn vertex_get_incident_edge(&self, vertex_id: VertexIndex) -> Option<EdgeIndex> {
-        self.vertex_(vertex_id).and_then(|x| x.incident_edge_)
+        self.vertex_(vertex_id).and_then(|x| x.incident_edge_.get())
     }
 
     /// Set the color of the vertex. This affects only the public bits, not the internal

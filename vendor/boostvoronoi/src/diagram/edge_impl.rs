@@ -11,7 +11,7 @@
 
 // Ported from C++ boost 1.76.0 to Rust in 2020/2021, 2025 by Eadf (github.com/eadf)
 
-use crate::diagram::ColorBits;
+use crate::diagram::{ColorBits, Packed};
 use crate::prelude::*;
 
 impl EdgeIndex {
@@ -34,11 +34,11 @@ impl Edge {
     pub(super) fn new_(id: EdgeIndex, cell: CellIndex, is_linear: bool, is_primary: bool) -> Edge {
         let mut rv = Self {
             id_: id,
-            cell_: Some(cell),
-            vertex_: None,
-            twin_: None,
-            next_ccw_: None,
-            prev_ccw_: None,
+            cell_: Some(cell).into(),
+            vertex_: Packed::NONE,
+            twin_: Packed::NONE,
+            next_ccw_: Packed::NONE,
+            prev_ccw_: Packed::NONE,
             color_: 0,
         };
         if is_linear {
@@ -58,13 +58,13 @@ impl Edge {
 
     #[inline(always)]
     pub(crate) fn cell_(&self) -> Option<CellIndex> {
-        self.cell_
+        self.cell_.get()
     }
 
     /// Returns the cell index of this edge, or a BvError
     #[inline(always)]
     pub fn cell(&self) -> Result<CellIndex, BvError> {
-        self.cell_.ok_or_else(|| {
+        self.cell_.get().ok_or_else(|| {
             BvError::ValueError("Edge didn't have any valid cell associated to it.".to_string())
         })
     }
@@ -73,19 +73,19 @@ impl Edge {
     /// Result<..> is needed here.
     #[inline(always)]
     pub fn vertex0(&self) -> Option<VertexIndex> {
-        self.vertex_
+        self.vertex_.get()
     }
 
     /// Returns the twin edge
     #[inline(always)]
     pub(crate) fn twin_(&self) -> Option<EdgeIndex> {
-        self.twin_
+        self.twin_.get()
     }
 
     /// Returns the twin edge or an error
     #[inline(always)]
     pub fn twin(&self) -> Result<EdgeIndex, BvError> {
-        self.twin_.ok_or_else(|| {
+        self.twin_.get().ok_or_else(|| {
             BvError::ValueError(
                 "Edge didn't have any valid twin edge associated to it.".to_string(),
             )
@@ -95,13 +95,13 @@ impl Edge {
     /// returns the next edge (counterclockwise winding)
     #[inline(always)]
     pub(crate) fn next_(&self) -> Option<EdgeIndex> {
-        self.next_ccw_
+        self.next_ccw_.get()
     }
 
     /// returns the next edge (counterclockwise winding) or an error
     #[inline(always)]
     pub fn next(&self) -> Result<EdgeIndex, BvError> {
-        self.next_ccw_.ok_or_else(|| {
+        self.next_ccw_.get().ok_or_else(|| {
             BvError::ValueError(format!(
                 "Edge {} didn't have any valid next edge associated to it. {}:{}",
                 self.id_.0,
@@ -114,7 +114,7 @@ impl Edge {
     /// returns the previous edge (counterclockwise winding)
     #[inline(always)]
     pub(crate) fn prev_(&self) -> Option<EdgeIndex> {
-        self.prev_ccw_
+        self.prev_ccw_.get()
     }
 
     /// returns the previous edge (counterclockwise winding)

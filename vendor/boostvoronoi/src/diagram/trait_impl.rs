@@ -21,7 +21,7 @@ impl fmt::Debug for Cell {
             "(id:{:?} ii:{} ie:{} col:{})",
             self.id_.0,
             self.source_index_.0,
-            crate::utils::ctypes::format_id(self.incident_edge_.map(|x| x.0)),
+            crate::utils::ctypes::format_id(self.incident_edge_.get().map(|x| x.0)),
             self.color_
         )
     }
@@ -59,7 +59,7 @@ impl fmt::Debug for Vertex {
             self.id_.0,
             self.x_,
             self.y_,
-            crate::utils::ctypes::format_id(self.incident_edge_.map(|x| x.0)),
+            crate::utils::ctypes::format_id(self.incident_edge_.get().map(|x| x.0)),
             self.color_
         )
     }
@@ -71,11 +71,11 @@ impl fmt::Debug for Edge {
             f,
             "id:{} cell:{} v0:{} t:{} n:{} p:{} c:{}",
             self.id_.0,
-            crate::utils::ctypes::format_id(self.cell_.map(|c| c.0)),
-            crate::utils::ctypes::format_id(self.vertex_.map(|v| v.0)),
-            crate::utils::ctypes::format_id(self.twin_.map(|e| e.0)),
-            crate::utils::ctypes::format_id(self.next_ccw_.map(|e| e.0)),
-            crate::utils::ctypes::format_id(self.prev_ccw_.map(|e| e.0)),
+            crate::utils::ctypes::format_id(self.cell_.get().map(|c| c.0)),
+            crate::utils::ctypes::format_id(self.vertex_.get().map(|v| v.0)),
+            crate::utils::ctypes::format_id(self.twin_.get().map(|e| e.0)),
+            crate::utils::ctypes::format_id(self.next_ccw_.get().map(|e| e.0)),
+            crate::utils::ctypes::format_id(self.prev_ccw_.get().map(|e| e.0)),
             self.color_
         )
     }

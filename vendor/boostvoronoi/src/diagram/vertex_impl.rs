@@ -9,7 +9,7 @@
 
 // Ported from C++ boost 1.76.0 to Rust in 2020/2021, 2025 by Eadf (github.com/eadf)
 
-use super::{ColorBits, ColorType, EdgeIndex, Vertex, VertexIndex};
+use super::{ColorBits, ColorType, EdgeIndex, Packed, Vertex, VertexIndex};
 use crate::BvError;
 use num_traits::NumCast;
 use std::cmp::Ordering;
@@ -38,7 +38,7 @@ impl Vertex {
             id_: id,
             x_: x,
             y_: y,
-            incident_edge_: None,
+            incident_edge_: Packed::NONE,
             color_: color,
         }
     }
@@ -61,12 +61,12 @@ impl Vertex {
     #[inline]
     #[cfg(feature = "console_debug")]
     pub(crate) fn get_incident_edge_(&self) -> Option<EdgeIndex> {
-        self.incident_edge_
+        self.incident_edge_.get()
     }
 
     #[inline(always)]
     pub fn get_incident_edge(&self) -> Result<EdgeIndex, BvError> {
-        self.incident_edge_.ok_or_else(|| {
+        self.incident_edge_.get().ok_or_else(|| {
             BvError::InternalError("Vertex didn't have an incident_edge".to_string())
         })
     }
