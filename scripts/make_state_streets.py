@@ -30,14 +30,31 @@ import shapely
 from shapely import affinity
 from shapely.geometry import LineString, Point, Polygon
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from make_streets import gmt_segments  # noqa: E402
 
 STATES = "CO UT AZ NM WY NE KS OK TX ID MT SD ND NV IA MO AR LA MN WI IL".split()
 NEAR = 2_000.0  # metres (EPSG:5070): a shared border lies within this of the neighbour
 MEET = 15_000.0  # border ends this close meet at one junction
 SCALE, WIDTH = 1 / 5000, 10.0
 X0, Y0 = 500_000.0, 6_650_000.0
+
+
+def gmt_segments(*args: str) -> list[list[tuple[float, float]]]:
+    """The segments (lists of lon/lat points, longitudes in −180…180) GMT prints with `-M` for `args`."""
+    import subprocess
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as d:  # GMT leaves gmt.history behind
+        text = subprocess.run(["gmt", *args], check=True, capture_output=True, text=True, cwd=d).stdout
+    segments, cur = [], []
+    for line in text.splitlines() + [">"]:
+        if line.startswith(">"):
+            if cur:
+                segments.append(cur)
+            cur = []
+        else:
+            x, y = map(float, line.split()[:2])
+            cur.append((x - 360 if x > 180 else x, y))
+    return segments
 
 
 def state(code: str) -> Polygon:

@@ -29,6 +29,7 @@ each metre, moved across it by up to ±1 m, seeded), whose reference is the quar
 
 from __future__ import annotations
 
+import os
 import sys
 
 import geopandas as gpd
@@ -37,26 +38,10 @@ import shapely.ops
 from shapely import affinity
 from shapely.geometry import LineString, box
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from make_state_streets import frames as state_frames, gmt_segments  # noqa: E402
+
 X0, Y0 = 500_000.0, 6_650_000.0
-
-
-def gmt_segments(*args: str) -> list[list[tuple[float, float]]]:
-    """The segments (lists of lon/lat points, longitudes in −180…180) GMT prints with `-M` for `args`."""
-    import subprocess
-    import tempfile
-
-    with tempfile.TemporaryDirectory() as d:  # GMT leaves gmt.history behind
-        text = subprocess.run(["gmt", *args], check=True, capture_output=True, text=True, cwd=d).stdout
-    segments, cur = [], []
-    for line in text.splitlines() + [">"]:
-        if line.startswith(">"):
-            if cur:
-                segments.append(cur)
-            cur = []
-        else:
-            x, y = map(float, line.split()[:2])
-            cur.append((x - 360 if x > 180 else x, y))
-    return segments
 
 
 def ragged_box(x0, y0, x1, y1, amp, step, seed):
@@ -200,7 +185,6 @@ def main(out: str) -> None:
         junctions, ends = nodes(space, list(frames[name + "_lines"].geometry.values), crs)
         frames[name + "_junctions"], frames[name + "_ends"] = junctions, ends
     # Street space between real blocks (US states of GMT's DCW): scripts/make_state_streets.py.
-    from make_state_streets import frames as state_frames
     frames.update(state_frames())
     for layer, frame in frames.items():
         frame.to_file(out, layer=layer, driver="GPKG")
