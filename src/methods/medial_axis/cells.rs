@@ -81,13 +81,14 @@ impl Extractor<'_> {
             if r0 == r1 {
                 continue;
             }
-            let (w0, _) = self.position(r0, k.s0);
-            let (w1, _) = self.position(r1, k.s0);
-            if let Some(line) = self.through_vertex(&vertices, k.s0, k.s1, r0, r1, w0, w1) {
+            let (s0, s1) = self.sites(k);
+            let (w0, _) = self.position(r0, s0);
+            let (w1, _) = self.position(r1, s0);
+            if let Some(line) = self.through_vertex(&vertices, s0, s1, r0, r1, w0, w1) {
                 out.push(CellEdge {
                     sites: [
-                        self.world_site(&vertices, k.s0),
-                        self.world_site(&vertices, k.s1),
+                        self.world_site(&vertices, s0),
+                        self.world_site(&vertices, s1),
                     ],
                     line,
                 });
@@ -96,13 +97,13 @@ impl Extractor<'_> {
             let mut line = vec![w0];
             if k.curved {
                 let (p0, p1) = (self.vertex_at(r0), self.vertex_at(r1));
-                line.extend(self.arc_points(p0, p1, k.s0, k.s1));
+                line.extend(self.arc_points(p0, p1, s0, s1));
             }
             line.push(w1);
             out.push(CellEdge {
                 sites: [
-                    self.world_site(&vertices, k.s0),
-                    self.world_site(&vertices, k.s1),
+                    self.world_site(&vertices, s0),
+                    self.world_site(&vertices, s1),
                 ],
                 line,
             });

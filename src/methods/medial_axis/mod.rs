@@ -299,13 +299,13 @@ fn site_distance(site: Site, segs: &[Seg], q: [f64; 2]) -> f64 {
 /// rounding to the grid perturbs junctions by about one unit.
 const CONTRACT: f64 = 4.0;
 
-/// A Voronoi edge kept for the medial axis.
+/// A Voronoi edge kept for the medial axis: its vertices and the cells of
+/// its two sites (20 bytes: a rough rim keeps millions of them).
 #[derive(Debug, Clone, Copy)]
 struct Kept {
     v0: VertexIndex,
     v1: VertexIndex,
-    s0: Site,
-    s1: Site,
+    cells: [u32; 2],
     curved: bool,
 }
 
@@ -350,6 +350,13 @@ impl<'a> Extractor<'a> {
         }
     }
 
+    /// The sites of a kept edge's two cells.
+    fn sites(&self, k: &Kept) -> (Site, Site) {
+        let cells = self.diagram.cells();
+        let [c0, c1] = k.cells.map(|c| &cells[c as usize]);
+        (self.site(c0), self.site(c1))
+    }
+
     fn vertex(&self, v: VertexIndex) -> [f64; 2] {
         self.vertex_at(v.usize())
     }
@@ -366,29 +373,33 @@ impl<'a> Extractor<'a> {
         let kept = self.inside_edges(false)?;
         let mut rep = self.representatives(&kept);
         // The kept edges between two clusters, with their ends.
-        let joined: Vec<Joined> = kept
-            .iter()
-            .filter_map(|k| {
-                let (r0, r1) = (find(&mut rep, k.v0.usize()), find(&mut rep, k.v1.usize()));
-                (r0 != r1).then(|| Joined {
-                    r: [r0, r1],
-                    p: [self.vertex_at(r0), self.vertex_at(r1)],
-                    kept: *k,
-                })
-            })
-            .collect();
-        drop((kept, rep));
         // A cluster's node is made where an edge first reaches it, placed
         // by that edge's first site.
         let mut made = vec![false; self.diagram.vertices().len()];
         let mut nodes = Vec::new();
-        for j in &joined {
-            for v in j.r {
+        let mut joined = Vec::with_capacity(kept.len());
+        for k in &kept {
+            let (r0, r1) = (find(&mut rep, k.v0.usize()), find(&mut rep, k.v1.usize()));
+            if r0 == r1 {
+                continue;
+            }
+            let (s0, s1) = self.sites(k);
+            for v in [r0, r1] {
                 if !std::mem::replace(&mut made[v], true) {
-                    let (pos, r) = self.position(v, j.kept.s0);
+                    let (pos, r) = self.position(v, s0);
                     nodes.push((pos, self.grid.length(r)));
                 }
             }
+            let arc = match (k.curved, s0, s1) {
+                (true, Site::Point(q), Site::Segment(s))
+                | (true, Site::Segment(s), Site::Point(q)) => Some((q, s as u32)),
+                _ => None,
+            };
+            joined.push(Joined {
+                r: [r0, r1].map(|r| r as u32),
+                p: [self.vertex_at(r0), self.vertex_at(r1)],
+                arc,
+            });
         }
         Ok(Plan {
             joined,
@@ -472,8 +483,7 @@ impl<'a> Extractor<'a> {
             kept.push(Kept {
                 v0,
                 v1,
-                s0,
-                s1,
+                cells: [c0.u32(), c1.u32()],
                 curved: e.is_curved(),
             });
         }
@@ -542,11 +552,12 @@ impl<'a> Extractor<'a> {
 }
 
 /// A kept edge of the Voronoi diagram between the clusters `r` (their
-/// representatives, at `p`).
+/// representatives, at `p`), with its arc's point and segment sites when
+/// it is a parabolic arc.
 struct Joined {
-    r: [usize; 2],
+    r: [u32; 2],
     p: [[f64; 2]; 2],
-    kept: Kept,
+    arc: Option<(Pt, u32)>,
 }
 
 /// [`Extractor::run`] samples the arcs on every core from this many edges
@@ -585,10 +596,8 @@ impl Plan {
             vertices,
         } = self;
         let sample = |j: &Joined| {
-            j.kept
-                .curved
-                .then(|| arc_samples(segs, grid, tolerance, j.p, j.kept.s0, j.kept.s1))
-                .flatten()
+            j.arc
+                .and_then(|(q, s)| arc_samples(segs, grid, tolerance, j.p, q, s as usize))
                 .unwrap_or_default()
         };
         // The arcs' samples first (on every core for a large diagram: a
@@ -614,14 +623,14 @@ impl Plan {
                 Arcs { samples, ends }
             })
             .collect();
-        let clusters: Vec<[usize; 2]> = joined.iter().map(|j| j.r).collect();
+        let clusters: Vec<[u32; 2]> = joined.iter().map(|j| j.r).collect();
         drop(joined);
         let mut graph = SkeletonGraph::new();
         graph.reserve(nodes.len(), clusters.len());
         let mut node_of: Vec<Option<NodeId>> = vec![None; vertices];
         let mut nodes = nodes.into_iter();
-        let mut node = |graph: &mut SkeletonGraph, v: usize| {
-            *node_of[v].get_or_insert_with(|| {
+        let mut node = |graph: &mut SkeletonGraph, v: u32| {
+            *node_of[v as usize].get_or_insert_with(|| {
                 let (pos, r) = nodes.next().expect("the plan has a node for every cluster");
                 graph.add_node(pos, r, None)
             })
@@ -647,20 +656,16 @@ impl Plan {
 }
 
 /// The interior samples of the parabolic edge from `p[0]` to `p[1]`
-/// between sites `s0` and `s1` (grid units), or `None` when it is drawn
-/// straight (not between a point and a segment, or degenerate).
+/// between the point site `point` and the segment `seg` (grid units), or
+/// `None` when it is degenerate (drawn straight).
 fn arc_samples(
     segs: &[Seg],
     grid: &Grid,
     tolerance: ArcTolerance,
     p: [[f64; 2]; 2],
-    s0: Site,
-    s1: Site,
+    point: Pt,
+    seg: usize,
 ) -> Option<Vec<Sample>> {
-    let (point, seg) = match (s0, s1) {
-        (Site::Point(p), Site::Segment(s)) | (Site::Segment(s), Site::Point(p)) => (p, s),
-        _ => return None,
-    };
     let s = segs[seg];
     let par = Parabola::new(fpt(point), fpt(s.a), fpt(s.b))?;
     Some(par.samples(par.abscissa(p[0]), par.abscissa(p[1]), |r| {
