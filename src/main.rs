@@ -617,7 +617,7 @@ mod tests {
     }
 
     /// The option index is mimalloc's `purge_delay`: it holds mimalloc 3's
-    /// default, and setting it is what the allocator then reads.
+    /// default (1 000 ms) unless already set, and `prompt_purge` sets it.
     #[test]
     fn the_purge_delay_is_the_option_set() {
         if std::env::var_os("MIMALLOC_PURGE_DELAY").is_some() {

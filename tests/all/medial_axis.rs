@@ -345,6 +345,18 @@ fn finer_tolerance_gives_more_pieces() {
     assert!(n(0.01) > n(0.3));
 }
 
+/// A finer tolerance adds vertices inside an arc's edge, not edges and
+/// nodes: the raw graph of a rough rim stays a few nodes per boundary
+/// vertex however finely its arcs are drawn.
+#[test]
+fn an_arc_is_one_edge_whatever_the_tolerance() {
+    let g = |t| ma_with(&l_shape(), ArcTolerance::Relative(t)).1;
+    let (fine, coarse) = (g(0.0001), g(0.3));
+    assert!(pieces_of(&fine) > pieces_of(&coarse));
+    assert_eq!(fine.edges().len(), coarse.edges().len());
+    assert_eq!(fine.nodes().len(), coarse.nodes().len());
+}
+
 #[test]
 fn relative_tolerance_is_scale_free() {
     let (_, g1) = ma(&l_shape());

@@ -196,8 +196,8 @@ impl SkeletonMethod for MedialAxis {
         match quantised(polygon)? {
             Some((grid, segs, diagram)) => {
                 let plan = Extractor::new(&diagram, &segs, &grid, self.tolerance).plan()?;
-                // The diagram (48 bytes a half-edge, six half-edges a
-                // boundary vertex) is not needed for the graph.
+                // The diagram (six half-edges a boundary vertex) is not
+                // needed for the graph.
                 drop(diagram);
                 Ok(plan.graph(&segs, &grid, self.tolerance))
             }
@@ -560,7 +560,7 @@ struct Joined {
     arc: Option<(Pt, u32)>,
 }
 
-/// [`Extractor::run`] samples the arcs on every core from this many edges
+/// [`Plan::graph`] samples the arcs on every core from this many edges
 /// on (fewer: on the calling thread — most polygons, in a run that has a
 /// thread per feature already).
 const ARCS_IN_PARALLEL: usize = 1 << 15;
