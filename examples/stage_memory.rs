@@ -64,8 +64,8 @@ fn main() {
     });
     let method = Registry::builtin()
         .build(id, &SkeletonParams::default())
-        .unwrap_or_else(|e| {
-            eprintln!("{e}");
+        .unwrap_or_else(|| {
+            eprintln!("method {id} is not registered");
             std::process::exit(1)
         });
     println!("vertices\tinput_MB\tskeleton_MB\traw_MB\tnodes\tfinished_nodes\tprune_s\tprune_MB\tprune_B_per_node\tscore_MB\tscore_B_per_vertex");

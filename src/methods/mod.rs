@@ -427,15 +427,10 @@ impl Registry {
             })
     }
 
-    /// An instance of method `id` configured by `params`.
-    pub fn build(
-        &self,
-        id: MethodId,
-        params: &SkeletonParams,
-    ) -> Result<Box<dyn SkeletonMethod>, String> {
-        self.get(id)
-            .map(|e| (e.build)(params))
-            .ok_or_else(|| format!("method {id} is not registered"))
+    /// An instance of method `id` configured by `params` (`None`: `id`
+    /// is not registered).
+    pub fn build(&self, id: MethodId, params: &SkeletonParams) -> Option<Box<dyn SkeletonMethod>> {
+        self.get(id).map(|e| (e.build)(params))
     }
 }
 

@@ -8,6 +8,7 @@
 
 use super::layer::CoverageRow;
 use super::owners::{with_inserted, Inserts, Unit};
+use super::UnitError;
 use crate::geometry::overlay::{self, signed_union, Edits};
 use crate::geometry::tolerance::SAME_POINT;
 use crate::geometry::vector::norm;
@@ -40,7 +41,7 @@ struct Changes {
 pub fn assemble(
     units: &[Unit],
     grown: Vec<(Option<u64>, Growth)>,
-) -> Result<Vec<CoverageRow>, String> {
+) -> Result<Vec<CoverageRow>, UnitError> {
     let mut by_fid: FxHashMap<u64, Changes> = FxHashMap::default();
     for (fid, g) in grown {
         let Some(f) = fid else { continue };
@@ -121,17 +122,15 @@ fn tolerance(c: &Changes) -> f64 {
 /// Why a changed unit cannot be written: a part that is not a valid
 /// polygon, or an area other than the unit's, less what it held, plus what
 /// it was given.
-fn checked(u: &Unit, g: &MultiPolygon<f64>, c: &Changes) -> Result<(), String> {
-    let fid = u.fid.map_or_else(|| "(no fid)".into(), |f| f.to_string());
+fn checked(u: &Unit, g: &MultiPolygon<f64>, c: &Changes) -> Result<(), UnitError> {
+    let fid = || super::fid_text(u.fid);
     for p in &g.0 {
         let problem = match PreparedPolygon::new(p) {
             Ok(pp) => crate::geometry::validity::problem(&pp),
             Err(e) => Some(e.to_string()),
         };
         if let Some(why) = problem {
-            return Err(format!(
-                "unit {fid} of `input.neighbours` is not valid once the collapsed polygons' areas are cut out of it and given to it ({why}); check that the units form a coverage (no overlap between units) and that `input.neighbours.snap` is below the narrowest part of the units"
-            ));
+            return Err(UnitError::NotValidGrown { fid: fid(), why });
         }
     }
     let want = c.edits.apply(&u.geometry).unsigned_area() - overlay::area(&c.held)
@@ -139,9 +138,11 @@ fn checked(u: &Unit, g: &MultiPolygon<f64>, c: &Changes) -> Result<(), String> {
     let got = g.unsigned_area();
     let scale = u.geometry.unsigned_area() + overlay::area(&c.given);
     if (got - want).abs() > 1e-9 * scale.max(f64::MIN_POSITIVE) {
-        return Err(format!(
-            "unit {fid} of `input.neighbours` would be written with an area of {got}, not {want} (its area less what it held of the collapsed polygons plus what it was given); please report this with the data"
-        ));
+        return Err(UnitError::AreaNotKept {
+            fid: fid(),
+            got,
+            want,
+        });
     }
     Ok(())
 }

@@ -14,6 +14,7 @@
 //! so that the coverage is written as `unit snapped − held + given`.
 
 use super::owners::{with_inserted, Coverage, Inserts, Unit};
+use super::UnitError;
 use crate::geometry::overlay::{
     self, contact, overlay, snap_edges, snap_vertices, vertex_index, with_hole, BankInsert,
     Contact, Edits,
@@ -49,7 +50,7 @@ impl Near {
     /// and cut by it (points within `tol` of an edge count as on it).
     /// Or why a unit could not be cut exactly (its pieces would not add up
     /// to it).
-    pub fn of(p: &PreparedPolygon, cov: &Coverage, snap: f64, tol: f64) -> Result<Near, String> {
+    pub fn of(p: &PreparedPolygon, cov: &Coverage, snap: f64, tol: f64) -> Result<Near, UnitError> {
         let b = p.boundary();
         let grow = Coord { x: snap, y: snap };
         let indices = cov.units_near(b.bbox_min() - grow, b.bbox_max() + grow);
@@ -67,7 +68,7 @@ impl Near {
         let points = vertex_index(&polygon);
         let bank = crate::geometry::Boundary::new(&polygon);
         let probe = geo::InteriorPoint::interior_point(&polygon).map(|q| q.0);
-        let near: Result<Vec<NearUnit>, String> = indices
+        let near: Result<Vec<NearUnit>, UnitError> = indices
             .iter()
             .zip(edits)
             .map(|(&k, mut e)| {
@@ -100,12 +101,16 @@ impl Near {
                     Contact::Crosses => {}
                 }
                 let o = overlay(&snapped.0, &polygon, tol);
-                let (whole, parts) = (snapped.unsigned_area(), overlay::area(&o.outside) + overlay::area(&o.inside));
+                let (whole, parts) = (
+                    snapped.unsigned_area(),
+                    overlay::area(&o.outside) + overlay::area(&o.inside),
+                );
                 if (whole - parts).abs() > 1e-9 * whole.max(p.polygon().unsigned_area()) {
-                    let fid = units[k as usize].fid.map_or_else(|| "(no fid)".into(), |f| f.to_string());
-                    return Err(format!(
-                        "unit {fid} of `input.neighbours` could not be cut exactly by the polygon (its pieces add up to {parts}, not {whole}); check the unit's validity, or try another `input.neighbours.snap`"
-                    ));
+                    return Err(UnitError::NotCutExactly {
+                        fid: super::fid_text(units[k as usize].fid),
+                        parts,
+                        whole,
+                    });
                 }
                 Ok(NearUnit {
                     index: k,

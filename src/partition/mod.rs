@@ -223,24 +223,82 @@ pub enum PartitionError {
         y: f64,
     },
     /// A unit near the polygon cannot be cut exactly by it.
-    #[error("{0}")]
-    Unit(String),
+    #[error(transparent)]
+    Unit(#[from] UnitError),
     /// With `width`, the part's medial axis is needed and missing.
     #[error("a partition with `width` needs the part's medial axis")]
     NoMedialAxis,
-    /// The polygon, its cells or its faces could not be made (a bug or a
-    /// degenerate polygon: the text says which).
-    #[error("{0}")]
-    Geometry(String),
+    /// The polygon with the units' meeting points could not be prepared (a
+    /// degenerate polygon).
+    #[error(transparent)]
+    Geometry(#[from] crate::geometry::GeometryError),
+    /// The cells of the polygon's segment Voronoi diagram could not be made.
+    #[error(transparent)]
+    Cells(#[from] crate::methods::MethodError),
+    /// The new boundaries do not split the polygon into faces (a bug).
+    #[error("the new boundaries do not split the polygon ({0}); please report this feature")]
+    Split(#[from] crate::geometry::arrangement::SplitError),
     /// `expired()` stopped the partition (the caller, which owns the
     /// clock, gives the reason).
     #[error("partition stopped: its time is up")]
     Stopped,
 }
 
-/// A geometry step's error as the reason.
-fn geometry_error(e: impl std::fmt::Display) -> PartitionError {
-    PartitionError::Geometry(e.to_string())
+/// Why a unit of `input.neighbours` cannot be read into the coverage, cut
+/// by a polygon, or written once it has grown (`fid`: its FID, or
+/// `(no fid)`).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum UnitError {
+    /// Its geometry is of another type.
+    #[error("feature {fid} is not a polygon; the coverage is a layer of polygons")]
+    NotAPolygon {
+        /// The unit.
+        fid: String,
+    },
+    /// A coordinate is NaN or infinite.
+    #[error("feature {fid} has a coordinate that is not a finite number ({x}, {y}); fix or remove the unit")]
+    NotFinite {
+        /// The unit.
+        fid: String,
+        /// The coordinate (x).
+        x: f64,
+        /// The coordinate (y).
+        y: f64,
+    },
+    /// Its pieces inside and outside the polygon do not add up to it.
+    #[error("unit {fid} of `input.neighbours` could not be cut exactly by the polygon (its pieces add up to {parts}, not {whole}); check the unit's validity, or try another `input.neighbours.snap`")]
+    NotCutExactly {
+        /// The unit.
+        fid: String,
+        /// The area of its pieces.
+        parts: f64,
+        /// Its area.
+        whole: f64,
+    },
+    /// Grown by what it was given, a part is not a valid polygon.
+    #[error("unit {fid} of `input.neighbours` is not valid once the collapsed polygons' areas are cut out of it and given to it ({why}); check that the units form a coverage (no overlap between units) and that `input.neighbours.snap` is below the narrowest part of the units")]
+    NotValidGrown {
+        /// The unit.
+        fid: String,
+        /// What is wrong with the part.
+        why: String,
+    },
+    /// Grown, its area is not its own less what it held plus what it was
+    /// given.
+    #[error("unit {fid} of `input.neighbours` would be written with an area of {got}, not {want} (its area less what it held of the collapsed polygons plus what it was given); please report this with the data")]
+    AreaNotKept {
+        /// The unit.
+        fid: String,
+        /// The area it would have.
+        got: f64,
+        /// The area it should have.
+        want: f64,
+    },
+}
+
+/// A unit's FID as the messages name it.
+fn fid_text(fid: Option<u64>) -> String {
+    fid.map_or_else(|| "(no fid)".into(), |f| f.to_string())
 }
 
 /// Fails with [`PartitionError::Stopped`] once `expired()`.
@@ -265,13 +323,10 @@ pub fn partition(
     expired: &dyn Fn() -> bool,
 ) -> Result<PartPartition, PartitionError> {
     let tol = SAME_POINT * p.extent();
-    let near =
-        cut::Near::of(p, cov, cov.snap_for(p.extent()), tol).map_err(PartitionError::Unit)?;
+    let near = cut::Near::of(p, cov, cov.snap_for(p.extent()), tol)?;
     if params.overlap == Overlap::Reject {
         if let Some((k, area, at)) = near.first_overlap(tol) {
-            let fid = cov.units()[k as usize]
-                .fid
-                .map_or_else(|| "(no fid)".into(), |f| f.to_string());
+            let fid = fid_text(cov.units()[k as usize].fid);
             return Err(PartitionError::Overlap {
                 fid,
                 area: crate::numbers::sig(area, 4),
@@ -284,7 +339,7 @@ pub fn partition(
     stop_if(expired)?;
     let snapped = match near.polygon == *p.polygon() {
         true => None,
-        false => Some(PreparedPolygon::new(&near.polygon).map_err(geometry_error)?),
+        false => Some(PreparedPolygon::new(&near.polygon)?),
     };
     let mut out = partition_cut(
         snapped.as_ref().unwrap_or(p),
@@ -356,8 +411,8 @@ fn partition_cut(
         }
     }
     stop_if(expired)?;
-    let prepared = PreparedPolygon::new(&owned.polygon).map_err(geometry_error)?;
-    let edges = cell_edges(&prepared, ArcTolerance::default()).map_err(geometry_error)?;
+    let prepared = PreparedPolygon::new(&owned.polygon)?;
+    let edges = cell_edges(&prepared, ArcTolerance::default())?;
     stop_if(expired)?;
     let (pieces, vertices) = split::pieces(&owned, edges);
     let mut lines: Vec<Vec<Coord<f64>>> = pieces.into_iter().map(|q| q.line).collect();
@@ -368,8 +423,7 @@ fn partition_cut(
         .map(LineString)
         .collect();
     stop_if(expired)?;
-    let faces =
-        split::faces(&prepared, &owned, &vertices, &chords).map_err(PartitionError::Geometry)?;
+    let faces = split::faces(&prepared, &owned, &vertices, &chords)?;
     stop_if(expired)?;
     let mut sides: Vec<Side> = faces
         .iter()

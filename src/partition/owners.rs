@@ -35,31 +35,26 @@ pub struct Unit {
 pub fn unit_geometry(
     fid: Option<u64>,
     g: Option<&geo::Geometry<f64>>,
-) -> Result<MultiPolygon<f64>, String> {
+) -> Result<MultiPolygon<f64>, super::UnitError> {
+    use super::UnitError;
     use geo::{CoordsIter, HasDimensions};
-    let name = || fid.map_or_else(|| "(no fid)".into(), |f| f.to_string());
+    let name = || super::fid_text(fid);
     let m = match g {
         None => return Ok(MultiPolygon(Vec::new())),
         Some(g) if g.is_empty() => return Ok(MultiPolygon(Vec::new())),
         Some(geo::Geometry::Polygon(p)) => MultiPolygon(vec![p.clone()]),
         Some(geo::Geometry::MultiPolygon(m)) => m.clone(),
-        Some(_) => {
-            return Err(format!(
-                "feature {} is not a polygon; the coverage is a layer of polygons",
-                name()
-            ))
-        }
+        Some(_) => return Err(UnitError::NotAPolygon { fid: name() }),
     };
     if let Some(c) = m
         .coords_iter()
         .find(|c| !(c.x.is_finite() && c.y.is_finite()))
     {
-        return Err(format!(
-            "feature {} has a coordinate that is not a finite number ({}, {}); fix or remove the unit",
-            name(),
-            c.x,
-            c.y
-        ));
+        return Err(UnitError::NotFinite {
+            fid: name(),
+            x: c.x,
+            y: c.y,
+        });
     }
     Ok(MultiPolygon(
         m.0.into_iter().filter(|p| !p.is_empty()).collect(),

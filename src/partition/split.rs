@@ -292,10 +292,8 @@ pub fn faces(
     owned: &Owned,
     vertices: &Vertices,
     chords: &[LineString<f64>],
-) -> Result<Vec<OwnedFace>, String> {
-    let faces = split_network(p, chords).map_err(|e| {
-        format!("the new boundaries do not split the polygon ({e}); please report this feature")
-    })?;
+) -> Result<Vec<OwnedFace>, crate::geometry::arrangement::SplitError> {
+    let faces = split_network(p, chords)?;
     Ok(faces
         .into_iter()
         .map(|face| {

@@ -114,7 +114,7 @@ pub enum RunError {
     /// A unit of the partitioned coverage could not be written valid (exit
     /// 65: the output is not written).
     #[error("partition: {0}")]
-    Coverage(String),
+    Coverage(#[from] crate::partition::UnitError),
     /// The run's output was written but its report was not.
     #[error("the report failed ({0}); the GeoPackage was written, `skeletonise report` makes the report from it")]
     Report(#[from] ReportError),

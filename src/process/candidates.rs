@@ -2,7 +2,7 @@
 //! skeletons part by part, the reference's structure, pruning, extension,
 //! scores, bars and widths.
 
-use super::{part_reason, CandidateSkeleton, ProcessParams, StageTimes};
+use super::{CandidateError, CandidateSkeleton, ProcessParams, StageTimes};
 use crate::clock::{CpuClock, Stage, Stages, Stopwatch};
 use crate::geometry::PreparedPolygon;
 use crate::graph::extend::prune_and_extend;
@@ -28,14 +28,14 @@ pub(super) fn computed(
     // thread's CPU time over the feature at the end (two CPU clock readings
     // per feature instead of dozens).
     let whole = (!parallel).then(|| (CpuClock::start(), std::time::Instant::now()));
-    let skeletons = || -> Vec<Vec<(Result<PartSkeleton, String>, StageTimes)>> {
+    let skeletons = || -> Vec<Vec<(Result<PartSkeleton, CandidateError>, StageTimes)>> {
         prepared
             .iter()
             .enumerate()
             .map(|(i, p)| {
                 part_skeletons(p, params, parallel)
                     .into_iter()
-                    .map(|(r, t)| (r.map_err(|e| part_reason(i, n, &e)), t))
+                    .map(|(r, t)| (r.map_err(|e| e.of_part(i, n)), t))
                     .collect()
             })
             .collect()
@@ -62,7 +62,7 @@ pub(super) fn computed(
         for (_, t) in per_part.iter().map(|r| &r[k]) {
             time += *t;
         }
-        let parts: Result<Vec<PartSkeleton>, String> = per_part
+        let parts: Result<Vec<PartSkeleton>, CandidateError> = per_part
             .iter()
             .map(|r| r[k].0.clone())
             .collect::<Result<_, _>>()
@@ -102,7 +102,7 @@ fn every_part_has_a_skeleton(
     parts: Vec<PartSkeleton>,
     m: crate::methods::MethodId,
     prepared: &[PreparedPolygon],
-) -> Result<Vec<PartSkeleton>, String> {
+) -> Result<Vec<PartSkeleton>, CandidateError> {
     let n = parts.len();
     let empty = parts.iter().position(|p| p.graph.is_empty());
     match empty {
@@ -110,24 +110,18 @@ fn every_part_has_a_skeleton(
             let area = |p: &PreparedPolygon| geo::Area::unsigned_area(p.polygon());
             let part = prepared.get(i).map_or(f64::NAN, area);
             let whole: f64 = prepared.iter().map(area).sum();
-            Err(part_reason(
-                i,
-                n,
-                &format!(
-                    "{m} gives no skeleton of this polygon part (too thin or too small for the \
-                     method): it has {} CRS units² of the feature's {}; skip parts that small \
-                     with `prepare: {{ min_area: {} }}`, or list another method in \
-                     `skeleton.methods` (e.g. {})",
-                    sig(part, 4),
-                    sig(whole, 4),
-                    sig(part * 1.01, 4),
-                    if m == crate::methods::MethodId::MA {
-                        "CDT"
-                    } else {
-                        "MA"
-                    }
-                ),
-            ))
+            Err(CandidateError::LostPart {
+                method: m,
+                area: sig(part, 4),
+                whole: sig(whole, 4),
+                min_area: sig(part * 1.01, 4),
+                other: if m == crate::methods::MethodId::MA {
+                    crate::methods::MethodId::CDT
+                } else {
+                    crate::methods::MethodId::MA
+                },
+            }
+            .of_part(i, n))
         }
         _ => Ok(parts),
     }
@@ -203,7 +197,7 @@ pub(super) fn part_skeletons(
     p: &PreparedPolygon,
     params: &ProcessParams,
     parallel: bool,
-) -> Vec<(Result<PartSkeleton, String>, StageTimes)> {
+) -> Vec<(Result<PartSkeleton, CandidateError>, StageTimes)> {
     let work = PartWork::new(p, params, parallel);
     if let Some(why) = work.dropped() {
         return params
@@ -244,7 +238,7 @@ const HIDDEN: usize = usize::MAX;
 /// One method's raw skeleton of a polygon part, the time taken so far, and
 /// (for the first method of the reference order) its finished skeleton.
 struct Raw {
-    graph: Result<SkeletonGraph, String>,
+    graph: Result<SkeletonGraph, CandidateError>,
     stages: Stages,
     reference: Option<Reference>,
     /// Whether its finished skeleton was tried as the reference.
@@ -329,16 +323,12 @@ impl<'a> PartWork<'a> {
 
     /// Why this part gets no skeleton: `mode: network`, no line meets it,
     /// and `fallback: drop`.
-    fn dropped(&self) -> Option<String> {
+    fn dropped(&self) -> Option<CandidateError> {
         let asked = self.params.prune?;
         (asked.mode == crate::graph::prune::PruneMode::Network
             && self.network.is_none()
             && self.prune.is_none())
-        .then(|| {
-            "no line of `input.connect` meets this polygon, and `prune.fallback` is `drop`; \
-             use `fallback: significance` or `trunk` to give such polygons a skeleton"
-                .to_string()
-        })
+        .then_some(CandidateError::NoConnection)
     }
 
     /// A raw skeleton pruned and extended on its own (with `mode: network`,
@@ -393,7 +383,7 @@ impl<'a> PartWork<'a> {
         k: usize,
         raw: &SkeletonGraph,
         ctx: &MethodContext,
-    ) -> Result<Option<Reference>, String> {
+    ) -> Result<Option<Reference>, CandidateError> {
         let m = self.params.skeleton.methods[k];
         let g = self.staged(m, ctx, |x| self.finish(raw, x))?;
         Ok((!g.is_empty()).then(|| {
@@ -416,16 +406,15 @@ impl<'a> PartWork<'a> {
         m: crate::methods::MethodId,
         ctx: &MethodContext,
         finish: impl FnOnce(&dyn Fn() -> bool) -> Option<SkeletonGraph>,
-    ) -> Result<SkeletonGraph, String> {
+    ) -> Result<SkeletonGraph, CandidateError> {
         const STAGE: &str = "pruning and extending";
         let bytes = PRUNE_BYTES_PER_VERTEX * self.p.vertex_count() as f64;
         ctx.check_stage(m, STAGE)
-            .and_then(|()| ctx.afford_stage(m, STAGE, bytes))
-            .map_err(|e| e.to_string())?;
+            .and_then(|()| ctx.afford_stage(m, STAGE, bytes))?;
         let expired = || ctx.check_stage(m, STAGE).is_err();
         let g = finish(&expired);
-        ctx.check_stage(m, STAGE).map_err(|e| e.to_string())?;
-        g.ok_or_else(|| "pruning stopped without a deadline".to_string())
+        ctx.check_stage(m, STAGE)?;
+        g.ok_or(CandidateError::PruningStopped)
     }
 
     /// Every method's raw skeleton. The first of the reference order is
@@ -442,10 +431,12 @@ impl<'a> PartWork<'a> {
                 self.params
                     .registry
                     .build(m, &self.params.skeleton)
+                    .ok_or(CandidateError::NotRegistered(m))
                     .and_then(|method| {
                         guarded(m, || {
-                            budget::within(m, &ctx, |ctx| method.skeletonise(self.p, ctx))
-                                .map_err(|e| e.to_string())
+                            Ok(budget::within(m, &ctx, |ctx| {
+                                method.skeletonise(self.p, ctx)
+                            })?)
                         })
                     })
             });
@@ -508,10 +499,11 @@ impl<'a> PartWork<'a> {
         let mut stages = Stages::new(self.parallel);
         let r = stages.time(Stage::Prune, || {
             let ctx = MethodContext::start(self.params.skeleton.budget());
-            let method = self.params.registry.build(m, &self.params.skeleton).ok()?;
+            let method = self.params.registry.build(m, &self.params.skeleton)?;
             let raw = guarded(m, || {
-                budget::within(m, &ctx, |ctx| method.skeletonise(self.p, ctx))
-                    .map_err(|e| e.to_string())
+                Ok(budget::within(m, &ctx, |ctx| {
+                    method.skeletonise(self.p, ctx)
+                })?)
             })
             .ok()?;
             let g = self.staged(m, &ctx, |x| self.finish(&raw, x)).ok()?;
@@ -559,7 +551,7 @@ impl<'a> PartWork<'a> {
         &self,
         raws: Vec<Raw>,
         reference: Option<&Reference>,
-    ) -> Vec<(Result<PartSkeleton, String>, StageTimes)> {
+    ) -> Vec<(Result<PartSkeleton, CandidateError>, StageTimes)> {
         let methods = &self.params.skeleton.methods;
         let keep_ma = self.params.keeps_raw_medial_axis();
         map_in_order(&raws, self.parallel, |k, raw| {
@@ -603,17 +595,15 @@ fn usual_cost_rank(m: crate::methods::MethodId) -> u8 {
 /// end the run) becomes that method's error for this feature.
 fn guarded<T>(
     m: crate::methods::MethodId,
-    f: impl FnOnce() -> Result<T, String>,
-) -> Result<T, String> {
+    f: impl FnOnce() -> Result<T, CandidateError>,
+) -> Result<T, CandidateError> {
     std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).unwrap_or_else(|e| {
         let what = e
             .downcast_ref::<&str>()
             .map(|s| s.to_string())
             .or_else(|| e.downcast_ref::<String>().cloned())
             .unwrap_or_default();
-        Err(format!(
-            "{m} failed with an internal error ({what}); the other methods still ran — please report this polygon"
-        ))
+        Err(CandidateError::Internal { method: m, what })
     })
 }
 
@@ -742,7 +732,7 @@ fn scoring_budget(
     parts: &[PartSkeleton],
     rays: &[BarRays],
     params: &ProcessParams,
-) -> Result<(), String> {
+) -> Result<(), CandidateError> {
     const STAGE: &str = "scoring";
     if params.score.is_none() {
         return Ok(());
@@ -756,7 +746,7 @@ fn scoring_budget(
                 .check_stage(m, STAGE)
                 .and_then(|()| p.ctx.afford_stage(m, STAGE, bytes))
         })
-        .map_err(|e| e.to_string())
+        .map_err(CandidateError::from)
 }
 
 /// `f` over `items`, results in the items' order: in parallel, or on the

@@ -22,11 +22,11 @@ mod types;
 
 pub use crate::geometry::parts::polygon_parts;
 pub use candidates::map_in_order;
-pub use outcome::{process, process_checked, process_given};
-pub(crate) use prepare::part_reason;
+pub use outcome::{process, process_checked, process_given, StepError};
 pub use prepare::{prepare, prepare_checked, NotPrepared, PrepareParams};
 pub use rows::{feature_rows, FeatureRows, RowOptions, Skeletons, Status};
 pub use run::{FailedFeature, Run, RunCounts};
 pub use types::{
-    Candidate, CandidateSkeleton, FeatureOutcome, ProcessParams, Processed, StageTimes, StepTime,
+    Candidate, CandidateError, CandidateSkeleton, FeatureOutcome, ProcessParams, Processed,
+    StageTimes, StepTime,
 };

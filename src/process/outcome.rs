@@ -3,7 +3,9 @@
 //! widths, registered steps' rows); or its rejection.
 
 use super::prepare::prepare_checked;
-use super::types::{Candidate, FeatureOutcome, ProcessParams, Processed, StageTimes};
+use super::types::{
+    Candidate, CandidateError, FeatureOutcome, ProcessParams, Processed, StageTimes,
+};
 use super::{candidates, step};
 use crate::collapse::collapse_within;
 use crate::connect;
@@ -32,10 +34,38 @@ pub fn process_checked(
     let mut processed = choose(candidates, prepared.len(), params);
     if let Processed::Done(o) = &mut processed {
         if let Err(reason) = after_select(o, &prepared, params) {
-            return Processed::Rejected(reason);
+            return Processed::Rejected(reason.to_string());
         }
     }
     processed
+}
+
+/// Why a step after `select` rejects a feature (the text is its reason in
+/// `rejected`).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum StepError {
+    /// The step ran past the steps' deadline ([`StepClock`]).
+    #[error("`{step}` ran past `skeleton.timeout_s` ({seconds} s for this polygon: the steps after `select` have the budget once more for each polygon part, on a clock of their own); raise the budget, or leave `{step}` out for such polygons")]
+    TimeUp {
+        /// The step (its key in the pipeline file).
+        step: &'static str,
+        /// The deadline, in seconds.
+        seconds: f64,
+    },
+    /// `collapse` draws the medial axis, and the run has no MA.
+    #[error("`collapse` draws the medial axis: add MA to `skeleton.methods`")]
+    CollapseWithoutMedialAxis,
+    /// `collapse` draws the medial axis, and MA failed on this polygon.
+    #[error("`collapse` draws the medial axis, and MA failed on this polygon: {0}")]
+    MedialAxisFailed(CandidateError),
+    /// A polygon part could not be partitioned.
+    #[error("{}{error}", part.map_or_else(String::new, |i| format!("part {i}: ")))]
+    Partition {
+        /// The part, when the feature has several.
+        part: Option<usize>,
+        /// Why.
+        error: crate::partition::PartitionError,
+    },
 }
 
 /// The clock of the steps after `select` on one feature: `skeleton.timeout_s`
@@ -58,7 +88,7 @@ impl StepClock {
     }
 
     /// Fails with [`Self::reason`] once the deadline has passed.
-    fn check(&self, step: &str) -> Result<(), String> {
+    fn check(&self, step: &'static str) -> Result<(), StepError> {
         match self.0.expired() {
             true => Err(self.reason(step)),
             false => Ok(()),
@@ -66,11 +96,11 @@ impl StepClock {
     }
 
     /// Why the feature is rejected when `step` ran past the deadline.
-    fn reason(&self, step: &str) -> String {
-        format!(
-            "`{step}` ran past `skeleton.timeout_s` ({} s for this polygon: the steps after `select` have the budget once more for each polygon part, on a clock of their own); raise the budget, or leave `{step}` out for such polygons",
-            self.0.budget().time.unwrap_or_default().as_secs_f64()
-        )
+    fn reason(&self, step: &'static str) -> StepError {
+        StepError::TimeUp {
+            step,
+            seconds: self.0.budget().time.unwrap_or_default().as_secs_f64(),
+        }
     }
 }
 
@@ -81,7 +111,7 @@ fn after_select(
     o: &mut FeatureOutcome,
     prepared: &[PreparedPolygon],
     params: &ProcessParams,
-) -> Result<(), String> {
+) -> Result<(), StepError> {
     let clock = StepClock::start(params, prepared.len());
     if let Some(net) = &params.connect {
         connect_chosen(o, prepared, net, &clock)?;
@@ -129,19 +159,13 @@ fn collapse_chosen(
     c: &crate::collapse::CollapseParams,
     params: &ProcessParams,
     clock: &StepClock,
-) -> Result<(), String> {
+) -> Result<(), StepError> {
     let k = match o.candidates.iter().position(|c| c.method == MethodId::MA) {
         Some(k) => match &o.candidates[k].result {
             Ok(_) => k,
-            Err(e) => {
-                return Err(format!(
-                    "`collapse` draws the medial axis, and MA failed on this polygon: {e}"
-                ))
-            }
+            Err(e) => return Err(StepError::MedialAxisFailed(e.clone())),
         },
-        None => {
-            return Err("`collapse` draws the medial axis: add MA to `skeleton.methods`".into())
-        }
+        None => return Err(StepError::CollapseWithoutMedialAxis),
     };
     if o.chosen != k {
         o.chosen = k;
@@ -176,7 +200,7 @@ fn partition_chosen(
     pp: &crate::partition::PartitionParams,
     cov: &crate::partition::Coverage,
     clock: &StepClock,
-) -> Result<(), String> {
+) -> Result<(), StepError> {
     let started = crate::clock::CpuClock::start();
     let ma = o
         .candidates
@@ -189,7 +213,10 @@ fn partition_chosen(
         let expired = || clock.0.expired();
         let part = crate::partition::partition(p, cov, pp, g, &expired);
         clock.check("partition")?;
-        parts.push(part.map_err(|e| super::part_reason(i, prepared.len(), &e))?);
+        parts.push(part.map_err(|error| StepError::Partition {
+            part: (prepared.len() > 1).then_some(i),
+            error,
+        })?);
     }
     o.partition = Some(parts);
     o.partition_time = super::StepTime(started.elapsed());
@@ -229,7 +256,7 @@ fn connect_chosen(
     prepared: &[PreparedPolygon],
     net: &connect::Network,
     clock: &StepClock,
-) -> Result<(), String> {
+) -> Result<(), StepError> {
     let chosen = o.chosen;
     let Ok(c) = &mut o.candidates[chosen].result else {
         return Ok(());
@@ -379,7 +406,7 @@ fn rejection(candidates: &[Candidate]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::methods::SkeletonParams;
+    use crate::methods::{MethodError, SkeletonParams};
     use crate::process::{CandidateSkeleton, PrepareParams};
     use geo::{point, polygon};
 
@@ -498,10 +525,10 @@ mod tests {
             MethodId::DVD,
             5,
         );
-        assert!(c[0]
-            .result
-            .as_ref()
-            .is_err_and(|e| e.contains("max_points")));
+        assert!(matches!(
+            c[0].result,
+            Err(CandidateError::Method(MethodError::TooManyPoints { .. }))
+        ));
         let (cdt, stsk) = (c[1].result.as_ref().unwrap(), c[2].result.as_ref().unwrap());
         let alone = candidates_of(vec![MethodId::STSK], MethodId::STSK, 5);
         let alone = alone[0].result.as_ref().unwrap();

@@ -463,7 +463,7 @@ fn candidate_rows(
                 components: ok.map_or(0, |s| s.components),
                 legs_raw: ok.map_or(0, |s| s.legs_raw),
                 legs: ok.map_or(0, |s| s.legs),
-                error: c.result.as_ref().err().cloned(),
+                error: c.result.as_ref().err().map(ToString::to_string),
             });
         }
         if let (true, Some(s)) = (opts.bars, ok) {

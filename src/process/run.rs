@@ -155,7 +155,7 @@ impl<'a> Run<'a> {
     /// steps' [finish](super::step::FeatureStep::finish) rows (of the
     /// layers each declares; without source fields), and the counts.
     /// Fails when a unit of the coverage cannot be written valid.
-    pub fn finish(mut self) -> Result<(Rows, RunCounts), String> {
+    pub fn finish(mut self) -> Result<(Rows, RunCounts), crate::partition::UnitError> {
         let mut rows = Rows::default();
         for (e, kept) in self.params.extra.iter().zip(std::mem::take(&mut self.kept)) {
             let input = super::step::FinishInput {

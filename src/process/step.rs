@@ -321,13 +321,10 @@ pub struct Extra {
 impl Extra {
     /// The side input layer its options name, when the step has one and the
     /// pipeline file gives it: `(its key, the layer)`.
-    pub fn side_source(&self) -> Option<(&'static str, Result<LayerSource, String>)> {
+    pub fn side_source(&self) -> Option<(&'static str, Result<LayerSource, serde_json::Error>)> {
         let key = self.entry.needs.side?;
         let v = self.options.get(key).filter(|v| !v.is_null())?;
-        Some((
-            key,
-            serde_json::from_value(v.clone()).map_err(|e| e.to_string()),
-        ))
+        Some((key, serde_json::from_value(v.clone())))
     }
 }
 

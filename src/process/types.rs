@@ -7,7 +7,7 @@ use crate::connect;
 use crate::graph::extend::ExtendParams;
 use crate::graph::prune::PruneParams;
 use crate::graph::widths::MatSegment;
-use crate::methods::{MethodId, Registry, SkeletonParams};
+use crate::methods::{MethodError, MethodId, Registry, SkeletonParams};
 use crate::score::select::SelectParams;
 use crate::score::{Bar, ScoreParams, Scores};
 use geo::MultiLineString;
@@ -87,9 +87,77 @@ pub struct Candidate {
     /// The method.
     pub method: MethodId,
     /// The skeleton, or why the method failed on this feature.
-    pub result: Result<CandidateSkeleton, String>,
+    pub result: Result<CandidateSkeleton, CandidateError>,
     /// How long each step took for this method.
     pub time: StageTimes,
+}
+
+/// Why a method has no candidate for a feature: the `error` of its row in
+/// `candidates`, and, when no method has one, part of the feature's reason
+/// in `rejected`.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum CandidateError {
+    /// The method failed, or its budget stopped it.
+    #[error(transparent)]
+    Method(#[from] MethodError),
+    /// The method is not in the run's registry.
+    #[error("method {0} is not registered")]
+    NotRegistered(MethodId),
+    /// The method gives no skeleton of one polygon part while it gives one
+    /// of others: a candidate that lost a part is no candidate of the
+    /// feature (a one-pixel piece of a vectorised water mask has no Voronoi
+    /// skeleton, and with VD alone it would cost the whole river).
+    #[error("{method} gives no skeleton of this polygon part (too thin or too small for the method): it has {area} CRS units² of the feature's {whole}; skip parts that small with `prepare: {{ min_area: {min_area} }}`, or list another method in `skeleton.methods` (e.g. {other})")]
+    LostPart {
+        /// The method.
+        method: MethodId,
+        /// The part's area, to four significant digits.
+        area: String,
+        /// The feature's area, to four significant digits.
+        whole: String,
+        /// A `min_area` that skips the part.
+        min_area: String,
+        /// A method that gives one.
+        other: MethodId,
+    },
+    /// A panic in the method's work: a bug, which costs this method on this
+    /// feature and never the run.
+    #[error("{method} failed with an internal error ({what}); the other methods still ran — please report this polygon")]
+    Internal {
+        /// The method.
+        method: MethodId,
+        /// The panic's message.
+        what: String,
+    },
+    /// `prune: {mode: network, fallback: drop}` and no line of the network
+    /// meets the polygon.
+    #[error("no line of `input.connect` meets this polygon, and `prune.fallback` is `drop`; use `fallback: significance` or `trunk` to give such polygons a skeleton")]
+    NoConnection,
+    /// Pruning stopped though no deadline had passed (a bug).
+    #[error("pruning stopped without a deadline")]
+    PruningStopped,
+    /// The error of one polygon part of several.
+    #[error("part {index}: {error}")]
+    Part {
+        /// The part's index.
+        index: usize,
+        /// Its error.
+        error: Box<CandidateError>,
+    },
+}
+
+impl CandidateError {
+    /// This error of part `index` of a feature of `parts` polygon parts
+    /// (named only when there are several).
+    pub fn of_part(self, index: usize, parts: usize) -> Self {
+        match parts > 1 {
+            true => Self::Part {
+                index,
+                error: Box::new(self),
+            },
+            false => self,
+        }
+    }
 }
 
 /// A successful skeleton of one feature (all its polygon parts).

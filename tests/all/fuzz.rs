@@ -18,7 +18,7 @@ use skeletonise::graph::planar::crossings;
 use skeletonise::graph::prune::{PruneMode, PruneParams, Structure};
 use skeletonise::graph::SkeletonGraph;
 use skeletonise::methods::{build, MethodContext, MethodId};
-use skeletonise::process::{process, ProcessParams, Processed};
+use skeletonise::process::{process, CandidateError, ProcessParams, Processed};
 
 /// The steps in one of their modes.
 fn params(prune: usize, extend: usize, shared: bool) -> ProcessParams {
@@ -73,7 +73,7 @@ fn check(geom: &Geometry<f64>, p: &ProcessParams) -> Result<(), String> {
             let tol = 1e-6 * pp.extent();
             for c in &o.candidates {
                 let s = match &c.result {
-                    Err(e) if e.contains("internal error") => return Err(e.clone()),
+                    Err(e @ CandidateError::Internal { .. }) => return Err(e.to_string()),
                     Err(_) => continue,
                     Ok(s) => s,
                 };

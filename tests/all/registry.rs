@@ -10,7 +10,7 @@ use skeletonise::graph::{GraphBuilder, SkeletonGraph};
 use skeletonise::methods::{
     MethodContext, MethodEntry, MethodError, MethodId, Registry, SkeletonMethod,
 };
-use skeletonise::process::{process, ProcessParams, Processed};
+use skeletonise::process::{process, CandidateError, ProcessParams, Processed};
 use skeletonise::score::select::SelectParams;
 use skeletonise::score::ScoreParams;
 
@@ -88,7 +88,14 @@ fn a_registered_sixth_method_runs_beside_the_built_in_ones() {
         panic!("not processed");
     };
     let err = o.candidates[1].result.as_ref().unwrap_err();
-    assert!(err.contains("not registered"), "{err}");
+    assert!(
+        matches!(err, CandidateError::NotRegistered(m) if *m == centroid::ID),
+        "{err}"
+    );
+    assert_eq!(
+        err.to_string(),
+        format!("method {} is not registered", centroid::ID)
+    );
 }
 
 #[test]
