@@ -16,6 +16,7 @@
 
 pub(crate) mod arrangement;
 pub mod boundary;
+pub mod coverage;
 pub mod densify;
 pub mod key;
 pub(crate) mod lanes;

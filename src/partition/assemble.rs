@@ -2,7 +2,7 @@
 //! Where a piece meets its unit, the piece's vertices that lie on one of
 //! the unit's edges are inserted there; then the unit and its pieces share
 //! their common edges vertex for vertex, and their union drops those edges
-//! exactly ([`crate::geometry::arrangement::coverage_union`]): no vertex
+//! exactly ([`crate::geometry::coverage::coverage_union`]): no vertex
 //! moves, the area is the sum of the areas. A unit that received nothing is
 //! written as it was read, bit for bit.
 
@@ -164,7 +164,7 @@ fn grow(unit: &MultiPolygon<f64>, pieces: &[Polygon<f64>]) -> MultiPolygon<f64> 
         .map(|p| with_vertices(p, &vertices, tol))
         .collect();
     all.extend(pieces.iter().cloned());
-    MultiPolygon(crate::geometry::arrangement::coverage_union(&all))
+    MultiPolygon(crate::geometry::coverage::coverage_union(&all))
 }
 
 /// `p` with every point of `vertices` that lies on one of its edges (within

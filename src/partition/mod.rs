@@ -42,6 +42,7 @@ pub use layer::{BoundaryRow, CoverageRow, GivenRow, BOUNDARIES, COVERAGE, GIVEN}
 pub use owners::{unit_geometry, Coverage, Unit, DEFAULT_SNAP};
 pub use split::Owner;
 
+use crate::geometry::coverage::{coverage_union, RingEdges};
 use crate::geometry::vector::norm;
 use crate::geometry::CoordKey;
 use crate::geometry::{tolerance::SAME_POINT, PreparedPolygon};
@@ -467,13 +468,13 @@ fn assemble_part(
             Side::Wide => wide.push(f.face.polygon),
         }
     }
-    out.remainders = crate::geometry::arrangement::coverage_union(&unowned);
+    out.remainders = coverage_union(&unowned);
     let cut_ends: rustc_hash::FxHashSet<CoordKey> = cuts
         .iter()
         .flat_map(|l| [l[0], l[l.len() - 1]])
         .map(CoordKey::from)
         .collect();
-    out.wide = crate::geometry::arrangement::coverage_union(&wide)
+    out.wide = coverage_union(&wide)
         .into_iter()
         .map(|w| {
             let n = w
@@ -489,9 +490,6 @@ fn assemble_part(
     out
 }
 
-/// An edge by the bits of its two ends.
-type EdgeKey = (CoordKey, CoordKey);
-
 /// Which faces meet along which chord edges: every directed edge of a
 /// face's rings (the face on its left) whose reverse is another face's.
 struct Adjacency {
@@ -501,31 +499,8 @@ struct Adjacency {
 
 impl Adjacency {
     fn of(faces: &[split::OwnedFace]) -> Self {
-        let key = |c: Coord<f64>| CoordKey::from(c);
-        let mut by_edge: FxHashMap<EdgeKey, usize> = FxHashMap::default();
-        fn rings(f: &split::OwnedFace) -> impl Iterator<Item = &LineString<f64>> {
-            let p = &f.face.polygon;
-            std::iter::once(p.exterior()).chain(p.interiors())
-        }
-        for (i, f) in faces.iter().enumerate() {
-            for r in rings(f) {
-                for w in r.0.windows(2) {
-                    by_edge.insert((key(w[0]), key(w[1])), i);
-                }
-            }
-        }
-        let mut shared = Vec::new();
-        for (i, f) in faces.iter().enumerate() {
-            for r in rings(f) {
-                for w in r.0.windows(2) {
-                    if let Some(&j) = by_edge.get(&(key(w[1]), key(w[0]))) {
-                        if j != i {
-                            shared.push((w[0], w[1], i, j));
-                        }
-                    }
-                }
-            }
-        }
+        let polygons: Vec<&Polygon<f64>> = faces.iter().map(|f| &f.face.polygon).collect();
+        let shared = RingEdges::of(polygons.iter().copied()).shared(&polygons);
         Self { shared }
     }
 

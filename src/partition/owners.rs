@@ -4,6 +4,7 @@
 //! given to the unit whose boundary it lies on (or to none: unowned bank).
 
 use crate::feature::Value;
+use crate::geometry::coverage::{edge_key, EdgeKey};
 use crate::geometry::segment::{closest_on_segment, inner_points_along};
 use crate::geometry::vector::norm;
 use crate::geometry::CoordKey;
@@ -159,9 +160,6 @@ pub struct Owned {
     owner: FxHashMap<EdgeKey, Option<u32>>,
 }
 
-/// An edge by the bits of its two ends.
-type EdgeKey = (CoordKey, CoordKey);
-
 fn key(c: Coord<f64>) -> CoordKey {
     CoordKey::from(c)
 }
@@ -170,12 +168,12 @@ impl Owned {
     /// The owner of the polygon's edge from `a` to `b` (`None`: unowned or
     /// no such edge).
     pub fn owner(&self, a: Coord<f64>, b: Coord<f64>) -> Option<u32> {
-        self.owner.get(&(key(a), key(b))).copied().flatten()
+        self.owner.get(&edge_key(a, b)).copied().flatten()
     }
 
     /// Whether `a`–`b` is an edge of the polygon.
     pub fn is_edge(&self, a: Coord<f64>, b: Coord<f64>) -> bool {
-        self.owner.contains_key(&(key(a), key(b)))
+        self.owner.contains_key(&edge_key(a, b))
     }
 
     /// The polygon with `points` (each within `tol` of its boundary) put
@@ -212,7 +210,7 @@ impl Owned {
             let mut k = 0;
             for w in new.0.windows(2) {
                 let o = self.owner(old.0[k], old.0[k + 1]);
-                owner.insert((key(w[0]), key(w[1])), o);
+                owner.insert(edge_key(w[0], w[1]), o);
                 if w[1] == old.0[k + 1] {
                     k += 1;
                 }
@@ -263,7 +261,7 @@ pub fn owned(p: &PreparedPolygon, cov: &Coverage, tol: f64) -> Owned {
     let mut owner = FxHashMap::default();
     for r in std::iter::once(polygon.exterior()).chain(polygon.interiors()) {
         for w in r.0.windows(2) {
-            owner.insert((key(w[0]), key(w[1])), owner_of(cov, w[0], w[1], tol));
+            owner.insert(edge_key(w[0], w[1]), owner_of(cov, w[0], w[1], tol));
         }
     }
     Owned { polygon, owner }

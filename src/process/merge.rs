@@ -267,7 +267,7 @@ fn dissolve_exactly(mut group: Vec<Feature>) -> Feature {
         .iter()
         .flat_map(|f| polygons(f).unwrap_or_default())
         .collect();
-    let merged = crate::geometry::arrangement::coverage_union(&parts);
+    let merged = crate::geometry::coverage::coverage_union(&parts);
     merged_feature(group, merged)
 }
 
