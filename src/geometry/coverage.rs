@@ -10,7 +10,7 @@
 //!   what.
 //! - [`coverage_union`] and [`polygons_of_edges`]: the union of a coverage,
 //!   or the polygons a set of directed edges bounds, shared edges cancelling
-//!   (made in [`super::arrangement`], whose half-edge walk they share).
+//!   (made in `geometry::arrangement`, whose half-edge walk they share).
 
 pub use super::arrangement::{coverage_union, polygons_of_edges};
 use super::CoordKey;

@@ -44,7 +44,8 @@ pub fn process_checked(
 /// `rejected`).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum StepError {
-    /// The step ran past the steps' deadline ([`StepClock`]).
+    /// The step ran past the steps' deadline (`skeleton.timeout_s` once more
+    /// for each polygon part, on a clock of their own).
     #[error("`{step}` ran past `skeleton.timeout_s` ({seconds} s for this polygon: the steps after `select` have the budget once more for each polygon part, on a clock of their own); raise the budget, or leave `{step}` out for such polygons")]
     TimeUp {
         /// The step (its key in the pipeline file).
