@@ -126,6 +126,20 @@ fn branches(
     tol: f64,
     rough: bool,
 ) -> Option<(EdgeId, Vec<EdgeId>, Vec<EdgeId>, Vec<NodeId>)> {
+    if !rough {
+        // The straight rule's junction has exactly two legs, each one edge
+        // to a leaf on ∂P (what `small_branch` finds without `rough`):
+        // counted before anything is collected, since most junctions are
+        // no cut's (on many small islands the collecting cost more than the
+        // rest of the search).
+        let leg = |e: EdgeId| {
+            let o = m.opposite(e, j);
+            o != j && deg[o.index()] == 1 && m.node(o).radius <= tol
+        };
+        if adj[j.index()].iter().filter(|&&e| leg(e)).count() != 2 {
+            return None;
+        }
+    }
     let mut line = None;
     let (mut legs, mut tree, mut leaves) = (Vec::new(), Vec::new(), Vec::new());
     for &first in &adj[j.index()] {
