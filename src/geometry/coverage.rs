@@ -34,23 +34,24 @@ pub fn rings(p: &Polygon<f64>) -> impl Iterator<Item = &LineString<f64>> {
 /// that has it on its left when its rings are oriented so (shells
 /// counter-clockwise, holes clockwise): two polygons of a coverage share an
 /// edge when one has it from `a` to `b` and the other from `b` to `a`.
-#[derive(Debug, Default)]
-pub struct RingEdges {
+#[derive(Debug)]
+pub struct RingEdges<'a> {
+    polygons: &'a [&'a Polygon<f64>],
     left: FxHashMap<EdgeKey, usize>,
 }
 
-impl RingEdges {
+impl<'a> RingEdges<'a> {
     /// The edges of `polygons` (oriented: see [`RingEdges`]).
-    pub fn of<'a>(polygons: impl IntoIterator<Item = &'a Polygon<f64>>) -> Self {
+    pub fn of(polygons: &'a [&'a Polygon<f64>]) -> Self {
         let mut left = FxHashMap::default();
-        for (i, p) in polygons.into_iter().enumerate() {
+        for (i, p) in polygons.iter().enumerate() {
             for r in rings(p) {
                 for w in r.0.windows(2) {
                     left.insert(edge_key(w[0], w[1]), i);
                 }
             }
         }
-        Self { left }
+        Self { polygons, left }
     }
 
     /// The polygon that has the edge from `a` to `b` on its left.
@@ -58,16 +59,12 @@ impl RingEdges {
         self.left.get(&edge_key(a, b)).copied()
     }
 
-    /// Every edge two of `polygons` (the ones these edges were made of)
-    /// share, once from each side: `(a, b, i, j)`, polygon `i` on the left
-    /// of `a`→`b`, polygon `j` on its right; in the order of the polygons'
-    /// rings.
-    pub fn shared(
-        &self,
-        polygons: &[&Polygon<f64>],
-    ) -> Vec<(Coord<f64>, Coord<f64>, usize, usize)> {
+    /// Every edge two of the polygons share, once from each side:
+    /// `(a, b, i, j)`, polygon `i` on the left of `a`→`b`, polygon `j` on
+    /// its right; in the order of the polygons' rings.
+    pub fn shared(&self) -> Vec<(Coord<f64>, Coord<f64>, usize, usize)> {
         let mut shared = Vec::new();
-        for (i, p) in polygons.iter().enumerate() {
+        for (i, p) in self.polygons.iter().enumerate() {
             for r in rings(p) {
                 for w in r.0.windows(2) {
                     match self.left_of(w[1], w[0]) {
@@ -92,7 +89,7 @@ mod tests {
         let b = polygon![(x: 1., y: 0.), (x: 2., y: 0.), (x: 2., y: 1.), (x: 1., y: 1.)];
         let apart = polygon![(x: 5., y: 5.), (x: 6., y: 5.), (x: 6., y: 6.)];
         let all = [&a, &b, &apart];
-        let edges = RingEdges::of(all);
+        let edges = RingEdges::of(&all);
         assert_eq!(
             edges.left_of(Coord { x: 1., y: 0. }, Coord { x: 1., y: 1. }),
             Some(0)
@@ -101,7 +98,7 @@ mod tests {
             edges.left_of(Coord { x: 1., y: 1. }, Coord { x: 1., y: 0. }),
             Some(1)
         );
-        let shared = edges.shared(&all);
+        let shared = edges.shared();
         assert_eq!(
             shared,
             vec![
@@ -120,6 +117,6 @@ mod tests {
         let a = polygon![(x: 0., y: 0.), (x: 1., y: 0.), (x: 1., y: 1.), (x: 0., y: 1.)];
         let b = polygon![(x: 1. + 1e-12, y: 0.), (x: 2., y: 0.), (x: 2., y: 1.), (x: 1., y: 1.)];
         let all = [&a, &b];
-        assert!(RingEdges::of(all).shared(&all).is_empty());
+        assert!(RingEdges::of(&all).shared().is_empty());
     }
 }

@@ -113,10 +113,10 @@ pub struct CutEnd {
     pub contact: Coord<f64>,
 }
 
-/// The branches at `j` that end on ∂P (a leg; with `rough` also a small
-/// tree of legs within [`MAX_REACH`] radii of `j`), and the one branch that
-/// does not (the line): `(line, legs, tree edges, leaves)`, or `None` when
-/// not exactly one branch goes on.
+/// The branches at `j` that end on ∂P (without `rough` two legs; with it
+/// small trees of legs within [`MAX_REACH`] radii of `j`), and the one
+/// branch that does not (the line): `(line, legs, tree edges, leaves)`, or
+/// `None` when not exactly one branch goes on.
 #[allow(clippy::type_complexity)]
 fn branches(
     m: &SkeletonGraph,
@@ -127,23 +127,12 @@ fn branches(
     rough: bool,
 ) -> Option<(EdgeId, Vec<EdgeId>, Vec<EdgeId>, Vec<NodeId>)> {
     if !rough {
-        // The straight rule's junction has exactly two legs, each one edge
-        // to a leaf on ∂P (what `small_branch` finds without `rough`):
-        // counted before anything is collected, since most junctions are
-        // no cut's (on many small islands the collecting cost more than the
-        // rest of the search).
-        let leg = |e: EdgeId| {
-            let o = m.opposite(e, j);
-            o != j && deg[o.index()] == 1 && m.node(o).radius <= tol
-        };
-        if adj[j.index()].iter().filter(|&&e| leg(e)).count() != 2 {
-            return None;
-        }
+        return straight_branches(m, adj, deg, j, tol);
     }
     let mut line = None;
     let (mut legs, mut tree, mut leaves) = (Vec::new(), Vec::new(), Vec::new());
     for &first in &adj[j.index()] {
-        match small_branch(m, adj, deg, (j, first), tol, rough) {
+        match small_branch(m, adj, deg, (j, first), tol) {
             Some((edges, ends)) => {
                 legs.push(first);
                 tree.extend(edges);
@@ -184,24 +173,46 @@ fn contact(
     boundary.nearest_in_sector(j, right, left).map(|(q, _)| q)
 }
 
-/// The branch at `j` through `first`, walked away from `j`, when it is
-/// small: one edge to a leaf on ∂P; with `rough` a tree whose nodes lie
-/// within [`MAX_REACH`] radii of `j`, with every leaf on ∂P, no way back to
-/// `j` and at most [`MAX_TREE`] edges. Its edges and leaves.
+/// [`branches`] of the straight rule: exactly two legs, each one edge to a
+/// leaf on ∂P, and the line. The legs are counted before anything is
+/// collected: most junctions are no cut's, and on many small islands
+/// collecting every junction's branches cost more than the rest of the
+/// search.
+#[allow(clippy::type_complexity)]
+fn straight_branches(
+    m: &SkeletonGraph,
+    adj: &Adjacency,
+    deg: &[usize],
+    j: NodeId,
+    tol: f64,
+) -> Option<(EdgeId, Vec<EdgeId>, Vec<EdgeId>, Vec<NodeId>)> {
+    let leaf = |e: EdgeId| {
+        let o = m.opposite(e, j);
+        (o != j && deg[o.index()] == 1 && m.node(o).radius <= tol).then_some(o)
+    };
+    let edges = &adj[j.index()];
+    if edges.len() != 3 || edges.iter().filter(|&&e| leaf(e).is_some()).count() != 2 {
+        return None;
+    }
+    let line = *edges.iter().find(|&&e| leaf(e).is_none())?;
+    let legs: Vec<EdgeId> = edges.iter().copied().filter(|&e| e != line).collect();
+    let leaves = legs.iter().filter_map(|&e| leaf(e)).collect();
+    Some((line, legs.clone(), legs, leaves))
+}
+
+/// The branch at `j` through `first`, walked away from `j`, when it is a
+/// small tree of legs: its nodes within [`MAX_REACH`] radii of `j`, every
+/// leaf on ∂P, no way back to `j` and at most [`MAX_TREE`] edges. Its edges
+/// and leaves.
 fn small_branch(
     m: &SkeletonGraph,
     adj: &Adjacency,
     deg: &[usize],
     (j, first): (NodeId, EdgeId),
     tol: f64,
-    rough: bool,
 ) -> Option<(Vec<EdgeId>, Vec<NodeId>)> {
     let pj = m.node(j).pos;
-    let (reach, most) = if rough {
-        (MAX_REACH * m.node(j).radius, MAX_TREE)
-    } else {
-        (f64::INFINITY, 1)
-    };
+    let (reach, most) = (MAX_REACH * m.node(j).radius, MAX_TREE);
     let (mut edges, mut leaves) = (Vec::new(), Vec::new());
     let mut stack = vec![(first, j)];
     while let Some((e, from)) = stack.pop() {

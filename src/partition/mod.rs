@@ -500,7 +500,7 @@ struct Adjacency {
 impl Adjacency {
     fn of(faces: &[split::OwnedFace]) -> Self {
         let polygons: Vec<&Polygon<f64>> = faces.iter().map(|f| &f.face.polygon).collect();
-        let shared = RingEdges::of(polygons.iter().copied()).shared(&polygons);
+        let shared = RingEdges::of(&polygons).shared();
         Self { shared }
     }
 
