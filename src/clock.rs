@@ -138,6 +138,14 @@ impl Stages {
         }
     }
 
+    /// Takes `d` off `stage` (time counted there that another step's is).
+    pub fn remove(&mut self, stage: Stage, d: Duration) {
+        match stage {
+            Stage::Skeleton => self.times.skeleton = self.times.skeleton.saturating_sub(d),
+            Stage::Prune => self.times.prune_extend = self.times.prune_extend.saturating_sub(d),
+        }
+    }
+
     /// What was recorded.
     pub fn times(&self) -> StageTimes {
         self.times

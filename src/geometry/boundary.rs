@@ -391,6 +391,18 @@ impl Boundary {
             .unwrap_or(f64::INFINITY)
     }
 
+    /// Whether [`Boundary::distance`]`(p) <= limit`, searching only that
+    /// far (the same answer; a point far from ∂P costs no longer search
+    /// than one near it).
+    pub fn is_within(&self, p: Coord<f64>, limit: f64) -> bool {
+        let search = limit * (1.0 + BOUND_MARGIN) + f64::MIN_POSITIVE;
+        if !finite(p) || !search.is_finite() {
+            return self.distance(p) <= limit;
+        }
+        self.nearest_segment_within(p, search * search)
+            .is_some_and(|(d2, _)| d2.sqrt() <= limit)
+    }
+
     /// [`Boundary::distance`] when it is known to be at most `bound` (up to
     /// rounding): the bound keeps the search short and never changes the
     /// answer.

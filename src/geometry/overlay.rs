@@ -265,7 +265,7 @@ pub fn contact(
     let place = |c: Coord<f64>| -> u8 {
         if !in_box(c) {
             0
-        } else if b.distance(c) <= tol {
+        } else if b.is_within(c, tol) {
             1
         } else {
             2 * u8::from(b.contains(c))

@@ -304,6 +304,20 @@ pub trait SkeletonMethod: Send + Sync {
         polygon: &PreparedPolygon,
         ctx: &MethodContext,
     ) -> Result<SkeletonGraph, MethodError>;
+
+    /// [`Self::skeletonise`], and for a method made on the segment Voronoi
+    /// diagram of the boundary, that diagram's cells inside the polygon
+    /// ([`medial_axis::cells::cell_edges`] with the default arc tolerance),
+    /// made from the same diagram, with the time they took: what
+    /// `partition` splits the polygon along, without a diagram of its own.
+    /// `None` for every other method (the default).
+    fn skeletonise_with_cells(
+        &self,
+        polygon: &PreparedPolygon,
+        ctx: &MethodContext,
+    ) -> Result<(SkeletonGraph, Option<medial_axis::cells::DiagramCells>), MethodError> {
+        Ok((self.skeletonise(polygon, ctx)?, None))
+    }
 }
 
 /// One method as the registry knows it: its identifier, name, description

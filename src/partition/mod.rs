@@ -47,7 +47,8 @@ use crate::geometry::vector::norm;
 use crate::geometry::CoordKey;
 use crate::geometry::{tolerance::SAME_POINT, PreparedPolygon};
 use crate::graph::SkeletonGraph;
-use crate::methods::medial_axis::{cells::cell_edges, ArcTolerance};
+use crate::methods::medial_axis::cells::{cell_edges, CellEdge};
+use crate::methods::medial_axis::ArcTolerance;
 use crate::narrow::CollapseParams;
 use geo::{Area, Coord, LineString, MultiLineString, Polygon};
 use rustc_hash::FxHashMap;
@@ -312,7 +313,10 @@ fn stop_if(expired: &dyn Fn() -> bool) -> Result<(), PartitionError> {
 
 /// Partitions polygon part `p` between the units of `cov` (see the module
 /// documentation), or says why it cannot be. With `width`, `ma` is the
-/// part's medial axis (its discs say what is narrow). `expired()` is asked
+/// part's medial axis (its discs say what is narrow); `cells`, when given,
+/// the cells of the segment Voronoi diagram of `p`'s boundary inside it
+/// (as [`cell_edges`] makes them; the medial axis's diagram), which it is
+/// then split along without a diagram of its own. `expired()` is asked
 /// between the stages (the units near the part, the narrow parts, the
 /// cells, the faces); once it says the time is up the partition stops with
 /// [`PartitionError::Stopped`].
@@ -321,6 +325,7 @@ pub fn partition(
     cov: &Coverage,
     params: &PartitionParams,
     ma: Option<&SkeletonGraph>,
+    cells: Option<Vec<CellEdge>>,
     expired: &dyn Fn() -> bool,
 ) -> Result<PartPartition, PartitionError> {
     let tol = SAME_POINT * p.extent();
@@ -348,6 +353,7 @@ pub fn partition(
         &local,
         params,
         ma,
+        cells.filter(|_| snapped.is_none()),
         expired,
     )?;
     let global = |o: Owner| o.map(|i| near.units[i as usize].index);
@@ -372,13 +378,15 @@ pub fn partition(
 }
 
 /// [`partition`] of `p` (`original`, snapped) between the units of `cov`,
-/// which meet it along its bank.
+/// which meet it along its bank; `cells` those of `p`'s diagram, when
+/// given.
 fn partition_cut(
     p: &PreparedPolygon,
     original: &PreparedPolygon,
     cov: &Coverage,
     params: &PartitionParams,
     ma: Option<&SkeletonGraph>,
+    cells: Option<Vec<CellEdge>>,
     expired: &dyn Fn() -> bool,
 ) -> Result<PartPartition, PartitionError> {
     let tol = SAME_POINT * p.extent();
@@ -412,8 +420,12 @@ fn partition_cut(
         }
     }
     stop_if(expired)?;
+    let edges = match (owned.base == *p.polygon(), cells) {
+        (true, Some(cells)) => cells,
+        (true, None) => cell_edges(p, ArcTolerance::default())?,
+        (false, _) => cell_edges(&PreparedPolygon::new(&owned.base)?, ArcTolerance::default())?,
+    };
     let prepared = PreparedPolygon::new(&owned.polygon)?;
-    let edges = cell_edges(&prepared, ArcTolerance::default())?;
     stop_if(expired)?;
     let (pieces, vertices) = split::pieces(&owned, edges);
     let mut lines: Vec<Vec<Coord<f64>>> = pieces.into_iter().map(|q| q.line).collect();
@@ -684,7 +696,7 @@ mod tests {
     #[test]
     fn a_canal_between_two_units_is_split_on_its_centre_line() {
         let (p, cov) = canal();
-        let r = partition(&p, &cov, &PartitionParams::default(), None, &|| false).unwrap();
+        let r = partition(&p, &cov, &PartitionParams::default(), None, None, &|| false).unwrap();
         let areas = given_area(&r);
         assert_eq!(areas.len(), 4, "{areas:?}");
         for (unit, area) in areas {
@@ -724,7 +736,7 @@ mod tests {
             ),
         ]);
         let p = PreparedPolygon::new(&c).unwrap();
-        let r = partition(&p, &cov, &PartitionParams::default(), None, &|| false).unwrap();
+        let r = partition(&p, &cov, &PartitionParams::default(), None, None, &|| false).unwrap();
         let normal = r
             .boundaries
             .iter()
@@ -745,6 +757,67 @@ mod tests {
     }
 
     #[test]
+    fn units_meeting_inside_a_slanted_bank_are_split_on_its_exact_normal_from_the_medial_axis_cells(
+    ) {
+        // A canal at 30° whose bottom bank two units share, meeting at a
+        // point no grid holds (1/3 of the way along): their boundary is the
+        // bank's normal there, and the medial axis's own cells give the same
+        // partition as a diagram made for it.
+        let (s, c) = (30f64.to_radians().sin(), 30f64.to_radians().cos());
+        let at = |x: f64, y: f64| geo::Coord {
+            x: 1000.0 + x * c - y * s,
+            y: 2000.0 + x * s + y * c,
+        };
+        let ring = |pts: &[(f64, f64)]| {
+            Polygon::new(
+                geo::LineString(pts.iter().map(|&(x, y)| at(x, y)).collect()),
+                vec![],
+            )
+        };
+        let t = 100.0 / 3.0;
+        let canal = ring(&[(0., 0.), (100., 0.), (100., 10.), (0., 10.), (0., 0.)]);
+        let cov = Coverage::new(vec![
+            unit(
+                1,
+                ring(&[(0., -20.), (t, -20.), (t, 0.), (0., 0.), (0., -20.)]),
+            ),
+            unit(
+                5,
+                ring(&[(t, -20.), (100., -20.), (100., 0.), (t, 0.), (t, -20.)]),
+            ),
+            unit(
+                2,
+                ring(&[(0., 10.), (100., 10.), (100., 30.), (0., 30.), (0., 10.)]),
+            ),
+        ]);
+        let p = PreparedPolygon::new(&canal).unwrap();
+        let params = PartitionParams::default();
+        let own = partition(&p, &cov, &params, None, None, &|| false).unwrap();
+        let ma = crate::methods::medial_axis::MedialAxis::default();
+        let (_, cells) = crate::methods::SkeletonMethod::skeletonise_with_cells(
+            &ma,
+            &p,
+            &crate::methods::MethodContext::default(),
+        )
+        .unwrap();
+        let cells = cells.expect("the medial axis keeps its cells").edges;
+        let shared = partition(&p, &cov, &params, None, Some(cells), &|| false).unwrap();
+        assert_eq!(own, shared);
+        let normal = own
+            .boundaries
+            .iter()
+            .find(|b| (b.left, b.right) == (Some(0), Some(1)))
+            .expect("units 1 and 5 meet");
+        let line = &normal.lines.0[0].0;
+        let (first, last) = (line[0], line[line.len() - 1]);
+        let d = last - first;
+        // Along the bank's normal (-sin, cos), from the bank to the centre.
+        assert!((d.x * c + d.y * s).abs() < 1e-9, "{line:?}");
+        // To the centre line, as the diagram's grid places it.
+        assert!((d.x.hypot(d.y) - 5.0).abs() < 1e-6, "{line:?}");
+    }
+
+    #[test]
     fn a_polygon_over_a_unit_is_refused_with_overlap_reject() {
         let (p, _) = canal();
         let cov = Coverage::new(vec![unit(
@@ -755,7 +828,7 @@ mod tests {
             overlap: Overlap::Reject,
             ..PartitionParams::default()
         };
-        let e = partition(&p, &cov, &reject, None, &|| false).unwrap_err();
+        let e = partition(&p, &cov, &reject, None, None, &|| false).unwrap_err();
         assert!(matches!(e, PartitionError::Overlap { .. }), "{e:?}");
         let e = e.to_string();
         assert!(e.contains("overlaps unit 9"), "{e}");
@@ -763,7 +836,7 @@ mod tests {
         // A partition whose time is up stops with its own variant.
         let r = PartitionParams::default();
         assert_eq!(
-            partition(&p, &cov, &r, None, &|| true).unwrap_err(),
+            partition(&p, &cov, &r, None, None, &|| true).unwrap_err(),
             PartitionError::Stopped
         );
     }
@@ -794,7 +867,7 @@ mod tests {
     fn units_that_cover_the_canal_are_cut_and_share_it_down_the_middle() {
         let (p, _) = canal();
         let cov = covering_units();
-        let r = partition(&p, &cov, &PartitionParams::default(), None, &|| false).unwrap();
+        let r = partition(&p, &cov, &PartitionParams::default(), None, None, &|| false).unwrap();
         let areas = given_area(&r);
         assert_eq!(areas.len(), 4, "{areas:?}");
         for (unit, area) in areas {
@@ -857,7 +930,7 @@ mod tests {
             1,
             polygon![(x: 0., y: 0.), (x: 40., y: 0.), (x: 40., y: 30.), (x: 0., y: 30.)],
         )]);
-        let r = partition(&p, &cov, &PartitionParams::default(), None, &|| false).unwrap();
+        let r = partition(&p, &cov, &PartitionParams::default(), None, None, &|| false).unwrap();
         assert_eq!(given_area(&r), vec![(0, 170.0)]);
         assert_eq!(r.units.len(), 1);
         assert_eq!(crate::geometry::overlay::area(&r.units[0].held), 170.0);

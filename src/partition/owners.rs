@@ -157,6 +157,11 @@ pub struct Owned {
     /// The polygon, its rings normalised, the units' vertices on its edges
     /// inserted.
     pub polygon: Polygon<f64>,
+    /// The polygon before any point was put into its edges (its vertices
+    /// moved onto the units' where they meet): the segment Voronoi diagram
+    /// is of this one, and [`Self::splits`] says where its edges were
+    /// split.
+    pub base: Polygon<f64>,
     owner: FxHashMap<EdgeKey, Option<u32>>,
 }
 
@@ -216,7 +221,65 @@ impl Owned {
                 }
             }
         }
-        (Owned { polygon, owner }, at)
+        let base = self.base.clone();
+        (
+            Owned {
+                polygon,
+                base,
+                owner,
+            },
+            at,
+        )
+    }
+
+    /// Every edge of [`Self::base`] that points were put into, by its key:
+    /// its vertices in the polygon from its start to its end (the points
+    /// put in, in order between them).
+    pub fn splits(&self) -> FxHashMap<EdgeKey, Vec<Coord<f64>>> {
+        let mut out = FxHashMap::default();
+        let base = std::iter::once(self.base.exterior()).chain(self.base.interiors());
+        let new = std::iter::once(self.polygon.exterior()).chain(self.polygon.interiors());
+        for (old, new) in base.zip(new) {
+            // The base's vertices are the polygon's, in order, with the
+            // points put in between them.
+            let mut k = 0;
+            let mut run = vec![old.0[0]];
+            for &c in &new.0[1..] {
+                run.push(c);
+                if old.0.get(k + 1) == Some(&c) {
+                    if run.len() > 2 {
+                        out.insert(edge_key(old.0[k], c), std::mem::take(&mut run));
+                    }
+                    run.clear();
+                    run.push(c);
+                    k += 1;
+                }
+            }
+        }
+        out
+    }
+
+    /// The owner of base edge `a`–`b` (see [`Self::base`]) at the foot of
+    /// point `x` on it, with `splits` from [`Self::splits`]: where points
+    /// were put into the edge, the owner of the piece the foot lies on.
+    pub fn owner_along(
+        &self,
+        splits: &FxHashMap<EdgeKey, Vec<Coord<f64>>>,
+        a: Coord<f64>,
+        b: Coord<f64>,
+        x: Coord<f64>,
+    ) -> Option<u32> {
+        let Some(run) = splits.get(&edge_key(a, b)) else {
+            return self.owner(a, b);
+        };
+        let d = b - a;
+        let along = |c: Coord<f64>| crate::geometry::vector::dot(c - a, d);
+        let s = along(x);
+        let i = run[1..run.len() - 1]
+            .iter()
+            .take_while(|&&c| along(c) <= s)
+            .count();
+        self.owner(run[i], run[i + 1])
     }
 
     /// The owners of the edges into and out of every vertex.
@@ -257,14 +320,18 @@ pub struct VertexOwners {
 /// `p` with its owners in `cov`, whose units meet it only along its
 /// boundary (cut by it: [`super::cut`]).
 pub fn owned(p: &PreparedPolygon, cov: &Coverage, tol: f64) -> Owned {
-    let polygon = with_t_junctions(p, cov, tol);
+    let (polygon, base) = with_t_junctions(p, cov, tol);
     let mut owner = FxHashMap::default();
     for r in std::iter::once(polygon.exterior()).chain(polygon.interiors()) {
         for w in r.0.windows(2) {
             owner.insert(edge_key(w[0], w[1]), owner_of(cov, w[0], w[1], tol));
         }
     }
-    Owned { polygon, owner }
+    Owned {
+        polygon,
+        base,
+        owner,
+    }
 }
 
 /// The unit whose boundary holds the edge `a`–`b` (both ends within `tol`
@@ -285,8 +352,8 @@ fn owner_of(cov: &Coverage, a: Coord<f64>, b: Coord<f64>, tol: f64) -> Option<u3
 /// `tol`, not at its ends) inserted there, and every vertex of `p` within
 /// `tol` of a unit vertex moved onto it, with the unit's coordinates: where
 /// they meet, the polygon and the units then share their vertices exactly
-/// (the units keep theirs bit for bit).
-fn with_t_junctions(p: &PreparedPolygon, cov: &Coverage, tol: f64) -> Polygon<f64> {
+/// (the units keep theirs bit for bit); and `p` with only the moves.
+fn with_t_junctions(p: &PreparedPolygon, cov: &Coverage, tol: f64) -> (Polygon<f64>, Polygon<f64>) {
     let b = p.boundary();
     let (lo, hi) = (b.bbox_min(), b.bbox_max());
     let mut inserts = Inserts::default();
@@ -320,7 +387,11 @@ fn with_t_junctions(p: &PreparedPolygon, cov: &Coverage, tol: f64) -> Polygon<f6
         }
     }
     let moved = |c: Coord<f64>| moves.get(&key(c)).copied().unwrap_or(c);
-    with_inserted(p.polygon(), &inserts, moved)
+    let base = match moves.is_empty() {
+        true => p.polygon().clone(),
+        false => with_inserted(p.polygon(), &Inserts::default(), moved),
+    };
+    (with_inserted(p.polygon(), &inserts, moved), base)
 }
 
 /// Where points go into a polygon's edges: by (ring, edge index), ring 0

@@ -13,6 +13,7 @@
 
 use super::owners::{Owned, VertexOwners};
 use crate::geometry::arrangement::{split_network, Face};
+use crate::geometry::coverage::{edge_key, EdgeKey};
 use crate::geometry::vector::{cross, norm};
 use crate::geometry::CoordKey;
 use crate::geometry::PreparedPolygon;
@@ -92,29 +93,42 @@ fn left_normal(d: Coord<f64>) -> Coord<f64> {
     }
 }
 
+/// Where points were put into the base polygon's edges
+/// ([`Owned::splits`]).
+type Splits = FxHashMap<EdgeKey, Vec<Coord<f64>>>;
+
 /// The owner of a site at point `x` of its cell.
-fn site_owner(owned: &Owned, vertices: &Vertices, site: CellSite, x: Coord<f64>) -> Owner {
+fn site_owner(
+    owned: &Owned,
+    splits: &Splits,
+    vertices: &Vertices,
+    site: CellSite,
+    x: Coord<f64>,
+) -> Owner {
     match site {
-        CellSite::Segment(a, b) => owned.owner(a, b),
+        CellSite::Segment(a, b) => owned.owner_along(splits, a, b, x),
         CellSite::Vertex(v) => vertices.owner_at(v, x),
     }
 }
 
-/// The new boundaries of `owned` from the edges of its cells — every piece
-/// of an edge with different owners on its sides, and the splits of the
-/// cells of vertices where two units meet — and the owners at the
-/// vertices.
+/// The new boundaries of `owned` from the edges of the cells of its base
+/// polygon ([`Owned::base`]) — every piece of an edge with different owners
+/// on its sides, the splits of the cells of vertices where two units meet,
+/// and the normals from the points where two units meet inside an edge —
+/// and the owners at the vertices.
 pub fn pieces(owned: &Owned, mut edges: Vec<CellEdge>) -> (Vec<Piece>, Vertices) {
     let mut vertices = Vertices {
         owners: owned.at_vertices(),
         splits: FxHashMap::default(),
     };
+    let splits = owned.splits();
     let mut out = split_cells(&mut vertices, &mut edges);
+    out.extend(split_segment_cells(&vertices, &splits, &mut edges));
     for e in &edges {
         for w in e.line.windows(2) {
             let m = (w[0] + w[1]) * 0.5;
-            let left = site_owner(owned, &vertices, e.sites[0], m);
-            let right = site_owner(owned, &vertices, e.sites[1], m);
+            let left = site_owner(owned, &splits, &vertices, e.sites[0], m);
+            let right = site_owner(owned, &splits, &vertices, e.sites[1], m);
             if left == right {
                 continue;
             }
@@ -181,6 +195,54 @@ fn split_cells(vertices: &mut Vertices, edges: &mut [CellEdge]) -> Vec<Piece> {
             left,
             right,
         });
+    }
+    out
+}
+
+/// The splits of the cells of the base polygon's edges that two units meet
+/// inside (a unit's vertex put into the edge): the cell of a segment holds
+/// the points whose foot on it is inside it, so the part nearer each unit's
+/// piece is on one side of the normal at the meeting point — from the
+/// point to where it leaves the cell, that point put into the cell edge it
+/// meets. (A diagram of the polygon with the point as a vertex has the same
+/// normal as an edge; this one needs no second diagram.)
+fn split_segment_cells(vertices: &Vertices, splits: &Splits, edges: &mut [CellEdge]) -> Vec<Piece> {
+    let mut by_segment: FxHashMap<EdgeKey, Vec<usize>> = FxHashMap::default();
+    for (k, e) in edges.iter().enumerate() {
+        for s in e.sites {
+            if let CellSite::Segment(a, b) = s {
+                let sk = edge_key(a, b);
+                if splits.contains_key(&sk) {
+                    by_segment.entry(sk).or_default().push(k);
+                }
+            }
+        }
+    }
+    let mut runs: Vec<(&EdgeKey, &Vec<Coord<f64>>)> = splits.iter().collect();
+    runs.sort_unstable_by_key(|(k, _)| **k);
+    let mut out = Vec::new();
+    for (sk, run) in runs {
+        let Some(ks) = by_segment.get(sk) else {
+            continue;
+        };
+        let inward = left_normal(run[run.len() - 1] - run[0]);
+        for &t in &run[1..run.len() - 1] {
+            let Some(o) = vertices.owners.get(&key(t)) else {
+                continue;
+            };
+            if o.before == o.after {
+                continue;
+            }
+            let Some(x) = cell_exit(t, inward, ks, edges) else {
+                continue;
+            };
+            // Walking the normal inwards, the edge's start is on the left.
+            out.push(Piece {
+                line: vec![t, x],
+                left: o.before,
+                right: o.after,
+            });
+        }
     }
     out
 }

@@ -160,6 +160,7 @@ pub(super) fn given(
             legs_raw: legs,
             ctx: MethodContext::default(),
             raw: None,
+            cells: None,
         })
         .collect();
     let parallel = worth_splitting(prepared);
@@ -186,7 +187,13 @@ pub(super) struct PartSkeleton {
     /// The raw skeleton, when kept for a registered step (MA's, see
     /// [`ProcessParams::keeps_raw_medial_axis`]).
     raw: Option<std::sync::Arc<SkeletonGraph>>,
+    /// The cells of MA's diagram, when `partition` follows (see
+    /// [`crate::methods::SkeletonMethod::skeletonise_with_cells`]).
+    cells: Option<Cells>,
 }
+
+/// The cells of a polygon part's segment Voronoi diagram inside it.
+type Cells = std::sync::Arc<crate::methods::medial_axis::cells::DiagramCells>;
 
 /// Every method's finished skeleton of one polygon part, in `methods`
 /// order, as the SPEC sequences them: the raw skeletons, then the
@@ -239,6 +246,8 @@ const HIDDEN: usize = usize::MAX;
 /// (for the first method of the reference order) its finished skeleton.
 struct Raw {
     graph: Result<SkeletonGraph, CandidateError>,
+    /// The cells of MA's diagram, when `partition` follows.
+    cells: Option<Cells>,
     stages: Stages,
     reference: Option<Reference>,
     /// Whether its finished skeleton was tried as the reference.
@@ -427,19 +436,29 @@ impl<'a> PartWork<'a> {
             let m = methods[k];
             let ctx = MethodContext::start(self.params.skeleton.budget());
             let mut stages = Stages::new(self.parallel);
-            let mut graph = stages.time(Stage::Skeleton, || {
+            let with_cells = m == crate::methods::MethodId::MA && self.params.partition.is_some();
+            let made = stages.time(Stage::Skeleton, || {
                 self.params
                     .registry
                     .build(m, &self.params.skeleton)
                     .ok_or(CandidateError::NotRegistered(m))
                     .and_then(|method| {
                         guarded(m, || {
-                            Ok(budget::within(m, &ctx, |ctx| {
-                                method.skeletonise(self.p, ctx)
+                            Ok(budget::within(m, &ctx, |ctx| match with_cells {
+                                true => method.skeletonise_with_cells(self.p, ctx),
+                                false => method.skeletonise(self.p, ctx).map(|g| (g, None)),
                             })?)
                         })
                     })
             });
+            let (mut graph, cells) = match made {
+                Ok((g, cells)) => (Ok(g), cells.map(std::sync::Arc::new)),
+                Err(e) => (Err(e), None),
+            };
+            // The cells are `partition`'s work: its time, not the skeleton's.
+            if let Some(c) = &cells {
+                stages.remove(Stage::Skeleton, c.time);
+            }
             let mut reference = None;
             let tried = self.hidden.is_none() && self.order.first() == Some(&k);
             if tried {
@@ -452,6 +471,7 @@ impl<'a> PartWork<'a> {
             }
             Raw {
                 graph,
+                cells,
                 stages,
                 reference,
                 tried,
@@ -569,6 +589,7 @@ impl<'a> PartWork<'a> {
                     legs_raw: g.leg_count(),
                     ctx: raw.ctx,
                     raw: kept.then(|| std::sync::Arc::new(g.clone())),
+                    cells: raw.cells.clone(),
                 })
             });
             (result, stages.times())
@@ -653,6 +674,7 @@ fn finish(
     let mut widths = Vec::new();
     let mut graphs = Vec::new();
     let mut raw = Vec::new();
+    let mut cells = Vec::new();
     let (mut components, mut legs_raw, mut legs, mut hooks) = (0, 0, 0, 0);
     let mut branch_offset = 0;
     for (k, (p, part)) in prepared.iter().zip(parts).enumerate() {
@@ -693,6 +715,7 @@ fn finish(
             graphs.push(g.clone());
         }
         raw.extend(part.raw.clone());
+        cells.extend(part.cells.clone());
         // The branches as lines (`SkeletonGraph::to_multilinestring`).
         lines.extend(branches.into_iter().map(|b| LineString(b.coords)));
     }
@@ -711,6 +734,7 @@ fn finish(
         widths,
         graphs,
         raw,
+        cells,
         note: None,
     };
     (c, cast_time + clock.elapsed().saturating_sub(in_casts))

@@ -13,6 +13,7 @@ use crate::geometry::PreparedPolygon;
 use crate::methods::{MethodContext, MethodId};
 use crate::score::select::{select, Entry};
 use geo::{Geometry, MultiLineString};
+use std::sync::Arc;
 
 /// Processes one feature's geometry through every step.
 pub fn process(geom: Option<&Geometry<f64>>, params: &ProcessParams) -> Processed {
@@ -203,16 +204,34 @@ fn partition_chosen(
     clock: &StepClock,
 ) -> Result<(), StepError> {
     let started = crate::clock::CpuClock::start();
-    let ma = o
+    let mut ma = o
         .candidates
-        .iter()
+        .iter_mut()
         .find(|c| c.method == MethodId::MA)
-        .and_then(|c| c.result.as_ref().ok());
+        .and_then(|c| c.result.as_mut().ok());
+    // The diagram's cells are split where the units meet: taken from the
+    // candidate, which no later step reads.
+    let mut cells = ma
+        .as_deref_mut()
+        .map(|m| std::mem::take(&mut m.cells))
+        .filter(|c| c.len() == prepared.len())
+        .map(|c| {
+            c.into_iter().map(|a| {
+                let c = Arc::try_unwrap(a).unwrap_or_else(|a| (*a).clone());
+                (c.edges, c.time)
+            })
+        });
+    let ma = ma.as_deref();
+    let mut cells_time = std::time::Duration::ZERO;
     let mut parts = Vec::with_capacity(prepared.len());
     for (i, p) in prepared.iter().enumerate() {
         let g = ma.and_then(|m| m.graphs.get(i));
+        let cells = cells.as_mut().and_then(|c| c.next()).map(|(edges, time)| {
+            cells_time += time;
+            edges
+        });
         let expired = || clock.0.expired();
-        let part = crate::partition::partition(p, cov, pp, g, &expired);
+        let part = crate::partition::partition(p, cov, pp, g, cells, &expired);
         clock.check("partition")?;
         parts.push(part.map_err(|error| StepError::Partition {
             part: (prepared.len() > 1).then_some(i),
@@ -220,7 +239,7 @@ fn partition_chosen(
         })?);
     }
     o.partition = Some(parts);
-    o.partition_time = super::StepTime(started.elapsed());
+    o.partition_time = super::StepTime(started.elapsed() + cells_time);
     Ok(())
 }
 

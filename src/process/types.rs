@@ -187,6 +187,10 @@ pub struct CandidateSkeleton {
     /// The raw skeleton of every polygon part (before pruning), kept for MA
     /// when a registered step reads it ([`ProcessParams::keeps_raw_medial_axis`]).
     pub raw: Vec<std::sync::Arc<crate::graph::SkeletonGraph>>,
+    /// The cells of MA's segment Voronoi diagram inside every polygon part,
+    /// kept when `partition` follows: it splits the polygon along them
+    /// instead of making the diagram again (empty otherwise).
+    pub cells: Vec<std::sync::Arc<crate::methods::medial_axis::cells::DiagramCells>>,
     /// Something the scores alone do not tell (e.g. a given skeleton that
     /// leaves its polygon), for the row's `note`.
     pub note: Option<String>,

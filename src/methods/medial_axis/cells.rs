@@ -32,6 +32,18 @@ pub struct CellEdge {
     pub line: Vec<Coord<f64>>,
 }
 
+/// The cells of a polygon's diagram as a method made them beside its
+/// skeleton ([`crate::methods::SkeletonMethod::skeletonise_with_cells`]),
+/// and the thread CPU time they took: the step that reads them counts it
+/// as its own.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DiagramCells {
+    /// Every inside edge with its sites (see [`cell_edges`]).
+    pub edges: Vec<CellEdge>,
+    /// The time making them took.
+    pub time: std::time::Duration,
+}
+
 /// Every edge of the segment Voronoi diagram of `polygon`'s boundary that
 /// lies inside it (arcs within `tolerance`).
 pub fn cell_edges(
@@ -42,7 +54,7 @@ pub fn cell_edges(
     let Some((grid, segs, diagram)) = quantised(polygon)? else {
         return Ok(Vec::new());
     };
-    Extractor::new(&diagram, &segs, &grid, tolerance).cells()
+    Extractor::new(&diagram, &segs, &grid, tolerance).cell_edges()
 }
 
 /// The input vertex each grid point was rounded from (the first segment
@@ -65,7 +77,7 @@ impl Extractor<'_> {
     }
 
     /// Every inside edge with its sites (see [`cell_edges`]).
-    fn cells(mut self) -> Result<Vec<CellEdge>, MethodError> {
+    pub(super) fn cell_edges(mut self) -> Result<Vec<CellEdge>, MethodError> {
         let mut vertices = Vertices::default();
         for s in self.segs {
             vertices.entry(s.a).or_insert(s.wa);

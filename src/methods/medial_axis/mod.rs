@@ -204,6 +204,33 @@ impl SkeletonMethod for MedialAxis {
             None => Ok(SkeletonGraph::new()),
         }
     }
+
+    fn skeletonise_with_cells(
+        &self,
+        polygon: &PreparedPolygon,
+        _ctx: &MethodContext,
+    ) -> Result<(SkeletonGraph, Option<cells::DiagramCells>), MethodError> {
+        self.tolerance.validate().map_err(fail)?;
+        match quantised(polygon)? {
+            Some((grid, segs, diagram)) => {
+                let plan = Extractor::new(&diagram, &segs, &grid, self.tolerance).plan()?;
+                let clock = crate::clock::CpuClock::start();
+                let edges =
+                    Extractor::new(&diagram, &segs, &grid, ArcTolerance::default()).cell_edges()?;
+                let time = clock.elapsed();
+                drop(diagram);
+                let cells = cells::DiagramCells { edges, time };
+                Ok((plan.graph(&segs, &grid, self.tolerance), Some(cells)))
+            }
+            None => Ok((
+                SkeletonGraph::new(),
+                Some(cells::DiagramCells {
+                    edges: Vec::new(),
+                    time: std::time::Duration::ZERO,
+                }),
+            )),
+        }
+    }
 }
 
 /// ∂P on its grid and the Voronoi diagram of its segments (`None` for a
