@@ -673,8 +673,6 @@ fn finish(
     let mut all_bars = Vec::new();
     let mut widths = Vec::new();
     let mut graphs = Vec::new();
-    let mut raw = Vec::new();
-    let mut cells = Vec::new();
     let (mut components, mut legs_raw, mut legs, mut hooks) = (0, 0, 0, 0);
     let mut branch_offset = 0;
     for (k, (p, part)) in prepared.iter().zip(parts).enumerate() {
@@ -714,8 +712,6 @@ fn finish(
         {
             graphs.push(g.clone());
         }
-        raw.extend(part.raw.clone());
-        cells.extend(part.cells.clone());
         // The branches as lines (`SkeletonGraph::to_multilinestring`).
         lines.extend(branches.into_iter().map(|b| LineString(b.coords)));
     }
@@ -733,8 +729,8 @@ fn finish(
         bars: all_bars,
         widths,
         graphs,
-        raw,
-        cells,
+        raw: parts.iter().filter_map(|p| p.raw.clone()).collect(),
+        cells: parts.iter().filter_map(|p| p.cells.clone()).collect(),
         note: None,
     };
     (c, cast_time + clock.elapsed().saturating_sub(in_casts))
