@@ -353,7 +353,7 @@ pub fn partition(
         &local,
         params,
         ma,
-        cells.filter(|_| snapped.is_none()),
+        cells,
         expired,
     )?;
     let global = |o: Owner| o.map(|i| near.units[i as usize].index);
@@ -378,8 +378,8 @@ pub fn partition(
 }
 
 /// [`partition`] of `p` (`original`, snapped) between the units of `cov`,
-/// which meet it along its bank; `cells` those of `p`'s diagram, when
-/// given.
+/// which meet it along its bank; `cells` those of `original`'s diagram,
+/// when given.
 fn partition_cut(
     p: &PreparedPolygon,
     original: &PreparedPolygon,
@@ -390,7 +390,7 @@ fn partition_cut(
     expired: &dyn Fn() -> bool,
 ) -> Result<PartPartition, PartitionError> {
     let tol = SAME_POINT * p.extent();
-    let mut owned = owners::owned(p, cov, tol);
+    let mut owned = owners::owned(p, original.polygon(), cov, tol);
     let mut cuts: Vec<Vec<Coord<f64>>> = Vec::new();
     let mut wide_parts: Vec<Polygon<f64>> = Vec::new();
     if let Some(c) = params.narrow() {
@@ -420,9 +420,11 @@ fn partition_cut(
         }
     }
     stop_if(expired)?;
-    let edges = match (owned.base == *p.polygon(), cells) {
+    // The diagram of the polygon as it came (the points the units were
+    // snapped onto are split points of its edges, as their T-junctions).
+    let edges = match (owned.base == *original.polygon(), cells) {
         (true, Some(cells)) => cells,
-        (true, None) => cell_edges(p, ArcTolerance::default())?,
+        (true, None) => cell_edges(original, ArcTolerance::default())?,
         (false, _) => cell_edges(&PreparedPolygon::new(&owned.base)?, ArcTolerance::default())?,
     };
     let prepared = PreparedPolygon::new(&owned.polygon)?;

@@ -318,9 +318,11 @@ pub struct VertexOwners {
 }
 
 /// `p` with its owners in `cov`, whose units meet it only along its
-/// boundary (cut by it: [`super::cut`]).
-pub fn owned(p: &PreparedPolygon, cov: &Coverage, tol: f64) -> Owned {
-    let (polygon, base) = with_t_junctions(p, cov, tol);
+/// boundary (cut by it: [`super::cut`]); its [base](Owned::base) is `of`
+/// (whose vertices are `p`'s, `p` having more inside its edges: where the
+/// units were snapped onto it) with the same vertices moved.
+pub fn owned(p: &PreparedPolygon, of: &Polygon<f64>, cov: &Coverage, tol: f64) -> Owned {
+    let (polygon, base) = with_t_junctions(p, of, cov, tol);
     let mut owner = FxHashMap::default();
     for r in std::iter::once(polygon.exterior()).chain(polygon.interiors()) {
         for w in r.0.windows(2) {
@@ -352,8 +354,13 @@ fn owner_of(cov: &Coverage, a: Coord<f64>, b: Coord<f64>, tol: f64) -> Option<u3
 /// `tol`, not at its ends) inserted there, and every vertex of `p` within
 /// `tol` of a unit vertex moved onto it, with the unit's coordinates: where
 /// they meet, the polygon and the units then share their vertices exactly
-/// (the units keep theirs bit for bit); and `p` with only the moves.
-fn with_t_junctions(p: &PreparedPolygon, cov: &Coverage, tol: f64) -> (Polygon<f64>, Polygon<f64>) {
+/// (the units keep theirs bit for bit); and `of` with only the moves.
+fn with_t_junctions(
+    p: &PreparedPolygon,
+    of: &Polygon<f64>,
+    cov: &Coverage,
+    tol: f64,
+) -> (Polygon<f64>, Polygon<f64>) {
     let b = p.boundary();
     let (lo, hi) = (b.bbox_min(), b.bbox_max());
     let mut inserts = Inserts::default();
@@ -388,8 +395,8 @@ fn with_t_junctions(p: &PreparedPolygon, cov: &Coverage, tol: f64) -> (Polygon<f
     }
     let moved = |c: Coord<f64>| moves.get(&key(c)).copied().unwrap_or(c);
     let base = match moves.is_empty() {
-        true => p.polygon().clone(),
-        false => with_inserted(p.polygon(), &Inserts::default(), moved),
+        true => of.clone(),
+        false => with_inserted(of, &Inserts::default(), moved),
     };
     (with_inserted(p.polygon(), &inserts, moved), base)
 }
