@@ -41,9 +41,6 @@ METHODS = ["MA", "StSk", "DVD", "CDT", "VD"]
 PRUNE = ["significance", "length", "trunk", "none"]
 EXTEND = ["centred", "ray", "nearest", "none"]
 SELECT = ["distortion", "deviation", "deviation_parts", "distortion_sum"]
-COLLAPSE_MODES = ["partial", "whole"]
-UNOWNED = ["keep", "nearest"]
-OVERLAP = ["cut", "reject"]
 
 HELP_URL = "https://github.com/skeletonise/skeletonise#in-qgis"
 
@@ -523,18 +520,10 @@ class CollapseAlgorithm(_Algorithm):
         "Collapses polygons to lines where they are narrower than a width and keeps them as areas where "
         "they are wider, cut across the polygon between, as the command line's collapse step: rivers "
         "that become lines where narrow and stay areas where wide, lakes on a river network.\n\n"
+        "The collapse step's options (width, tolerance, min length, mode, min area) are its own, as "
+        "`skeletonise schema` gives them (names, defaults, ranges; their help below and as the tooltip "
+        "of each; 0 leaves min length unset: the width).\n\n"
         "<b>Polygons</b>: a polygon layer in a projected CRS.\n"
-        "<b>Collapse width</b>: the polygon becomes a line where its local width is below this (layer "
-        "units).\n"
-        "<b>Tolerance</b>: a band around the width, as a fraction of it (0.2): a point within "
-        "width·(1 ± tolerance) takes the class of the nearer point outside the band, so that a river "
-        "oscillating around the width is not chopped into pieces.\n"
-        "<b>Minimum length</b>: the shortest collapsed or kept stretch (0: the width); a shorter one "
-        "takes its neighbours' class.\n"
-        "<b>Mode</b>: partial (lines where narrow, areas where wide) or whole (a polygon part collapses "
-        "entirely when more than half of its area is narrow, otherwise it is kept).\n"
-        "<b>Smallest kept area</b>: a kept area smaller than this whose every cut leads to a collapsed "
-        "line is collapsed too (0: off; a few width² is typical).\n"
         "<b>Connecting lines</b>: optional line layer (rivers into a lake, roads): the skeleton gets a leg "
         "to every point where a line meets the polygon.\n"
         "<b>Snap distance</b>: a connecting line's end this close to the polygon's boundary meets it too "
@@ -545,14 +534,13 @@ class CollapseAlgorithm(_Algorithm):
         "<b>Kept areas</b>: the pieces kept as areas, with cuts (where collapsed lines meet them)."
     )
 
+    def shortHelpString(self):  # noqa: N802
+        """The help text, with each option of the collapse step explained by its schema."""
+        return _tr(self.HELP) + _tr(_options_help(_builtin_options(COLLAPSE_OPTIONS)))
+
     def initAlgorithm(self, config=None):  # noqa: N802
         _polygons(self)
-        number = QgsProcessingParameterNumber.Double
-        self.addParameter(QgsProcessingParameterNumber("WIDTH", _tr("Collapse width (layer units)"), number, minValue=0.0))
-        self.addParameter(QgsProcessingParameterNumber("TOLERANCE", _tr("Tolerance (fraction of the width)"), number, 0.2, minValue=0.0, maxValue=0.99))
-        self.addParameter(QgsProcessingParameterNumber("COLLAPSE_MIN_LENGTH", _tr("Minimum length (layer units; 0: the width)"), number, 0.0, minValue=0.0))
-        self.addParameter(QgsProcessingParameterEnum("MODE", _tr("Mode"), options=COLLAPSE_MODES, defaultValue=0))
-        self.addParameter(QgsProcessingParameterNumber("MIN_AREA", _tr("Smallest kept area (layer units²; 0: off)"), number, 0.0, minValue=0.0))
+        _option_parameters(self, _builtin_options(COLLAPSE_OPTIONS))
         _connect_parameters(self)
         _method_parameters(self, choose=False)
         _sinks(self, candidates=False)
@@ -560,18 +548,9 @@ class CollapseAlgorithm(_Algorithm):
         self._tooltips()
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802
-        width = self.parameterAsDouble(parameters, "WIDTH", context)
-        if not width > 0:
+        collapse = _option_values(self, _builtin_options(COLLAPSE_OPTIONS), parameters, context)
+        if not collapse.get("width", 0) > 0:
             raise QgsProcessingException("`width`: give the collapse width, a distance > 0 in the layer's units")
-        collapse = {
-            "width": width,
-            "tolerance": self.parameterAsDouble(parameters, "TOLERANCE", context),
-            "mode": COLLAPSE_MODES[self.parameterAsEnum(parameters, "MODE", context)],
-            "min_area": self.parameterAsDouble(parameters, "MIN_AREA", context),
-        }
-        min_length = self.parameterAsDouble(parameters, "COLLAPSE_MIN_LENGTH", context)
-        if min_length > 0:
-            collapse["min_length"] = min_length
         doc = {"steps": _method_steps(self, parameters, context, collapse)}
         pipeline = bridge.options_pipeline(doc, "skeletonise:collapse")
         snap = self.parameterAsDouble(parameters, "SNAP", context)
@@ -678,23 +657,53 @@ def _step_sinks():
     return [(f"STEP_{layer.upper()}", layer, _SINK_TYPES[kind]) for _step, layer, kind, _ in layers if kind in _SINK_TYPES]
 
 
-def _step_options(step):
-    """The options of the registered step ``step`` from the pipeline file's JSON Schema (the
-    wheel's ``schema()``, which ``skeletonise schema`` prints): ``(key, schema)`` pairs, each
-    schema resolved; empty without the wheel (the algorithm then says what to install)."""
+def _options(definition, first=()):
+    """The options of a step from the pipeline file's JSON Schema (the wheel's ``schema()``, which
+    ``skeletonise schema`` prints), ``definition`` naming them in its ``$defs``: ``(key, schema)``
+    pairs, each schema resolved, with ``nullable`` (the option may be left unset) and ``required``;
+    the keys of ``first`` first, the others in the schema's order. Empty without the wheel (the
+    algorithm then says what to install)."""
     try:
         schema = json.loads(bridge.core().schema())
     except QgsProcessingException:
         return []
     defs = schema["$defs"]
-    props = defs.get(f"{step}_options", {}).get("properties", {})
+    props = defs.get(definition, {}).get("properties", {})
+    required = defs.get(definition, {}).get("required", [])
 
     def resolve(v):
         ref = v.get("$ref", "")
         return defs[ref.rsplit("/", 1)[-1]] if ref.startswith("#/$defs/") else v
 
-    return [(key, dict(resolve(v), default=v.get("default"), description=v.get("description", "")))
-            for key, v in props.items()]
+    def option(v):
+        o = dict(resolve(v), default=v.get("default"), description=v.get("description", ""))
+        types = o.get("type") if isinstance(o.get("type"), list) else [o.get("type")]
+        o["type"] = next((t for t in types if t != "null"), None)
+        return dict(o, nullable="null" in types)
+
+    keys = [k for k in first if k in props] + [k for k in props if k not in first]
+    return [(key, dict(option(props[key]), required=key in required)) for key in keys]
+
+
+def _step_options(step):
+    """The options of the registered step ``step`` (see ``_options``)."""
+    return _options(f"{step}_options")
+
+
+# The built-in steps whose options are parameters of their algorithm, in the order shown, and the
+# parameter names that differ from the option's key in capitals (where another step's parameter of
+# the algorithm has that name: prune's MIN_LENGTH).
+COLLAPSE_OPTIONS = ("CollapseParams", ("width", "tolerance", "min_length", "mode", "min_area"))
+PARTITION_OPTIONS = ("PartitionParams", ("overlap", "unowned", "width", "tolerance", "min_length"))
+RENAMED = {"CollapseParams": {"min_length": "COLLAPSE_MIN_LENGTH"},
+           "PartitionParams": {"min_length": "PARTITION_MIN_LENGTH"}}
+
+
+def _builtin_options(spec):
+    """``(parameter name, key, schema)`` of a built-in step's options (``COLLAPSE_OPTIONS``, …)."""
+    definition, first = spec
+    names = RENAMED.get(definition, {})
+    return [(names.get(key, key.upper()), key, option) for key, option in _options(definition, first)]
 
 
 def _choices(option):
@@ -709,24 +718,37 @@ def _choices(option):
 def _step_parameters(alg, step):
     """The parameters of a registered step's options, from its schema: names (the key in capitals),
     defaults, ranges (an exclusive bound as the nearest number inside it) and help."""
-    for key, option in _step_options(step):
+    _option_parameters(alg, [(key.upper(), key, option) for key, option in _step_options(step)])
+
+
+def _option_parameters(alg, options):
+    """The parameters of ``(name, key, schema)`` options: defaults, ranges (an exclusive bound as
+    the nearest number inside it) and help from the schema; an option that may be left unset is 0
+    when it is (its help says what unset means)."""
+    for name, key, option in options:
         label = _tr(key.replace("_", " ").capitalize())
         choices = _choices(option)
         if choices is not None:
             default = choices.index(option["default"]) if option["default"] in choices else 0
-            p = QgsProcessingParameterEnum(key.upper(), label, options=choices, defaultValue=default)
+            p = QgsProcessingParameterEnum(name, label, options=choices, defaultValue=default)
         elif option.get("type") in ("number", "integer"):
             bounds = {}
-            for name, plain, exclusive, towards in (("minValue", "minimum", "exclusiveMinimum", math.inf),
-                                                    ("maxValue", "maximum", "exclusiveMaximum", -math.inf)):
+            for bound, plain, exclusive, towards in (("minValue", "minimum", "exclusiveMinimum", math.inf),
+                                                     ("maxValue", "maximum", "exclusiveMaximum", -math.inf)):
                 if plain in option:
-                    bounds[name] = float(option[plain])
+                    bounds[bound] = float(option[plain])
                 elif exclusive in option:
-                    bounds[name] = math.nextafter(float(option[exclusive]), towards)
+                    bounds[bound] = math.nextafter(float(option[exclusive]), towards)
             kind = QgsProcessingParameterNumber.Integer if option["type"] == "integer" else QgsProcessingParameterNumber.Double
-            p = QgsProcessingParameterNumber(key.upper(), label, kind, option["default"], **bounds)
+            default = option["default"]
+            if option["nullable"]:
+                # Unset is 0, below every value it may take.
+                bounds["minValue"] = 0.0
+                label = _tr(f"{key.replace('_', ' ').capitalize()} (0: unset)")
+                default = 0.0 if default is None else default
+            p = QgsProcessingParameterNumber(name, label, kind, default, **bounds)
         elif option.get("type") == "boolean":
-            p = QgsProcessingParameterBoolean(key.upper(), label, bool(option["default"]))
+            p = QgsProcessingParameterBoolean(name, label, bool(option["default"]))
         else:
             continue
         p.setHelp(_tr(option["description"]))
@@ -735,18 +757,30 @@ def _step_parameters(alg, step):
 
 def _step_values(alg, step, parameters, context):
     """The registered step's options as the user set them (the keys of its schema)."""
+    return _option_values(alg, [(key.upper(), key, option) for key, option in _step_options(step)], parameters, context)
+
+
+def _option_values(alg, options, parameters, context):
+    """The options of ``(name, key, schema)`` as the user set them (an unset one, 0, left out)."""
     out = {}
-    for key, option in _step_options(step):
+    for name, key, option in options:
         choices = _choices(option)
         if choices is not None:
-            out[key] = choices[alg.parameterAsEnum(parameters, key.upper(), context)]
+            out[key] = choices[alg.parameterAsEnum(parameters, name, context)]
         elif option.get("type") == "integer":
-            out[key] = alg.parameterAsInt(parameters, key.upper(), context)
+            out[key] = alg.parameterAsInt(parameters, name, context)
         elif option.get("type") == "number":
-            out[key] = alg.parameterAsDouble(parameters, key.upper(), context)
+            out[key] = alg.parameterAsDouble(parameters, name, context)
         elif option.get("type") == "boolean":
-            out[key] = alg.parameterAsBool(parameters, key.upper(), context)
+            out[key] = alg.parameterAsBool(parameters, name, context)
+        if option.get("nullable") and out.get(key) == 0:
+            del out[key]
     return out
+
+
+def _options_help(options):
+    """Each option's help from its schema, one paragraph each, for an algorithm's help text."""
+    return "".join(f"\n<b>{key.replace('_', ' ').capitalize()}</b>: {option['description']}" for _name, key, option in options)
 
 
 class LabelAlgorithm(_Algorithm):
@@ -771,10 +805,7 @@ class LabelAlgorithm(_Algorithm):
 
     def shortHelpString(self):  # noqa: N802
         """The help text, with each option of the label step explained by its schema."""
-        options = "".join(
-            f"\n<b>{key.replace('_', ' ').capitalize()}</b>: {option['description']}"
-            for key, option in _step_options("label")
-        )
+        options = _options_help([(key.upper(), key, option) for key, option in _step_options("label")])
         return _tr(self.HELP) + _tr(options)
 
     def initAlgorithm(self, config=None):  # noqa: N802
@@ -857,21 +888,17 @@ class PartitionAlgorithm(_Algorithm):
         "goes to the unit whose bank is nearest, so the new boundary between two units is the medial axis "
         "between their banks. Adjacent polygons (reaches of one river) are merged first, vertex for "
         "vertex. The grown coverage stays a coverage: shared edges with identical vertices, no gap, no "
-        "overlap, area conserved.\n\n"
+        "overlap, area conserved. The partition step's options (overlap, unowned, width, tolerance, min "
+        "length) are its own, as `skeletonise schema` gives them (names, defaults, ranges; their help "
+        "below and as the tooltip of each; 0 leaves width and min length unset: the whole polygon is "
+        "given away). Overlap cut gives a cartographic boundary down the middle of the water, not the "
+        "legal one.\n\n"
         "<b>Polygons</b>: the polygons to give away, in a projected CRS.\n"
         "<b>Neighbours</b>: the coverage of units around them (reprojected to the polygons' CRS when it "
         "differs). Real administrative units may contain their share of the water (the legal boundary "
         "inside it) or come from another source: see Overlap and Snap.\n"
-        "<b>Overlap</b>: where a unit overlaps a polygon: cut (the polygon is cut out of the unit and its "
-        "area given by the rule; the result is a cartographic boundary down the middle, not the legal one) "
-        "or reject (the polygon is rejected, naming the unit).\n"
         "<b>Snap</b>: unit vertices and edges within this distance of a polygon's bank are moved onto it "
         "(layer units; 0: 1e-7 × each polygon's extent, above a reprojection's round-off).\n"
-        "<b>Width</b>: give away only where the polygon is narrower than this (layer units; 0: the whole "
-        "polygon); wider parts stay polygons of their own (Remainders, kind = wide).\n"
-        "<b>Tolerance</b>: with a width, the band around it as a fraction of it, as in Collapse.\n"
-        "<b>Unowned area</b>: area nearest to bank no unit owns (the sea, the coverage's edge): keep (a "
-        "remainder, kind = unowned) or nearest (to the unit it borders along the longest stretch).\n"
         "<b>Prune</b>, <b>Minimum leg length</b>, <b>Extend</b>: the medial axis written to Skeletons, as in "
         "Skeletonise polygons.\n"
         "<b>Grown coverage</b>: every unit with its fields, src_fid (its FID), received (the area it "
@@ -882,16 +909,17 @@ class PartitionAlgorithm(_Algorithm):
         "<b>Skeletons</b>: optional; the polygons' medial axes."
     )
 
+    def shortHelpString(self):  # noqa: N802
+        """The help text, with each option of the partition step explained by its schema."""
+        return _tr(self.HELP) + _tr(_options_help(_builtin_options(PARTITION_OPTIONS)))
+
     def initAlgorithm(self, config=None):  # noqa: N802
         _polygons(self)
         self.addParameter(
             QgsProcessingParameterFeatureSource("NEIGHBOURS", _tr("Neighbours (a coverage of units)"), [QgsProcessing.TypeVectorPolygon])
         )
+        _option_parameters(self, _builtin_options(PARTITION_OPTIONS))
         number = QgsProcessingParameterNumber.Double
-        self.addParameter(QgsProcessingParameterNumber("WIDTH", _tr("Width (layer units; 0: the whole polygon)"), number, 0.0, minValue=0.0))
-        self.addParameter(QgsProcessingParameterNumber("TOLERANCE", _tr("Tolerance (fraction of the width)"), number, 0.2, minValue=0.0, maxValue=0.99))
-        self.addParameter(QgsProcessingParameterEnum("UNOWNED", _tr("Unowned area"), options=UNOWNED, defaultValue=0))
-        self.addParameter(QgsProcessingParameterEnum("OVERLAP", _tr("Overlap (units that overlap a polygon)"), options=OVERLAP, defaultValue=0))
         self.addParameter(QgsProcessingParameterNumber("SNAP", _tr("Snap (layer units; 0: 1e-7 × extent)"), number, 0.0, minValue=0.0))
         _method_parameters(self, choose=False)
         _partition_sinks(self, required=True)
@@ -904,14 +932,7 @@ class PartitionAlgorithm(_Algorithm):
         self._tooltips()
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802
-        partition = {
-            "unowned": UNOWNED[self.parameterAsEnum(parameters, "UNOWNED", context)],
-            "overlap": OVERLAP[self.parameterAsEnum(parameters, "OVERLAP", context)],
-            "tolerance": self.parameterAsDouble(parameters, "TOLERANCE", context),
-        }
-        width = self.parameterAsDouble(parameters, "WIDTH", context)
-        if width > 0:
-            partition["width"] = width
+        partition = _option_values(self, _builtin_options(PARTITION_OPTIONS), parameters, context)
         steps = [{"skeleton": {"methods": ["MA"]}}] + _prune_extend(self, parameters, context)
         doc = {"steps": steps + [{"partition": partition}]}
         pipeline = bridge.options_pipeline(doc, "skeletonise:partition")

@@ -991,6 +991,32 @@ class Labels(Case):
         self.assertGreater(alg.parameterDefinition("MIN_PIXELS").minimum(), 0.0)
         self.assertEqual(alg.parameterDefinition("SMOOTH").maximum(), 180.0)
 
+    def test_the_collapse_and_partition_parameters_are_their_steps_schema(self):
+        # The built-in steps' options as the label step's: what `skeletonise schema` says, so the
+        # dialog cannot offer a default or a range the command line does not have (tolerance 1:
+        # the range ends below it). An option that may be unset is 0 there.
+        defs = json.loads(cli("schema").stdout)["$defs"]
+        renamed = {"collapse": {"min_length": "COLLAPSE_MIN_LENGTH"}, "partition": {"min_length": "PARTITION_MIN_LENGTH"}}
+        for step, definition in (("collapse", "CollapseParams"), ("partition", "PartitionParams")):
+            alg = QgsApplication.processingRegistry().algorithmById(f"skeletonise:{step}")
+            for key, option in defs[definition]["properties"].items():
+                p = alg.parameterDefinition(renamed[step].get(key, key.upper()))
+                self.assertIsNotNone(p, (step, key))
+                self.assertEqual(p.help(), option["description"], (step, key))
+                self.assertIn(option["description"], alg.shortHelpString())
+                if "$ref" in option:
+                    values = [o["const"] for o in defs[option["$ref"].rsplit("/", 1)[-1]]["oneOf"]]
+                    self.assertEqual(p.options(), values, (step, key))
+                    self.assertEqual(p.options()[p.defaultValue()], option["default"], (step, key))
+                elif "default" in option:
+                    self.assertEqual(p.defaultValue(), option["default"] or 0.0, (step, key))
+            tolerance = alg.parameterDefinition("TOLERANCE")
+            self.assertEqual(tolerance.minimum(), 0.0)
+            self.assertLess(tolerance.maximum(), 1.0)
+            self.assertGreater(tolerance.maximum(), 0.999999)
+        self.assertGreater(QgsApplication.processingRegistry().algorithmById("skeletonise:collapse")
+                           .parameterDefinition("WIDTH").minimum(), 0.0)
+
     def test_labels_give_the_command_lines_rows_with_minzoom(self):
         cli("run", os.path.join(ROOT, "pipelines", "lake-labels.yaml"), "-o", self.out("cli.gpkg"))
         res = processing.run(

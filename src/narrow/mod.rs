@@ -77,18 +77,22 @@ pub enum CollapseMode {
 #[serde(deny_unknown_fields)]
 pub struct CollapseParams {
     /// Collapse width (CRS units): the polygon becomes a line where its local width 2r is below it.
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub width: f64,
     /// Band around `width` as a fraction of it (default 0.2): a point within width·(1 ± tolerance) takes the class of the nearer point outside the band, so that a river oscillating around the threshold is not chopped into pieces.
     #[serde(default = "default_tolerance")]
+    #[schemars(range(min = 0), extend("exclusiveMaximum" = 1))]
     pub tolerance: f64,
     /// Shortest collapsed or kept stretch of skeleton (CRS units; default: `width`); a shorter one takes its neighbours' class.
     #[serde(default)]
+    #[schemars(range(min = 0))]
     pub min_length: Option<f64>,
     /// `partial` (default): lines where narrow, areas where wide; `whole`: a polygon part collapses entirely when more than half of its area is narrow, otherwise it is kept.
     #[serde(default)]
     pub mode: CollapseMode,
     /// Smallest kept area (CRS units²; default 0: off): a kept area smaller than this whose every cut leads to a collapsed line (a bead on a collapsed river, at a confluence) is collapsed too; a few width² is typical.
     #[serde(default)]
+    #[schemars(range(min = 0))]
     pub min_area: f64,
 }
 

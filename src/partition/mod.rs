@@ -91,12 +91,15 @@ pub struct PartitionParams {
     pub unowned: Unowned,
     /// Give away only the narrow parts (CRS units, as `collapse`'s `width`): where the medial axis's local width 2r is above it the polygon stays a polygon of its own (`areas`, `kind = wide`), cut across where it meets the given parts. Needs MA among `skeleton.methods`. Default: the whole polygon is given away.
     #[serde(default)]
+    #[schemars(extend("exclusiveMinimum" = 0))]
     pub width: Option<f64>,
     /// With `width`: the band around it as a fraction of it (default 0.2), as in `collapse`.
     #[serde(default = "default_tolerance")]
+    #[schemars(range(min = 0), extend("exclusiveMaximum" = 1))]
     pub tolerance: f64,
     /// With `width`: the shortest narrow or wide stretch of the medial axis (CRS units; default `width`), as in `collapse`.
     #[serde(default)]
+    #[schemars(range(min = 0))]
     pub min_length: Option<f64>,
 }
 
