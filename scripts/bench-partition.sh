@@ -7,7 +7,8 @@
 #   B: the same with `partition`;
 # wall time, CPU time and peak RSS from /usr/bin/time -v of each whole process. The step's own
 # cost is its thread CPU time in B's run record (skeletonise_runs.stage_seconds: "partition", the
-# polygons and the coverage assembled at the end); the MA skeleton's is its thread CPU time there
+# polygons, the cells of the medial axis's diagram it splits — made beside MA's skeleton, counted
+# here, not in "skeleton" — and the coverage assembled at the end); the MA skeleton's is its thread CPU time there
 # too ("MA": "skeleton"). The whole run's extra cost (B's CPU time less A's) also counts reading
 # the units and writing them grown. Then GEOS CoverageCleaner (shapely.coverage_clean, longest
 # border) on the same units, for scale.
