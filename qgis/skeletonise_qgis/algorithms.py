@@ -38,9 +38,6 @@ from qgis.PyQt.QtGui import QIcon
 from . import bridge
 
 METHODS = ["MA", "StSk", "DVD", "CDT", "VD"]
-PRUNE = ["significance", "length", "trunk", "none"]
-EXTEND = ["centred", "ray", "nearest", "none"]
-SELECT = ["distortion", "deviation", "deviation_parts", "distortion_sum"]
 
 HELP_URL = "https://github.com/skeletonise/skeletonise#in-qgis"
 
@@ -419,6 +416,42 @@ class SkeletoniseAlgorithm(_Algorithm):
         return self._pipeline_rows(pipeline, parameters, context, feedback, explode)
 
 
+def _modes(step, key, leave_out=()):
+    """The values of a step's option that is one of a few texts (``("PruneParams", "mode")``, …)
+    in the schema's order, less ``leave_out``, and the index of its default: the choices the
+    command line has, none copied by hand. Empty without the wheel (the algorithm then says what
+    to install)."""
+    options = dict(_options(step))
+    option = options.get(key)
+    choices = [c for c in (_choices(option) or []) if c not in leave_out] if option else []
+    default = choices.index(option["default"]) if choices and option["default"] in choices else 0
+    return choices, default
+
+
+# Pruning to a network needs its lines (the collapse algorithm's connect lines only legs them).
+PRUNE = ("PruneParams", "mode", ("network",))
+EXTEND = ("ExtendParams", "mode", ())
+SELECT = ("SelectParams", "by", ())
+
+
+def _mode_parameter(alg, name, label, spec):
+    """An enum parameter of a step's option (``PRUNE``, ``EXTEND``, ``SELECT``) from the schema;
+    none without the wheel (the algorithm cannot run, and says what to install)."""
+    choices, default = _modes(*spec)
+    if not choices:
+        return
+    alg.addParameter(QgsProcessingParameterEnum(name, label, options=choices, defaultValue=default))
+
+
+def _mode_value(alg, name, spec, parameters, context):
+    """The value chosen for an enum parameter made by ``_mode_parameter`` (without the wheel, the
+    message saying what to install)."""
+    choices = _modes(*spec)[0]
+    if not choices:
+        bridge.core()
+    return choices[alg.parameterAsEnum(parameters, name, context)]
+
+
 def _method_parameters(alg, choose=True):
     """METHODS, PRUNE, MIN_LENGTH, EXTEND and SELECT: the skeleton, prune, extend and select steps
     (without METHODS and SELECT when the method is not a choice: collapse draws the medial axis)."""
@@ -428,7 +461,7 @@ def _method_parameters(alg, choose=True):
                 "METHODS", _tr("Methods"), options=METHODS, allowMultiple=True, defaultValue=list(range(len(METHODS)))
             )
         )
-    alg.addParameter(QgsProcessingParameterEnum("PRUNE", _tr("Prune"), options=PRUNE, defaultValue=0))
+    _mode_parameter(alg, "PRUNE", _tr("Prune"), PRUNE)
     alg.addParameter(
         QgsProcessingParameterNumber(
             "MIN_LENGTH",
@@ -438,18 +471,18 @@ def _method_parameters(alg, choose=True):
             minValue=0.0,
         )
     )
-    alg.addParameter(QgsProcessingParameterEnum("EXTEND", _tr("Extend"), options=EXTEND, defaultValue=0))
+    _mode_parameter(alg, "EXTEND", _tr("Extend"), EXTEND)
     if choose:
-        alg.addParameter(QgsProcessingParameterEnum("SELECT", _tr("Select by"), options=SELECT, defaultValue=0))
+        _mode_parameter(alg, "SELECT", _tr("Select by"), SELECT)
 
 
 def _prune_extend(alg, parameters, context):
     """The prune and extend steps of PRUNE, MIN_LENGTH and EXTEND, as the pipeline file's."""
-    prune = {"mode": PRUNE[alg.parameterAsEnum(parameters, "PRUNE", context)]}
+    prune = {"mode": _mode_value(alg, "PRUNE", PRUNE, parameters, context)}
     min_length = alg.parameterAsDouble(parameters, "MIN_LENGTH", context)
     if min_length > 0:
         prune["min_length"] = min_length
-    return [{"prune": prune}, {"extend": {"mode": EXTEND[alg.parameterAsEnum(parameters, "EXTEND", context)]}}]
+    return [{"prune": prune}, {"extend": {"mode": _mode_value(alg, "EXTEND", EXTEND, parameters, context)}}]
 
 
 def _method_steps(alg, parameters, context, collapse=None):
@@ -465,7 +498,7 @@ def _method_steps(alg, parameters, context, collapse=None):
     if collapse is not None:
         steps += [{"collapse": collapse}, {"score": {}}, {"select": {}}]
     else:
-        steps += [{"score": {}}, {"select": {"by": SELECT[alg.parameterAsEnum(parameters, "SELECT", context)]}}]
+        steps += [{"score": {}}, {"select": {"by": _mode_value(alg, "SELECT", SELECT, parameters, context)}}]
     return steps
 
 

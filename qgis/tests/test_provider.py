@@ -1016,6 +1016,17 @@ class Labels(Case):
             self.assertGreater(tolerance.maximum(), 0.999999)
         self.assertGreater(QgsApplication.processingRegistry().algorithmById("skeletonise:collapse")
                            .parameterDefinition("WIDTH").minimum(), 0.0)
+        # The prune, extend and select modes are the schema's too (pruning to a network needs its
+        # lines, which these algorithms do not take), each defaulting as the pipeline file does.
+        alg = QgsApplication.processingRegistry().algorithmById("skeletonise:skeletonise")
+        for name, definition, key, leave_out in (("PRUNE", "PruneParams", "mode", {"network"}),
+                                                 ("EXTEND", "ExtendParams", "mode", set()),
+                                                 ("SELECT", "SelectParams", "by", set())):
+            option = defs[definition]["properties"][key]
+            values = [o["const"] for o in defs[option["$ref"].rsplit("/", 1)[-1]]["oneOf"]]
+            p = alg.parameterDefinition(name)
+            self.assertEqual(p.options(), [v for v in values if v not in leave_out], name)
+            self.assertEqual(p.options()[p.defaultValue()], option["default"], name)
 
     def test_labels_give_the_command_lines_rows_with_minzoom(self):
         cli("run", os.path.join(ROOT, "pipelines", "lake-labels.yaml"), "-o", self.out("cli.gpkg"))
