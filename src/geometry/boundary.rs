@@ -722,6 +722,26 @@ mod tests {
         Boundary::new(&p)
     }
 
+    /// `is_within` answers as the whole distance does, on the limit itself
+    /// too (points on a grid around and inside a ring with a hole, limits
+    /// from 0 to beyond every point's distance, and each point's own).
+    #[test]
+    fn is_within_is_the_distance_compared_with_the_limit() {
+        let b = square_with_hole();
+        for i in -8..=72 {
+            for k in -8..=72 {
+                let p = Coord {
+                    x: i as f64 * 0.21 - 1.3,
+                    y: k as f64 * 0.17 - 0.9,
+                };
+                let d = b.distance(p);
+                for limit in [0.0, 0.05, 0.5, 1.0, 3.0, 20.0, d, d * (1.0 - 1e-15)] {
+                    assert_eq!(b.is_within(p, limit), d <= limit, "{p:?} {limit} {d}");
+                }
+            }
+        }
+    }
+
     /// The parity ray along each axis direction gives the one answer, for
     /// points on a grid through a jagged ring with a hole (many of them on
     /// the lines of its vertices, where the half-open rule decides).

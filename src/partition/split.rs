@@ -207,6 +207,9 @@ fn split_cells(vertices: &mut Vertices, edges: &mut [CellEdge]) -> Vec<Piece> {
 /// meets. (A diagram of the polygon with the point as a vertex has the same
 /// normal as an edge; this one needs no second diagram.)
 fn split_segment_cells(vertices: &Vertices, splits: &Splits, edges: &mut [CellEdge]) -> Vec<Piece> {
+    if splits.is_empty() {
+        return Vec::new();
+    }
     let mut by_segment: FxHashMap<EdgeKey, Vec<usize>> = FxHashMap::default();
     for (k, e) in edges.iter().enumerate() {
         for s in e.sites {
