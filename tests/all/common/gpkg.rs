@@ -48,7 +48,6 @@ pub fn make_layer(path: &Path, layer: &str, epsg: u32, wkts: &[Option<&str>]) {
         f.set_field_integer(0, i as i32).unwrap();
         f.create(&l).unwrap();
     }
-    drop(l);
     ds.commit().unwrap();
 }
 
