@@ -257,7 +257,7 @@ stages() { # stages GPKG: the run's stage_seconds, per method: skeleton / prune+
 import json, pyogrio, sys
 r = pyogrio.read_dataframe(sys.argv[1], layer='skeletonise_runs', read_geometry=False)
 s = json.loads(r.stage_seconds.iloc[-1])
-print(', '.join(f'{m} {v.get(\"skeleton\", 0):.1f}/{v.get(\"prune_extend\", 0):.1f}/{v.get(\"score\", 0):.1f}' for m, v in sorted(s.items())))" "$1"
+print(', '.join(f'{m} {v.get(\"skeleton\", 0):.1f}/{v.get(\"prune_extend\", 0):.1f}/{v.get(\"score\", 0):.1f}' for m, v in sorted(s.items()) if isinstance(v, dict)))" "$1"
 }
 declined_in() { # declined_in GPKG: methods a budget declined, with the reason
   "$PY" -c "

@@ -395,7 +395,7 @@ fn init_logging(cli: &Cli) {
 fn run_error(e: RunError) -> ExitCode {
     tracing::error!("{e}");
     match e {
-        RunError::Rejected { .. } | RunError::Coverage(_) => ExitCode::from(EXIT_REJECTED),
+        RunError::Rejected { .. } | RunError::Finish(_) => ExitCode::from(EXIT_REJECTED),
         // `--threads 0` or too many: a usage error, as `--threads abc` is.
         RunError::TooManyThreads { .. } => ExitCode::from(EXIT_USAGE),
         _ => ExitCode::from(EXIT_RUNTIME),

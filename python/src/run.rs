@@ -58,9 +58,10 @@ enum Stop {
     Rejected(String),
     /// The cancel flag was set.
     Cancelled,
-    /// A unit of the partitioned coverage could not be made valid: the
+    /// The work after the last feature failed (a unit of the partitioned
+    /// coverage could not be made valid, a registered step's finish): the
     /// command line's text.
-    Coverage(String),
+    Finish(String),
 }
 
 /// The geometries as handed over.
@@ -367,9 +368,7 @@ fn work(
         })?;
         kept.push(rows);
     }
-    let (finished, c) = run
-        .finish()
-        .map_err(|e| Stop::Coverage(format!("partition: {e}")))?;
+    let (finished, c) = run.finish().map_err(|e| Stop::Finish(e.to_string()))?;
     let counts = [input.len() as u64, c.written, c.rejected, c.filtered];
     let plan = &opts.plan;
     let layer: &dyn Layer = if opts.candidates {
@@ -626,7 +625,7 @@ pub fn run<'py>(
     let done = detached(py, &input, fids, repaired, params, opts)?.map_err(|e| match e {
         Stop::Rejected(text) => RejectedError::new_err(text),
         Stop::Cancelled => Cancelled::new_err("cancelled"),
-        Stop::Coverage(text) => crate::PipelineError::new_err(text),
+        Stop::Finish(text) => crate::PipelineError::new_err(text),
     })?;
     to_python(py, done)
 }

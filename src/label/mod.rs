@@ -29,7 +29,9 @@ use crate::graph::prune::PruneParams;
 use crate::graph::SkeletonGraph;
 use crate::layer::{Cell, ColumnType, GeometryKind, StepLayer, StepRow};
 use crate::methods::{MethodContext, MethodId, SkeletonParams};
-use crate::process::step::{FeatureStep, LonLat, Needs, OptionError, StepEntry, StepInput};
+use crate::process::step::{
+    FeatureStep, LonLat, Needs, OptionError, StepEntry, StepInput, StepRows,
+};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
@@ -258,8 +260,9 @@ impl LabelParams {
 }
 
 impl FeatureStep for LabelParams {
-    fn rows(&self, input: &StepInput<'_>) -> Vec<(&'static str, StepRow)> {
-        self.labels_on(input.parts, input.medial_axis, input.budget)
+    fn rows(&self, input: &StepInput<'_>) -> StepRows {
+        let rows = self
+            .labels_on(input.parts, input.medial_axis, input.budget)
             .into_iter()
             .map(|(i, l)| {
                 let (geometry, kind) = match l.as_ref().map(|l| &l.label) {
@@ -282,7 +285,8 @@ impl FeatureStep for LabelParams {
                 ];
                 ("labels", StepRow { geometry, cells })
             })
-            .collect()
+            .collect();
+        Ok(rows)
     }
 }
 

@@ -111,10 +111,11 @@ pub enum RunError {
         /// Cores of this machine.
         cores: usize,
     },
-    /// A unit of the partitioned coverage could not be written valid (exit
-    /// 65: the output is not written).
-    #[error("partition: {0}")]
-    Coverage(#[from] crate::partition::UnitError),
+    /// The work after the last feature failed — a unit of the partitioned
+    /// coverage could not be written valid, a registered step's finish
+    /// failed — (exit 65: the output is not written).
+    #[error(transparent)]
+    Finish(#[from] crate::process::FinishError),
     /// The run's output was written but its report was not.
     #[error("the report failed ({0}); the GeoPackage was written, `skeletonise report` makes the report from it")]
     Report(#[from] ReportError),
@@ -550,7 +551,7 @@ impl Workers<'_> {
                 let _ = rows_tx.send(rows);
                 (Ok(()), counts)
             }
-            Ok(Err(e)) => (Err(RunError::Coverage(e)), Default::default()),
+            Ok(Err(e)) => (Err(RunError::Finish(e)), Default::default()),
             Err(e) => (Err(e), Default::default()),
         }
     }

@@ -39,7 +39,7 @@ pub(super) fn finish_run(
         filtered: counts.filtered,
         elapsed_s,
         threads,
-        stage_seconds: stage_json(&counts.stages, counts.units.map(|_| counts.partition_time)),
+        stage_seconds: stage_json(&counts.stages, &counts.step_times),
         area_held: counts.units.map(|_| counts.area_held),
     };
     let out = writer.finish(&record)?;
@@ -64,8 +64,12 @@ pub(super) fn finish_run(
 
 /// Step times as JSON for `skeletonise_runs.stage_seconds`:
 /// `{"MA": {"skeleton": 1.2, "prune_extend": 0.3, "score": 0.4}, …}`, and
-/// `"partition": 0.8` when the run partitions.
-fn stage_json(stages: &[(MethodId, StageTimes)], partition: Option<std::time::Duration>) -> String {
+/// each step after `select` that has a time of its own by its name
+/// (`"partition": 0.8`, `"label": 0.2`).
+fn stage_json(
+    stages: &[(MethodId, StageTimes)],
+    steps: &[(&'static str, std::time::Duration)],
+) -> String {
     let mut map: serde_json::Map<String, serde_json::Value> = stages
         .iter()
         .map(|(m, t)| {
@@ -79,8 +83,8 @@ fn stage_json(stages: &[(MethodId, StageTimes)], partition: Option<std::time::Du
             )
         })
         .collect();
-    if let Some(p) = partition {
-        map.insert("partition".into(), serde_json::json!(round_ms(p)));
+    for (name, t) in steps {
+        map.insert((*name).into(), serde_json::json!(round_ms(*t)));
     }
     serde_json::Value::Object(map).to_string()
 }

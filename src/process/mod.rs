@@ -25,7 +25,7 @@ pub use candidates::map_in_order;
 pub use outcome::{process, process_checked, process_given, StepError};
 pub use prepare::{prepare, prepare_checked, NotPrepared, PrepareParams};
 pub use rows::{feature_rows, FeatureRows, RowOptions, Skeletons, Status};
-pub use run::{FailedFeature, Run, RunCounts};
+pub use run::{FailedFeature, FinishError, Run, RunCounts};
 pub use types::{
     Candidate, CandidateError, CandidateSkeleton, FeatureOutcome, ProcessParams, Processed,
     StageTimes, StepTime,

@@ -60,6 +60,15 @@ pub enum StepError {
     /// `collapse` draws the medial axis, and MA failed on this polygon.
     #[error("`collapse` draws the medial axis, and MA failed on this polygon: {0}")]
     MedialAxisFailed(CandidateError),
+    /// A registered step rejected the feature
+    /// ([`FeatureStep::rows`](step::FeatureStep::rows) failed).
+    #[error("`{step}`: {reason}")]
+    Step {
+        /// The step (its key in the pipeline file).
+        step: &'static str,
+        /// Why, as the step says.
+        reason: String,
+    },
     /// A polygon part could not be partitioned.
     #[error("{}{error}", part.map_or_else(String::new, |i| format!("part {i}: ")))]
     Partition {
@@ -137,6 +146,7 @@ fn after_select(
             .and_then(|c| c.result.as_ref().ok())
             .map(|c| c.raw.as_slice())
             .filter(|raw| raw.len() == prepared.len());
+        let started = crate::clock::CpuClock::start();
         let rows = e.step.rows(&step::StepInput {
             parts: prepared,
             outcome: o,
@@ -145,7 +155,13 @@ fn after_select(
             side: e.side.as_deref(),
             budget: &clock.0,
         });
+        o.step_times
+            .push((e.entry.name, super::StepTime(started.elapsed())));
         clock.check(e.entry.name)?;
+        let rows = rows.map_err(|f| StepError::Step {
+            step: e.entry.name,
+            reason: f.0,
+        })?;
         o.extra.extend(rows);
     }
     Ok(())
@@ -239,7 +255,8 @@ fn partition_chosen(
         })?);
     }
     o.partition = Some(parts);
-    o.partition_time = super::StepTime(started.elapsed() + cells_time);
+    o.step_times
+        .push(("partition", super::StepTime(started.elapsed() + cells_time)));
     Ok(())
 }
 
@@ -405,7 +422,7 @@ fn choose(candidates: Vec<Candidate>, parts: usize, params: &ProcessParams) -> P
             measures: None,
             extra: Vec::new(),
             partition: None,
-            partition_time: Default::default(),
+            step_times: Vec::new(),
         }),
         None => Processed::Rejected(rejection(&candidates)),
     }

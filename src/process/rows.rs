@@ -78,8 +78,9 @@ pub struct FeatureRows {
     pub status: Status,
     /// Each method's step times on this feature (all its units).
     pub times: Vec<(MethodId, StageTimes)>,
-    /// The `partition` step's CPU time on this feature.
-    pub partition_time: std::time::Duration,
+    /// The CPU time on this feature of `partition` and of each registered
+    /// step, by the step's name (all its units).
+    pub step_times: Vec<(&'static str, std::time::Duration)>,
 }
 
 /// One polygon (or polygon part) through the per-feature path, its
@@ -123,12 +124,12 @@ pub fn feature_rows(
             rows,
             status: Status::Rejected,
             times: Vec::new(),
-            partition_time: Default::default(),
+            step_times: Vec::new(),
         };
     }
     let mut methods = Vec::new();
     let mut times: Vec<(MethodId, StageTimes)> = Vec::new();
-    let mut partition_time = std::time::Duration::ZERO;
+    let mut step_times: Vec<(&'static str, std::time::Duration)> = Vec::new();
     let mut reasons: Vec<String> = Vec::new();
     for (part, geom) in units(f.geometry.as_ref(), opts.explode) {
         let processed = fenced(geom.as_ref(), f.checked, skeletons, params);
@@ -144,7 +145,9 @@ pub fn feature_rows(
                         None => times.push((c.method, c.time)),
                     }
                 }
-                partition_time += o.partition_time.0;
+                for &(name, t) in &o.step_times {
+                    super::run::add_time(&mut step_times, name, t.0);
+                }
                 methods.push(outcome_rows(f, part, &o, label, opts, &mut rows));
             }
             Processed::Filtered => {}
@@ -176,7 +179,7 @@ pub fn feature_rows(
         rows,
         status,
         times,
-        partition_time,
+        step_times,
     }
 }
 

@@ -46,9 +46,27 @@ pub struct RunCounts {
     /// With a partition: the area the units held of the collapsed polygons
     /// before (set by [`Run::finish`]).
     pub area_held: f64,
-    /// The `partition` step's CPU time: the polygons, and the coverage
-    /// assembled at the end.
-    pub partition_time: Duration,
+    /// The CPU time of `partition` and of each registered step, by the
+    /// step's name in the order first met: on the features, and after the
+    /// last one (the coverage assembled, a step's finish).
+    pub step_times: Vec<(&'static str, Duration)>,
+}
+
+/// Why the work after the last feature failed: the run stops and writes
+/// nothing (exit 65).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum FinishError {
+    /// A unit of the partitioned coverage cannot be written valid.
+    #[error("partition: {0}")]
+    Coverage(#[from] crate::partition::UnitError),
+    /// A registered step's [finish](super::step::FeatureStep::finish) failed.
+    #[error("`{step}`: {reason}")]
+    Step {
+        /// The step (its key in the pipeline file).
+        step: &'static str,
+        /// Why, as the step says.
+        reason: String,
+    },
 }
 
 /// A feature rejected under `on_error: fail`: the run stops.
@@ -114,7 +132,9 @@ impl<'a> Run<'a> {
         c.connections += rows.connections.len() as u64;
         c.lines_used
             .extend(rows.connections.iter().map(|l| l.line_fid));
-        c.partition_time += r.partition_time;
+        for &(name, t) in &r.step_times {
+            add_time(&mut c.step_times, name, t);
+        }
         for (m, t) in &r.times {
             match c.stages.iter_mut().find(|(x, _)| x == m) {
                 Some((_, total)) => *total += *t,
@@ -154,15 +174,23 @@ impl<'a> Run<'a> {
     /// unit grown by what it received — (with `partition`), the registered
     /// steps' [finish](super::step::FeatureStep::finish) rows (of the
     /// layers each declares; without source fields), and the counts.
-    /// Fails when a unit of the coverage cannot be written valid.
-    pub fn finish(mut self) -> Result<(Rows, RunCounts), crate::partition::UnitError> {
+    /// Fails when a unit of the coverage cannot be written valid, or a
+    /// registered step's finish fails.
+    pub fn finish(mut self) -> Result<(Rows, RunCounts), FinishError> {
         let mut rows = Rows::default();
         for (e, kept) in self.params.extra.iter().zip(std::mem::take(&mut self.kept)) {
             let input = super::step::FinishInput {
                 rows: &kept,
                 side: e.side.as_deref(),
             };
-            for (layer, row) in e.step.finish(&input) {
+            let clock = crate::clock::CpuClock::start();
+            let made = e.step.finish(&input);
+            add_time(&mut self.counts.step_times, e.entry.name, clock.elapsed());
+            let made = made.map_err(|f| FinishError::Step {
+                step: e.entry.name,
+                reason: f.0,
+            })?;
+            for (layer, row) in made {
                 if e.entry.layers.iter().any(|l| l.name == layer) {
                     rows.extra
                         .entry(layer)
@@ -184,7 +212,7 @@ impl<'a> Run<'a> {
             let grown = std::mem::take(&mut self.grown);
             rows.coverage = crate::partition::assemble(cov.units(), grown)?;
             let c = &mut self.counts;
-            c.partition_time += clock.elapsed();
+            add_time(&mut c.step_times, "partition", clock.elapsed());
             c.units = Some(rows.coverage.len() as u64);
             c.area_held = rows
                 .coverage
@@ -195,5 +223,14 @@ impl<'a> Run<'a> {
                 + 0.0;
         }
         Ok((rows, self.counts))
+    }
+}
+
+/// Adds `t` to step `name`'s time in `times` (a new entry at the end when
+/// the step has none yet).
+pub(crate) fn add_time(times: &mut Vec<(&'static str, Duration)>, name: &'static str, t: Duration) {
+    match times.iter_mut().find(|(n, _)| *n == name) {
+        Some((_, total)) => *total += t,
+        None => times.push((name, t)),
     }
 }

@@ -5,8 +5,10 @@
 //! [needs](Needs) beyond the feature (the medial axis's raw skeleton,
 //! longitude and latitude, a side input layer), the layers it writes
 //! ([`StepLayer`]s, declared next to its code) — and a [`FeatureStep`] that
-//! turns each feature's outcome into rows of those layers and, after the
-//! last feature, may add rows of its own ([`FeatureStep::finish`]).
+//! turns each feature's outcome into rows of those layers (or rejects the
+//! feature with a reason) and, after the last feature, may add rows of its
+//! own ([`FeatureStep::finish`], or stop the run with a reason). The run
+//! records each registered step's CPU time under its name.
 //! Parsing (`config::load_with`), validation, the output plan, the run
 //! driver (`process::Run`), the writer, the Python table and
 //! `skeletonise methods` follow from the entry, as a method follows from
@@ -14,16 +16,16 @@
 //!
 //! ```
 //! use skeletonise::output::{Cell, ColumnType, GeometryKind, StepLayer, StepRow};
-//! use skeletonise::process::step::{FeatureStep, StepEntry, StepInput};
+//! use skeletonise::process::step::{FeatureStep, StepEntry, StepInput, StepRows};
 //!
 //! /// Writes each feature's number of polygon parts.
 //! #[derive(Debug)]
 //! struct Parts;
 //!
 //! impl FeatureStep for Parts {
-//!     fn rows(&self, input: &StepInput<'_>) -> Vec<(&'static str, StepRow)> {
+//!     fn rows(&self, input: &StepInput<'_>) -> StepRows {
 //!         let cells = vec![Cell::Int(input.parts.len() as i64)];
-//!         vec![("parts", StepRow { geometry: None, cells })]
+//!         Ok(vec![("parts", StepRow { geometry: None, cells })])
 //!     }
 //! }
 //!
@@ -123,19 +125,46 @@ impl PartialEq for LonLat {
     }
 }
 
+/// Why a registered step rejects a feature (its reason in `rejected`, after
+/// the step's name), or why its [finish](FeatureStep::finish) stops the run:
+/// what went wrong, where, and how to fix it.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct StepFailure(pub String);
+
+impl From<String> for StepFailure {
+    fn from(reason: String) -> Self {
+        Self(reason)
+    }
+}
+
+impl From<&str> for StepFailure {
+    fn from(reason: &str) -> Self {
+        Self(reason.into())
+    }
+}
+
+/// A registered step's rows, each with its layer's name, or why it failed.
+pub type StepRows = Result<Vec<(&'static str, StepRow)>, StepFailure>;
+
 /// A registered step's work on one feature: rows of its own layers, each
 /// with the layer's name.
 pub trait FeatureStep: Send + Sync + std::fmt::Debug + std::panic::RefUnwindSafe {
-    /// The rows of the step's layers for one feature.
-    fn rows(&self, input: &StepInput<'_>) -> Vec<(&'static str, StepRow)>;
+    /// The rows of the step's layers for one feature; an error rejects the
+    /// feature (every row of it, as a method's failure on every part
+    /// does), with the step's name and the reason in `rejected`, and the
+    /// run goes on (or stops under `on_error: fail`).
+    fn rows(&self, input: &StepInput<'_>) -> StepRows;
 
     /// Rows of the step's layers made once, after the last feature (a
     /// summary, what is left of the side input): written without source
     /// fields, `src_fid` NULL. `input.rows` holds the step's per-feature
-    /// rows when its entry [keeps them](Needs::finish).
-    fn finish(&self, input: &FinishInput<'_>) -> Vec<(&'static str, StepRow)> {
+    /// rows when its entry [keeps them](Needs::finish). An error stops the
+    /// run (exit 65) and no output is written: for what cannot be made
+    /// right afterwards, such as a coverage that would not be valid.
+    fn finish(&self, input: &FinishInput<'_>) -> StepRows {
         let _ = input;
-        Vec::new()
+        Ok(Vec::new())
     }
 }
 

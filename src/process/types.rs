@@ -228,8 +228,9 @@ pub struct FeatureOutcome {
     pub extra: Vec<(&'static str, crate::layer::StepRow)>,
     /// The partition of every polygon part, when the pipeline partitions.
     pub partition: Option<Vec<crate::partition::PartPartition>>,
-    /// The `partition` step's CPU time on the feature.
-    pub partition_time: StepTime,
+    /// The CPU time on the feature of `partition` and of each registered
+    /// step, by the step's name, in the order they ran.
+    pub step_times: Vec<(&'static str, StepTime)>,
 }
 
 impl FeatureOutcome {

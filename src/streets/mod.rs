@@ -36,7 +36,9 @@ use crate::geometry::vector::norm;
 use crate::geometry::PreparedPolygon;
 use crate::graph::SkeletonGraph;
 use crate::layer::{Cell, ColumnType, GeometryKind, LayerSource, StepLayer, StepRow};
-use crate::process::step::{FeatureStep, FinishInput, Needs, SideLayer, StepEntry, StepInput};
+use crate::process::step::{
+    FeatureStep, FinishInput, Needs, SideLayer, StepEntry, StepInput, StepRows,
+};
 use geo::{Coord, LineString};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -82,7 +84,7 @@ pub const STREETS: &[StepLayer] = &[
 struct Streets;
 
 impl FeatureStep for Streets {
-    fn rows(&self, input: &StepInput<'_>) -> Vec<(&'static str, StepRow)> {
+    fn rows(&self, input: &StepInput<'_>) -> StepRows {
         let (_, chosen) = input.outcome.chosen();
         let g = SkeletonGraph::from_lines(&chosen.geometry);
         let degrees = g.degrees();
@@ -109,10 +111,10 @@ impl FeatureStep for Streets {
             let geometry = Some(geo::Geometry::LineString(line));
             rows.push(("streets", StepRow { geometry, cells }));
         }
-        rows
+        Ok(rows)
     }
 
-    fn finish(&self, input: &FinishInput<'_>) -> Vec<(&'static str, StepRow)> {
+    fn finish(&self, input: &FinishInput<'_>) -> StepRows {
         use crate::geometry::CoordKey;
         // Every node of the whole network in the order first met: its
         // position, degree and the features it is in.
@@ -137,14 +139,15 @@ impl FeatureStep for Streets {
                 }
             }
         }
-        nodes
+        let rows = nodes
             .into_iter()
             .map(|(c, degree, features)| {
                 let cells = vec![Cell::Int(degree), crate::layer::int(features.len())];
                 let geometry = Some(geo::Geometry::Point(c.into()));
                 ("street_nodes", StepRow { geometry, cells })
             })
-            .collect()
+            .collect();
+        Ok(rows)
     }
 }
 

@@ -3,7 +3,9 @@
 //! layer), its own layers (`toy`, with the chosen skeleton as geometry and
 //! `scaled_length`, the skeleton's length times the option, and `near`, the
 //! side layer's features whose boxes meet the polygon's; `toy_total`, one
-//! row made after the last feature) — runs through the pipeline file, its
+//! row made after the last feature), a reason to reject a feature
+//! (`max_length`) and one to stop the run after the last feature
+//! (`min_total`) — runs through the pipeline file, its
 //! JSON Schema, validation and `--set`, the run the binary makes
 //! (`pipeline::run`: the GeoPackage) and the run driver the Python package
 //! uses (`process::Run`, `output::columns`).
@@ -14,7 +16,7 @@ use skeletonise::output::{
     columns::{columns, Item, Values},
     Cell, ColumnType, GeometryKind, Rows, StepLayer, StepRow,
 };
-use skeletonise::process::step::{FeatureStep, FinishInput, Needs, StepEntry, StepInput};
+use skeletonise::process::step::{FeatureStep, FinishInput, Needs, StepEntry, StepInput, StepRows};
 
 /// The module of the toy step: everything it is, in one place.
 mod toy {
@@ -32,16 +34,28 @@ mod toy {
         #[serde(default)]
         #[allow(dead_code)]
         near: Option<skeletonise::config::LayerSource>,
+        /// A feature whose skeleton is longer is rejected.
+        #[serde(default)]
+        max_length: Option<f64>,
+        /// The run fails when the scaled lengths sum to less.
+        #[serde(default)]
+        min_total: Option<f64>,
     }
 
     /// The step.
     #[derive(Debug)]
-    struct Toy(f64);
+    struct Toy(Options);
 
     impl FeatureStep for Toy {
-        fn rows(&self, input: &StepInput<'_>) -> Vec<(&'static str, StepRow)> {
+        fn rows(&self, input: &StepInput<'_>) -> StepRows {
             let (_, chosen) = input.outcome.chosen();
             let length: f64 = chosen.geometry.0.iter().map(|l| Euclidean.length(l)).sum();
+            if let Some(max) = self.0.max_length.filter(|&m| length > m) {
+                return Err(format!(
+                    "the skeleton is {length:.0} m long, over `max_length` ({max} m): raise it"
+                )
+                .into());
+            }
             let near = match (input.side, input.parts.first()) {
                 (Some(side), Some(p)) => {
                     let rect = p.polygon().bounding_rect().expect("a polygon has a box");
@@ -49,16 +63,16 @@ mod toy {
                 }
                 _ => Cell::Null,
             };
-            vec![(
+            Ok(vec![(
                 "toy",
                 StepRow {
                     geometry: Some(geo::Geometry::MultiLineString(chosen.geometry.clone())),
-                    cells: vec![Cell::Real(self.0 * length), near],
+                    cells: vec![Cell::Real(self.0.scale * length), near],
                 },
-            )]
+            )])
         }
 
-        fn finish(&self, input: &FinishInput<'_>) -> Vec<(&'static str, StepRow)> {
+        fn finish(&self, input: &FinishInput<'_>) -> StepRows {
             let total: f64 = input
                 .rows
                 .iter()
@@ -70,14 +84,20 @@ mod toy {
             let side = input
                 .side
                 .map_or(Cell::Null, |s| Cell::Int(s.features().len() as i64));
+            if let Some(min) = self.0.min_total.filter(|&m| total < m) {
+                return Err(format!(
+                    "the lengths sum to {total:.0} m, under `min_total` ({min} m)"
+                )
+                .into());
+            }
             let cells = vec![Cell::Int(input.rows.len() as i64), Cell::Real(total), side];
-            vec![(
+            Ok(vec![(
                 "toy_total",
                 StepRow {
                     geometry: None,
                     cells,
                 },
-            )]
+            )])
         }
     }
 
@@ -122,7 +142,7 @@ mod toy {
             if !(o.scale.is_finite() && o.scale > 0.0) {
                 return Err(("scale".into(), "scale must be a positive number".into()));
             }
-            Ok(std::sync::Arc::new(Toy(o.scale)))
+            Ok(std::sync::Arc::new(Toy(o)))
         },
     };
 }
@@ -378,4 +398,69 @@ fn a_registered_steps_options_and_place_are_checked_like_the_others() {
         !out.exists(),
         "no output for a run that could not read its side input"
     );
+}
+
+#[test]
+fn a_registered_step_rejects_a_feature_or_stops_the_run_with_its_reason_and_has_its_time() {
+    let registry = skeletonise::config::builtin_steps().with(toy::ENTRY);
+    let d = tmp();
+    let out = d.path().join("toy.gpkg");
+    let run = |toy: &str| {
+        let p = skeletonise::config::load_str_with(
+            &pipeline_text(&out, toy),
+            "toy.yaml",
+            &[],
+            &registry,
+        )
+        .unwrap();
+        skeletonise::pipeline::run(&p, &skeletonise::pipeline::RunOptions::default())
+    };
+    // The lakes' skeletons are long, the rivers' short or long: every
+    // feature over 20 km is rejected naming the step, the others written.
+    let s = run("  - toy: { scale: 1, max_length: 20000 }\n").unwrap();
+    assert_eq!(s.read, 17);
+    assert!(s.rejected > 0 && s.written > 0, "{s:?}");
+    assert_eq!(s.written + s.rejected, 17);
+    let ds = open(&out);
+    let reasons: Vec<String> = crate::common::strings(&ds, "rejected", "reason")
+        .into_iter()
+        .flatten()
+        .collect();
+    assert_eq!(reasons.len() as u64, s.rejected);
+    assert!(
+        reasons
+            .iter()
+            .all(|r| r.starts_with("`toy`: the skeleton is ")
+                && r.ends_with("over `max_length` (20000 m): raise it")),
+        "{reasons:?}"
+    );
+    // A rejected feature has no row in any layer, the step's included.
+    assert_eq!(crate::common::count(&ds, "toy"), s.written);
+    assert_eq!(crate::common::count(&ds, "skeletons"), s.written);
+    // Its CPU time is in the run record, under its name.
+    let stages: serde_json::Value = serde_json::from_str(
+        &crate::common::strings(&ds, "skeletonise_runs", "stage_seconds")[0]
+            .clone()
+            .unwrap(),
+    )
+    .unwrap();
+    assert!(stages["toy"].as_f64().is_some_and(|t| t >= 0.0), "{stages}");
+    drop(ds);
+    // A finish that fails stops the run with its reason (exit 65), and
+    // nothing is written: not the output, not a temporary file.
+    std::fs::remove_file(&out).unwrap();
+    let e = run("  - toy: { scale: 1, min_total: 1.0e12 }\n").unwrap_err();
+    assert!(
+        e.to_string().starts_with("`toy`: the lengths sum to ")
+            && e.to_string()
+                .ends_with("under `min_total` (1000000000000 m)"),
+        "{e}"
+    );
+    assert!(matches!(e, skeletonise::pipeline::RunError::Finish(_)));
+    let left: Vec<_> = std::fs::read_dir(d.path())
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name())
+        .collect();
+    assert!(left.is_empty(), "{left:?}");
 }
