@@ -267,6 +267,61 @@ pub struct StepLayer {
     pub columns: &'static [(&'static str, ColumnType)],
 }
 
+impl StepLayer {
+    /// Whether `row` fits this layer — one cell per column, each NULL or of
+    /// the column's type (an integer within the range of an `Int32`
+    /// column), and a geometry of the layer's kind (none for an attribute
+    /// table, any for `Unknown`; a row may have no geometry) — or what does
+    /// not: the run checks every row a step makes, so that a step's mistake
+    /// is an error naming the step instead of a column written empty or a
+    /// value written into the wrong one.
+    pub fn check(&self, row: &StepRow) -> Result<(), String> {
+        let layer = self.name;
+        if row.cells.len() != self.columns.len() {
+            return Err(format!(
+                "a row of layer `{layer}` has {} cells for its {} columns",
+                row.cells.len(),
+                self.columns.len()
+            ));
+        }
+        for (cell, (name, ty)) in row.cells.iter().zip(self.columns) {
+            let fits = match (cell, ty) {
+                (Cell::Null, _) => true,
+                (Cell::Int(v), ColumnType::Int32) => i32::try_from(*v).is_ok(),
+                (Cell::Int(_), ColumnType::Int64) => true,
+                (Cell::Real(_), ColumnType::Real) => true,
+                (Cell::Text(_), ColumnType::Text) => true,
+                _ => false,
+            };
+            if !fits {
+                return Err(format!(
+                    "column `{name}` of layer `{layer}` is {ty:?}, and a row gives it {cell:?}"
+                ));
+            }
+        }
+        use geo::Geometry as G;
+        let kind_fits = match (&row.geometry, self.geometry) {
+            (None, _) | (Some(_), GeometryKind::Unknown) => true,
+            (Some(_), GeometryKind::None) => false,
+            (Some(g), kind) => matches!(
+                (g, kind),
+                (G::MultiLineString(_), GeometryKind::MultiLineString)
+                    | (G::LineString(_), GeometryKind::LineString)
+                    | (G::Polygon(_), GeometryKind::Polygon)
+                    | (G::MultiPolygon(_), GeometryKind::MultiPolygon)
+                    | (G::Point(_), GeometryKind::Point)
+            ),
+        };
+        if !kind_fits {
+            return Err(format!(
+                "layer `{layer}` holds {:?} geometries, and a row gives it another kind",
+                self.geometry
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// A layer chosen by name or by index.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(untagged)]
@@ -301,4 +356,56 @@ pub struct LayerSource {
     /// OGR SQL attribute filter: only these features are read.
     #[serde(default, rename = "where")]
     pub where_: Option<String>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const LINES: StepLayer = StepLayer {
+        name: "lines",
+        geometry: GeometryKind::LineString,
+        attributes: false,
+        columns: &[("n", ColumnType::Int32), ("kind", ColumnType::Text)],
+    };
+
+    fn row(geometry: Option<geo::Geometry<f64>>, cells: Vec<Cell>) -> StepRow {
+        StepRow { geometry, cells }
+    }
+
+    #[test]
+    fn a_step_row_fits_its_layer_or_says_what_does_not() {
+        let line = || {
+            Some(geo::Geometry::LineString(
+                vec![(0.0, 0.0), (1.0, 1.0)].into(),
+            ))
+        };
+        let text = || Cell::Text("a".into());
+        assert_eq!(
+            LINES.check(&row(line(), vec![Cell::Int(3), text()])),
+            Ok(())
+        );
+        assert_eq!(
+            LINES.check(&row(None, vec![Cell::Null, Cell::Null])),
+            Ok(())
+        );
+        let e = LINES.check(&row(line(), vec![Cell::Int(3)])).unwrap_err();
+        assert_eq!(e, "a row of layer `lines` has 1 cells for its 2 columns");
+        let e = LINES
+            .check(&row(line(), vec![Cell::Int(1 << 40), text()]))
+            .unwrap_err();
+        assert!(e.starts_with("column `n` of layer `lines` is Int32"), "{e}");
+        let point = Some(geo::Geometry::Point((0.0, 0.0).into()));
+        let e = LINES
+            .check(&row(point.clone(), vec![Cell::Int(3), text()]))
+            .unwrap_err();
+        assert!(e.contains("holds LineString geometries"), "{e}");
+        let table = StepLayer {
+            geometry: GeometryKind::None,
+            ..LINES
+        };
+        assert!(table
+            .check(&row(point, vec![Cell::Int(3), text()]))
+            .is_err());
+    }
 }

@@ -186,21 +186,21 @@ impl<'a> Run<'a> {
             let clock = crate::clock::CpuClock::start();
             let made = e.step.finish(&input);
             add_time(&mut self.counts.step_times, e.entry.name, clock.elapsed());
-            let made = made.map_err(|f| FinishError::Step {
-                step: e.entry.name,
-                reason: f.0,
-            })?;
+            let made = made
+                .and_then(|made| e.entry.check(&made).map(|()| made))
+                .map_err(|f| FinishError::Step {
+                    step: e.entry.name,
+                    reason: f.0,
+                })?;
             for (layer, row) in made {
-                if e.entry.layers.iter().any(|l| l.name == layer) {
-                    rows.extra
-                        .entry(layer)
-                        .or_default()
-                        .push(crate::output::ExtraRow {
-                            src_fid: None,
-                            attributes: Vec::new(),
-                            row,
-                        });
-                }
+                rows.extra
+                    .entry(layer)
+                    .or_default()
+                    .push(crate::output::ExtraRow {
+                        src_fid: None,
+                        attributes: Vec::new(),
+                        row,
+                    });
             }
         }
         if let Some(net) = &self.params.connect {

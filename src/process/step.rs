@@ -314,6 +314,27 @@ pub struct StepRegistry {
     entries: Vec<StepEntry>,
 }
 
+impl StepEntry {
+    /// Whether every row of `rows` is of a layer this step declares and
+    /// fits it ([`StepLayer::check`]); else a failure that says the step
+    /// made a row it cannot have (a bug in the step, reported as such).
+    pub fn check(&self, rows: &[(&'static str, StepRow)]) -> Result<(), StepFailure> {
+        for (name, row) in rows {
+            let layer = self.layers.iter().find(|l| l.name == *name).ok_or_else(|| {
+                StepFailure(format!(
+                    "internal error in the step: a row of layer `{name}`, which it does not declare; please report it"
+                ))
+            })?;
+            layer.check(row).map_err(|why| {
+                StepFailure(format!(
+                    "internal error in the step: {why}; please report it"
+                ))
+            })?;
+        }
+        Ok(())
+    }
+}
+
 impl StepRegistry {
     /// This registry and `entry`.
     pub fn with(mut self, entry: StepEntry) -> Self {

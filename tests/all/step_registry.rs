@@ -464,3 +464,110 @@ fn a_registered_step_rejects_a_feature_or_stops_the_run_with_its_reason_and_has_
         .collect();
     assert!(left.is_empty(), "{left:?}");
 }
+
+/// A step that makes rows its layers cannot hold: its feature rows give a
+/// text to a number column, its finish a row of a layer it never declared.
+mod wrong {
+    use super::*;
+
+    #[derive(Debug)]
+    struct Wrong;
+
+    impl FeatureStep for Wrong {
+        fn rows(&self, _: &StepInput<'_>) -> StepRows {
+            let cells = vec![Cell::Text("long".into())];
+            Ok(vec![(
+                "wrong",
+                StepRow {
+                    geometry: None,
+                    cells,
+                },
+            )])
+        }
+
+        fn finish(&self, _: &FinishInput<'_>) -> StepRows {
+            let cells = vec![Cell::Real(1.0)];
+            Ok(vec![(
+                "elsewhere",
+                StepRow {
+                    geometry: None,
+                    cells,
+                },
+            )])
+        }
+    }
+
+    pub const ENTRY: StepEntry = StepEntry {
+        name: "wrong",
+        after: "select",
+        description: "rows that do not fit its layer (a test step)",
+        schema: || schemars::json_schema!({ "type": ["object", "null"] }),
+        needs: Needs::NOTHING,
+        layers: &[StepLayer {
+            name: "wrong",
+            geometry: GeometryKind::None,
+            attributes: false,
+            columns: &[("length", ColumnType::Real)],
+        }],
+        build: |_| Ok(std::sync::Arc::new(Wrong)),
+    };
+}
+
+#[test]
+fn rows_that_do_not_fit_a_steps_layers_are_an_error_naming_the_step_never_a_column_written_wrong() {
+    let registry = skeletonise::config::builtin_steps().with(wrong::ENTRY);
+    let d = tmp();
+    let out = d.path().join("wrong.gpkg");
+    let p = skeletonise::config::load_str_with(
+        &pipeline_text(&out, "  - wrong: {}\n"),
+        "wrong.yaml",
+        &[],
+        &registry,
+    )
+    .unwrap();
+    // The finish's row of an undeclared layer stops the run, naming the
+    // step and the layer; nothing is written.
+    let e = skeletonise::pipeline::run(&p, &skeletonise::pipeline::RunOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("`wrong`: internal error in the step: a row of layer `elsewhere`, which it does not declare"),
+        "{e}"
+    );
+    assert!(!out.exists());
+    // Through the run driver: the rows are checked before they are kept,
+    // and the finish's row of an undeclared layer stops the run.
+    let params = p.process_params();
+    let mut reader = skeletonise::io::reader::Reader::open(&p.file.input).unwrap();
+    let mut all = Vec::new();
+    reader
+        .read::<skeletonise::io::IoError>(64, true, |b| {
+            all.extend(b);
+            Ok(())
+        })
+        .unwrap();
+    let mut run = skeletonise::process::Run::new(&params, false);
+    for f in &all {
+        let r = skeletonise::process::feature_rows(
+            f,
+            skeletonise::process::Skeletons::Computed,
+            &params,
+            skeletonise::process::RowOptions::of(&p.plan()),
+        );
+        // Each feature's row is refused before it is kept: the feature is
+        // rejected naming the step, the column and the value.
+        let rows = run.add(f, r).unwrap();
+        assert!(rows.extra.is_empty() && rows.skeletons.is_empty());
+        assert_eq!(rows.rejected.len(), 1);
+        assert_eq!(
+            rows.rejected[0].reason,
+            "`wrong`: internal error in the step: column `length` of layer `wrong` is Real, and a row gives it Text(\"long\"); please report it"
+        );
+    }
+    assert_eq!(run.counts().rejected, 17);
+    let e = run.finish().unwrap_err().to_string();
+    assert!(
+        e.starts_with("`wrong`: internal error in the step: a row of layer `elsewhere`, which it does not declare"),
+        "{e}"
+    );
+}
