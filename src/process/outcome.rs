@@ -158,12 +158,10 @@ fn after_select(
         o.step_times
             .push((e.entry.name, super::StepTime(started.elapsed())));
         clock.check(e.entry.name)?;
-        let rows = rows
-            .and_then(|rows| e.entry.check(&rows).map(|()| rows))
-            .map_err(|f| StepError::Step {
-                step: e.entry.name,
-                reason: f.0,
-            })?;
+        let rows = e.entry.checked(rows).map_err(|f| StepError::Step {
+            step: e.entry.name,
+            reason: f.0,
+        })?;
         o.extra.extend(rows);
     }
     Ok(())

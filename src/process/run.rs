@@ -186,12 +186,10 @@ impl<'a> Run<'a> {
             let clock = crate::clock::CpuClock::start();
             let made = e.step.finish(&input);
             add_time(&mut self.counts.step_times, e.entry.name, clock.elapsed());
-            let made = made
-                .and_then(|made| e.entry.check(&made).map(|()| made))
-                .map_err(|f| FinishError::Step {
-                    step: e.entry.name,
-                    reason: f.0,
-                })?;
+            let made = e.entry.checked(made).map_err(|f| FinishError::Step {
+                step: e.entry.name,
+                reason: f.0,
+            })?;
             for (layer, row) in made {
                 rows.extra
                     .entry(layer)

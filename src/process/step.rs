@@ -333,6 +333,11 @@ impl StepEntry {
         }
         Ok(())
     }
+
+    /// `made` when its rows all [fit](Self::check) the step's layers.
+    pub fn checked(&self, made: StepRows) -> StepRows {
+        made.and_then(|rows| self.check(&rows).map(|()| rows))
+    }
 }
 
 impl StepRegistry {

@@ -169,6 +169,19 @@ fn demo_boxes() -> Vec<geo::Rect<f64>> {
         .collect()
 }
 
+/// Every feature of the pipeline's input, as the reader gives them.
+fn features(p: &skeletonise::config::Pipeline) -> Vec<skeletonise::feature::Feature> {
+    let mut reader = skeletonise::io::reader::Reader::open(&p.file.input).unwrap();
+    let mut all = Vec::new();
+    reader
+        .read::<skeletonise::io::IoError>(64, true, |b| {
+            all.extend(b);
+            Ok(())
+        })
+        .unwrap();
+    all
+}
+
 #[test]
 fn a_registered_step_writes_its_own_layers_through_the_run_and_the_python_table() {
     let registry = skeletonise::config::builtin_steps().with(toy::ENTRY);
@@ -271,14 +284,7 @@ fn a_registered_step_writes_its_own_layers_through_the_run_and_the_python_table(
     params.extra[0].side = Some(std::sync::Arc::new(
         skeletonise::process::step::SideLayer::new(Vec::new()),
     ));
-    let mut reader = skeletonise::io::reader::Reader::open(&p.file.input).unwrap();
-    let mut all = Vec::new();
-    reader
-        .read::<skeletonise::io::IoError>(64, true, |b| {
-            all.extend(b);
-            Ok(())
-        })
-        .unwrap();
+    let all = features(&p);
     let mut run = skeletonise::process::Run::new(&params, false);
     let mut rows = Rows::default();
     for f in &all {
@@ -538,14 +544,7 @@ fn rows_that_do_not_fit_a_steps_layers_are_an_error_naming_the_step_never_a_colu
     // Through the run driver: the rows are checked before they are kept,
     // and the finish's row of an undeclared layer stops the run.
     let params = p.process_params();
-    let mut reader = skeletonise::io::reader::Reader::open(&p.file.input).unwrap();
-    let mut all = Vec::new();
-    reader
-        .read::<skeletonise::io::IoError>(64, true, |b| {
-            all.extend(b);
-            Ok(())
-        })
-        .unwrap();
+    let all = features(&p);
     let mut run = skeletonise::process::Run::new(&params, false);
     for f in &all {
         let r = skeletonise::process::feature_rows(
