@@ -11,7 +11,7 @@ venv=target/py-venv
 # The binding's Rust crate: its unit tests (WKB, GeoArrow buffers) linked to the venv's Python,
 # unoptimised, crate and dependencies alike: they run in milliseconds, and compiling the core
 # at opt-level 1 (and its dependencies at 2) for them took 70-80 s of a fresh clone's test run
-# (unoptimised: under 50 s). Its lints run in CI (.ci/run) beside the core's.
+# (unoptimised: under 50 s). Its lints run in CI (.ci/run, after the tests).
 export PYO3_PYTHON="$PWD/$venv/bin/python"
 cargo test -p skeletonise-python --config profile.test.opt-level=0 \
   --config 'profile.test.package."*".opt-level=0' --config 'profile.dev.package."*".opt-level=0'
