@@ -83,9 +83,18 @@ impl Feature {
     /// A feature with only a geometry (library use, tests).
     pub fn from_geometry(fid: Option<u64>, geometry: geo::Geometry<f64>) -> Self {
         Self {
-            fid,
-            attributes: Vec::new(),
             geometry: Some(geometry),
+            ..Self::new(fid, Vec::new())
+        }
+    }
+
+    /// A feature with its FID and source fields, no geometry yet, standing
+    /// for itself alone (not merged, not repaired, not checked).
+    pub fn new(fid: Option<u64>, attributes: Vec<Value>) -> Self {
+        Self {
+            fid,
+            attributes,
+            geometry: None,
             geometry_error: None,
             source_wkb: None,
             repaired: false,

@@ -188,15 +188,8 @@ pub(crate) fn features(
         let repaired = repaired.is_some_and(|r| r[i]);
         let fid = fids.and_then(|f| u64::try_from(f[i]).ok());
         let mut f = Feature {
-            fid,
-            attributes: Vec::new(),
-            geometry: None,
-            geometry_error: None,
-            source_wkb: None,
             repaired,
-            checked: false,
-            members: Vec::new(),
-            member_wkb: Vec::new(),
+            ..Feature::new(fid, Vec::new())
         };
         match input.geometry(i) {
             Ok(Some(g)) if repaired => match wkb::areal_parts(g) {

@@ -342,17 +342,7 @@ impl Reader {
         let attributes = (0..self.info.fields.len())
             .map(|i| value(f.field(i).ok().flatten()))
             .collect();
-        let mut feat = Feature {
-            fid: f.fid(),
-            attributes,
-            geometry: None,
-            geometry_error: None,
-            source_wkb: None,
-            repaired: false,
-            checked: false,
-            members: Vec::new(),
-            member_wkb: Vec::new(),
-        };
+        let mut feat = Feature::new(f.fid(), attributes);
         // gdal hands out a wrapper around a null handle for NULL geometries.
         // SAFETY: the handle is only compared with null.
         let geometry = f
