@@ -421,8 +421,9 @@ impl Pipeline {
         side_inputs(&mut params, sides.unwrap_or_default())?;
         let partition = params.partition.is_some();
         params.neighbours = self.units(partition, neighbours, neighbour_fids, neighbour_snap)?;
-        // A partition merges adjacent polygons by FID: positions stand in for missing FIDs.
-        let positions: Option<numpy::PyReadonlyArray1<'py, i64>> = match (&fids, partition) {
+        // Adjacent polygons are merged by FID: positions stand in for missing FIDs.
+        let merge = params.needs().merge;
+        let positions: Option<numpy::PyReadonlyArray1<'py, i64>> = match (&fids, merge) {
             (None, true) => {
                 let n = geometry.len()? as i64;
                 Some(numpy::PyArrayMethods::readonly(&numpy::PyArray1::from_vec(
@@ -458,7 +459,7 @@ impl Pipeline {
             plan: self
                 .steps
                 .call_plan(explode.unwrap_or_else(|| self.explode()), connect_given),
-            partition,
+            merge,
             with_candidates,
             cancel: cancel.map(|c| c.0.clone()),
             given: None,
@@ -539,7 +540,7 @@ fn score<'py>(
         fail: false,
         geoarrow_out: output == "geoarrow",
         plan: run::bare_plan(),
-        partition: false,
+        merge: false,
         with_candidates: false,
         cancel: cancel.map(|c| c.0.clone()),
         given: Some(run::Given {

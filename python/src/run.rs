@@ -30,11 +30,10 @@ pub struct Options {
     /// The layers and columns of the call: the pipeline's own plan
     /// (`config::Steps::call_plan`), as the command line's for the same file.
     pub plan: Plan,
-    /// The pipeline has a `partition` step (with the coverage in the
-    /// parameters): adjacent input polygons are merged exactly first, as
-    /// the command line's reader merges them, and the layers `coverage`,
-    /// `boundaries`, `given` and `areas` come back too.
-    pub partition: bool,
+    /// A step [needs](skeletonise::process::step::Needs::merge) adjacent
+    /// input polygons merged exactly first (`partition`), as the command
+    /// line's reader merges them.
+    pub merge: bool,
     /// Also the `candidates` layer, among `layers` (one pass for both).
     pub with_candidates: bool,
     /// Stop before the next feature once set (`Cancel`).
@@ -266,8 +265,8 @@ pub fn step_holds(collapse: bool, partition: bool) -> Vec<When> {
     holds
 }
 
-/// Adjacent features merged into one (with `partition`, as the command
-/// line's reader merges them), and the input row of every merged feature:
+/// Adjacent features merged into one (for a step that needs it, as the
+/// command line's reader merges them), and the input row of every merged feature:
 /// its smallest member's, whose FID it takes.
 fn merged(feats: Vec<Feature>) -> (Vec<Feature>, Option<Vec<i64>>) {
     let by_fid: std::collections::HashMap<u64, i64> = feats
@@ -344,7 +343,7 @@ fn work(
     let par = opts.threads != Some(1) && input.len() > 1;
     let t0 = Instant::now();
     let feats = features(input, fids, repaired, par);
-    let (feats, input_rows) = match opts.partition {
+    let (feats, input_rows) = match opts.merge {
         true => merged(feats),
         false => (feats, None),
     };

@@ -105,6 +105,18 @@ impl Step {
         }
     }
 
+    /// What the step needs of the run beyond each feature (see
+    /// [`ProcessParams::needs`], the union over a pipeline's steps).
+    pub fn needs(&self) -> crate::process::step::Needs {
+        use crate::process::step::Needs;
+        match self {
+            Step::Collapse(_) => crate::collapse::NEEDS,
+            Step::Partition(p) => p.needs(),
+            Step::Extra(e) => e.entry.needs,
+            _ => Needs::NOTHING,
+        }
+    }
+
     /// Steps in the only order they may appear in.
     pub const ORDER: [&'static str; 8] = [
         "prepare",
@@ -212,7 +224,7 @@ pub fn plan_with(
     flag(collapse, When::Collapse);
     flag(partition, When::Partition);
     flag(collapse || partition, When::Areas);
-    flag(merge || partition, When::Merge);
+    flag(merge || steps.iter().any(|s| s.needs().merge), When::Merge);
     flag(connect, When::Connect);
     let mut layers = Vec::new();
     for s in steps {

@@ -301,6 +301,7 @@ pub const ENTRY: StepEntry = StepEntry {
         lonlat: true,
         side: None,
         finish: false,
+        ..Needs::NOTHING
     },
     layers: LABELS,
     build: |v| {

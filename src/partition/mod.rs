@@ -120,6 +120,19 @@ impl Default for PartitionParams {
 }
 
 impl PartitionParams {
+    /// What the step needs of the run: the medial axis's diagram cells (the
+    /// polygon is split along them), adjacent polygons merged exactly (a
+    /// river cut into reaches is given away as one), and with `width` the
+    /// medial axis's graphs (their discs say what is narrow).
+    pub fn needs(&self) -> crate::process::step::Needs {
+        crate::process::step::Needs {
+            cells: true,
+            merge: true,
+            graphs: self.width.is_some(),
+            ..crate::process::step::Needs::NOTHING
+        }
+    }
+
     /// The `collapse` options that decide what is narrow, with `width`.
     pub fn narrow(&self) -> Option<CollapseParams> {
         self.width.map(|width| CollapseParams {

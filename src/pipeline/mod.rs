@@ -384,10 +384,11 @@ fn settled(
     }
 }
 
-/// How the reader treats adjacent polygons: a partition merges them
-/// exactly (every vertex kept), `merge_adjacent` dissolves them.
+/// How the reader treats adjacent polygons: merged exactly (every vertex
+/// kept) for a step that [needs it](crate::process::step::Needs::merge),
+/// dissolved with `merge_adjacent`.
 fn merge_of(job: &Job<'_>) -> Merge {
-    if job.params.partition.is_some() {
+    if job.params.needs().merge {
         Merge::Exactly
     } else if job.input.merge_adjacent {
         Merge::Dissolve

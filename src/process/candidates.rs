@@ -436,7 +436,7 @@ impl<'a> PartWork<'a> {
             let m = methods[k];
             let ctx = MethodContext::start(self.params.skeleton.budget());
             let mut stages = Stages::new(self.parallel);
-            let with_cells = m == crate::methods::MethodId::MA && self.params.partition.is_some();
+            let with_cells = m == crate::methods::MethodId::MA && self.params.needs().cells;
             let made = stages.time(Stage::Skeleton, || {
                 self.params
                     .registry
@@ -673,6 +673,7 @@ fn finish(
     let mut all_bars = Vec::new();
     let mut widths = Vec::new();
     let mut graphs = Vec::new();
+    let keep_graphs = params.needs().graphs;
     let (mut components, mut legs_raw, mut legs, mut hooks) = (0, 0, 0, 0);
     let mut branch_offset = 0;
     for (k, (p, part)) in prepared.iter().zip(parts).enumerate() {
@@ -706,10 +707,7 @@ fn finish(
         if params.keep_widths {
             widths.extend(medial_axis_transform(g, Some(p.boundary())));
         }
-        if params.collapse.is_some()
-            || params.connect.is_some()
-            || params.partition.is_some_and(|p| p.width.is_some())
-        {
+        if keep_graphs {
             graphs.push(g.clone());
         }
         // The branches as lines (`SkeletonGraph::to_multilinestring`).

@@ -201,6 +201,17 @@ pub struct Needs {
     /// The run keeps the step's per-feature rows for its
     /// [`FeatureStep::finish`].
     pub finish: bool,
+    /// The cells of the medial axis's segment Voronoi diagram of every
+    /// part (what `partition` splits the polygon along), kept by the
+    /// `skeleton` step when MA is among the methods.
+    pub cells: bool,
+    /// The chosen method's graphs of every part (pruned and extended), kept
+    /// in the candidate beside its lines.
+    pub graphs: bool,
+    /// Adjacent polygons merged into one, exactly (every vertex kept),
+    /// before any step sees them: the reader (or the Python call) merges
+    /// them, and the `members` column lists the FIDs.
+    pub merge: bool,
 }
 
 impl Needs {
@@ -210,7 +221,26 @@ impl Needs {
         lonlat: false,
         side: None,
         finish: false,
+        cells: false,
+        graphs: false,
+        merge: false,
     };
+
+    /// What `self` and `other` need together (the first side input key).
+    pub const fn and(self, other: Needs) -> Needs {
+        Needs {
+            medial_axis: self.medial_axis || other.medial_axis,
+            lonlat: self.lonlat || other.lonlat,
+            side: match self.side {
+                Some(s) => Some(s),
+                None => other.side,
+            },
+            finish: self.finish || other.finish,
+            cells: self.cells || other.cells,
+            graphs: self.graphs || other.graphs,
+            merge: self.merge || other.merge,
+        }
+    }
 }
 
 /// A side input layer's features, reprojected to the polygons' CRS, with an

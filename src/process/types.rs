@@ -59,12 +59,34 @@ impl ProcessParams {
     /// registered step that reads it (`label`): MA is among the methods and
     /// has its default options (what the step would make itself).
     pub fn keeps_raw_medial_axis(&self) -> bool {
-        self.extra.iter().any(|e| e.entry.needs.medial_axis)
+        self.needs().medial_axis
             && self
                 .skeleton
                 .methods
                 .contains(&crate::methods::MethodId::MA)
             && self.skeleton.medial_axis == Default::default()
+    }
+
+    /// What the pipeline's steps need together beyond each feature (the
+    /// union of their [`Needs`](super::step::Needs)): the `skeleton` step
+    /// keeps MA's raw skeleton, its diagram cells and the chosen graphs
+    /// only for a step that reads them, and the reader merges adjacent
+    /// polygons exactly only for a step that asks. `collapse` and the
+    /// network of `input.connect` read the chosen graphs.
+    pub fn needs(&self) -> super::step::Needs {
+        use super::step::Needs;
+        let network = Needs {
+            graphs: self.connect.is_some(),
+            ..Needs::NOTHING
+        };
+        let collapse = self
+            .collapse
+            .map_or(Needs::NOTHING, |_| crate::collapse::NEEDS);
+        let partition = self.partition.map_or(Needs::NOTHING, |p| p.needs());
+        let built_in = network.and(collapse).and(partition);
+        self.extra
+            .iter()
+            .fold(built_in, |n, e| n.and(e.entry.needs))
     }
 
     /// Every step with its defaults, as a pipeline file that lists

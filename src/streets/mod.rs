@@ -259,6 +259,7 @@ pub const ENTRY: StepEntry = StepEntry {
         lonlat: false,
         side: Some("units"),
         finish: true,
+        ..Needs::NOTHING
     },
     layers: STREETS,
     build: |v| {

@@ -135,6 +135,7 @@ mod toy {
             lonlat: false,
             side: Some("near"),
             finish: true,
+            ..Needs::NOTHING
         },
         layers: LAYERS,
         build: |v| {
