@@ -97,10 +97,6 @@ pub enum When {
     Widths,
     /// With `output.measures: width` (the skeleton layer's lines carry M).
     Measures,
-    /// When the pipeline has a `partition` step.
-    Partition,
-    /// When the pipeline has kept areas: a `collapse` or `partition` step.
-    Areas,
     /// When the pipeline has the step of this name (a registered step's
     /// own layers and columns).
     Step(&'static str),
@@ -157,7 +153,7 @@ pub enum Attributes<R: 'static> {
     None,
     /// The input's fields.
     Input(fn(&R) -> &[Value]),
-    /// The fields of `input.neighbours` (the units of a partition).
+    /// The fields of `input.neighbours` (the units of a coverage).
     Neighbours(fn(&R) -> &[Value]),
 }
 
@@ -261,8 +257,12 @@ pub struct StepLayer {
     pub name: &'static str,
     /// Geometry type.
     pub geometry: GeometryKind,
-    /// Whether the source feature's fields come first.
-    pub attributes: bool,
+    /// Whose fields come first: the input's (a layer of rows per feature:
+    /// then `polygon_part` with `explode` and `members` with merged
+    /// polygons follow `src_fid`, as in the skeleton layer), the units' of
+    /// `input.neighbours` (a layer of the coverage's units, `src_fid` the
+    /// unit's), or none.
+    pub fields: Option<Fields>,
     /// The step's columns (after `src_fid`), in order.
     pub columns: &'static [(&'static str, ColumnType)],
 }
@@ -365,7 +365,7 @@ mod tests {
     const LINES: StepLayer = StepLayer {
         name: "lines",
         geometry: GeometryKind::LineString,
-        attributes: false,
+        fields: None,
         columns: &[("n", ColumnType::Int32), ("kind", ColumnType::Text)],
     };
 

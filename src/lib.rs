@@ -59,6 +59,7 @@ pub mod label;
 pub mod layer;
 pub mod methods;
 pub mod narrow;
+pub mod neighbours;
 pub mod numbers;
 pub mod output;
 pub mod partition;

@@ -56,6 +56,10 @@ class Pipeline:
     def partition(self) -> bool:
         """Whether the pipeline has a ``partition`` step (``run`` then needs ``neighbours``)."""
     @property
+    def neighbours(self) -> bool:
+        """Whether a step of the pipeline reads the coverage of ``input.neighbours`` (``run`` then
+        needs ``neighbours``)."""
+    @property
     def explode(self) -> bool:
         """One row per polygon part (``output.explode``)."""
     @property
@@ -111,12 +115,10 @@ class Pipeline:
         ``cancel`` is set.
         """
 
-def columns(
-    layer: str, explode: bool = False, collapse: bool = False, partition: bool = False
-) -> tuple[list[tuple[str, str]], bool]:
-    """The columns of ``skeletons``, ``candidates``, ``areas``, ``coverage``, ``boundaries`` or ``given``
-    as ``(name, type)`` (with a collapse or partition step as given), and whether the layer carries
-    the input's attributes."""
+def columns(layer: str, explode: bool = False, collapse: bool = False) -> tuple[list[tuple[str, str]], bool]:
+    """The columns of ``skeletons``, ``candidates`` or ``areas`` (a collapse step's) as ``(name, type)``
+    (with a collapse step as given), and whether the layer carries the input's attributes; a
+    registered step's layers (``coverage``, ``labels``, …): ``Pipeline.layer_columns``."""
 
 def score(
     polygons: list[Optional[bytes]],
@@ -134,9 +136,9 @@ def score(
     (both key lists) or by location; what ``Pipeline.run`` returns, and ``unjoined`` (why some
     line rows joined no polygon). Raises ValueError when no line joins any polygon."""
 
-def reserved(collapse: bool = False, partition: bool = False, neighbours: bool = False) -> list[str]:
+def reserved(collapse: bool = False, neighbours: bool = False) -> list[str]:
     """The names for which a source field is written as ``src_<name>`` (in every layer alike), with or without a
-    collapse or partition step; with ``neighbours``, those of a field of the units."""
+    collapse step; with ``neighbours``, those of a field of the units (a pipeline's own: ``Pipeline.reserved``)."""
 
 def source_names(names: list[str], reserved: list[str]) -> list[str]:
     """The names source fields ``names`` are written under beside the tool's columns ``reserved``: ``src_``

@@ -115,18 +115,18 @@ impl Pipeline {
         })
     }
 
-    /// The coverage of a `partition` step (`partition`) from the units
-    /// `neighbours` (WKB) and their FIDs, with `neighbour_snap` or else the
-    /// pipeline file's `input.neighbours.snap`; an error when the one is
-    /// given without the other.
+    /// The coverage of `input.neighbours`, for the steps that read it
+    /// (`reads`), from the units `neighbours` (WKB) and their FIDs, with
+    /// `neighbour_snap` or else the pipeline file's `input.neighbours.snap`;
+    /// an error when the one is given without the other.
     fn units(
         &self,
-        partition: bool,
+        reads: bool,
         neighbours: Option<Vec<Option<Vec<u8>>>>,
         neighbour_fids: Option<Vec<i64>>,
         neighbour_snap: Option<f64>,
-    ) -> PyResult<Option<std::sync::Arc<skeletonise::partition::Coverage>>> {
-        match (partition, neighbours) {
+    ) -> PyResult<Option<std::sync::Arc<skeletonise::neighbours::Coverage>>> {
+        match (reads, neighbours) {
             (true, Some(units)) => {
                 let from_file = self
                     .steps
@@ -144,14 +144,29 @@ impl Pipeline {
                 let cov = coverage(&units, neighbour_fids.as_deref())?.with_snap(snap);
                 Ok(Some(std::sync::Arc::new(cov)))
             }
-            (true, None) => Err(PipelineError::new_err(
-                "the `partition` step gives the polygons' area to the units of a coverage: give it as `neighbours` (the polygons of `input.neighbours`)",
-            )),
+            (true, None) => Err(PipelineError::new_err(format!(
+                "{} reads the units of a coverage: give it as `neighbours` (the polygons of `input.neighbours`)",
+                self.neighbour_readers()
+            ))),
             (false, Some(_)) => Err(PipelineError::new_err(
-                "`neighbours` is the coverage of a `partition` step, and the pipeline has none",
+                "`neighbours` is a coverage for a step that reads it (`partition`), and the pipeline has none",
             )),
             (false, None) => Ok(None),
         }
+    }
+
+    /// The steps of the pipeline that read `input.neighbours`, for messages
+    /// (`` `partition` ``).
+    fn neighbour_readers(&self) -> String {
+        let names: Vec<String> = self
+            .steps
+            .file
+            .steps
+            .iter()
+            .filter(|s| s.needs().neighbours)
+            .map(|s| format!("the `{}` step", s.name()))
+            .collect();
+        names.join(" and ")
     }
 
     /// What the command line refuses of a file whose `input` lacks the
@@ -250,7 +265,18 @@ impl Pipeline {
     /// `neighbours` and also returns the partitioned coverage).
     #[getter]
     fn partition(&self) -> bool {
-        self.steps.process_params().partition.is_some()
+        self.steps
+            .file
+            .steps
+            .iter()
+            .any(|s| s.name() == "partition")
+    }
+
+    /// Whether a step of the pipeline reads the coverage of
+    /// `input.neighbours` (`run` then needs `neighbours`).
+    #[getter]
+    fn neighbours(&self) -> bool {
+        self.steps.process_params().needs().neighbours
     }
 
     /// Whether the `prepare` step repairs invalid polygons.
@@ -419,8 +445,8 @@ impl Pipeline {
             params.lonlat = proj.and_then(lonlat::lonlat_of);
         }
         side_inputs(&mut params, sides.unwrap_or_default())?;
-        let partition = params.partition.is_some();
-        params.neighbours = self.units(partition, neighbours, neighbour_fids, neighbour_snap)?;
+        let reads = params.needs().neighbours;
+        params.neighbours = self.units(reads, neighbours, neighbour_fids, neighbour_snap)?;
         // Adjacent polygons are merged by FID: positions stand in for missing FIDs.
         let merge = params.needs().merge;
         let positions: Option<numpy::PyReadonlyArray1<'py, i64>> = match (&fids, merge) {
@@ -560,7 +586,7 @@ fn score<'py>(
 fn coverage(
     units: &[Option<Vec<u8>>],
     fids: Option<&[i64]>,
-) -> PyResult<skeletonise::partition::Coverage> {
+) -> PyResult<skeletonise::neighbours::Coverage> {
     if fids.is_some_and(|f| f.len() != units.len()) {
         return Err(PyValueError::new_err(
             "neighbour_fids must have one FID per polygon of neighbours",
@@ -575,15 +601,15 @@ fn coverage(
                 fid.map_or_else(|| i.to_string(), |f| f.to_string())
             ))
         })?;
-        let geometry = skeletonise::partition::unit_geometry(fid, read.as_ref())
+        let geometry = skeletonise::neighbours::unit_geometry(fid, read.as_ref())
             .map_err(|e| PipelineError::new_err(format!("`neighbours`: {e}")))?;
-        out.push(skeletonise::partition::Unit {
+        out.push(skeletonise::neighbours::Unit {
             fid,
             geometry,
             attributes: Vec::new(),
         });
     }
-    Ok(skeletonise::partition::Coverage::new(out))
+    Ok(skeletonise::neighbours::Coverage::new(out))
 }
 
 /// Registered steps' side input layers by step name: WKB geometries and
@@ -681,23 +707,16 @@ fn network(
 /// The columns of a layer (`skeletons`, `candidates`, or `areas`, the
 /// `collapse` step's kept areas) as `(name, type)` pairs, type one of
 /// `int32`, `int64`, `real`, `text`, and whether the layer carries the
-/// source's attributes; `collapse`: the pipeline has a `collapse` step.
+/// source's attributes; `collapse`: the pipeline has a `collapse` step (a
+/// registered step's layers: `Pipeline.layer_columns`).
 #[pyfunction]
-#[pyo3(signature = (layer, explode = false, collapse = false, partition = false))]
+#[pyo3(signature = (layer, explode = false, collapse = false))]
 fn columns(
     layer: &str,
     explode: bool,
     collapse: bool,
-    partition: bool,
 ) -> PyResult<(Vec<(&'static str, &'static str)>, bool)> {
-    let names = [
-        "skeletons",
-        "candidates",
-        "areas",
-        "coverage",
-        "boundaries",
-        "given",
-    ];
+    let names = ["skeletons", "candidates", "areas"];
     let Some(layer) = skeletonise::output::BUILTIN
         .iter()
         .copied()
@@ -709,7 +728,7 @@ fn columns(
         )));
     };
     let mut holds = if explode { vec![When::Explode] } else { vec![] };
-    holds.extend(run::step_holds(collapse, partition));
+    holds.extend(run::step_holds(collapse));
     let plan = Plan::new(skeletonise::output::SKELETONS.name, holds, &[]);
     Ok(plan_columns(&plan, layer))
 }
@@ -731,15 +750,23 @@ fn plan_columns(
 
 /// The names for which a source field is written as `src_<name>` (in every
 /// layer alike, as the command line's writer renames them), with or without
-/// a `collapse` or `partition` step; with `neighbours`, those of a field of
-/// the units (`input.neighbours`).
+/// a `collapse` step; with `neighbours`, those of a field of the units
+/// (`input.neighbours`, in the layers of the registered steps that carry
+/// them). A pipeline's own: `Pipeline.reserved`.
 #[pyfunction]
-#[pyo3(signature = (collapse = false, partition = false, neighbours = false))]
-fn reserved(collapse: bool, partition: bool, neighbours: bool) -> Vec<&'static str> {
+#[pyo3(signature = (collapse = false, neighbours = false))]
+fn reserved(collapse: bool, neighbours: bool) -> Vec<&'static str> {
+    let registry = config::builtin_steps();
+    let steps: Vec<&skeletonise::layer::StepLayer> = registry
+        .entries()
+        .iter()
+        .flat_map(|e| e.layers)
+        .filter(|l| neighbours && l.fields == Some(skeletonise::layer::Fields::Neighbours))
+        .collect();
     let plan = Plan::new(
         skeletonise::output::SKELETONS.name,
-        run::step_holds(collapse, partition),
-        &[],
+        run::step_holds(collapse),
+        &steps,
     );
     match neighbours {
         true => plan.reserved_neighbour_names(),
@@ -793,7 +820,12 @@ fn step_layers() -> Vec<(&'static str, &'static str, &'static str, bool)> {
                 G::Unknown => "unknown",
                 G::None => "none",
             };
-            (step, l.name, geometry, l.attributes)
+            (
+                step,
+                l.name,
+                geometry,
+                l.fields == Some(skeletonise::layer::Fields::Input),
+            )
         })
         .collect()
 }

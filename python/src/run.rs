@@ -249,20 +249,13 @@ pub fn bare_plan() -> Plan {
     )
 }
 
-/// What the `collapse` and `partition` steps add to a plan (as the
-/// command line's `config::plan_of`).
-pub fn step_holds(collapse: bool, partition: bool) -> Vec<When> {
-    let mut holds = Vec::new();
-    if collapse {
-        holds.push(When::Collapse);
+/// What the `collapse` step adds to a plan (as the command line's
+/// `config::plan_of`).
+pub fn step_holds(collapse: bool) -> Vec<When> {
+    match collapse {
+        true => vec![When::Collapse],
+        false => Vec::new(),
     }
-    if partition {
-        holds.extend([When::Partition, When::Merge]);
-    }
-    if collapse || partition {
-        holds.push(When::Areas);
-    }
-    holds
 }
 
 /// Adjacent features merged into one (for a step that needs it, as the

@@ -263,20 +263,20 @@ class _Algorithm(QgsProcessingAlgorithm):
             if key in names and (layer != "areas" or collapse or partition) and (layer == "areas" or partition):
                 sinks.append((key, layer, kind))
         # A registered step's layer, when the pipeline has the step and the algorithm the sink.
-        registered = {}
         for key, layer, kind in _step_sinks():
             if key in names and parameters.get(key) is not None:
-                try:
-                    registered[layer] = pipeline.layer_columns(layer, connect=connect is not None, explode=explode)
-                except ValueError:
-                    continue
                 sinks.append((key, layer, kind))
         results, outputs = {}, {}
+        columns = {}
         for key, layer, kind in sinks:
-            if layer in registered:
-                tool, carries = registered[layer]
-            else:
-                tool, carries = core_columns(layer, explode, collapse, partition)
+            try:
+                # The pipeline's own plan: the columns the command line writes.
+                columns[key] = pipeline.layer_columns(layer, connect=connect is not None, explode=explode)
+            except ValueError:
+                continue
+        sinks = [s for s in sinks if s[0] in columns]
+        for key, layer, kind in sinks:
+            tool, carries = columns[key]
             if layer == "coverage":
                 fields_of, keep = unit_fields, bridge.source_fields(unit_fields, unit_skip)
             else:
@@ -340,9 +340,9 @@ class _Algorithm(QgsProcessingAlgorithm):
         return results
 
 
-def core_columns(layer, explode, collapse=False, partition=False):
+def core_columns(layer, explode, collapse=False):
     """The tool's columns of ``layer`` and whether it carries the input's fields."""
-    return bridge.core().columns(layer, explode, collapse, partition)
+    return bridge.core().columns(layer, explode, collapse)
 
 
 def _sinks(alg, candidates=True):
@@ -687,7 +687,14 @@ def _step_sinks():
         layers = bridge.core().step_layers()
     except QgsProcessingException:
         return []
-    return [(f"STEP_{layer.upper()}", layer, _SINK_TYPES[kind]) for _step, layer, kind, _ in layers if kind in _SINK_TYPES]
+    # The layers with sinks of their own (AREAS, COVERAGE, BOUNDARIES: the collapse and partition
+    # algorithms' parameters) are not repeated.
+    own = {layer for layer, _ in _Algorithm.LAYER_SINKS.values()}
+    return [
+        (f"STEP_{layer.upper()}", layer, _SINK_TYPES[kind])
+        for _step, layer, kind, _ in layers
+        if kind in _SINK_TYPES and layer not in own
+    ]
 
 
 def _options(definition, first=()):
@@ -727,9 +734,9 @@ def _step_options(step):
 # parameter names that differ from the option's key in capitals (where another step's parameter of
 # the algorithm has that name: prune's MIN_LENGTH).
 COLLAPSE_OPTIONS = ("CollapseParams", ("width", "tolerance", "min_length", "mode", "min_area"))
-PARTITION_OPTIONS = ("PartitionParams", ("overlap", "unowned", "width", "tolerance", "min_length"))
+PARTITION_OPTIONS = ("partition_options", ("overlap", "unowned", "width", "tolerance", "min_length"))
 RENAMED = {"CollapseParams": {"min_length": "COLLAPSE_MIN_LENGTH"},
-           "PartitionParams": {"min_length": "PARTITION_MIN_LENGTH"}}
+           "partition_options": {"min_length": "PARTITION_MIN_LENGTH"}}
 
 
 def _builtin_options(spec):

@@ -997,7 +997,7 @@ class Labels(Case):
         # the range ends below it). An option that may be unset is 0 there.
         defs = json.loads(cli("schema").stdout)["$defs"]
         renamed = {"collapse": {"min_length": "COLLAPSE_MIN_LENGTH"}, "partition": {"min_length": "PARTITION_MIN_LENGTH"}}
-        for step, definition in (("collapse", "CollapseParams"), ("partition", "PartitionParams")):
+        for step, definition in (("collapse", "CollapseParams"), ("partition", "partition_options")):
             alg = QgsApplication.processingRegistry().algorithmById(f"skeletonise:{step}")
             for key, option in defs[definition]["properties"].items():
                 p = alg.parameterDefinition(renamed[step].get(key, key.upper()))

@@ -18,20 +18,16 @@ pub struct AreaRow {
     pub attributes: Vec<Value>,
     /// The piece.
     pub geometry: geo::Polygon<f64>,
-    /// Cuts on its boundary, where collapsed lines meet it (0 in a
-    /// partition).
+    /// Cuts on its boundary, where collapsed lines meet it.
     pub cuts: usize,
     /// With `input.merge_adjacent`: the source FIDs dissolved, comma-separated.
     pub members: Option<String>,
-    /// With a `partition` step: `wide` (a part wider than `width`) or
-    /// `unowned` (nearest to bank no unit owns).
-    pub kind: Option<&'static str>,
 }
 
 /// The `areas` layer (with a `collapse` step).
 pub const AREAS: LayerDef<AreaRow> = LayerDef {
     name: "areas",
-    when: When::Areas,
+    when: When::Collapse,
     geometry: GeometryKind::Polygon,
     shape: |r| Some(Shape::Polygon(&r.geometry)),
     attributes: Attributes::Input(|r| &r.attributes),
@@ -43,9 +39,6 @@ pub const AREAS: LayerDef<AreaRow> = LayerDef {
         col("cuts", ColumnType::Int32, |r| int(r.cuts)),
         col_when(When::Merge, "members", ColumnType::Text, |r| {
             r.members.as_deref().map_or(Cell::Null, text)
-        }),
-        col_when(When::Partition, "kind", ColumnType::Text, |r| {
-            r.kind.map_or(Cell::Null, text)
         }),
     ],
 };

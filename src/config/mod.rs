@@ -64,8 +64,6 @@ pub enum Step {
     Extend(ExtendParams),
     /// Partial collapse for map production: the chosen skeleton replaces the polygon where its local width 2r is below `width` (lines in the skeleton layer with `collapsed = 1`), the wider pieces stay areas (layer `areas`), cut across the polygon where the lines meet them.
     Collapse(CollapseParams),
-    /// The polygon's area given to the units of `input.neighbours` around it: every point to the unit whose bank is nearest, the new boundaries (layer `boundaries`) running down the middle; the units grown by what they received (layer `coverage`), the areas given (layer `given`).
-    Partition(crate::partition::PartitionParams),
     /// The paper's metrics.
     Score(ScoreParams),
     /// A registered step (`process::step`), parsed by its own entry.
@@ -85,7 +83,6 @@ impl Step {
             Step::Prune(_) => "prune",
             Step::Extend(_) => "extend",
             Step::Collapse(_) => "collapse",
-            Step::Partition(_) => "partition",
             Step::Score(_) => "score",
             Step::Select(_) => "select",
             Step::Extra(e) => e.entry.name,
@@ -99,7 +96,6 @@ impl Step {
             Step::Skeleton(p) => p.validate(),
             Step::Prune(p) => p.validate(),
             Step::Collapse(p) => p.validate(),
-            Step::Partition(p) => p.validate(),
             Step::Extend(_) | Step::Score(_) | Step::Extra(_) => Ok(()),
             Step::Select(p) => p.validate(),
         }
@@ -111,22 +107,14 @@ impl Step {
         use crate::process::step::Needs;
         match self {
             Step::Collapse(_) => crate::collapse::NEEDS,
-            Step::Partition(p) => p.needs(),
-            Step::Extra(e) => e.entry.needs,
+            Step::Extra(e) => e.step.needs(e.entry.needs),
             _ => Needs::NOTHING,
         }
     }
 
     /// Steps in the only order they may appear in.
-    pub const ORDER: [&'static str; 8] = [
-        "prepare",
-        "skeleton",
-        "prune",
-        "extend",
-        "collapse",
-        "partition",
-        "score",
-        "select",
+    pub const ORDER: [&'static str; 7] = [
+        "prepare", "skeleton", "prune", "extend", "collapse", "score", "select",
     ];
 }
 
@@ -139,7 +127,7 @@ pub struct PipelineFile {
     pub name: Option<String>,
     /// Where the polygons come from.
     pub input: InputSpec,
-    /// Steps, in the order prepare → skeleton → prune → extend → collapse → partition → score → select; only `skeleton` is required.
+    /// Steps, in the order prepare → skeleton → prune → extend → collapse → score → select, each registered step after the one it follows (`skeletonise methods` lists the order); only `skeleton` is required.
     pub steps: Vec<Step>,
     /// Where the GeoPackage goes.
     pub output: OutputSpec,
@@ -172,7 +160,6 @@ pub fn process_params(steps: &[Step], plan: &crate::output::Plan) -> ProcessPara
             Step::Prune(x) => p.prune = Some(*x),
             Step::Extend(x) => p.extend = Some(*x),
             Step::Collapse(x) => p.collapse = Some(*x),
-            Step::Partition(x) => p.partition = Some(*x),
             Step::Score(x) => p.score = Some(*x),
             Step::Select(x) => p.select = Some(*x),
             Step::Extra(e) => p.extra.push(e.clone()),
@@ -219,11 +206,10 @@ pub fn plan_with(
     flag(output.bars, When::Bars);
     flag(output.widths, When::Widths);
     flag(output.measures == Measures::Width, When::Measures);
-    let collapse = steps.iter().any(|s| matches!(s, Step::Collapse(_)));
-    let partition = steps.iter().any(|s| matches!(s, Step::Partition(_)));
-    flag(collapse, When::Collapse);
-    flag(partition, When::Partition);
-    flag(collapse || partition, When::Areas);
+    flag(
+        steps.iter().any(|s| matches!(s, Step::Collapse(_))),
+        When::Collapse,
+    );
     flag(merge || steps.iter().any(|s| s.needs().merge), When::Merge);
     flag(connect, When::Connect);
     let mut layers = Vec::new();
@@ -256,7 +242,7 @@ pub struct StepsFile {
     /// Ignored (the caller brings the data).
     #[serde(default)]
     pub input: Option<InputSpec>,
-    /// Steps, in the order prepare → skeleton → prune → extend → collapse → partition → score → select (`Step::ORDER`); only `skeleton` is required.
+    /// Steps, in the order prepare → skeleton → prune → extend → collapse → score → select (`Step::ORDER`), each registered step after the one it follows; only `skeleton` is required.
     pub steps: Vec<Step>,
     /// Only `explode` is used (the caller writes the data).
     #[serde(default)]
@@ -404,10 +390,11 @@ pub fn load_str(text: &str, origin: &str, overrides: &[String]) -> Result<Pipeli
     load_str_with(text, origin, overrides, &builtin_steps())
 }
 
-/// The registered steps every pipeline file may use (`label`, `streets`),
-/// assembled here, above the steps and the registry's own module.
+/// The registered steps every pipeline file may use, assembled here, above
+/// the steps and the registry's own module.
 pub fn builtin_steps() -> StepRegistry {
     StepRegistry::default()
+        .with(crate::partition::ENTRY)
         .with(crate::label::ENTRY)
         .with(crate::streets::ENTRY)
 }

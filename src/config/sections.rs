@@ -33,12 +33,13 @@ pub struct InputSpec {
     /// A line network (any OGR source and layer of lines, e.g. the rivers) to continue through the polygons: where a line touches or crosses a polygon's boundary (or ends within `snap` of it) the skeleton gets a leg to that point (layer `connections`).
     #[serde(default)]
     pub connect: Option<ConnectSpec>,
-    /// The coverage whose units take the polygons' area (the `partition` step): any OGR source and layer of polygons, reprojected to the polygons' CRS; only the units that pass its `where` are read, written and own anything.
+    /// A coverage of units read beside the polygons, for a step that reads it (the units that take the polygons' area): any OGR source and layer of polygons, reprojected to the polygons' CRS; only the units that pass its `where` are read, written and own anything.
     #[serde(default)]
     pub neighbours: Option<NeighboursSpec>,
 }
 
-/// The `input.neighbours` section: the coverage a `partition` gives area to.
+/// The `input.neighbours` section: a coverage of units read beside the
+/// polygons (the units a step gives the polygons' area to).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct NeighboursSpec {

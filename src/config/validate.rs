@@ -6,7 +6,7 @@ use crate::process::step::StepRegistry;
 
 pub(super) fn validate(f: &PipelineFile) -> Result<(), (String, String)> {
     validate_steps(&f.steps)?;
-    partition_needs_neighbours(f)?;
+    neighbours_read(f)?;
     network_needs_connect(f)?;
     f.input
         .validate()
@@ -109,7 +109,36 @@ pub(super) fn validate_steps(steps: &[Step]) -> Result<(), (String, String)> {
             .map_err(|(k, m)| (format!("steps[{i}].{}.{k}", s.name()), m))?;
     }
     collapse_on_ma(steps)?;
-    partition_width_on_ma(steps)
+    registered_checks(steps)
+}
+
+/// Each registered step's own [checks](crate::process::step::FeatureStep::check)
+/// against the rest of the pipeline.
+fn registered_checks(steps: &[Step]) -> Result<(), (String, String)> {
+    let methods = steps
+        .iter()
+        .find_map(|s| match s {
+            Step::Skeleton(p) => Some(p.methods.clone()),
+            _ => None,
+        })
+        .unwrap_or_default();
+    let names: Vec<&str> = steps.iter().map(Step::name).collect();
+    let context = crate::process::step::StepContext {
+        methods: &methods,
+        steps: &names,
+    };
+    for (i, s) in steps.iter().enumerate() {
+        if let Step::Extra(e) = s {
+            e.step.check(&context).map_err(|(k, m)| {
+                let key = match k.is_empty() {
+                    true => format!("steps[{i}].{}", e.entry.name),
+                    false => format!("steps[{i}].{}.{k}", e.entry.name),
+                };
+                (key, m)
+            })?;
+        }
+    }
+    Ok(())
 }
 
 /// `collapse` cuts the polygon by the medial axis's inscribed discs and
@@ -128,27 +157,6 @@ fn collapse_on_ma(steps: &[Step]) -> Result<(), (String, String)> {
         Some((i, p)) if collapses && !p.methods.contains(&crate::methods::MethodId::MA) => Err((
             format!("steps[{i}].skeleton.methods"),
             "`collapse` cuts the polygon where the medial axis's inscribed discs meet the collapse width and draws the medial axis: add MA to the list (or leave `methods` out: with `collapse` it is MA alone); other methods' lines are not centred on those discs, so their collapsed lines would cross the kept areas".into(),
-        )),
-        _ => Ok(()),
-    }
-}
-
-/// A partition with `width` decides what is narrow on the medial axis's
-/// discs, as `collapse` does: MA must be among the methods (whichever
-/// `select` chooses for the skeleton layer).
-fn partition_width_on_ma(steps: &[Step]) -> Result<(), (String, String)> {
-    let width = steps.iter().enumerate().find_map(|(i, s)| match s {
-        Step::Partition(p) if p.width.is_some() => Some(i),
-        _ => None,
-    });
-    let has_ma = steps.iter().any(|s| match s {
-        Step::Skeleton(p) => p.methods.contains(&crate::methods::MethodId::MA),
-        _ => false,
-    });
-    match width {
-        Some(i) if !has_ma => Err((
-            format!("steps[{i}].partition.width"),
-            "`width` gives away only the narrow parts, measured by the medial axis's inscribed discs: add MA to `skeleton.methods` (any method may still be chosen for the skeleton layer)".into(),
         )),
         _ => Ok(()),
     }
@@ -211,23 +219,38 @@ fn order_of(steps: &[Step]) -> Vec<&'static str> {
     names.into_iter().map(|(_, n)| n).collect()
 }
 
-/// `partition` gives area to the units of `input.neighbours`: one needs the
-/// other; and a polygon is either partitioned or collapsed.
-fn partition_needs_neighbours(f: &PipelineFile) -> Result<(), (String, String)> {
-    let at = |name: &str| f.steps.iter().position(|s| s.name() == name);
-    match (at("partition"), at("collapse"), &f.input.neighbours) {
-        (Some(p), Some(_), _) => Err((
-            format!("steps[{p}].partition"),
-            "a pipeline has `partition` (the area given to the neighbours) or `collapse` (lines and kept areas), not both: remove one".into(),
+/// A step that [reads](crate::process::step::Needs::neighbours) the
+/// coverage of `input.neighbours` needs it, and `input.neighbours` needs a
+/// step that reads it.
+fn neighbours_read(f: &PipelineFile) -> Result<(), (String, String)> {
+    let reader = f
+        .steps
+        .iter()
+        .enumerate()
+        .find(|(_, s)| s.needs().neighbours);
+    match (reader, &f.input.neighbours) {
+        (Some((i, s)), None) => Err((
+            format!("steps[{i}].{}", s.name()),
+            format!(
+                "`{}` reads the units of a coverage: add `input.neighbours: {{ source: …, layer: … }}`",
+                s.name()
+            ),
         )),
-        (Some(p), None, None) => Err((
-            format!("steps[{p}].partition"),
-            "`partition` gives the polygons' area to the units of a coverage: add `input.neighbours: { source: …, layer: … }`".into(),
-        )),
-        (None, _, Some(_)) => Err((
-            "input.neighbours".into(),
-            "`input.neighbours` is the coverage a `partition` step gives area to: add `- partition: {}` to the steps, or remove it".into(),
-        )),
+        (None, Some(_)) => {
+            let readers: Vec<String> = super::builtin_steps()
+                .entries()
+                .iter()
+                .filter(|e| e.needs.neighbours)
+                .map(|e| format!("`- {}: {{}}`", e.name))
+                .collect();
+            Err((
+                "input.neighbours".into(),
+                format!(
+                    "`input.neighbours` is a coverage no step of the pipeline reads: add {} to the steps (a step that reads it), or remove it",
+                    readers.join(" or ")
+                ),
+            ))
+        }
         _ => Ok(()),
     }
 }

@@ -198,7 +198,7 @@ impl LabelParams {
 pub const LABELS: &[StepLayer] = &[StepLayer {
     name: "labels",
     geometry: GeometryKind::Unknown,
-    attributes: true,
+    fields: Some(crate::layer::Fields::Input),
     columns: &[
         ("polygon_part", ColumnType::Int32),
         ("kind", ColumnType::Text),

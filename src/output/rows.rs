@@ -10,7 +10,6 @@ use crate::collapse::{AreaRow, AREAS};
 use crate::connect::{ConnectionRow, NetworkRow, CONNECTIONS, NETWORK};
 use crate::feature::Value;
 use crate::layer::{Cell, ColumnType, GeometryKind, LayerDef, Shape, StepLayer, StepRow, When};
-use crate::partition::{BoundaryRow, CoverageRow, GivenRow, BOUNDARIES, COVERAGE, GIVEN};
 
 /// A row of a registered step's layer, with what the per-feature path
 /// knows of its feature.
@@ -18,10 +17,31 @@ use crate::partition::{BoundaryRow, CoverageRow, GivenRow, BOUNDARIES, COVERAGE,
 pub struct ExtraRow {
     /// Source FID.
     pub src_fid: Option<u64>,
+    /// The polygon part (with `explode`; written in a layer that carries
+    /// the input's fields).
+    pub polygon_part: Option<usize>,
+    /// The source FIDs of a merged feature, comma-separated (written in a
+    /// layer that carries the input's fields when adjacent polygons are
+    /// merged).
+    pub members: Option<String>,
     /// Source attributes (written when the layer has them).
     pub attributes: Vec<Value>,
     /// The step's geometry and cells.
     pub row: StepRow,
+}
+
+impl ExtraRow {
+    /// A row made after the last feature, of no feature: `src_fid` NULL,
+    /// no fields.
+    pub fn summary(row: StepRow) -> Self {
+        Self {
+            src_fid: None,
+            polygon_part: None,
+            members: None,
+            attributes: Vec::new(),
+            row,
+        }
+    }
 }
 
 /// The rows one feature produces, layer by layer.
@@ -42,15 +62,9 @@ pub struct Rows {
     /// `network` rows (the skeletons' per feature, the lines' once, after
     /// the features).
     pub network: Vec<NetworkRow>,
-    /// `boundaries` rows (a partition's new boundaries).
-    pub boundaries: Vec<BoundaryRow>,
-    /// `given` rows (a partition's areas given).
-    pub given: Vec<GivenRow>,
-    /// `coverage` rows (the units, grown: written once, after the features).
-    pub coverage: Vec<CoverageRow>,
-    /// The pieces given to each unit (its FID): not a layer, but what the
-    /// `coverage` rows are made of at the end of a run.
-    pub grown: Vec<(Option<u64>, crate::partition::Growth)>,
+    /// What registered steps keep of each feature for their finish (not a
+    /// layer): the step, the feature's FID and the kept value.
+    pub kept: Vec<(&'static str, Option<u64>, crate::process::step::Kept)>,
     /// `rejected` rows.
     pub rejected: Vec<RejectedRow>,
     /// Rows of registered steps' layers, by layer name.
@@ -69,10 +83,7 @@ impl Rows {
         self.areas.append(&mut other.areas);
         self.connections.append(&mut other.connections);
         self.network.append(&mut other.network);
-        self.boundaries.append(&mut other.boundaries);
-        self.given.append(&mut other.given);
-        self.coverage.append(&mut other.coverage);
-        self.grown.append(&mut other.grown);
+        self.kept.append(&mut other.kept);
         self.rejected.append(&mut other.rejected);
         for (layer, mut rows) in other.extra {
             self.extra.entry(layer).or_default().append(&mut rows);
@@ -89,9 +100,6 @@ impl Rows {
             + self.areas.len()
             + self.connections.len()
             + self.network.len()
-            + self.boundaries.len()
-            + self.given.len()
-            + self.coverage.len()
             + self.rejected.len()
             + self.extra.values().map(Vec::len).sum::<usize>()
             + self.runs.len()
@@ -201,42 +209,75 @@ impl Layer for StepLayer {
         self.geometry
     }
     fn fields(&self) -> Option<crate::layer::Fields> {
-        self.attributes.then_some(crate::layer::Fields::Input)
+        self.fields
     }
     fn columns(&self) -> Vec<ColumnInfo> {
-        std::iter::once(("src_fid", ColumnType::Int64))
-            .chain(self.columns.iter().copied())
-            .map(|(name, ty)| ColumnInfo {
-                name,
-                ty,
-                when: When::Always,
-            })
+        let col = |name, ty, when| ColumnInfo { name, ty, when };
+        std::iter::once(col("src_fid", ColumnType::Int64, When::Always))
+            .chain(stamped(self).map(|(name, ty, when, _)| col(name, ty, when)))
+            .chain(
+                self.columns
+                    .iter()
+                    .map(|&(name, ty)| col(name, ty, When::Always)),
+            )
             .collect()
     }
     fn count(&self, rows: &Rows) -> usize {
         own(self, rows).len()
     }
     fn shape<'r>(&self, rows: &'r Rows, i: usize) -> Option<Shape<'r>> {
-        own(self, rows)[i]
-            .row
-            .geometry
-            .as_ref()
-            .map(Shape::Geometry)
+        use geo::Geometry as G;
+        Some(match own(self, rows)[i].row.geometry.as_ref()? {
+            G::Polygon(p) => Shape::Polygon(p),
+            G::MultiPolygon(m) => Shape::MultiPolygon(m),
+            G::MultiLineString(m) => Shape::Lines(m),
+            g => Shape::Geometry(g),
+        })
     }
     fn attributes<'r>(&self, rows: &'r Rows, i: usize) -> &'r [Value] {
-        if self.attributes {
-            &own(self, rows)[i].attributes
-        } else {
-            &[]
+        match self.fields {
+            Some(_) => &own(self, rows)[i].attributes,
+            None => &[],
         }
     }
     fn cell(&self, rows: &Rows, i: usize, column: usize) -> Cell {
         let r = &own(self, rows)[i];
-        match column {
-            0 => crate::layer::fid(r.src_fid),
-            k => r.row.cells.get(k - 1).cloned().unwrap_or(Cell::Null),
+        let stamped: Vec<_> = stamped(self).collect();
+        match column.checked_sub(1) {
+            None => crate::layer::fid(r.src_fid),
+            Some(k) => match stamped.get(k) {
+                Some((.., of)) => of(r),
+                None => r
+                    .row
+                    .cells
+                    .get(k - stamped.len())
+                    .cloned()
+                    .unwrap_or(Cell::Null),
+            },
         }
     }
+}
+
+/// The columns the per-feature path adds after `src_fid` to a registered
+/// step's layer that carries the input's fields — `polygon_part` (with
+/// `explode`) and `members` (with merged polygons), as the skeleton layer
+/// has them — unless the step has a column of that name: name, type, when,
+/// and the value of a row.
+#[allow(clippy::type_complexity)]
+fn stamped(
+    layer: &StepLayer,
+) -> impl Iterator<Item = (&'static str, ColumnType, When, fn(&ExtraRow) -> Cell)> + '_ {
+    let all: [(&'static str, ColumnType, When, fn(&ExtraRow) -> Cell); 2] = [
+        ("polygon_part", ColumnType::Int32, When::Explode, |r| {
+            r.polygon_part.map_or(Cell::Null, crate::layer::int)
+        }),
+        ("members", ColumnType::Text, When::Merge, |r| {
+            r.members.clone().map_or(Cell::Null, Cell::Text)
+        }),
+    ];
+    let by_feature = layer.fields == Some(crate::layer::Fields::Input);
+    all.into_iter()
+        .filter(move |(name, ..)| by_feature && !layer.columns.iter().any(|(c, _)| c == name))
 }
 
 /// The skeleton layer.
@@ -253,7 +294,7 @@ pub static CANDIDATE_LAYER: Builtin<CandidateRow> = Builtin {
 
 /// Every built-in layer, in the order they are created (the run record,
 /// written once at the end of a run, last).
-pub static BUILTIN: [&dyn Layer; 12] = [
+pub static BUILTIN: [&dyn Layer; 9] = [
     &SKELETON_LAYER,
     &CANDIDATE_LAYER,
     &Builtin {
@@ -275,18 +316,6 @@ pub static BUILTIN: [&dyn Layer; 12] = [
     &Builtin {
         def: &NETWORK,
         rows: |r| &r.network,
-    },
-    &Builtin {
-        def: &COVERAGE,
-        rows: |r| &r.coverage,
-    },
-    &Builtin {
-        def: &BOUNDARIES,
-        rows: |r| &r.boundaries,
-    },
-    &Builtin {
-        def: &GIVEN,
-        rows: |r| &r.given,
     },
     &Builtin {
         def: &REJECTED,

@@ -1,13 +1,12 @@
 //! The layers a partition writes, declared next to the step: `coverage`
 //! (every unit, grown by what it received), `boundaries` (the new
-//! boundaries inside each collapsed polygon) and `given` (the area each
-//! unit received from each polygon).
+//! boundaries inside each collapsed polygon), `given` (the area each unit
+//! received from each polygon) and `areas` (what stays a polygon: the wide
+//! parts and what no unit takes).
 
 use crate::feature::Value;
-use crate::layer::{
-    col, fid, real, Attributes, Cell, ColumnType, GeometryKind, LayerDef, Shape, When,
-};
-use geo::{MultiLineString, MultiPolygon};
+use crate::layer::{ColumnType, Fields, GeometryKind, StepLayer};
+use geo::MultiPolygon;
 
 /// One row of `coverage`: a unit of `input.neighbours`, grown by the
 /// pieces it received (unchanged, bit for bit, when it received none).
@@ -26,76 +25,53 @@ pub struct CoverageRow {
     pub held: f64,
 }
 
-/// The `coverage` layer.
-pub const COVERAGE: LayerDef<CoverageRow> = LayerDef {
+/// The `coverage` layer: the units' fields, `src_fid` (the unit's), then
+/// these columns.
+pub const COVERAGE: StepLayer = StepLayer {
     name: "coverage",
-    when: When::Partition,
     geometry: GeometryKind::MultiPolygon,
-    shape: |r| Some(Shape::MultiPolygon(&r.geometry)),
-    attributes: Attributes::Neighbours(|r| &r.attributes),
-    columns: &[
-        col("src_fid", ColumnType::Int64, |r| fid(r.src_fid)),
-        col("received", ColumnType::Real, |r| Cell::Real(r.received)),
-        col("held", ColumnType::Real, |r| Cell::Real(r.held)),
-    ],
+    fields: Some(Fields::Neighbours),
+    columns: &[("received", ColumnType::Real), ("held", ColumnType::Real)],
 };
 
-/// One row of `boundaries`: the new boundary between two owners inside one
-/// collapsed polygon.
-#[derive(Debug, Clone, PartialEq)]
-pub struct BoundaryRow {
-    /// The collapsed polygon's FID.
-    pub src_fid: Option<u64>,
-    /// The unit on the lines' left, walking them (`None`: unowned).
-    pub left_fid: Option<u64>,
-    /// The unit on their right.
-    pub right_fid: Option<u64>,
-    /// The lines.
-    pub geometry: MultiLineString<f64>,
-    /// Their length.
-    pub length: f64,
-}
-
-/// The `boundaries` layer.
-pub const BOUNDARIES: LayerDef<BoundaryRow> = LayerDef {
+/// The `boundaries` layer: the new boundary between two owners inside one
+/// collapsed polygon (`src_fid`), the units on the lines' left and right
+/// walking them (NULL: unowned), and the lines' length.
+pub const BOUNDARIES: StepLayer = StepLayer {
     name: "boundaries",
-    when: When::Partition,
     geometry: GeometryKind::MultiLineString,
-    shape: |r| Some(Shape::Lines(&r.geometry)),
-    attributes: Attributes::None,
+    fields: None,
     columns: &[
-        col("src_fid", ColumnType::Int64, |r| fid(r.src_fid)),
-        col("left_fid", ColumnType::Int64, |r| fid(r.left_fid)),
-        col("right_fid", ColumnType::Int64, |r| fid(r.right_fid)),
-        col("length", ColumnType::Real, |r| real(Some(r.length))),
+        ("left_fid", ColumnType::Int64),
+        ("right_fid", ColumnType::Int64),
+        ("length", ColumnType::Real),
     ],
 };
 
-/// One row of `given`: the area one collapsed polygon gave one unit.
-#[derive(Debug, Clone, PartialEq)]
-pub struct GivenRow {
-    /// The collapsed polygon's FID.
-    pub src_fid: Option<u64>,
-    /// The unit's FID.
-    pub unit_fid: Option<u64>,
-    /// The area given.
-    pub area: f64,
-    /// The area of the polygon the unit held before (`overlap: cut`): how
-    /// far the cartographic boundary moved from the legal one.
-    pub held: f64,
-}
-
-/// The `given` layer (an attribute table).
-pub const GIVEN: LayerDef<GivenRow> = LayerDef {
+/// The `given` layer (an attribute table): the area one collapsed polygon
+/// (`src_fid`) gave one unit, and the area of it the unit held before
+/// (`overlap: cut`): how far the cartographic boundary moved from the legal
+/// one.
+pub const GIVEN: StepLayer = StepLayer {
     name: "given",
-    when: When::Partition,
     geometry: GeometryKind::None,
-    shape: |_| None,
-    attributes: Attributes::None,
+    fields: None,
     columns: &[
-        col("src_fid", ColumnType::Int64, |r| fid(r.src_fid)),
-        col("unit_fid", ColumnType::Int64, |r| fid(r.unit_fid)),
-        col("area", ColumnType::Real, |r| real(Some(r.area))),
-        col("held", ColumnType::Real, |r| real(Some(r.held))),
+        ("unit_fid", ColumnType::Int64),
+        ("area", ColumnType::Real),
+        ("held", ColumnType::Real),
     ],
 };
+
+/// The `areas` layer of a partition: what stays a polygon, with the
+/// collapsed polygon's fields — `wide` (a part wider than `width`, with the
+/// cuts on its boundary) or `unowned` (nearest to bank no unit owns).
+pub const AREAS: StepLayer = StepLayer {
+    name: "areas",
+    geometry: GeometryKind::Polygon,
+    fields: Some(Fields::Input),
+    columns: &[("cuts", ColumnType::Int32), ("kind", ColumnType::Text)],
+};
+
+/// Every layer of the step.
+pub const LAYERS: &[StepLayer] = &[COVERAGE, BOUNDARIES, GIVEN, AREAS];

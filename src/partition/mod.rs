@@ -36,11 +36,13 @@ mod layer;
 mod narrow;
 mod owners;
 mod split;
+mod step;
 
+pub use crate::neighbours::{Coverage, Unit};
 pub use assemble::{assemble, Growth};
-pub use layer::{BoundaryRow, CoverageRow, GivenRow, BOUNDARIES, COVERAGE, GIVEN};
-pub use owners::{unit_geometry, Coverage, Unit, DEFAULT_SNAP};
+pub use layer::{CoverageRow, AREAS, BOUNDARIES, COVERAGE, GIVEN, LAYERS};
 pub use split::Owner;
+pub use step::ENTRY;
 
 use crate::geometry::coverage::{coverage_union, RingEdges};
 use crate::geometry::vector::norm;
@@ -120,19 +122,6 @@ impl Default for PartitionParams {
 }
 
 impl PartitionParams {
-    /// What the step needs of the run: the medial axis's diagram cells (the
-    /// polygon is split along them), adjacent polygons merged exactly (a
-    /// river cut into reaches is given away as one), and with `width` the
-    /// medial axis's graphs (their discs say what is narrow).
-    pub fn needs(&self) -> crate::process::step::Needs {
-        crate::process::step::Needs {
-            cells: true,
-            merge: true,
-            graphs: self.width.is_some(),
-            ..crate::process::step::Needs::NOTHING
-        }
-    }
-
     /// The `collapse` options that decide what is narrow, with `width`.
     pub fn narrow(&self) -> Option<CollapseParams> {
         self.width.map(|width| CollapseParams {
@@ -262,27 +251,11 @@ pub enum PartitionError {
     Stopped,
 }
 
-/// Why a unit of `input.neighbours` cannot be read into the coverage, cut
-/// by a polygon, or written once it has grown (`fid`: its FID, or
+/// Why a unit of `input.neighbours` cannot be cut by a polygon, or written
+/// once it has grown (`fid`: its FID, or
 /// `(no fid)`).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum UnitError {
-    /// Its geometry is of another type.
-    #[error("feature {fid} is not a polygon; the coverage is a layer of polygons")]
-    NotAPolygon {
-        /// The unit.
-        fid: String,
-    },
-    /// A coordinate is NaN or infinite.
-    #[error("feature {fid} has a coordinate that is not a finite number ({x}, {y}); fix or remove the unit")]
-    NotFinite {
-        /// The unit.
-        fid: String,
-        /// The coordinate (x).
-        x: f64,
-        /// The coordinate (y).
-        y: f64,
-    },
     /// Its pieces inside and outside the polygon do not add up to it.
     #[error("unit {fid} of `input.neighbours` could not be cut exactly by the polygon (its pieces add up to {parts}, not {whole}); check the unit's validity, or try another `input.neighbours.snap`")]
     NotCutExactly {

@@ -111,9 +111,9 @@ pub enum RunError {
         /// Cores of this machine.
         cores: usize,
     },
-    /// The work after the last feature failed — a unit of the partitioned
-    /// coverage could not be written valid, a registered step's finish
-    /// failed — (exit 65: the output is not written).
+    /// The work after the last feature failed — a registered step's finish
+    /// failed, such as a unit of a partitioned coverage that could not be
+    /// written valid — (exit 65: the output is not written).
     #[error(transparent)]
     Finish(#[from] crate::process::FinishError),
     /// The run's output was written but its report was not.
@@ -470,56 +470,6 @@ fn log_start(job: &Job<'_>, info: &SourceInfo, threads: usize) {
     );
 }
 
-/// Logs what the partition gave: how many units grew and by how much, what
-/// they held of the collapsed polygons before, and the units that lie wholly
-/// in them.
-fn log_coverage(coverage: &[crate::partition::CoverageRow]) {
-    let grew: Vec<f64> = coverage
-        .iter()
-        .map(|c| c.received)
-        .filter(|&a| a > 0.0)
-        .collect();
-    tracing::info!(
-        units = coverage.len(),
-        grown = grew.len(),
-        area_given = grew.iter().sum::<f64>(),
-        "partition: {} of {} units grew by {:.6e} (CRS units²), the others are written unchanged",
-        grew.len(),
-        coverage.len(),
-        grew.iter().sum::<f64>()
-    );
-    let held: Vec<f64> = coverage
-        .iter()
-        .map(|c| c.held)
-        .filter(|&a| a > 0.0)
-        .collect();
-    if !held.is_empty() {
-        tracing::info!(
-            units_held = held.len(),
-            area_held = held.iter().sum::<f64>(),
-            "partition: {} units held {:.6e} (CRS units²) of the collapsed polygons before: cut out of them and given by the rule (`held` in layers `given` and `coverage`)",
-            held.len(),
-            held.iter().sum::<f64>()
-        );
-    }
-    let landless: Vec<String> = coverage
-        .iter()
-        .filter(|c| c.held > 0.0 && c.geometry.0.is_empty())
-        .map(|c| {
-            c.src_fid
-                .map_or_else(|| "(no fid)".into(), |f| f.to_string())
-        })
-        .collect();
-    if !landless.is_empty() {
-        tracing::info!(
-            units = %landless.join(","),
-            "partition: {} units lie wholly in the collapsed polygons (FIDs {}): they get nothing and are written with an empty geometry",
-            landless.len(),
-            landless.join(", ")
-        );
-    }
-}
-
 /// What the worker threads need for every batch.
 struct Workers<'a> {
     job: &'a Job<'a>,
@@ -531,8 +481,9 @@ struct Workers<'a> {
 impl Workers<'_> {
     /// Every feature through the run driver ([`crate::process::Run`]),
     /// then the rows it makes once after the last feature — the network's
-    /// lines split where they met the polygons, the partitioned coverage —
-    /// handed to the writer too; the result and the counts.
+    /// lines split where they met the polygons, the registered steps'
+    /// finish (the coverage a partition grows) — handed to the writer too;
+    /// the result and the counts.
     fn run(
         &self,
         batches: &mpsc::Receiver<Batch>,
@@ -544,9 +495,6 @@ impl Workers<'_> {
         progress.finish();
         match result.map(|()| run.finish()) {
             Ok(Ok((rows, counts))) => {
-                if self.params.neighbours.is_some() {
-                    log_coverage(&rows.coverage);
-                }
                 // A closed channel: the writer stopped on an error; it
                 // says which after the workers.
                 let _ = rows_tx.send(rows);

@@ -40,7 +40,7 @@ pub(super) fn finish_run(
         elapsed_s,
         threads,
         stage_seconds: stage_json(&counts.stages, &counts.step_times),
-        area_held: counts.units.map(|_| counts.area_held),
+        area_held: counts.figure(crate::output::name::run::AREA_HELD),
     };
     let out = writer.finish(&record)?;
     Ok(RunSummary {

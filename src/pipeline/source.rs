@@ -200,7 +200,8 @@ pub(super) enum Merge {
     None,
     /// `input.merge_adjacent`: dissolved.
     Dissolve,
-    /// A partition's collapsed polygons: their union made exactly.
+    /// For a step that [needs it](crate::process::step::Needs::merge):
+    /// their union made exactly.
     Exactly,
 }
 
@@ -209,8 +210,8 @@ pub(super) enum Merge {
 pub(super) fn read_neighbours(
     n: &crate::config::NeighboursSpec,
     polygons: &SourceInfo,
-) -> Result<(crate::partition::Coverage, SourceInfo), RunError> {
-    use crate::partition::{Coverage, Unit};
+) -> Result<(crate::neighbours::Coverage, SourceInfo), RunError> {
+    use crate::neighbours::{unit_geometry, Coverage, Unit};
     let error = |reason: String| {
         RunError::Io(IoError::Read {
             source_name: n.source.clone(),
@@ -221,7 +222,7 @@ pub(super) fn read_neighbours(
     let mut units = Vec::new();
     let mut bad = None;
     for f in features {
-        match crate::partition::unit_geometry(f.fid, f.geometry.as_ref()) {
+        match unit_geometry(f.fid, f.geometry.as_ref()) {
             Ok(geometry) => units.push(Unit {
                 fid: f.fid,
                 geometry,
@@ -245,7 +246,7 @@ pub(super) fn read_neighbours(
         )));
     }
     units.sort_by_key(|u| u.fid);
-    tracing::info!(source = %n.source, layer = %info.layer, units = units.len(), "partition: coverage read");
+    tracing::info!(source = %n.source, layer = %info.layer, units = units.len(), "input.neighbours: coverage read");
     Ok((Coverage::new(units).with_snap(n.snap), info))
 }
 

@@ -187,7 +187,7 @@ pub(super) struct PartSkeleton {
     /// The raw skeleton, when kept for a registered step (MA's, see
     /// [`ProcessParams::keeps_raw_medial_axis`]).
     raw: Option<std::sync::Arc<SkeletonGraph>>,
-    /// The cells of MA's diagram, when `partition` follows (see
+    /// The cells of MA's diagram, when a step needs them (see
     /// [`crate::methods::SkeletonMethod::skeletonise_with_cells`]).
     cells: Option<Cells>,
 }
@@ -246,7 +246,7 @@ const HIDDEN: usize = usize::MAX;
 /// (for the first method of the reference order) its finished skeleton.
 struct Raw {
     graph: Result<SkeletonGraph, CandidateError>,
-    /// The cells of MA's diagram, when `partition` follows.
+    /// The cells of MA's diagram, when a step needs them.
     cells: Option<Cells>,
     stages: Stages,
     reference: Option<Reference>,
@@ -455,7 +455,8 @@ impl<'a> PartWork<'a> {
                 Ok((g, cells)) => (Ok(g), cells.map(std::sync::Arc::new)),
                 Err(e) => (Err(e), None),
             };
-            // The cells are `partition`'s work: its time, not the skeleton's.
+            // The cells are the work of the step that needs them: its time,
+            // not the skeleton's.
             if let Some(c) = &cells {
                 stages.remove(Stage::Skeleton, c.time);
             }

@@ -60,7 +60,7 @@ pub fn merge_adjacent_exactly(features: Vec<Feature>, by: Option<usize>) -> Vec<
                 .map(|f| f.fid.map_or_else(|| "(no fid)".into(), |x| x.to_string()))
                 .collect();
             tracing::warn!(
-                "features {} overlap each other: dissolved into one polygon (not exactly, as `merge_adjacent` does) before the partition",
+                "features {} overlap each other: dissolved into one polygon (not exactly, as `merge_adjacent` does) before the steps",
                 fids.join(", ")
             );
             dissolve(group)

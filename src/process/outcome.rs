@@ -13,7 +13,6 @@ use crate::geometry::PreparedPolygon;
 use crate::methods::{MethodContext, MethodId};
 use crate::score::select::{select, Entry};
 use geo::{Geometry, MultiLineString};
-use std::sync::Arc;
 
 /// Processes one feature's geometry through every step.
 pub fn process(geom: Option<&Geometry<f64>>, params: &ProcessParams) -> Processed {
@@ -69,14 +68,6 @@ pub enum StepError {
         /// Why, as the step says.
         reason: String,
     },
-    /// A polygon part could not be partitioned.
-    #[error("{}{error}", part.map_or_else(String::new, |i| format!("part {i}: ")))]
-    Partition {
-        /// The part, when the feature has several.
-        part: Option<usize>,
-        /// Why.
-        error: crate::partition::PartitionError,
-    },
 }
 
 /// The clock of the steps after `select` on one feature: `skeleton.timeout_s`
@@ -116,8 +107,8 @@ impl StepClock {
 }
 
 /// The steps after `select` on one feature, in their order: the connection
-/// legs, `collapse`, the local widths (`keep_measures`), `partition` and the
-/// registered steps, within one [`StepClock`].
+/// legs, `collapse`, the local widths (`keep_measures`) and the registered
+/// steps (`partition`, `label`, …), within one [`StepClock`].
 fn after_select(
     o: &mut FeatureOutcome,
     prepared: &[PreparedPolygon],
@@ -134,36 +125,68 @@ fn after_select(
         measure(o, prepared);
         clock.check("output.measures")?;
     }
-    if let (Some(pp), Some(cov)) = (&params.partition, &params.neighbours) {
-        partition_chosen(o, prepared, pp, cov, &clock)?;
-    }
     for e in &params.extra {
-        let needs = e.entry.needs;
-        let medial_axis = o
-            .candidates
-            .iter()
-            .find(|c| c.method == MethodId::MA && needs.medial_axis)
-            .and_then(|c| c.result.as_ref().ok())
-            .map(|c| c.raw.as_slice())
-            .filter(|raw| raw.len() == prepared.len());
-        let started = crate::clock::CpuClock::start();
-        let rows = e.step.rows(&step::StepInput {
-            parts: prepared,
-            outcome: o,
-            lonlat: params.lonlat.as_ref().filter(|_| needs.lonlat),
-            medial_axis,
-            side: e.side.as_deref(),
-            budget: &clock.0,
-        });
-        o.step_times
-            .push((e.entry.name, super::StepTime(started.elapsed())));
-        clock.check(e.entry.name)?;
-        let rows = e.entry.checked(rows).map_err(|f| StepError::Step {
-            step: e.entry.name,
-            reason: f.0,
-        })?;
-        o.extra.extend(rows);
+        registered(o, prepared, e, params, &clock)?;
     }
+    Ok(())
+}
+
+/// A registered step on one feature: what it [needs](step::Needs) taken
+/// from the outcome and the run, its rows and what it keeps added to the
+/// outcome, its CPU time (with the time of MA's diagram cells it reads).
+fn registered(
+    o: &mut FeatureOutcome,
+    prepared: &[PreparedPolygon],
+    e: &step::Extra,
+    params: &ProcessParams,
+    clock: &StepClock,
+) -> Result<(), StepError> {
+    let needs = e.step.needs(e.entry.needs);
+    let started = crate::clock::CpuClock::start();
+    // The diagram's cells are taken from MA's candidate, which no later
+    // step reads.
+    let cells: Vec<step::DiagramCells> = match needs.cells {
+        true => o
+            .candidates
+            .iter_mut()
+            .find(|c| c.method == MethodId::MA)
+            .and_then(|c| c.result.as_mut().ok())
+            .map(|m| std::mem::take(&mut m.cells))
+            .filter(|c| c.len() == prepared.len())
+            .unwrap_or_default(),
+        false => Vec::new(),
+    };
+    let cells_time: std::time::Duration = cells.iter().map(|c| c.time).sum();
+    let has_cells = !cells.is_empty();
+    let cells = std::cell::RefCell::new(cells);
+    let medial_axis = o
+        .candidates
+        .iter()
+        .find(|c| c.method == MethodId::MA && needs.medial_axis)
+        .and_then(|c| c.result.as_ref().ok())
+        .map(|c| c.raw.as_slice())
+        .filter(|raw| raw.len() == prepared.len());
+    let made = e.step.output(&step::StepInput {
+        parts: prepared,
+        outcome: o,
+        lonlat: params.lonlat.as_ref().filter(|_| needs.lonlat),
+        medial_axis,
+        side: e.side.as_deref(),
+        neighbours: params.neighbours.as_deref().filter(|_| needs.neighbours),
+        cells: has_cells.then_some(&cells),
+        budget: &clock.0,
+    });
+    o.step_times.push((
+        e.entry.name,
+        super::StepTime(started.elapsed() + cells_time),
+    ));
+    clock.check(e.entry.name)?;
+    let (rows, kept) = e.entry.checked_output(made).map_err(|f| StepError::Step {
+        step: e.entry.name,
+        reason: f.0,
+    })?;
+    o.extra.extend(rows);
+    o.kept.extend(kept.map(|k| (e.entry.name, k)));
     Ok(())
 }
 
@@ -207,56 +230,6 @@ fn collapse_chosen(
         parts.push(part.ok_or_else(|| clock.reason("collapse"))?);
     }
     o.collapse = Some(parts);
-    Ok(())
-}
-
-/// `partition` of every polygon part between the units of `cov`; with
-/// `width`, the medial axis's discs say what is narrow.
-fn partition_chosen(
-    o: &mut FeatureOutcome,
-    prepared: &[PreparedPolygon],
-    pp: &crate::partition::PartitionParams,
-    cov: &crate::partition::Coverage,
-    clock: &StepClock,
-) -> Result<(), StepError> {
-    let started = crate::clock::CpuClock::start();
-    let mut ma = o
-        .candidates
-        .iter_mut()
-        .find(|c| c.method == MethodId::MA)
-        .and_then(|c| c.result.as_mut().ok());
-    // The diagram's cells are split where the units meet: taken from the
-    // candidate, which no later step reads.
-    let mut cells = ma
-        .as_deref_mut()
-        .map(|m| std::mem::take(&mut m.cells))
-        .filter(|c| c.len() == prepared.len())
-        .map(|c| {
-            c.into_iter().map(|a| {
-                let c = Arc::try_unwrap(a).unwrap_or_else(|a| (*a).clone());
-                (c.edges, c.time)
-            })
-        });
-    let ma = ma.as_deref();
-    let mut cells_time = std::time::Duration::ZERO;
-    let mut parts = Vec::with_capacity(prepared.len());
-    for (i, p) in prepared.iter().enumerate() {
-        let g = ma.and_then(|m| m.graphs.get(i));
-        let cells = cells.as_mut().and_then(|c| c.next()).map(|(edges, time)| {
-            cells_time += time;
-            edges
-        });
-        let expired = || clock.0.expired();
-        let part = crate::partition::partition(p, cov, pp, g, cells, &expired);
-        clock.check("partition")?;
-        parts.push(part.map_err(|error| StepError::Partition {
-            part: (prepared.len() > 1).then_some(i),
-            error,
-        })?);
-    }
-    o.partition = Some(parts);
-    o.step_times
-        .push(("partition", super::StepTime(started.elapsed() + cells_time)));
     Ok(())
 }
 
@@ -421,7 +394,7 @@ fn choose(candidates: Vec<Candidate>, parts: usize, params: &ProcessParams) -> P
             connections: Vec::new(),
             measures: None,
             extra: Vec::new(),
-            partition: None,
+            kept: Vec::new(),
             step_times: Vec::new(),
         }),
         None => Processed::Rejected(rejection(&candidates)),

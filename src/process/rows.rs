@@ -78,8 +78,8 @@ pub struct FeatureRows {
     pub status: Status,
     /// Each method's step times on this feature (all its units).
     pub times: Vec<(MethodId, StageTimes)>,
-    /// The CPU time on this feature of `partition` and of each registered
-    /// step, by the step's name (all its units).
+    /// The CPU time on this feature of each registered step, by the step's
+    /// name (all its units).
     pub step_times: Vec<(&'static str, std::time::Duration)>,
 }
 
@@ -314,19 +314,20 @@ fn outcome_rows(
         }));
     }
     candidate_rows(f, part, o, &name, opts, rows);
-    if let Some(parts) = &o.partition {
-        partition_rows(f, part, parts, rows);
-    }
     for (layer, row) in &o.extra {
         rows.extra
             .entry(layer)
             .or_default()
             .push(crate::output::ExtraRow {
                 src_fid: f.fid,
+                polygon_part: part,
+                members: members.clone(),
                 attributes: f.attributes.clone(),
                 row: row.clone(),
             });
     }
+    rows.kept
+        .extend(o.kept.iter().map(|(step, k)| (*step, f.fid, k.clone())));
     method
 }
 
@@ -377,68 +378,6 @@ fn collapse_rows(
             geometry: a.polygon.clone(),
             cuts: a.cuts,
             members: members.clone(),
-            kind: None,
-        }));
-}
-
-/// The rows of a partitioned feature: its new boundaries, the area given
-/// to each unit, the wide parts kept (`areas`, `kind = wide`) and what no
-/// unit takes (`kind = unowned`), and
-/// the pieces the units grow by.
-fn partition_rows(
-    f: &Feature,
-    part: Option<usize>,
-    parts: &[crate::partition::PartPartition],
-    rows: &mut Rows,
-) {
-    use crate::partition::{BoundaryRow, GivenRow, Growth};
-    use geo::{Area, Euclidean, Length};
-    // (area given, area held) by unit.
-    let mut given: std::collections::BTreeMap<Option<u64>, (f64, f64)> = Default::default();
-    for p in parts {
-        for b in &p.boundaries {
-            rows.boundaries.push(BoundaryRow {
-                src_fid: f.fid,
-                left_fid: b.fids[0],
-                right_fid: b.fids[1],
-                length: b.lines.0.iter().map(|l| Euclidean.length(l)).sum(),
-                geometry: b.lines.clone(),
-            });
-        }
-        for g in &p.given {
-            given.entry(g.fid).or_default().0 += g.polygon.unsigned_area();
-            rows.grown.push((g.fid, Growth::Given(g.polygon.clone())));
-        }
-        for u in &p.units {
-            let held: f64 = u.held.iter().map(|h| h.unsigned_area()).sum();
-            if !u.held.is_empty() {
-                given.entry(u.fid).or_default().1 += held;
-            }
-            rows.grown
-                .extend(u.held.iter().map(|h| (u.fid, Growth::Held(h.clone()))));
-            if !u.edits.is_empty() {
-                rows.grown.push((u.fid, Growth::Snapped(u.edits.clone())));
-            }
-        }
-        let kept = p.wide.iter().map(|(w, cuts)| (w, *cuts, "wide"));
-        let remainders = p.remainders.iter().map(|r| (r, 0, "unowned"));
-        rows.areas
-            .extend(kept.chain(remainders).map(|(polygon, cuts, kind)| AreaRow {
-                src_fid: f.fid,
-                polygon_part: part,
-                attributes: f.attributes.clone(),
-                geometry: polygon.clone(),
-                cuts,
-                members: members_text(f),
-                kind: Some(kind),
-            }));
-    }
-    rows.given
-        .extend(given.into_iter().map(|(unit_fid, (area, held))| GivenRow {
-            src_fid: f.fid,
-            unit_fid,
-            area,
-            held,
         }));
 }
 

@@ -3,10 +3,12 @@
 //! [`FeatureRows`] (computed by [`super::feature_rows`] on any thread); the
 //! run counts them, applies `on_error: fail`, keeps what the steps need
 //! after the last feature (the pieces each unit received, the points where
-//! the network's lines met the polygons), and [`Run::finish`] makes those
-//! rows once: the network's lines split at the polygons, the partitioned
-//! coverage. No I/O: the caller reads, writes and logs.
+//! the network's lines met the polygons, what the registered steps keep for
+//! their finish), and [`Run::finish`] makes those rows once: the network's
+//! lines split at the polygons, each registered step's finish (the coverage
+//! a partition grows). No I/O: the caller reads, writes and logs.
 
+use super::step::Kept;
 use super::{FeatureRows, ProcessParams, StageTimes, Status};
 use crate::feature::Feature;
 use crate::layer::StepRow;
@@ -40,25 +42,30 @@ pub struct RunCounts {
     /// Lines of `input.connect`, when the run has a network (set by
     /// [`Run::finish`]).
     pub network: Option<u64>,
-    /// Units of the partitioned coverage, when the run partitions (set by
-    /// [`Run::finish`]).
-    pub units: Option<u64>,
-    /// With a partition: the area the units held of the collapsed polygons
-    /// before (set by [`Run::finish`]).
-    pub area_held: f64,
-    /// The CPU time of `partition` and of each registered step, by the
-    /// step's name in the order first met: on the features, and after the
-    /// last one (the coverage assembled, a step's finish).
+    /// The figures registered steps report after the last feature, each
+    /// under the name of the run record's column it fills (`area_held`;
+    /// set by [`Run::finish`]).
+    pub figures: Vec<(&'static str, f64)>,
+    /// The CPU time of each registered step, by the step's name in the
+    /// order first met: on the features, and after the last one (a step's
+    /// finish: the coverage a partition grows).
     pub step_times: Vec<(&'static str, Duration)>,
+}
+
+impl RunCounts {
+    /// The figure `name` a step reported, if any.
+    pub fn figure(&self, name: &str) -> Option<f64> {
+        self.figures
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|&(_, v)| v)
+    }
 }
 
 /// Why the work after the last feature failed: the run stops and writes
 /// nothing (exit 65).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum FinishError {
-    /// A unit of the partitioned coverage cannot be written valid.
-    #[error("partition: {0}")]
-    Coverage(#[from] crate::partition::UnitError),
     /// A registered step's [finish](super::step::FeatureStep::finish) failed.
     #[error("`{step}`: {reason}")]
     Step {
@@ -84,11 +91,13 @@ pub struct Run<'a> {
     params: &'a ProcessParams,
     fail: bool,
     counts: RunCounts,
-    grown: Vec<(Option<u64>, crate::partition::Growth)>,
     met: Vec<(Option<u64>, geo::Coord<f64>)>,
     /// The per-feature rows of each registered step whose finish reads
     /// them (by its index in `params.extra`).
     kept: Vec<Vec<(Option<u64>, &'static str, StepRow)>>,
+    /// What each such step kept of every feature (by its index in
+    /// `params.extra`).
+    kept_values: Vec<Vec<(Option<u64>, Kept)>>,
 }
 
 impl<'a> Run<'a> {
@@ -99,9 +108,9 @@ impl<'a> Run<'a> {
             params,
             fail,
             counts: RunCounts::default(),
-            grown: Vec::new(),
             met: Vec::new(),
             kept: vec![Vec::new(); params.extra.len()],
+            kept_values: vec![Vec::new(); params.extra.len()],
         }
     }
 
@@ -141,8 +150,7 @@ impl<'a> Run<'a> {
                 None => c.stages.push((*m, *t)),
             }
         }
-        self.keep_for_finish(&rows);
-        self.grown.append(&mut rows.grown);
+        self.keep_for_finish(&mut rows);
         self.met.extend(
             rows.connections
                 .iter()
@@ -151,9 +159,12 @@ impl<'a> Run<'a> {
         Ok(rows)
     }
 
-    /// Keeps the rows of the registered steps whose finish reads them.
-    fn keep_for_finish(&mut self, rows: &Rows) {
-        for (e, kept) in self.params.extra.iter().zip(&mut self.kept) {
+    /// Keeps the rows of the registered steps whose finish reads them, and
+    /// what they kept of the features (taken out of `rows`).
+    fn keep_for_finish(&mut self, rows: &mut Rows) {
+        let mut values = std::mem::take(&mut rows.kept);
+        let steps = self.params.extra.iter();
+        for ((e, kept), kept_values) in steps.zip(&mut self.kept).zip(&mut self.kept_values) {
             if !e.entry.needs.finish {
                 continue;
             }
@@ -161,6 +172,11 @@ impl<'a> Run<'a> {
                 let own = rows.extra.get(layer.name).into_iter().flatten();
                 kept.extend(own.map(|r| (r.src_fid, layer.name, r.row.clone())));
             }
+            let (own, others): (Vec<_>, Vec<_>) = values
+                .into_iter()
+                .partition(|(step, _, _)| *step == e.entry.name);
+            kept_values.extend(own.into_iter().map(|(_, fid, k)| (fid, k)));
+            values = others;
         }
     }
 
@@ -169,56 +185,41 @@ impl<'a> Run<'a> {
         &self.counts
     }
 
-    /// After the last feature: the network's lines split where they met the
-    /// polygons (with `input.connect`), the partitioned coverage — every
-    /// unit grown by what it received — (with `partition`), the registered
-    /// steps' [finish](super::step::FeatureStep::finish) rows (of the
-    /// layers each declares; without source fields), and the counts.
-    /// Fails when a unit of the coverage cannot be written valid, or a
-    /// registered step's finish fails.
+    /// After the last feature: the registered steps'
+    /// [finish](super::step::FeatureStep::finish_rows) rows (of the layers
+    /// each declares) and figures, the network's lines split where they
+    /// met the polygons (with `input.connect`), and the counts. Fails when
+    /// a registered step's finish fails (a unit of a partitioned coverage
+    /// that cannot be written valid).
     pub fn finish(mut self) -> Result<(Rows, RunCounts), FinishError> {
         let mut rows = Rows::default();
-        for (e, kept) in self.params.extra.iter().zip(std::mem::take(&mut self.kept)) {
+        let kept = std::mem::take(&mut self.kept);
+        let kept_values = std::mem::take(&mut self.kept_values);
+        for ((e, kept), kept_values) in self.params.extra.iter().zip(kept).zip(kept_values) {
             let input = super::step::FinishInput {
                 rows: &kept,
+                kept: &kept_values,
                 side: e.side.as_deref(),
+                neighbours: self.params.neighbours.as_deref(),
             };
             let clock = crate::clock::CpuClock::start();
-            let made = e.step.finish(&input);
+            let made = e.step.finish_rows(&input);
             add_time(&mut self.counts.step_times, e.entry.name, clock.elapsed());
-            let made = e.entry.checked(made).map_err(|f| FinishError::Step {
-                step: e.entry.name,
-                reason: f.0,
-            })?;
-            for (layer, row) in made {
-                rows.extra
-                    .entry(layer)
-                    .or_default()
-                    .push(crate::output::ExtraRow {
-                        src_fid: None,
-                        attributes: Vec::new(),
-                        row,
-                    });
+            let made = e
+                .entry
+                .checked_finish(made)
+                .map_err(|f| FinishError::Step {
+                    step: e.entry.name,
+                    reason: f.0,
+                })?;
+            for (layer, row) in made.rows {
+                rows.extra.entry(layer).or_default().push(row);
             }
+            self.counts.figures.extend(made.figures);
         }
         if let Some(net) = &self.params.connect {
             rows.network = net.rows(&self.met);
             self.counts.network = Some(net.len() as u64);
-        }
-        if let (Some(_), Some(cov)) = (&self.params.partition, &self.params.neighbours) {
-            let clock = crate::clock::CpuClock::start();
-            let grown = std::mem::take(&mut self.grown);
-            rows.coverage = crate::partition::assemble(cov.units(), grown)?;
-            let c = &mut self.counts;
-            add_time(&mut c.step_times, "partition", clock.elapsed());
-            c.units = Some(rows.coverage.len() as u64);
-            c.area_held = rows
-                .coverage
-                .iter()
-                .map(|u| u.held)
-                .filter(|&a| a > 0.0)
-                .sum::<f64>()
-                + 0.0;
         }
         Ok((rows, self.counts))
     }

@@ -32,7 +32,7 @@
 //! const LAYERS: &[StepLayer] = &[StepLayer {
 //!     name: "parts",
 //!     geometry: GeometryKind::None,
-//!     attributes: false,
+//!     fields: None,
 //!     columns: &[("parts", ColumnType::Int32)],
 //! }];
 //!
@@ -75,6 +75,15 @@ pub struct StepInput<'a> {
     /// The step's side input layer, when it [has one](Needs::side) and the
     /// pipeline gives it.
     pub side: Option<&'a SideLayer>,
+    /// The coverage of `input.neighbours`, when the step
+    /// [needs it](Needs::neighbours) (validation makes sure the pipeline
+    /// gives it; a library caller may not).
+    pub neighbours: Option<&'a crate::neighbours::Coverage>,
+    /// The cells of MA's segment Voronoi diagram of every polygon part, when
+    /// the step [needs them](Needs::cells) and MA succeeded: taken out of
+    /// the candidate (no later step reads them), for the step to take in
+    /// turn; their time is counted as the step's.
+    pub cells: Option<&'a std::cell::RefCell<Vec<DiagramCells>>>,
     /// The clock of the steps after `select` on this feature
     /// (`skeleton.timeout_s` once more): a step with long work asks
     /// [`MethodContext::expired`] and stops; rows that come after the
@@ -147,6 +156,55 @@ impl From<&str> for StepFailure {
 /// A registered step's rows, each with its layer's name, or why it failed.
 pub type StepRows = Result<Vec<(&'static str, StepRow)>, StepFailure>;
 
+/// The cells of MA's segment Voronoi diagram of one polygon part (see
+/// [`StepInput::cells`]).
+pub type DiagramCells = Arc<crate::methods::medial_axis::cells::DiagramCells>;
+
+/// What a step keeps of one feature for its [finish](FeatureStep::finish_rows)
+/// beside its rows (the pieces each unit of a coverage receives): any type
+/// of the step's, which its finish downcasts.
+#[derive(Clone)]
+pub struct Kept(pub Arc<dyn std::any::Any + Send + Sync>);
+
+impl std::fmt::Debug for Kept {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("Kept")
+    }
+}
+
+impl PartialEq for Kept {
+    fn eq(&self, other: &Self) -> bool {
+        Arc::ptr_eq(&self.0, &other.0)
+    }
+}
+
+/// A step's work on one feature in full: its rows and what it keeps for
+/// its finish.
+pub type StepOutput = Result<(Vec<(&'static str, StepRow)>, Option<Kept>), StepFailure>;
+
+/// What a step's [`FeatureStep::finish_rows`] makes after the last feature.
+#[derive(Debug, Default)]
+pub struct Finished {
+    /// Rows of the step's layers, each with its layer, its `src_fid` (NULL
+    /// for a summary; a side input feature's FID for a row of it) and the
+    /// fields the layer carries (none, or the side input feature's).
+    pub rows: Vec<(&'static str, crate::output::ExtraRow)>,
+    /// Figures of the run the step reports (`area_held`), each under a name
+    /// of a column of the run record (`skeletonise_runs`) that it fills.
+    pub figures: Vec<(&'static str, f64)>,
+}
+
+/// What the pipeline around a step holds, for the step's own
+/// [checks](FeatureStep::check): the methods of the `skeleton` step and the
+/// names of the pipeline's steps, in order.
+#[derive(Debug, Clone, Copy)]
+pub struct StepContext<'a> {
+    /// `skeleton.methods`.
+    pub methods: &'a [crate::methods::MethodId],
+    /// Every step's name.
+    pub steps: &'a [&'a str],
+}
+
 /// A registered step's work on one feature: rows of its own layers, each
 /// with the layer's name.
 pub trait FeatureStep: Send + Sync + std::fmt::Debug + std::panic::RefUnwindSafe {
@@ -155,6 +213,14 @@ pub trait FeatureStep: Send + Sync + std::fmt::Debug + std::panic::RefUnwindSafe
     /// does), with the step's name and the reason in `rejected`, and the
     /// run goes on (or stops under `on_error: fail`).
     fn rows(&self, input: &StepInput<'_>) -> StepRows;
+
+    /// [`Self::rows`] and what the step keeps of the feature for its
+    /// [finish](Self::finish_rows) when its entry [keeps](Needs::finish)
+    /// (the run calls this one; a step that keeps nothing writes `rows`
+    /// alone).
+    fn output(&self, input: &StepInput<'_>) -> StepOutput {
+        self.rows(input).map(|rows| (rows, None))
+    }
 
     /// Rows of the step's layers made once, after the last feature (a
     /// summary, what is left of the side input): written without source
@@ -166,6 +232,34 @@ pub trait FeatureStep: Send + Sync + std::fmt::Debug + std::panic::RefUnwindSafe
         let _ = input;
         Ok(Vec::new())
     }
+
+    /// [`Self::finish`] in full (the run calls this one): rows with their
+    /// own `src_fid` and fields, and the run's figures the step reports.
+    fn finish_rows(&self, input: &FinishInput<'_>) -> Result<Finished, StepFailure> {
+        let rows = self.finish(input)?;
+        Ok(Finished {
+            rows: rows
+                .into_iter()
+                .map(|(layer, row)| (layer, crate::output::ExtraRow::summary(row)))
+                .collect(),
+            figures: Vec::new(),
+        })
+    }
+
+    /// What the step needs of the run, from what its entry declares (a step
+    /// whose options need less may say so: `partition` reads MA's graphs
+    /// only with `width`).
+    fn needs(&self, declared: Needs) -> Needs {
+        declared
+    }
+
+    /// Checks the step's options against the rest of the pipeline (a method
+    /// they need, a step they cannot run with): `(key within the step,
+    /// message)`.
+    fn check(&self, context: &StepContext<'_>) -> Result<(), OptionError> {
+        let _ = context;
+        Ok(())
+    }
 }
 
 /// What a registered step's [`FeatureStep::finish`] sees: the rows it made
@@ -175,8 +269,13 @@ pub trait FeatureStep: Send + Sync + std::fmt::Debug + std::panic::RefUnwindSafe
 pub struct FinishInput<'a> {
     /// `(src_fid, layer, row)` of every feature, when [`Needs::finish`].
     pub rows: &'a [(Option<u64>, &'static str, StepRow)],
+    /// What the step [kept](FeatureStep::output) of every feature, with its
+    /// `src_fid`, when [`Needs::finish`].
+    pub kept: &'a [(Option<u64>, Kept)],
     /// The step's side input layer, when it has one.
     pub side: Option<&'a SideLayer>,
+    /// The coverage of `input.neighbours`, when the step needs it.
+    pub neighbours: Option<&'a crate::neighbours::Coverage>,
 }
 
 /// What a registered step needs beyond its feature's polygon parts and the
@@ -212,6 +311,10 @@ pub struct Needs {
     /// before any step sees them: the reader (or the Python call) merges
     /// them, and the `members` column lists the FIDs.
     pub merge: bool,
+    /// The coverage of `input.neighbours` ([`StepInput::neighbours`]):
+    /// validation asks for it, the command line reads it (reprojected to
+    /// the polygons' CRS), the Python package takes it as a GeoDataFrame.
+    pub neighbours: bool,
 }
 
 impl Needs {
@@ -224,6 +327,7 @@ impl Needs {
         cells: false,
         graphs: false,
         merge: false,
+        neighbours: false,
     };
 
     /// What `self` and `other` need together (the first side input key).
@@ -239,6 +343,7 @@ impl Needs {
             cells: self.cells || other.cells,
             graphs: self.graphs || other.graphs,
             merge: self.merge || other.merge,
+            neighbours: self.neighbours || other.neighbours,
         }
     }
 }
@@ -349,8 +454,16 @@ impl StepEntry {
     /// fits it ([`StepLayer::check`]); else a failure that says the step
     /// made a row it cannot have (a bug in the step, reported as such).
     pub fn check(&self, rows: &[(&'static str, StepRow)]) -> Result<(), StepFailure> {
+        self.check_each(rows.iter().map(|(name, row)| (*name, row)))
+    }
+
+    /// [`Self::check`] of rows given one by one.
+    pub fn check_each<'r>(
+        &self,
+        rows: impl IntoIterator<Item = (&'static str, &'r StepRow)>,
+    ) -> Result<(), StepFailure> {
         for (name, row) in rows {
-            let layer = self.layers.iter().find(|l| l.name == *name).ok_or_else(|| {
+            let layer = self.layers.iter().find(|l| l.name == name).ok_or_else(|| {
                 StepFailure(format!(
                     "internal error in the step: a row of layer `{name}`, which it does not declare; please report it"
                 ))
@@ -367,6 +480,22 @@ impl StepEntry {
     /// `made` when its rows all [fit](Self::check) the step's layers.
     pub fn checked(&self, made: StepRows) -> StepRows {
         made.and_then(|rows| self.check(&rows).map(|()| rows))
+    }
+
+    /// [`Self::checked`] of a step's [full output](FeatureStep::output).
+    pub fn checked_output(&self, made: StepOutput) -> StepOutput {
+        made.and_then(|(rows, kept)| self.check(&rows).map(|()| (rows, kept)))
+    }
+
+    /// [`Self::checked`] of a step's [finish](FeatureStep::finish_rows).
+    pub fn checked_finish(
+        &self,
+        made: Result<Finished, StepFailure>,
+    ) -> Result<Finished, StepFailure> {
+        made.and_then(|f| {
+            self.check_each(f.rows.iter().map(|(name, r)| (*name, &r.row)))
+                .map(|()| f)
+        })
     }
 }
 

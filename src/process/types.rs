@@ -30,10 +30,9 @@ pub struct ProcessParams {
     pub collapse: Option<CollapseParams>,
     /// `input.connect`: the line network the chosen skeleton gets legs to.
     pub connect: Option<std::sync::Arc<connect::Network>>,
-    /// `partition` step, when present.
-    pub partition: Option<crate::partition::PartitionParams>,
-    /// `input.neighbours`: the coverage a partition gives area to.
-    pub neighbours: Option<std::sync::Arc<crate::partition::Coverage>>,
+    /// `input.neighbours`: the coverage read beside the polygons (whose
+    /// units a partition gives area to).
+    pub neighbours: Option<std::sync::Arc<crate::neighbours::Coverage>>,
     /// `score` step, when present.
     pub score: Option<ScoreParams>,
     /// `select` step, when present.
@@ -82,11 +81,9 @@ impl ProcessParams {
         let collapse = self
             .collapse
             .map_or(Needs::NOTHING, |_| crate::collapse::NEEDS);
-        let partition = self.partition.map_or(Needs::NOTHING, |p| p.needs());
-        let built_in = network.and(collapse).and(partition);
-        self.extra
-            .iter()
-            .fold(built_in, |n, e| n.and(e.entry.needs))
+        self.extra.iter().fold(network.and(collapse), |n, e| {
+            n.and(e.step.needs(e.entry.needs))
+        })
     }
 
     /// Every step with its defaults, as a pipeline file that lists
@@ -210,8 +207,9 @@ pub struct CandidateSkeleton {
     /// when a registered step reads it ([`ProcessParams::keeps_raw_medial_axis`]).
     pub raw: Vec<std::sync::Arc<crate::graph::SkeletonGraph>>,
     /// The cells of MA's segment Voronoi diagram inside every polygon part,
-    /// kept when `partition` follows: it splits the polygon along them
-    /// instead of making the diagram again (empty otherwise).
+    /// kept when a step [needs them](super::step::Needs::cells) (a
+    /// partition splits the polygon along them instead of making the
+    /// diagram again; empty otherwise).
     pub cells: Vec<std::sync::Arc<crate::methods::medial_axis::cells::DiagramCells>>,
     /// Something the scores alone do not tell (e.g. a given skeleton that
     /// leaves its polygon), for the row's `note`.
@@ -248,10 +246,11 @@ pub struct FeatureOutcome {
     pub measures: Option<Vec<Vec<f64>>>,
     /// Rows of the registered steps' layers, each with its layer's name.
     pub extra: Vec<(&'static str, crate::layer::StepRow)>,
-    /// The partition of every polygon part, when the pipeline partitions.
-    pub partition: Option<Vec<crate::partition::PartPartition>>,
-    /// The CPU time on the feature of `partition` and of each registered
-    /// step, by the step's name, in the order they ran.
+    /// What each registered step keeps of the feature for its finish, by
+    /// the step's name.
+    pub kept: Vec<(&'static str, super::step::Kept)>,
+    /// The CPU time on the feature of each registered step, by the step's
+    /// name, in the order they ran.
     pub step_times: Vec<(&'static str, StepTime)>,
 }
 

@@ -58,7 +58,7 @@ pub const STREETS: &[StepLayer] = &[
     StepLayer {
         name: "streets",
         geometry: GeometryKind::LineString,
-        attributes: true,
+        fields: Some(crate::layer::Fields::Input),
         columns: &[
             ("piece", ColumnType::Int32),
             ("start_degree", ColumnType::Int32),
@@ -71,7 +71,7 @@ pub const STREETS: &[StepLayer] = &[
     StepLayer {
         name: "street_nodes",
         geometry: GeometryKind::Point,
-        attributes: false,
+        fields: None,
         columns: &[
             ("degree", ColumnType::Int32),
             ("features", ColumnType::Int32),

@@ -371,3 +371,33 @@ fn the_skeleton_steps_medial_axis_is_kept_for_the_label_step_only() {
     };
     assert_eq!(kept(&params), 0, "another MA: the step makes its own");
 }
+
+#[test]
+fn exploded_labels_have_one_polygon_part_column_the_steps_own() {
+    // The label step numbers the parts itself (`polygon_part`); with
+    // `explode` the column the per-feature path adds to a layer of the
+    // features is not added twice, and merged polygons add `members`.
+    let d = crate::common::tmp();
+    let out = d.path().join("exploded.gpkg");
+    let o = skeletonise(&[
+        "run",
+        &root("pipelines/lake-labels.yaml"),
+        "--set",
+        "output.explode=true",
+        "--set",
+        "input.merge_adjacent=true",
+        "-o",
+        out.to_str().unwrap(),
+        "-q",
+    ]);
+    assert!(o.status.success(), "{}", code_and_err(&o).1);
+    let ds = crate::common::open(&out);
+    let l = ds.layer_by_name("labels").unwrap();
+    let names: Vec<String> = l.defn().fields().map(|f| f.name()).collect();
+    let count = |n: &str| names.iter().filter(|x| x.as_str() == n).count();
+    assert_eq!(
+        (count("polygon_part"), count("members")),
+        (1, 1),
+        "{names:?}"
+    );
+}

@@ -106,7 +106,7 @@ mod toy {
         StepLayer {
             name: "toy",
             geometry: GeometryKind::MultiLineString,
-            attributes: true,
+            fields: Some(skeletonise::layer::Fields::Input),
             columns: &[
                 ("scaled_length", ColumnType::Real),
                 ("near", ColumnType::Int32),
@@ -115,7 +115,7 @@ mod toy {
         StepLayer {
             name: "toy_total",
             geometry: GeometryKind::None,
-            attributes: false,
+            fields: None,
             columns: &[
                 ("features", ColumnType::Int32),
                 ("scaled_length", ColumnType::Real),
@@ -513,7 +513,7 @@ mod wrong {
         layers: &[StepLayer {
             name: "wrong",
             geometry: GeometryKind::None,
-            attributes: false,
+            fields: None,
             columns: &[("length", ColumnType::Real)],
         }],
         build: |_| Ok(std::sync::Arc::new(Wrong)),
@@ -570,4 +570,56 @@ fn rows_that_do_not_fit_a_steps_layers_are_an_error_naming_the_step_never_a_colu
         e.starts_with("`wrong`: internal error in the step: a row of layer `elsewhere`, which it does not declare"),
         "{e}"
     );
+}
+
+#[test]
+fn a_registered_steps_layer_of_the_features_carries_their_parts_and_members_as_the_skeletons_do() {
+    // With `explode` and `merge_adjacent`, a step layer that carries the
+    // input's fields gets `polygon_part` and `members` after `src_fid`,
+    // with the skeleton layer's values row for row; its own columns
+    // follow, and a layer without the input's fields (`toy_total`) gets
+    // neither.
+    let registry = skeletonise::config::builtin_steps().with(toy::ENTRY);
+    let d = tmp();
+    let out = d.path().join("toy.gpkg");
+    let text = pipeline_text(&out, "  - toy: { scale: 1 }\n");
+    let sets = [
+        "output.explode=true".to_string(),
+        "input.merge_adjacent=true".to_string(),
+    ];
+    let p = skeletonise::config::load_str_with(&text, "toy.yaml", &sets, &registry).unwrap();
+    skeletonise::pipeline::run(&p, &skeletonise::pipeline::RunOptions::default()).unwrap();
+    let ds = open(&out);
+    let names = |layer: &str| -> Vec<String> {
+        let l = ds.layer_by_name(layer).unwrap();
+        let names = l.defn().fields().map(|f| f.name()).collect();
+        names
+    };
+    let toy = names("toy");
+    let at = toy.iter().position(|n| n == "src_fid").unwrap();
+    assert_eq!(
+        toy[at..],
+        [
+            "src_fid",
+            "polygon_part",
+            "members",
+            "scaled_length",
+            "near"
+        ],
+        "{toy:?}"
+    );
+    let total = names("toy_total");
+    assert!(
+        !total.contains(&"polygon_part".into()) && !total.contains(&"members".into()),
+        "{total:?}"
+    );
+    let ints = |layer: &str, c: &str| crate::common::ints(&ds, layer, c);
+    assert!(ints("skeletons", "polygon_part")
+        .iter()
+        .any(|p| p.is_some()));
+    for c in ["src_fid", "polygon_part"] {
+        assert_eq!(ints("toy", c), ints("skeletons", c), "{c}");
+    }
+    let members = |layer: &str| crate::common::strings(&ds, layer, "members");
+    assert_eq!(members("toy"), members("skeletons"));
 }
