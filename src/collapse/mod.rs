@@ -13,10 +13,3 @@ pub use crate::narrow::{
     collapse, collapse_within, Area, CollapseMode, CollapseParams, PartCollapse,
 };
 pub use layer::{AreaRow, AREAS};
-
-/// What the step needs of the run: the chosen skeleton's graphs (MA's, which
-/// it collapses the polygon along).
-pub const NEEDS: crate::process::step::Needs = crate::process::step::Needs {
-    graphs: true,
-    ..crate::process::step::Needs::NOTHING
-};

@@ -106,7 +106,7 @@ impl Step {
     pub fn needs(&self) -> crate::process::step::Needs {
         use crate::process::step::Needs;
         match self {
-            Step::Collapse(_) => crate::collapse::NEEDS,
+            Step::Collapse(_) => crate::process::COLLAPSE_NEEDS,
             Step::Extra(e) => e.step.needs(e.entry.needs),
             _ => Needs::NOTHING,
         }

@@ -21,5 +21,5 @@ pub use layers::{
 };
 pub use plan::{source_names, Plan};
 pub use rows::{
-    Builtin, ColumnInfo, ExtraRow, Layer, Rows, BUILTIN, CANDIDATE_LAYER, SKELETON_LAYER,
+    Builtin, ColumnInfo, ExtraRow, Kept, Layer, Rows, BUILTIN, CANDIDATE_LAYER, SKELETON_LAYER,
 };

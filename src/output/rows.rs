@@ -44,6 +44,24 @@ impl ExtraRow {
     }
 }
 
+/// What a step keeps of one feature for its finish (`FeatureStep::finish_rows`)
+/// beside its rows (the pieces each unit of a coverage receives): any type
+/// of the step's, which its finish downcasts.
+#[derive(Clone)]
+pub struct Kept(pub std::sync::Arc<dyn std::any::Any + Send + Sync>);
+
+impl std::fmt::Debug for Kept {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("Kept")
+    }
+}
+
+impl PartialEq for Kept {
+    fn eq(&self, other: &Self) -> bool {
+        std::sync::Arc::ptr_eq(&self.0, &other.0)
+    }
+}
+
 /// The rows one feature produces, layer by layer.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Rows {
@@ -64,7 +82,7 @@ pub struct Rows {
     pub network: Vec<NetworkRow>,
     /// What registered steps keep of each feature for their finish (not a
     /// layer): the step, the feature's FID and the kept value.
-    pub kept: Vec<(&'static str, Option<u64>, crate::process::step::Kept)>,
+    pub kept: Vec<(&'static str, Option<u64>, Kept)>,
     /// `rejected` rows.
     pub rejected: Vec<RejectedRow>,
     /// Rows of registered steps' layers, by layer name.

@@ -28,5 +28,5 @@ pub use rows::{feature_rows, FeatureRows, RowOptions, Skeletons, Status};
 pub use run::{FailedFeature, FinishError, Run, RunCounts};
 pub use types::{
     Candidate, CandidateError, CandidateSkeleton, FeatureOutcome, ProcessParams, Processed,
-    StageTimes, StepTime,
+    StageTimes, StepTime, COLLAPSE_NEEDS,
 };

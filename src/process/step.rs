@@ -160,23 +160,7 @@ pub type StepRows = Result<Vec<(&'static str, StepRow)>, StepFailure>;
 /// [`StepInput::cells`]).
 pub type DiagramCells = Arc<crate::methods::medial_axis::cells::DiagramCells>;
 
-/// What a step keeps of one feature for its [finish](FeatureStep::finish_rows)
-/// beside its rows (the pieces each unit of a coverage receives): any type
-/// of the step's, which its finish downcasts.
-#[derive(Clone)]
-pub struct Kept(pub Arc<dyn std::any::Any + Send + Sync>);
-
-impl std::fmt::Debug for Kept {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str("Kept")
-    }
-}
-
-impl PartialEq for Kept {
-    fn eq(&self, other: &Self) -> bool {
-        Arc::ptr_eq(&self.0, &other.0)
-    }
-}
+pub use crate::output::Kept;
 
 /// A step's work on one feature in full: its rows and what it keeps for
 /// its finish.

@@ -78,9 +78,7 @@ impl ProcessParams {
             graphs: self.connect.is_some(),
             ..Needs::NOTHING
         };
-        let collapse = self
-            .collapse
-            .map_or(Needs::NOTHING, |_| crate::collapse::NEEDS);
+        let collapse = self.collapse.map_or(Needs::NOTHING, |_| COLLAPSE_NEEDS);
         self.extra.iter().fold(network.and(collapse), |n, e| {
             n.and(e.step.needs(e.entry.needs))
         })
@@ -99,6 +97,13 @@ impl ProcessParams {
         }
     }
 }
+
+/// What the `collapse` step needs of the run: the chosen skeleton's graphs
+/// (MA's, which it collapses the polygon along).
+pub const COLLAPSE_NEEDS: super::step::Needs = super::step::Needs {
+    graphs: true,
+    ..super::step::Needs::NOTHING
+};
 
 /// One method's result for one feature.
 #[derive(Debug, Clone, PartialEq)]
