@@ -37,8 +37,6 @@ from qgis.PyQt.QtGui import QIcon
 
 from . import bridge
 
-METHODS = ["MA", "StSk", "DVD", "CDT", "VD"]
-
 HELP_URL = "https://github.com/skeletonise/skeletonise#in-qgis"
 
 
@@ -428,6 +426,22 @@ def _modes(step, key, leave_out=()):
     return choices, default
 
 
+def _methods():
+    """The methods the skeleton step may list, from the schema: its default list first, in that
+    order (the order saved models' indices keep, ties in selection going to the earlier method),
+    then any other the wheel has. Empty without the wheel (the algorithm then says what to
+    install)."""
+    options = dict(_options("SkeletonParams"))
+    if "methods" not in options:
+        return []
+    default = list(options["methods"].get("default") or [])
+    try:
+        every = json.loads(bridge.core().schema())["$defs"]["MethodId"]["enum"]
+    except (QgsProcessingException, KeyError):
+        every = default
+    return default + [m for m in every if m not in default]
+
+
 # Pruning to a network needs its lines (the collapse algorithm's connect lines only legs them).
 PRUNE = ("PruneParams", "mode", ("network",))
 EXTEND = ("ExtendParams", "mode", ())
@@ -455,10 +469,11 @@ def _mode_value(alg, name, spec, parameters, context):
 def _method_parameters(alg, choose=True):
     """METHODS, PRUNE, MIN_LENGTH, EXTEND and SELECT: the skeleton, prune, extend and select steps
     (without METHODS and SELECT when the method is not a choice: collapse draws the medial axis)."""
-    if choose:
+    methods = _methods()
+    if choose and methods:
         alg.addParameter(
             QgsProcessingParameterEnum(
-                "METHODS", _tr("Methods"), options=METHODS, allowMultiple=True, defaultValue=list(range(len(METHODS)))
+                "METHODS", _tr("Methods"), options=methods, allowMultiple=True, defaultValue=list(range(len(methods)))
             )
         )
     _mode_parameter(alg, "PRUNE", _tr("Prune"), PRUNE)
@@ -491,7 +506,10 @@ def _method_steps(alg, parameters, context, collapse=None):
     if collapse is not None:
         methods = ["MA"]
     else:
-        methods = [METHODS[i] for i in alg.parameterAsEnums(parameters, "METHODS", context)]
+        every = _methods()
+        if not every:
+            bridge.core()  # without the wheel: raises, saying what to install
+        methods = [every[i] for i in alg.parameterAsEnums(parameters, "METHODS", context)]
     if not methods:
         raise QgsProcessingException("`methods`: choose at least one method")
     steps = [{"prepare": {}}, {"skeleton": {"methods": methods}}] + _prune_extend(alg, parameters, context)

@@ -991,6 +991,19 @@ class Labels(Case):
         self.assertGreater(alg.parameterDefinition("MIN_PIXELS").minimum(), 0.0)
         self.assertEqual(alg.parameterDefinition("SMOOTH").maximum(), 180.0)
 
+    def test_the_methods_are_the_schemas_in_the_default_lists_order(self):
+        # Every method the command line has, none copied by hand: the default list's order first
+        # (the indices saved models keep), as `skeletonise schema` says.
+        defs = json.loads(cli("schema").stdout)["$defs"]
+        default = defs["SkeletonParams"]["properties"]["methods"]["default"]
+        every = default + [m for m in defs["MethodId"]["enum"] if m not in default]
+        self.assertEqual(sorted(every), sorted(defs["MethodId"]["enum"]))
+        p = QgsApplication.processingRegistry().algorithmById("skeletonise:skeletonise").parameterDefinition("METHODS")
+        self.assertEqual(p.options(), every)
+        self.assertEqual(p.defaultValue(), list(range(len(every))))
+        # The order the plugin has always had: saved models' indices keep their methods.
+        self.assertEqual(every, ["MA", "StSk", "DVD", "CDT", "VD"])
+
     def test_the_collapse_and_partition_parameters_are_their_steps_schema(self):
         # The built-in steps' options as the label step's: what `skeletonise schema` says, so the
         # dialog cannot offer a default or a range the command line does not have (tolerance 1:
