@@ -13,7 +13,7 @@ use rstar::{RTree, AABB};
 /// Why a feature of `input.neighbours` cannot be a unit of the coverage
 /// (`fid`: its FID, or `(no fid)`).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum UnitError {
+pub enum NotAUnit {
     /// Its geometry is of another type.
     #[error("feature {fid} is not a polygon; the coverage is a layer of polygons")]
     NotAPolygon {
@@ -54,7 +54,7 @@ pub struct Unit {
 pub fn unit_geometry(
     fid: Option<u64>,
     g: Option<&geo::Geometry<f64>>,
-) -> Result<MultiPolygon<f64>, UnitError> {
+) -> Result<MultiPolygon<f64>, NotAUnit> {
     use geo::{CoordsIter, HasDimensions};
     let name = || fid.map_or_else(|| "(no fid)".into(), |f| f.to_string());
     let m = match g {
@@ -62,13 +62,13 @@ pub fn unit_geometry(
         Some(g) if g.is_empty() => return Ok(MultiPolygon(Vec::new())),
         Some(geo::Geometry::Polygon(p)) => MultiPolygon(vec![p.clone()]),
         Some(geo::Geometry::MultiPolygon(m)) => m.clone(),
-        Some(_) => return Err(UnitError::NotAPolygon { fid: name() }),
+        Some(_) => return Err(NotAUnit::NotAPolygon { fid: name() }),
     };
     if let Some(c) = m
         .coords_iter()
         .find(|c| !(c.x.is_finite() && c.y.is_finite()))
     {
-        return Err(UnitError::NotFinite {
+        return Err(NotAUnit::NotFinite {
             fid: name(),
             x: c.x,
             y: c.y,
