@@ -239,15 +239,26 @@ pub fn real(v: Option<f64>) -> Cell {
 }
 
 /// One row of a layer that a registered step declares ([`StepLayer`]):
-/// its geometry and its cells in the order of the layer's columns; the
-/// feature's `src_fid` (and source fields, when the layer has them) are
-/// added by the per-feature path.
+/// its geometry and its cells, each named by its column (in any order,
+/// every column of the layer once: a value cannot land in the wrong
+/// column); the feature's `src_fid` (and source fields, when the layer has
+/// them) are added by the per-feature path.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StepRow {
     /// The row's geometry.
     pub geometry: Option<geo::Geometry<f64>>,
-    /// One cell per column of the layer, in order.
-    pub cells: Vec<Cell>,
+    /// `(column, cell)` for every column of the layer.
+    pub cells: Vec<(&'static str, Cell)>,
+}
+
+impl StepRow {
+    /// The cell of column `name` (NULL when the row has none).
+    pub fn cell(&self, name: &str) -> Cell {
+        self.cells
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map_or(Cell::Null, |(_, c)| c.clone())
+    }
 }
 
 /// A layer declared by a registered step: its rows are [`StepRow`]s.
@@ -268,23 +279,45 @@ pub struct StepLayer {
 }
 
 impl StepLayer {
-    /// Whether `row` fits this layer — one cell per column, each NULL or of
-    /// the column's type (an integer within the range of an `Int32`
-    /// column), and a geometry of the layer's kind (none for an attribute
-    /// table, any for `Unknown`; a row may have no geometry) — or what does
-    /// not: the run checks every row a step makes, so that a step's mistake
-    /// is an error naming the step instead of a column written empty or a
-    /// value written into the wrong one.
+    /// Whether `row` fits this layer — one cell for every column and none
+    /// for a column the layer does not have, each NULL or of the column's
+    /// type (an integer within the range of an `Int32` column), and a
+    /// geometry of the layer's kind (none for an attribute table, any for
+    /// `Unknown`; a row may have no geometry) — or what does not: the run
+    /// checks every row a step makes, so that a step's mistake is an error
+    /// naming the step instead of a column written empty or wrong.
     pub fn check(&self, row: &StepRow) -> Result<(), String> {
         let layer = self.name;
-        if row.cells.len() != self.columns.len() {
+        if let Some((name, _)) = row
+            .cells
+            .iter()
+            .find(|(n, _)| !self.columns.iter().any(|(c, _)| c == n))
+        {
             return Err(format!(
-                "a row of layer `{layer}` has {} cells for its {} columns",
-                row.cells.len(),
-                self.columns.len()
+                "a row of layer `{layer}` has a cell for column `{name}`, which the layer does not have"
             ));
         }
-        for (cell, (name, ty)) in row.cells.iter().zip(self.columns) {
+        for (name, ty) in self.columns {
+            let named: Vec<&Cell> = row
+                .cells
+                .iter()
+                .filter(|(n, _)| n == name)
+                .map(|(_, c)| c)
+                .collect();
+            let cell = match named[..] {
+                [cell] => cell,
+                [] => {
+                    return Err(format!(
+                        "a row of layer `{layer}` has no cell for column `{name}`"
+                    ))
+                }
+                _ => {
+                    return Err(format!(
+                        "a row of layer `{layer}` has {} cells for column `{name}`",
+                        named.len()
+                    ))
+                }
+            };
             let fits = match (cell, ty) {
                 (Cell::Null, _) => true,
                 (Cell::Int(v), ColumnType::Int32) => i32::try_from(*v).is_ok(),
@@ -370,6 +403,7 @@ mod tests {
     };
 
     fn row(geometry: Option<geo::Geometry<f64>>, cells: Vec<Cell>) -> StepRow {
+        let cells = ["n", "kind"].into_iter().zip(cells).collect();
         StepRow { geometry, cells }
     }
 
@@ -390,7 +424,24 @@ mod tests {
             Ok(())
         );
         let e = LINES.check(&row(line(), vec![Cell::Int(3)])).unwrap_err();
-        assert_eq!(e, "a row of layer `lines` has 1 cells for its 2 columns");
+        assert_eq!(e, "a row of layer `lines` has no cell for column `kind`");
+        let mut three = row(line(), vec![Cell::Int(3), text()]);
+        three.cells.push(("n", Cell::Int(4)));
+        let e = LINES.check(&three).unwrap_err();
+        assert_eq!(e, "a row of layer `lines` has 2 cells for column `n`");
+        three.cells[2].0 = "m";
+        let e = LINES.check(&three).unwrap_err();
+        assert!(
+            e.contains("column `m`, which the layer does not have"),
+            "{e}"
+        );
+        // In any order.
+        let swapped = StepRow {
+            geometry: line(),
+            cells: vec![("kind", text()), ("n", Cell::Int(3))],
+        };
+        assert_eq!(LINES.check(&swapped), Ok(()));
+        assert_eq!(swapped.cell("n"), Cell::Int(3));
         let e = LINES
             .check(&row(line(), vec![Cell::Int(1 << 40), text()]))
             .unwrap_err();

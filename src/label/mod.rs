@@ -275,13 +275,16 @@ impl FeatureStep for LabelParams {
                 let real =
                     |f: fn(&Labelled) -> f64| l.as_ref().map_or(Cell::Null, |l| Cell::Real(f(l)));
                 let cells = vec![
-                    Cell::Int(i as i64),
-                    Cell::Text(kind.into()),
-                    real(|l| l.length),
-                    real(|l| l.max_width),
-                    real(|l| l.elongation),
-                    self.zoom_of(l.as_ref(), input.lonlat)
-                        .map_or(Cell::Null, Cell::Int),
+                    ("polygon_part", Cell::Int(i as i64)),
+                    ("kind", Cell::Text(kind.into())),
+                    ("length", real(|l| l.length)),
+                    ("max_width", real(|l| l.max_width)),
+                    ("elongation", real(|l| l.elongation)),
+                    (
+                        "minzoom",
+                        self.zoom_of(l.as_ref(), input.lonlat)
+                            .map_or(Cell::Null, Cell::Int),
+                    ),
                 ];
                 ("labels", StepRow { geometry, cells })
             })

@@ -265,12 +265,10 @@ impl Layer for StepLayer {
             None => crate::layer::fid(r.src_fid),
             Some(k) => match stamped.get(k) {
                 Some((.., of)) => of(r),
-                None => r
-                    .row
-                    .cells
+                None => self
+                    .columns
                     .get(k - stamped.len())
-                    .cloned()
-                    .unwrap_or(Cell::Null),
+                    .map_or(Cell::Null, |(name, _)| r.row.cell(name)),
             },
         }
     }

@@ -108,7 +108,10 @@ impl FeatureStep for Partition {
             .map(|u| {
                 let row = StepRow {
                     geometry: Some(geo::Geometry::MultiPolygon(u.geometry)),
-                    cells: vec![Cell::Real(u.received), Cell::Real(u.held)],
+                    cells: vec![
+                        ("received", Cell::Real(u.received)),
+                        ("held", Cell::Real(u.held)),
+                    ],
                 };
                 let row = ExtraRow {
                     attributes: u.attributes,
@@ -164,7 +167,11 @@ fn rows_of(parts: &[PartPartition]) -> (Vec<(&'static str, StepRow)>, Pieces) {
                 BOUNDARIES.name,
                 StepRow {
                     geometry: Some(geo::Geometry::MultiLineString(b.lines.clone())),
-                    cells: vec![fid(b.fids[0]), fid(b.fids[1]), Cell::Real(length)],
+                    cells: vec![
+                        ("left_fid", fid(b.fids[0])),
+                        ("right_fid", fid(b.fids[1])),
+                        ("length", Cell::Real(length)),
+                    ],
                 },
             ));
         }
@@ -189,7 +196,10 @@ fn rows_of(parts: &[PartPartition]) -> (Vec<(&'static str, StepRow)>, Pieces) {
                 AREAS.name,
                 StepRow {
                     geometry: Some(geo::Geometry::Polygon(polygon.clone())),
-                    cells: vec![crate::layer::int(cuts), Cell::Text(kind.into())],
+                    cells: vec![
+                        ("cuts", crate::layer::int(cuts)),
+                        ("kind", Cell::Text(kind.into())),
+                    ],
                 },
             )
         }));
@@ -199,7 +209,11 @@ fn rows_of(parts: &[PartPartition]) -> (Vec<(&'static str, StepRow)>, Pieces) {
             GIVEN.name,
             StepRow {
                 geometry: None,
-                cells: vec![fid(unit), Cell::Real(area), Cell::Real(held)],
+                cells: vec![
+                    ("unit_fid", fid(unit)),
+                    ("area", Cell::Real(area)),
+                    ("held", Cell::Real(held)),
+                ],
             },
         )
     }));

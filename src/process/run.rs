@@ -1,10 +1,10 @@
 //! The run driver every caller shares — the command line's pipeline and the
 //! Python module (and so Dask and QGIS): features go in, in read order, as
 //! [`FeatureRows`] (computed by [`super::feature_rows`] on any thread); the
-//! run counts them, applies `on_error: fail`, keeps what the steps need
-//! after the last feature (the pieces each unit received, the points where
-//! the network's lines met the polygons, what the registered steps keep for
-//! their finish), and [`Run::finish`] makes those rows once: the network's
+//! run counts them, applies `on_error: fail`, keeps what is needed after
+//! the last feature (the points where the network's lines met the
+//! polygons, what the registered steps keep for their finish: the pieces
+//! each unit of a partition receives), and [`Run::finish`] makes those rows once: the network's
 //! lines split at the polygons, each registered step's finish (the coverage
 //! a partition grows). No I/O: the caller reads, writes and logs.
 
@@ -200,7 +200,11 @@ impl<'a> Run<'a> {
                 rows: &kept,
                 kept: &kept_values,
                 side: e.side.as_deref(),
-                neighbours: self.params.neighbours.as_deref(),
+                neighbours: self
+                    .params
+                    .neighbours
+                    .as_deref()
+                    .filter(|_| e.step.needs(e.entry.needs).neighbours),
             };
             let clock = crate::clock::CpuClock::start();
             let made = e.step.finish_rows(&input);

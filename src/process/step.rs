@@ -2,13 +2,18 @@
 //! its name, its place in the step order, its options (a type of its own:
 //! their JSON Schema for `skeletonise schema`, `skeletonise methods` and
 //! QGIS, parsed from the pipeline file by its own `build`), what it
-//! [needs](Needs) beyond the feature (the medial axis's raw skeleton,
-//! longitude and latitude, a side input layer), the layers it writes
-//! ([`StepLayer`]s, declared next to its code) — and a [`FeatureStep`] that
-//! turns each feature's outcome into rows of those layers (or rejects the
-//! feature with a reason) and, after the last feature, may add rows of its
-//! own ([`FeatureStep::finish`], or stop the run with a reason). The run
-//! records each registered step's CPU time under its name.
+//! [needs](Needs) beyond the feature (the medial axis's raw skeleton or its
+//! diagram cells, the chosen graphs, longitude and latitude, a side input
+//! layer, the coverage of `input.neighbours`, adjacent polygons merged
+//! exactly), the layers it writes ([`StepLayer`]s, declared next to its
+//! code) — and a [`FeatureStep`] that turns each feature's outcome into
+//! rows of those layers (or rejects the feature with a reason), may keep a
+//! value of each feature for later ([`FeatureStep::output`]) and, after the
+//! last feature, may add rows of its own ([`FeatureStep::finish`],
+//! [`FeatureStep::finish_rows`]; or stop the run with a reason). It may check
+//! its options against the rest of the pipeline ([`FeatureStep::check`]).
+//! The run records each registered step's CPU time under its name.
+//! `partition`, `label` and `streets` are such steps.
 //! Parsing (`config::load_with`), validation, the output plan, the run
 //! driver (`process::Run`), the writer, the Python table and
 //! `skeletonise methods` follow from the entry, as a method follows from
@@ -24,7 +29,7 @@
 //!
 //! impl FeatureStep for Parts {
 //!     fn rows(&self, input: &StepInput<'_>) -> StepRows {
-//!         let cells = vec![Cell::Int(input.parts.len() as i64)];
+//!         let cells = vec![("parts", Cell::Int(input.parts.len() as i64))];
 //!         Ok(vec![("parts", StepRow { geometry: None, cells })])
 //!     }
 //! }

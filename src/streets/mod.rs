@@ -101,12 +101,12 @@ impl FeatureStep for Streets {
             };
             let fid = |f: Option<u64>| f.map_or(Cell::Null, crate::layer::int);
             let cells = vec![
-                crate::layer::int(k),
-                crate::layer::int(degrees[br.start.index()]),
-                crate::layer::int(degrees[br.end.index()]),
-                Cell::Real(br.length()),
-                fid(left),
-                fid(right),
+                ("piece", crate::layer::int(k)),
+                ("start_degree", crate::layer::int(degrees[br.start.index()])),
+                ("end_degree", crate::layer::int(degrees[br.end.index()])),
+                ("length", Cell::Real(br.length())),
+                ("left_fid", fid(left)),
+                ("right_fid", fid(right)),
             ];
             let geometry = Some(geo::Geometry::LineString(line));
             rows.push(("streets", StepRow { geometry, cells }));
@@ -142,7 +142,10 @@ impl FeatureStep for Streets {
         let rows = nodes
             .into_iter()
             .map(|(c, degree, features)| {
-                let cells = vec![Cell::Int(degree), crate::layer::int(features.len())];
+                let cells = vec![
+                    ("degree", Cell::Int(degree)),
+                    ("features", crate::layer::int(features.len())),
+                ];
                 let geometry = Some(geo::Geometry::Point(c.into()));
                 ("street_nodes", StepRow { geometry, cells })
             })

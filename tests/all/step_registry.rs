@@ -67,7 +67,10 @@ mod toy {
                 "toy",
                 StepRow {
                     geometry: Some(geo::Geometry::MultiLineString(chosen.geometry.clone())),
-                    cells: vec![Cell::Real(self.0.scale * length), near],
+                    cells: vec![
+                        ("scaled_length", Cell::Real(self.0.scale * length)),
+                        ("near", near),
+                    ],
                 },
             )])
         }
@@ -76,7 +79,7 @@ mod toy {
             let total: f64 = input
                 .rows
                 .iter()
-                .filter_map(|(_, _, r)| match r.cells[0] {
+                .filter_map(|(_, _, r)| match r.cell("scaled_length") {
                     Cell::Real(x) => Some(x),
                     _ => None,
                 })
@@ -90,7 +93,11 @@ mod toy {
                 )
                 .into());
             }
-            let cells = vec![Cell::Int(input.rows.len() as i64), Cell::Real(total), side];
+            let cells = vec![
+                ("features", Cell::Int(input.rows.len() as i64)),
+                ("scaled_length", Cell::Real(total)),
+                ("side_features", side),
+            ];
             Ok(vec![(
                 "toy_total",
                 StepRow {
@@ -482,7 +489,7 @@ mod wrong {
 
     impl FeatureStep for Wrong {
         fn rows(&self, _: &StepInput<'_>) -> StepRows {
-            let cells = vec![Cell::Text("long".into())];
+            let cells = vec![("length", Cell::Text("long".into()))];
             Ok(vec![(
                 "wrong",
                 StepRow {
@@ -493,7 +500,7 @@ mod wrong {
         }
 
         fn finish(&self, _: &FinishInput<'_>) -> StepRows {
-            let cells = vec![Cell::Real(1.0)];
+            let cells = vec![("length", Cell::Real(1.0))];
             Ok(vec![(
                 "elsewhere",
                 StepRow {
