@@ -90,3 +90,17 @@ def test_a_side_input_the_pipeline_names_must_be_given():
     layers = skeletonise.apply_layers(quarter, path, sides={"streets": blocks})
     streets = layers["streets"]
     assert streets.left_fid.notna().all() and streets.right_fid.notna().all()
+
+
+def test_every_registered_step_has_a_pipeline_file_above():
+    """Every step the registry has (``partition``, ``label``, ``streets``, …) is in a pipeline file
+    of the repository, so that the test above compares its rows through the command line and
+    Python: a new step cannot be added without that check."""
+    steps = {step for step, *_ in skeletonise._core.step_layers()}
+    used = {
+        name
+        for p in PIPELINES
+        for step in yaml.safe_load((ROOT / "pipelines" / p).read_text())["steps"]
+        for name in step
+    }
+    assert steps and steps <= used, steps - used
