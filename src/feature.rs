@@ -72,6 +72,11 @@ pub struct Feature {
     pub member_wkb: Vec<Option<Vec<u8>>>,
 }
 
+/// A source FID as messages name it: the number, or `(no fid)`.
+pub fn fid_text(fid: Option<u64>) -> String {
+    fid.map_or_else(|| "(no fid)".into(), |f| f.to_string())
+}
+
 impl Feature {
     /// How many source features this one stands for.
     pub fn source_count(&self) -> u64 {

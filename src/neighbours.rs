@@ -56,7 +56,7 @@ pub fn unit_geometry(
     g: Option<&geo::Geometry<f64>>,
 ) -> Result<MultiPolygon<f64>, NotAUnit> {
     use geo::{CoordsIter, HasDimensions};
-    let name = || fid.map_or_else(|| "(no fid)".into(), |f| f.to_string());
+    let name = || crate::feature::fid_text(fid);
     let m = match g {
         None => return Ok(MultiPolygon(Vec::new())),
         Some(g) if g.is_empty() => return Ok(MultiPolygon(Vec::new())),

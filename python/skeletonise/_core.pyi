@@ -56,10 +56,6 @@ class Pipeline:
     def partition(self) -> bool:
         """Whether the pipeline has a ``partition`` step (``run`` then needs ``neighbours``)."""
     @property
-    def neighbours(self) -> bool:
-        """Whether a step of the pipeline reads the coverage of ``input.neighbours`` (``run`` then
-        needs ``neighbours``)."""
-    @property
     def explode(self) -> bool:
         """One row per polygon part (``output.explode``)."""
     @property

@@ -272,13 +272,6 @@ impl Pipeline {
             .any(|s| s.name() == "partition")
     }
 
-    /// Whether a step of the pipeline reads the coverage of
-    /// `input.neighbours` (`run` then needs `neighbours`).
-    #[getter]
-    fn neighbours(&self) -> bool {
-        self.steps.process_params().needs().neighbours
-    }
-
     /// Whether the `prepare` step repairs invalid polygons.
     #[getter]
     fn make_valid(&self) -> bool {

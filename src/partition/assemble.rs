@@ -123,7 +123,7 @@ fn tolerance(c: &Changes) -> f64 {
 /// polygon, or an area other than the unit's, less what it held, plus what
 /// it was given.
 fn checked(u: &Unit, g: &MultiPolygon<f64>, c: &Changes) -> Result<(), UnitError> {
-    let fid = || super::fid_text(u.fid);
+    let fid = || crate::feature::fid_text(u.fid);
     for p in &g.0 {
         let problem = match PreparedPolygon::new(p) {
             Ok(pp) => crate::geometry::validity::problem(&pp),

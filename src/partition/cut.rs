@@ -107,7 +107,7 @@ impl Near {
                 );
                 if (whole - parts).abs() > 1e-9 * whole.max(p.polygon().unsigned_area()) {
                     return Err(UnitError::NotCutExactly {
-                        fid: super::fid_text(units[k as usize].fid),
+                        fid: crate::feature::fid_text(units[k as usize].fid),
                         parts,
                         whole,
                     });

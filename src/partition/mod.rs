@@ -287,11 +287,6 @@ pub enum UnitError {
     },
 }
 
-/// A unit's FID as the messages name it.
-fn fid_text(fid: Option<u64>) -> String {
-    fid.map_or_else(|| "(no fid)".into(), |f| f.to_string())
-}
-
 /// Fails with [`PartitionError::Stopped`] once `expired()`.
 fn stop_if(expired: &dyn Fn() -> bool) -> Result<(), PartitionError> {
     match expired() {
@@ -321,7 +316,7 @@ pub fn partition(
     let near = cut::Near::of(p, cov, cov.snap_for(p.extent()), tol)?;
     if params.overlap == Overlap::Reject {
         if let Some((k, area, at)) = near.first_overlap(tol) {
-            let fid = fid_text(cov.units()[k as usize].fid);
+            let fid = crate::feature::fid_text(cov.units()[k as usize].fid);
             return Err(PartitionError::Overlap {
                 fid,
                 area: crate::numbers::sig(area, 4),

@@ -80,7 +80,7 @@ impl FeatureStep for Partition {
             })?;
             parts.push(part);
         }
-        let (rows, pieces) = rows_of(&parts);
+        let (rows, pieces) = rows_of(parts);
         Ok((rows, Some(Kept(Arc::new(pieces)))))
     }
 
@@ -88,12 +88,13 @@ impl FeatureStep for Partition {
         let Some(cov) = input.neighbours else {
             return Ok(Finished::default());
         };
+        // Taken, not copied: the run holds the only reference to each.
         let pieces: Pieces = input
             .kept
-            .iter()
-            .filter_map(|(_, k)| k.0.downcast_ref::<Pieces>())
-            .flatten()
-            .cloned()
+            .take()
+            .into_iter()
+            .filter_map(|(_, k)| k.0.downcast::<Pieces>().ok())
+            .flat_map(|p| Arc::try_unwrap(p).unwrap_or_else(|p| (*p).clone()))
             .collect();
         let coverage = assemble(cov.units(), pieces).map_err(|e| StepFailure(e.to_string()))?;
         log_coverage(&coverage);
@@ -154,19 +155,19 @@ impl FeatureStep for Partition {
 /// The rows of a partitioned feature — its new boundaries, the area given
 /// to each unit, the wide parts kept (`areas`, `kind = wide`) and what no
 /// unit takes (`kind = unowned`) — and the pieces the units grow by.
-fn rows_of(parts: &[PartPartition]) -> (Vec<(&'static str, StepRow)>, Pieces) {
-    let fid = |f: Option<u64>| f.map_or(Cell::Null, crate::layer::int);
+fn rows_of(parts: Vec<PartPartition>) -> (Vec<(&'static str, StepRow)>, Pieces) {
+    use crate::layer::fid;
     let mut rows = Vec::new();
     let mut pieces = Vec::new();
     // (area given, area held) by unit.
     let mut given: std::collections::BTreeMap<Option<u64>, (f64, f64)> = Default::default();
     for p in parts {
-        for b in &p.boundaries {
+        for b in p.boundaries {
             let length: f64 = b.lines.0.iter().map(|l| Euclidean.length(l)).sum();
             rows.push((
                 BOUNDARIES.name,
                 StepRow {
-                    geometry: Some(geo::Geometry::MultiLineString(b.lines.clone())),
+                    geometry: Some(geo::Geometry::MultiLineString(b.lines)),
                     cells: vec![
                         ("left_fid", fid(b.fids[0])),
                         ("right_fid", fid(b.fids[1])),
@@ -175,27 +176,27 @@ fn rows_of(parts: &[PartPartition]) -> (Vec<(&'static str, StepRow)>, Pieces) {
                 },
             ));
         }
-        for g in &p.given {
+        for g in p.given {
             given.entry(g.fid).or_default().0 += g.polygon.unsigned_area();
-            pieces.push((g.fid, Growth::Given(g.polygon.clone())));
+            pieces.push((g.fid, Growth::Given(g.polygon)));
         }
-        for u in &p.units {
+        for u in p.units {
             if !u.held.is_empty() {
                 let held: f64 = u.held.iter().map(|h| h.unsigned_area()).sum();
                 given.entry(u.fid).or_default().1 += held;
             }
-            pieces.extend(u.held.iter().map(|h| (u.fid, Growth::Held(h.clone()))));
+            pieces.extend(u.held.into_iter().map(|h| (u.fid, Growth::Held(h))));
             if !u.edits.is_empty() {
-                pieces.push((u.fid, Growth::Snapped(u.edits.clone())));
+                pieces.push((u.fid, Growth::Snapped(u.edits)));
             }
         }
-        let kept = p.wide.iter().map(|(w, cuts)| (w, *cuts, "wide"));
-        let remainders = p.remainders.iter().map(|r| (r, 0, "unowned"));
+        let kept = p.wide.into_iter().map(|(w, cuts)| (w, cuts, "wide"));
+        let remainders = p.remainders.into_iter().map(|r| (r, 0, "unowned"));
         rows.extend(kept.chain(remainders).map(|(polygon, cuts, kind)| {
             (
                 AREAS.name,
                 StepRow {
-                    geometry: Some(geo::Geometry::Polygon(polygon.clone())),
+                    geometry: Some(geo::Geometry::Polygon(polygon)),
                     cells: vec![
                         ("cuts", crate::layer::int(cuts)),
                         ("kind", Cell::Text(kind.into())),
@@ -255,10 +256,7 @@ fn log_coverage(coverage: &[CoverageRow]) {
     let landless: Vec<String> = coverage
         .iter()
         .filter(|c| c.held > 0.0 && c.geometry.0.is_empty())
-        .map(|c| {
-            c.src_fid
-                .map_or_else(|| "(no fid)".into(), |f| f.to_string())
-        })
+        .map(|c| crate::feature::fid_text(c.src_fid))
         .collect();
     if !landless.is_empty() {
         tracing::info!(

@@ -57,7 +57,7 @@ pub fn merge_adjacent_exactly(features: Vec<Feature>, by: Option<usize>) -> Vec<
         {
             let fids: Vec<String> = group
                 .iter()
-                .map(|f| f.fid.map_or_else(|| "(no fid)".into(), |x| x.to_string()))
+                .map(|f| crate::feature::fid_text(f.fid))
                 .collect();
             tracing::warn!(
                 "features {} overlap each other: dissolved into one polygon (not exactly, as `merge_adjacent` does) before the steps",

@@ -122,7 +122,7 @@ impl<'a> Run<'a> {
         c.read += f.source_count();
         if let (true, Some(rej)) = (self.fail, r.rows.rejected.first()) {
             return Err(FailedFeature {
-                fid: f.fid.map_or_else(|| "(no fid)".into(), |x| x.to_string()),
+                fid: crate::feature::fid_text(f.fid),
                 reason: rej.reason.clone(),
             });
         }
@@ -196,6 +196,7 @@ impl<'a> Run<'a> {
         let kept = std::mem::take(&mut self.kept);
         let kept_values = std::mem::take(&mut self.kept_values);
         for ((e, kept), kept_values) in self.params.extra.iter().zip(kept).zip(kept_values) {
+            let kept_values = std::cell::RefCell::new(kept_values);
             let input = super::step::FinishInput {
                 rows: &kept,
                 kept: &kept_values,

@@ -259,8 +259,9 @@ pub struct FinishInput<'a> {
     /// `(src_fid, layer, row)` of every feature, when [`Needs::finish`].
     pub rows: &'a [(Option<u64>, &'static str, StepRow)],
     /// What the step [kept](FeatureStep::output) of every feature, with its
-    /// `src_fid`, when [`Needs::finish`].
-    pub kept: &'a [(Option<u64>, Kept)],
+    /// `src_fid`, in read order, when [`Needs::finish`]: the step may take
+    /// them (`kept.take()`) to own them without a copy.
+    pub kept: &'a std::cell::RefCell<Vec<(Option<u64>, Kept)>>,
     /// The step's side input layer, when it has one.
     pub side: Option<&'a SideLayer>,
     /// The coverage of `input.neighbours`, when the step needs it.

@@ -99,7 +99,7 @@ impl FeatureStep for Streets {
                 (Some(units), Some(p)) => sides(&br.coords, p, units),
                 _ => (None, None),
             };
-            let fid = |f: Option<u64>| f.map_or(Cell::Null, crate::layer::int);
+            use crate::layer::fid;
             let cells = vec![
                 ("piece", crate::layer::int(k)),
                 ("start_degree", crate::layer::int(degrees[br.start.index()])),
