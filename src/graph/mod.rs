@@ -19,6 +19,7 @@ pub mod junctions;
 pub mod line;
 pub mod planar;
 pub mod prune;
+pub mod roundabouts;
 pub(crate) mod structure;
 pub mod widths;
 

@@ -355,12 +355,21 @@ impl<'a> PartWork<'a> {
         )))
     }
 
-    /// `g` with its junctions merged where `prune.junctions` asks it.
+    /// `g` with its junctions merged where `prune.junctions` asks it, and
+    /// its roundabouts made one node where `prune.roundabouts` gives their
+    /// size.
     fn junctions(&self, g: SkeletonGraph) -> SkeletonGraph {
         use crate::graph::junctions::{merge, Junctions};
-        match self.params.prune.map(|p| p.junctions) {
-            Some(Junctions::Merge) => merge(&g, self.p),
-            _ => g,
+        let Some(prune) = self.params.prune else {
+            return g;
+        };
+        let g = match prune.junctions {
+            Junctions::Merge => merge(&g, self.p),
+            Junctions::Keep => g,
+        };
+        match prune.roundabouts > 0.0 {
+            true => crate::graph::roundabouts::roundabouts(&g, self.p, prune.roundabouts),
+            false => g,
         }
     }
 

@@ -173,6 +173,9 @@ pub struct PruneParams {
     pub fallback: Fallback,
     /// `merge`: junctions whose inscribed discs overlap become one node at the centre of the largest disc, the stubs between them removed and the lines straightened into it — one node per crossing of a street or road network — and a street cut by an edge within a fifth of its width of straight ends once on it; `keep` (default): every junction stays, and only straight cuts are cuts.
     pub junctions: crate::graph::junctions::Junctions,
+    /// Roundabouts made one node: an island (a hole of the polygon) no wider than this (CRS units: the largest distance between two of its vertices) that the lines ring becomes one node at its centre, the ring removed and every road that met it running straight into that node; a turning circle ends its road at its centre. 0 (default): every ring stays. Give a size between the largest roundabout island and the smallest block.
+    #[schemars(range(min = 0))]
+    pub roundabouts: f64,
 }
 
 impl Default for PruneParams {
@@ -186,6 +189,7 @@ impl Default for PruneParams {
             structure: Structure::Shared,
             fallback: Fallback::Significance,
             junctions: crate::graph::junctions::Junctions::Keep,
+            roundabouts: 0.0,
         }
     }
 }
@@ -255,6 +259,12 @@ impl PruneParams {
             return Err((
                 "min_length".into(),
                 "min_length must be ≥ 0 (CRS units)".into(),
+            ));
+        }
+        if !(self.roundabouts >= 0.0 && self.roundabouts.is_finite()) {
+            return Err((
+                "roundabouts".into(),
+                "roundabouts must be a finite number ≥ 0 (CRS units: the widest island made one node; 0 keeps every ring)".into(),
             ));
         }
         if self.mode != PruneMode::Network && self.fallback != Fallback::default() {
