@@ -476,3 +476,62 @@ fn a_side_input_is_checked_by_validate_and_never_written_over() {
     assert!(err.contains("side input"), "{err}");
     assert_eq!(std::fs::read(&blocks).unwrap(), before);
 }
+
+#[test]
+fn roundabouts_no_wider_than_the_size_given_become_one_node_each_and_blocks_stay_rings() {
+    // The real network of `roads` with a roundabout at each of its 12
+    // junctions that lie 80 m or more from any other
+    // (`scripts/make_roundabouts.py`): a ring road 16 m wide around an
+    // island of radius 12 m centred on the junction, the roads meeting it.
+    // The islands are holes of the street space, their centres outside it.
+    let d = tmp();
+    let islands: Vec<Polygon<f64>> = geometries(Path::new(&root(STREETS)), "roundabouts")
+        .into_iter()
+        .flat_map(|g| match g {
+            Geometry::Polygon(p) => vec![p],
+            Geometry::MultiPolygon(m) => m.0,
+            other => panic!("not a polygon: {other:?}"),
+        })
+        .collect();
+    use geo::Contains;
+    let ringed: Vec<Coord<f64>> = points("roundabouts_junctions")
+        .into_iter()
+        .filter(|&r| !islands.iter().any(|p| p.contains(&r)))
+        .collect();
+    assert_eq!(ringed.len(), 12);
+    let dist = |a: Coord<f64>, b: Coord<f64>| Euclidean.distance(geo::Point(a), geo::Point(b));
+    let near = |out: &[Coord<f64>], r: Coord<f64>, within: f64| {
+        out.iter().filter(|&&o| dist(o, r) <= within).count()
+    };
+    let (rings, ring_ends) =
+        junctions_and_ends(&run(d.path(), "roundabouts", "{ junctions: merge }"));
+    let merged = "{ junctions: merge, roundabouts: 30 }";
+    let lines = run(d.path(), "roundabouts", merged);
+    let (one, ends) = junctions_and_ends(&lines);
+    let mut centres = 0;
+    for &r in &ringed {
+        // Kept, the ring has a junction where each road meets it (its
+        // outer kerb 28 m from the centre); made one node, the roads meet
+        // at the island's centre and nowhere else near it. Two of the
+        // twelve are on a through road (the reference's junction there is a
+        // loop of the line narrower than the road, see above): two roads
+        // meet their ring, and the road runs on through the centre.
+        assert!(near(&rings, r, 36.0) >= 2, "{r:?}: {rings:?}");
+        assert_eq!(near(&one, r, 36.0), near(&one, r, 0.5), "{r:?}: {one:?}");
+        centres += near(&one, r, 0.5);
+        assert!(Euclidean.distance(&geo::Point(r), &lines) < 0.5, "{r:?}");
+    }
+    assert_eq!(centres, 10);
+    // The network is then the one of the same roads without roundabouts:
+    // as many junctions, the same line ends.
+    let (plain, plain_ends) = junctions_and_ends(&run(d.path(), "roads", "{ junctions: merge }"));
+    assert_eq!(one.len(), plain.len(), "{one:?}\n{plain:?}");
+    assert_eq!(ends.len(), plain_ends.len());
+    assert_eq!(ends.len(), ring_ends.len());
+    // The quarter's blocks (60–100 m across) are wider than 30 m: their
+    // rings of streets stay, the lines the same as without the option.
+    assert_eq!(
+        run(d.path(), "quarter", merged),
+        run(d.path(), "quarter", "{ junctions: merge }")
+    );
+}
