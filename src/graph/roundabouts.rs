@@ -51,10 +51,11 @@ pub fn roundabouts(g: &SkeletonGraph, polygon: &PreparedPolygon, max: f64) -> Sk
         return g.clone();
     }
     let branches = g.branches();
+    let out = leaving(&branches);
     let mut ring_of: Vec<Option<Coord<f64>>> = vec![None; branches.len()];
     for (k, c) in centres.iter().enumerate() {
         let Some(c) = *c else { continue };
-        let Some(ring) = face_around(&branches, c) else {
+        let Some(ring) = face_around(&branches, &out, c) else {
             continue;
         };
         let others = holes
@@ -153,19 +154,18 @@ struct Face {
 /// One way along a branch: its index and whether from its start.
 type Half = (usize, bool);
 
-/// The boundary of the face of the plane graph `branches` that holds `c`
-/// (see the module documentation); `None` when no branch lies east of `c`
-/// or the walk does not close.
-fn face_around(branches: &[Branch], c: Coord<f64>) -> Option<Face> {
-    let first = first_east(branches, c)?;
-    // The half-edges leaving each node, with their directions.
-    let mut out: std::collections::HashMap<NodeId, Vec<(Half, f64)>> = Default::default();
+/// The half-edges leaving each node of the plane graph `branches`, with
+/// their directions.
+type Leaving = std::collections::HashMap<NodeId, Vec<(Half, f64)>>;
+
+fn leaving(branches: &[Branch]) -> Leaving {
+    let mut out = Leaving::default();
+    let angle = |p: Coord<f64>, q: Coord<f64>| (q.y - p.y).atan2(q.x - p.x);
     for (k, b) in branches.iter().enumerate() {
         let n = b.coords.len();
         if n < 2 {
             continue;
         }
-        let angle = |p: Coord<f64>, q: Coord<f64>| (q.y - p.y).atan2(q.x - p.x);
         out.entry(b.start)
             .or_default()
             .push(((k, true), angle(b.coords[0], b.coords[1])));
@@ -173,6 +173,14 @@ fn face_around(branches: &[Branch], c: Coord<f64>) -> Option<Face> {
             .or_default()
             .push(((k, false), angle(b.coords[n - 1], b.coords[n - 2])));
     }
+    out
+}
+
+/// The boundary of the face of the plane graph `branches` (leaving its
+/// nodes as `out` says) that holds `c` (see the module documentation);
+/// `None` when no branch lies east of `c` or the walk does not close.
+fn face_around(branches: &[Branch], out: &Leaving, c: Coord<f64>) -> Option<Face> {
+    let first = first_east(branches, c)?;
     let end_of = |(k, fwd): Half| {
         if fwd {
             branches[k].end
