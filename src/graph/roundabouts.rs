@@ -20,8 +20,10 @@
 //! number of roads that meet the roundabout; a turning circle at a dead end
 //! (one road) ends that road at the circle's centre. The straight lines
 //! cross the island, which is not street space: that is what one node
-//! means. An island that no face of the lines holds alone is left as it
-//! is, and so is every island wider than `D`.
+//! means. Two islands whose rings share a branch (a double roundabout)
+//! are two nodes joined by a straight link, each road meeting the nearer.
+//! An island that no face of the lines holds alone is left as it is, and so
+//! is every island wider than `D`.
 
 use super::{Branch, GraphBuilder, NodeId, SkeletonGraph};
 use crate::geometry::PreparedPolygon;
@@ -51,11 +53,69 @@ pub fn roundabouts(g: &SkeletonGraph, polygon: &PreparedPolygon, max: f64) -> Sk
         return g.clone();
     }
     let branches = g.branches();
-    let out = leaving(&branches);
-    let mut ring_of: Vec<Option<Coord<f64>>> = vec![None; branches.len()];
+    let ring_of = rings(&branches, holes, &centres);
+    if ring_of.iter().all(Vec::is_empty) {
+        return g.clone();
+    }
+    // The centre a node of a ring is replaced by: the nearest of the
+    // rings' it is on.
+    let mut hub: Vec<Option<Coord<f64>>> = vec![None; g.nodes().len()];
+    for (br, cs) in branches.iter().zip(&ring_of) {
+        for &c in cs {
+            for n in [br.start, br.end] {
+                let at = g.node(n).pos;
+                let d = |q: Coord<f64>| (q.x - at.x).hypot(q.y - at.y);
+                if hub[n.index()].is_none_or(|h| d(c) < d(h)) {
+                    hub[n.index()] = Some(c);
+                }
+            }
+        }
+    }
+    let mut b = GraphBuilder::new();
+    for (br, cs) in branches.iter().zip(&ring_of) {
+        match cs.as_slice() {
+            // Between two islands (a double roundabout): a link between
+            // their nodes.
+            [c1, c2] => {
+                b.segment(*c1, *c2);
+            }
+            [_, ..] => {}
+            [] => {
+                let mut coords = br.coords.clone();
+                if let Some(c) = hub[br.start.index()] {
+                    coords = into_centre(&coords, c);
+                }
+                if let Some(c) = hub[br.end.index()] {
+                    coords.reverse();
+                    coords = into_centre(&coords, c);
+                    coords.reverse();
+                }
+                if coords.first() == coords.last() && coords.len() > 2 {
+                    let mid = coords.len() / 2;
+                    b.polyline(&coords[..=mid]);
+                    b.polyline(&coords[mid..]);
+                } else {
+                    b.polyline(&coords);
+                }
+            }
+        }
+    }
+    b.finish(polygon.boundary())
+}
+
+/// For each branch, the centres of the islands (`holes` with a `centres`
+/// entry) whose ring it is on: the boundary of the face holding the island
+/// and no other.
+fn rings(
+    branches: &[Branch],
+    holes: &[LineString<f64>],
+    centres: &[Option<Coord<f64>>],
+) -> Vec<Vec<Coord<f64>>> {
+    let out = leaving(branches);
+    let mut ring_of: Vec<Vec<Coord<f64>>> = vec![Vec::new(); branches.len()];
     for (k, c) in centres.iter().enumerate() {
         let Some(c) = *c else { continue };
-        let Some(ring) = face_around(&branches, &out, c) else {
+        let Some(ring) = face_around(branches, &out, c) else {
             continue;
         };
         let others = holes
@@ -63,49 +123,13 @@ pub fn roundabouts(g: &SkeletonGraph, polygon: &PreparedPolygon, max: f64) -> Sk
             .enumerate()
             .filter(|&(j, _)| j != k)
             .any(|(_, h)| ring.outline.contains(&h.0[0]));
-        if ring.outline.contains(&c)
-            && !others
-            && ring.branches.iter().all(|&b| ring_of[b].is_none())
-        {
+        if ring.outline.contains(&c) && !others {
             for &b in &ring.branches {
-                ring_of[b] = Some(c);
+                ring_of[b].push(c);
             }
         }
     }
-    if ring_of.iter().all(Option::is_none) {
-        return g.clone();
-    }
-    // The centre a node of a ring is replaced by.
-    let mut hub: Vec<Option<Coord<f64>>> = vec![None; g.nodes().len()];
-    for (b, c) in branches.iter().zip(&ring_of) {
-        if let Some(c) = *c {
-            hub[b.start.index()] = Some(c);
-            hub[b.end.index()] = Some(c);
-        }
-    }
-    let mut b = GraphBuilder::new();
-    for (br, ring) in branches.iter().zip(&ring_of) {
-        if ring.is_some() {
-            continue;
-        }
-        let mut coords = br.coords.clone();
-        if let Some(c) = hub[br.start.index()] {
-            coords = into_centre(&coords, c);
-        }
-        if let Some(c) = hub[br.end.index()] {
-            coords.reverse();
-            coords = into_centre(&coords, c);
-            coords.reverse();
-        }
-        if coords.first() == coords.last() && coords.len() > 2 {
-            let mid = coords.len() / 2;
-            b.polyline(&coords[..=mid]);
-            b.polyline(&coords[mid..]);
-        } else {
-            b.polyline(&coords);
-        }
-    }
-    b.finish(polygon.boundary())
+    ring_of
 }
 
 /// The centre of an island: its centroid, or a point inside it when the
@@ -297,6 +321,13 @@ mod tests {
             let road = geo::LineString::from(vec![c(0., 0.), *e]).buffer(8.0);
             space = space.union(&road.difference(&geo::Point::new(0.0, 0.0).buffer(r)));
         }
+        axis(&space)
+    }
+
+    /// The medial axis of `space`, pruned and extended as the pipeline's
+    /// defaults make it.
+    fn axis(space: &geo::MultiPolygon<f64>) -> (PreparedPolygon, SkeletonGraph) {
+        assert_eq!(space.0.len(), 1);
         let p = PreparedPolygon::new(&space.0[0]).unwrap();
         let raw = crate::methods::build(
             crate::methods::MethodId::MA,
@@ -311,6 +342,44 @@ mod tests {
             Some(&crate::graph::extend::ExtendParams::default()),
         );
         (p, g)
+    }
+
+    #[test]
+    fn a_double_roundabout_is_two_nodes_joined_by_a_straight_link() {
+        // Two islands of radius 8 at (±15, 0), each ringed by a road 12
+        // wide, the rings run together between them; a road 12 wide leaves
+        // each west or east and north.
+        use geo::{BooleanOps, Buffer};
+        let o = |x: f64| geo::Point::new(x, 0.0);
+        let mut space = o(-15.).buffer(20.0).union(&o(15.).buffer(20.0));
+        for (a, b) in [
+            (c(-15., 0.), c(-150., 0.)),
+            (c(15., 0.), c(150., 0.)),
+            (c(-15., 0.), c(-15., 150.)),
+            (c(15., 0.), c(15., 150.)),
+        ] {
+            space = space.union(&geo::LineString::from(vec![a, b]).buffer(6.0));
+        }
+        space = space.difference(&o(-15.).buffer(8.0).union(&o(15.).buffer(8.0)));
+        let (p, g) = axis(&space);
+        let two = roundabouts(&g, &p, 20.0);
+        two.check_invariants().unwrap();
+        let n = nodes(&two);
+        let hubs: Vec<_> = n.iter().filter(|(_, d)| *d >= 3).collect();
+        assert_eq!(hubs.len(), 2, "{n:?}");
+        for (q, d) in hubs {
+            assert_eq!(*d, 3, "{n:?}");
+            assert!((q.x.abs() - 15.0).abs() < 0.5 && q.y.abs() < 0.5, "{n:?}");
+        }
+        assert_eq!(n.iter().filter(|(_, d)| *d == 1).count(), 4, "{n:?}");
+        // The link and the four roads, straight from the centres to their
+        // rounded ends (at x = ±156 west and east, y = 156 north).
+        let want = 30.0 + 2.0 * 141.0 + 2.0 * 156.0;
+        assert!(
+            (two.total_length() - want).abs() < 1e-3,
+            "{}",
+            two.total_length()
+        );
     }
 
     /// The nodes of `g` with their degrees, leaves and junctions only.
