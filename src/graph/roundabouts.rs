@@ -143,30 +143,28 @@ fn centre(island: &LineString<f64>) -> Option<Coord<f64>> {
 }
 
 /// The largest distance between two vertices of `ring` (above
-/// [`MAX_PAIRS`] vertices, the diagonal of its bounding box).
+/// [`MAX_PAIRS`] vertices, between two of its convex hull's; a hull of
+/// more: the diagonal of its bounding box).
 fn diameter(ring: &LineString<f64>) -> f64 {
-    let pts = &ring.0;
-    if pts.len() > MAX_PAIRS {
-        let (mut lo, mut hi) = (pts[0], pts[0]);
-        for p in pts {
-            lo = Coord {
-                x: lo.x.min(p.x),
-                y: lo.y.min(p.y),
-            };
-            hi = Coord {
-                x: hi.x.max(p.x),
-                y: hi.y.max(p.y),
-            };
+    use geo::{BoundingRect, ConvexHull};
+    let pairs = |pts: &[Coord<f64>]| {
+        let mut d2: f64 = 0.0;
+        for (i, a) in pts.iter().enumerate() {
+            for q in &pts[i + 1..] {
+                d2 = d2.max((a.x - q.x).powi(2) + (a.y - q.y).powi(2));
+            }
         }
-        return (hi.x - lo.x).hypot(hi.y - lo.y);
+        d2.sqrt()
+    };
+    if ring.0.len() <= MAX_PAIRS {
+        return pairs(&ring.0);
     }
-    let mut d2: f64 = 0.0;
-    for (i, a) in pts.iter().enumerate() {
-        for q in &pts[i + 1..] {
-            d2 = d2.max((a.x - q.x).powi(2) + (a.y - q.y).powi(2));
-        }
+    let hull = ring.convex_hull();
+    if hull.exterior().0.len() <= MAX_PAIRS {
+        return pairs(&hull.exterior().0);
     }
-    d2.sqrt()
+    ring.bounding_rect()
+        .map_or(0.0, |r| r.width().hypot(r.height()))
 }
 
 /// A face's boundary: the branches walked one way only, and its outline.
@@ -463,5 +461,26 @@ mod tests {
     fn the_diameter_is_the_largest_distance_between_two_vertices() {
         let sq = LineString::from(vec![(0., 0.), (3., 0.), (3., 4.), (0., 4.), (0., 0.)]);
         assert_eq!(diameter(&sq), 5.0);
+        // A densely digitised island: its hull's vertices, pair by pair
+        // (a circle's bounding box would say √2 times more); a hull of too
+        // many vertices, its bounding box.
+        let circle = |n: usize| {
+            LineString::from(
+                (0..=n)
+                    .map(|i| {
+                        let a = std::f64::consts::TAU * (i % n) as f64 / n as f64;
+                        (10.0 * a.cos(), 10.0 * a.sin())
+                    })
+                    .collect::<Vec<_>>(),
+            )
+        };
+        let mut teeth = circle(1000).0;
+        teeth.extend(circle(4000).0.iter().map(|p| Coord {
+            x: p.x * 0.5,
+            y: p.y * 0.5,
+        }));
+        teeth.push(teeth[0]);
+        assert!((diameter(&LineString(teeth)) - 20.0).abs() < 1e-6);
+        assert!((diameter(&circle(5000)) - 20.0 * 2f64.sqrt()).abs() < 1e-6);
     }
 }
