@@ -33,8 +33,9 @@ use geo::{Centroid, Contains, Coord, InteriorPoint, LineString, Polygon};
 /// last point within this many times the ring's distance from the centre.
 pub const STRAIGHT_FROM: f64 = 1.25;
 
-/// Most vertices of an island whose diameter is measured pair by pair
-/// (larger ones: the diagonal of their bounding box).
+/// Most vertices measured pair by pair for an island's diameter (an island
+/// of more: its convex hull's vertices; a hull of more: the diagonal of its
+/// bounding box).
 const MAX_PAIRS: usize = 2048;
 
 /// `g` with the ring around every island of `polygon` no wider than `max`
