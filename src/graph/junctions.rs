@@ -86,14 +86,8 @@ pub fn merge(g: &SkeletonGraph, polygon: &PreparedPolygon) -> SkeletonGraph {
     }
     let mut b = GraphBuilder::new();
     for (coords, _) in lines.iter().flatten() {
-        if coords.first() == coords.last() {
-            // A loop from a hub back to it: two edges through its middle.
-            let mid = coords.len() / 2;
-            b.polyline(&coords[..=mid]);
-            b.polyline(&coords[mid..]);
-        } else {
-            b.polyline(coords);
-        }
+        // A loop from a hub back to it: two edges through its middle.
+        b.path(coords);
     }
     let merged = b.finish(polygon.boundary());
     super::planar::node_crossings(merged, polygon.boundary()).0

@@ -683,6 +683,19 @@ impl GraphBuilder {
         Some(self.graph.add_edge(a, b, interior))
     }
 
+    /// Adds a polyline as [`GraphBuilder::polyline`] does, a closed one
+    /// (a loop from a node back to it) as two edges through its middle, so
+    /// that no edge joins a node to itself.
+    pub fn path(&mut self, pts: &[Coord<f64>]) {
+        if pts.len() > 2 && pts.first() == pts.last() {
+            let mid = pts.len() / 2;
+            self.polyline(&pts[..=mid]);
+            self.polyline(&pts[mid..]);
+        } else {
+            self.polyline(pts);
+        }
+    }
+
     /// Finishes the graph: node radii set to their distance to ∂P.
     pub fn finish(mut self, boundary: &Boundary) -> SkeletonGraph {
         self.graph.set_radii(boundary);

@@ -91,13 +91,7 @@ pub fn roundabouts(g: &SkeletonGraph, polygon: &PreparedPolygon, max: f64) -> Sk
                     coords = into_centre(&coords, c);
                     coords.reverse();
                 }
-                if coords.first() == coords.last() && coords.len() > 2 {
-                    let mid = coords.len() / 2;
-                    b.polyline(&coords[..=mid]);
-                    b.polyline(&coords[mid..]);
-                } else {
-                    b.polyline(&coords);
-                }
+                b.path(&coords);
             }
         }
     }
